@@ -1,0 +1,1 @@
+//! shine-scene: everything the engine needs to know about a scene, as plain data. No GPU.

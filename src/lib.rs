@@ -1,0 +1,1 @@
+//! shine: a real-time soft global-illumination engine on Vulkan 1.3.

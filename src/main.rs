@@ -1,0 +1,3 @@
+//! The `shine` command-line tool.
+
+fn main() {}
