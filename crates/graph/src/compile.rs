@@ -261,7 +261,8 @@ fn usage_words(desc: &AnyDesc, bits: u32) -> String {
 }
 
 /// Usage bits per resource: from the running passes, and for temporal resources from every
-/// declared pass so the resource is not recreated on frames where a periodic pass skips.
+/// declared pass (both halves of a history pair alike) so the resource is not recreated on
+/// frames where a periodic pass skips or the pair swaps.
 fn derive_usage(
     graph: &RenderGraph,
     merged: &[(usize, Vec<PassResource>)],
@@ -290,6 +291,11 @@ fn derive_usage(
                 usage[a.resource.0 as usize] |= a.access.info().usage;
             }
         }
+    }
+    for &(a, b) in &graph.pairs {
+        let both = usage[a.0 as usize] | usage[b.0 as usize];
+        usage[a.0 as usize] = both;
+        usage[b.0 as usize] = both;
     }
     for (decl, u) in graph.resources.iter().zip(usage.iter_mut()) {
         if let Lifetime::Imported(import) = &decl.lifetime {

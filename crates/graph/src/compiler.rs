@@ -7,6 +7,7 @@ use crate::alias::MemoryRequirements;
 use crate::compile;
 use crate::error::GraphError;
 use crate::graph::{RenderGraph, ResourceDecl};
+use crate::handle::ResourceId;
 use crate::pass::PassDecl;
 use crate::plan::Plan;
 use crate::resource::Lifetime;
@@ -17,6 +18,7 @@ use crate::temporal::{TemporalState, TemporalStore};
 struct Shape {
     resources: Vec<ResourceDecl>,
     passes: Vec<PassDecl>,
+    pairs: Vec<(ResourceId, ResourceId)>,
     active: Vec<bool>,
     temporal: Vec<Option<TemporalState>>,
 }
@@ -43,6 +45,7 @@ impl Compiler {
         Shape {
             resources: graph.resources.clone(),
             passes: graph.passes.clone(),
+            pairs: graph.pairs.clone(),
             active: graph
                 .passes
                 .iter()

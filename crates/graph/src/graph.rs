@@ -34,6 +34,8 @@ pub struct RenderGraph {
     pub(crate) frame: u64,
     pub(crate) resources: Vec<ResourceDecl>,
     pub(crate) passes: Vec<PassDecl>,
+    /// The halves of history pairs, which share their usage flags.
+    pub(crate) pairs: Vec<(ResourceId, ResourceId)>,
     /// Mistakes found while declaring, reported by compilation.
     pub(crate) errors: Vec<GraphError>,
 }
@@ -46,6 +48,7 @@ impl RenderGraph {
             frame,
             resources: Vec::new(),
             passes: Vec::new(),
+            pairs: Vec::new(),
             errors: Vec::new(),
         }
     }
@@ -142,19 +145,23 @@ impl RenderGraph {
     /// they swap roles every frame.
     pub fn history_image(&mut self, key: &str, desc: ImageDesc) -> History<Image> {
         let (prev, cur) = self.history_keys(key);
-        History {
+        let history = History {
             previous: self.temporal_image(&prev, desc),
             current: self.temporal_image(&cur, desc),
-        }
+        };
+        self.pairs.push((history.previous.id, history.current.id));
+        history
     }
 
     /// A ping-pong pair of temporal buffers under `key`, like [`RenderGraph::history_image`].
     pub fn history_buffer(&mut self, key: &str, desc: BufferDesc) -> History<Buffer> {
         let (prev, cur) = self.history_keys(key);
-        History {
+        let history = History {
             previous: self.temporal_buffer(&prev, desc),
             current: self.temporal_buffer(&cur, desc),
-        }
+        };
+        self.pairs.push((history.previous.id, history.current.id));
+        history
     }
 
     /// Declare a pass whose accesses are given through the returned builder.
