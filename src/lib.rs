@@ -1,1 +1,19 @@
 //! shine: a real-time soft global-illumination engine on Vulkan 1.3.
+//!
+//! The engine is a set of compute and raster passes (DESIGN §4) on [`shine_gpu`]; every
+//! shader under `shaders/` is compiled and reflected at build time into [`shaders`].
+
+pub use shine_gpu as gpu;
+
+/// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
+///
+/// One `pub static` per shader (and per `//! variant` of it), named after its path:
+/// `sh_eval.comp` variant `bands3` is [`shaders::SH_EVAL_COMP_BANDS3`].
+pub mod shaders {
+    include!(concat!(env!("OUT_DIR"), "/shaders.rs"));
+
+    /// Looks a shader up by its name (`"sh_eval.comp:bands3"`).
+    pub fn get(name: &str) -> Option<&'static shine_gpu::ShaderDesc> {
+        ALL.iter().copied().find(|s| s.name == name)
+    }
+}

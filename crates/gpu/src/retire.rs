@@ -1,0 +1,146 @@
+//! Deferred destruction: a dropped resource is destroyed only once every submission that was
+//! recorded before the drop has completed on the GPU.
+//!
+//! Each submission gets a serial. A dropped object is tagged with the newest serial handed out;
+//! [`Device::retire`] polls the fences of submissions in flight, advances the completed serial
+//! and destroys what is old enough.
+
+use crate::commands::Context;
+use crate::device::{Device, lock};
+use crate::error::{Result, VkContext};
+use ash::vk;
+use gpu_allocator::vulkan::{Allocation, Allocator};
+use std::collections::VecDeque;
+
+/// A Vulkan object waiting for the GPU to finish with it.
+pub(crate) enum Garbage {
+    Buffer(vk::Buffer, Option<Allocation>),
+    Image(vk::Image, vk::ImageView, Option<Allocation>),
+    Memory(Allocation),
+    Pipeline(
+        vk::Pipeline,
+        vk::PipelineLayout,
+        Vec<vk::DescriptorSetLayout>,
+    ),
+    Sampler(vk::Sampler),
+}
+
+impl Garbage {
+    fn destroy(self, device: &ash::Device, allocator: &mut Allocator) {
+        // SAFETY (all arms): the object was created on `device` and the GPU is done with it.
+        match self {
+            Self::Buffer(buffer, allocation) => {
+                unsafe { device.destroy_buffer(buffer, None) };
+                if let Some(a) = allocation {
+                    let _ = allocator.free(a);
+                }
+            }
+            Self::Image(image, view, allocation) => {
+                unsafe {
+                    device.destroy_image_view(view, None);
+                    device.destroy_image(image, None);
+                }
+                if let Some(a) = allocation {
+                    let _ = allocator.free(a);
+                }
+            }
+            Self::Memory(a) => {
+                let _ = allocator.free(a);
+            }
+            Self::Pipeline(pipeline, layout, set_layouts) => unsafe {
+                device.destroy_pipeline(pipeline, None);
+                device.destroy_pipeline_layout(layout, None);
+                for l in set_layouts {
+                    device.destroy_descriptor_set_layout(l, None);
+                }
+            },
+            Self::Sampler(sampler) => unsafe { device.destroy_sampler(sampler, None) },
+        }
+    }
+}
+
+/// Submission serials, objects awaiting destruction and recyclable command contexts.
+#[derive(Default)]
+pub(crate) struct Tracker {
+    /// Serial of the newest submission.
+    pub submitted: u64,
+    /// Every submission up to this serial has completed.
+    pub completed: u64,
+    /// Fences of submissions not yet seen complete, oldest first.
+    pub in_flight: VecDeque<(u64, vk::Fence)>,
+    garbage: Vec<(u64, Garbage)>,
+    /// Contexts ready for reuse.
+    pub free_contexts: Vec<Context>,
+    /// Contexts of submissions dropped without waiting, with their serial.
+    pub orphaned: Vec<(u64, Context)>,
+    /// Command buffers being recorded: an object dropped now may be used by their submission.
+    pub recording: usize,
+}
+
+impl Tracker {
+    /// Destroys everything; the device must be idle.
+    pub(crate) fn destroy_all(&mut self, device: &ash::Device, allocator: &mut Allocator) {
+        for (_, g) in self.garbage.drain(..) {
+            g.destroy(device, allocator);
+        }
+        let contexts = self
+            .free_contexts
+            .drain(..)
+            .chain(self.orphaned.drain(..).map(|(_, c)| c));
+        for c in contexts {
+            c.destroy(device);
+        }
+    }
+}
+
+impl Device {
+    /// Hands an object over for destruction once the GPU can no longer be using it.
+    pub(crate) fn defer(&self, garbage: Garbage) {
+        let mut tracker = lock(&self.inner.tracker);
+        if tracker.completed == tracker.submitted && tracker.recording == 0 {
+            drop(tracker);
+            garbage.destroy(&self.inner.raw, &mut self.allocator());
+        } else {
+            // A command buffer still being recorded will be submitted with the next serial.
+            let serial = tracker.submitted + u64::from(tracker.recording > 0);
+            tracker.garbage.push((serial, garbage));
+        }
+    }
+
+    /// Polls submissions in flight and destroys or recycles what they no longer use.
+    pub fn retire(&self) -> Result<()> {
+        let mut tracker = lock(&self.inner.tracker);
+        while let Some(&(serial, fence)) = tracker.in_flight.front() {
+            // SAFETY: the fence belongs to a live context of this device.
+            let done = unsafe { self.inner.raw.get_fence_status(fence) }
+                .ctx("polling a submission fence")?;
+            if !done {
+                break;
+            }
+            tracker.completed = serial;
+            tracker.in_flight.pop_front();
+        }
+        let completed = tracker.completed;
+        let (ready, waiting): (Vec<_>, Vec<_>) = tracker
+            .garbage
+            .drain(..)
+            .partition(|(serial, _)| *serial <= completed);
+        tracker.garbage = waiting;
+        let (free, orphaned): (Vec<_>, Vec<_>) = tracker
+            .orphaned
+            .drain(..)
+            .partition(|(serial, _)| *serial <= completed);
+        tracker.orphaned = orphaned;
+        tracker
+            .free_contexts
+            .extend(free.into_iter().map(|(_, c)| c));
+        drop(tracker);
+        if !ready.is_empty() {
+            let mut allocator = self.allocator();
+            for (_, g) in ready {
+                g.destroy(&self.inner.raw, &mut allocator);
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,288 @@
+//! Staging uploads and readbacks. Each is synchronous (submit and wait): for loading scenes,
+//! capturing frames and tests, never for per-frame streaming.
+
+use crate::device::Device;
+use crate::error::{Error, Result};
+use crate::memory::{Buffer, BufferDesc, Image, MemoryLocation, format_texel_size};
+use ash::vk;
+
+impl Device {
+    fn staging(
+        &self,
+        name: &str,
+        size: u64,
+        usage: vk::BufferUsageFlags,
+        location: MemoryLocation,
+    ) -> Result<Buffer> {
+        Buffer::new(
+            self,
+            &BufferDesc {
+                name,
+                size,
+                usage,
+                location,
+            },
+        )
+    }
+
+    /// Writes `data` at `offset` of `buffer` through a staging buffer and a copy (the buffer
+    /// needs `TRANSFER_DST`); host-visible buffers can also be written through
+    /// [`Buffer::mapped_mut`].
+    pub fn upload_buffer(&self, buffer: &Buffer, offset: u64, data: &[u8]) -> Result<()> {
+        let end = offset + data.len() as u64;
+        if end > buffer.size() {
+            return Err(Error::InvalidUsage(format!(
+                "upload of {} bytes at {offset} overflows `{}` ({} bytes)",
+                data.len(),
+                buffer.name(),
+                buffer.size()
+            )));
+        }
+        if data.is_empty() {
+            return Ok(());
+        }
+        let mut staging = self.staging(
+            "staging upload",
+            data.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let mapped = staging
+            .mapped_mut()
+            .ok_or_else(|| Error::InvalidUsage("staging memory is not host-visible".into()))?;
+        mapped[..data.len()].copy_from_slice(data);
+        let region = [vk::BufferCopy {
+            src_offset: 0,
+            dst_offset: offset,
+            size: data.len() as u64,
+        }];
+        self.run_once(|cmd| {
+            let raw = cmd.device().raw().clone();
+            let cb = cmd.raw();
+            // SAFETY: both buffers are alive and the region lies inside both.
+            unsafe { raw.cmd_copy_buffer(cb, staging.raw(), buffer.raw(), &region) };
+            Ok(())
+        })?;
+        Ok(())
+    }
+
+    /// Reads a whole buffer back (it needs `TRANSFER_SRC`). Waits for the copy.
+    pub fn read_buffer(&self, buffer: &Buffer) -> Result<Vec<u8>> {
+        let staging = self.staging(
+            "staging readback",
+            buffer.size(),
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let region = [vk::BufferCopy {
+            src_offset: 0,
+            dst_offset: 0,
+            size: buffer.size(),
+        }];
+        self.run_once(|cmd| {
+            cmd.memory_barrier(
+                (
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::MEMORY_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_READ,
+                ),
+            );
+            let raw = cmd.device().raw().clone();
+            let cb = cmd.raw();
+            // SAFETY: both buffers are alive and the region lies inside both.
+            unsafe { raw.cmd_copy_buffer(cb, buffer.raw(), staging.raw(), &region) };
+            cmd.memory_barrier(
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                ),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
+            Ok(())
+        })?;
+        staging
+            .mapped()
+            .map(<[u8]>::to_vec)
+            .ok_or_else(|| Error::InvalidUsage("readback memory is not host-visible".into()))
+    }
+
+    /// Uploads mip 0, layer 0 of `image` from tightly packed texels and leaves the image in
+    /// `final_layout` (it needs `TRANSFER_DST`).
+    pub fn upload_image(
+        &self,
+        image: &Image,
+        data: &[u8],
+        final_layout: vk::ImageLayout,
+    ) -> Result<()> {
+        let expected = image_bytes(image)?;
+        if data.len() as u64 != expected {
+            return Err(Error::InvalidUsage(format!(
+                "image `{}` needs {expected} bytes, {} given",
+                image.name(),
+                data.len()
+            )));
+        }
+        let mut staging = self.staging(
+            "staging image upload",
+            expected,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let mapped = staging
+            .mapped_mut()
+            .ok_or_else(|| Error::InvalidUsage("staging memory is not host-visible".into()))?;
+        mapped[..data.len()].copy_from_slice(data);
+        let range = image.full_range();
+        self.run_once(|cmd| {
+            cmd.image_barrier(
+                image.raw(),
+                range,
+                (
+                    vk::ImageLayout::UNDEFINED,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                ),
+                (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                ),
+            );
+            let region = [copy_region(image)];
+            let raw = cmd.device().raw().clone();
+            let cb = cmd.raw();
+            // SAFETY: the image is in TRANSFER_DST_OPTIMAL and the region lies inside both.
+            unsafe {
+                raw.cmd_copy_buffer_to_image(
+                    cb,
+                    staging.raw(),
+                    image.raw(),
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &region,
+                )
+            };
+            cmd.image_barrier(
+                image.raw(),
+                range,
+                (vk::ImageLayout::TRANSFER_DST_OPTIMAL, final_layout),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::MEMORY_READ,
+                ),
+            );
+            Ok(())
+        })?;
+        Ok(())
+    }
+
+    /// Reads mip 0, layer 0 of `image`, currently in `layout` (it needs `TRANSFER_SRC`), as
+    /// tightly packed texels; the image is returned to `layout`.
+    pub fn read_image(&self, image: &Image, layout: vk::ImageLayout) -> Result<Vec<u8>> {
+        let bytes = image_bytes(image)?;
+        let staging = self.staging(
+            "staging image readback",
+            bytes,
+            vk::BufferUsageFlags::TRANSFER_DST,
+            MemoryLocation::GpuToCpu,
+        )?;
+        let range = image.full_range();
+        self.run_once(|cmd| {
+            cmd.image_barrier(
+                image.raw(),
+                range,
+                (layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
+                (
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::MEMORY_WRITE,
+                ),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_READ,
+                ),
+            );
+            let region = [copy_region(image)];
+            let raw = cmd.device().raw().clone();
+            let cb = cmd.raw();
+            // SAFETY: the image is in TRANSFER_SRC_OPTIMAL and the region lies inside both.
+            unsafe {
+                raw.cmd_copy_image_to_buffer(
+                    cb,
+                    image.raw(),
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    staging.raw(),
+                    &region,
+                )
+            };
+            let back = if layout == vk::ImageLayout::UNDEFINED {
+                vk::ImageLayout::GENERAL
+            } else {
+                layout
+            };
+            cmd.image_barrier(
+                image.raw(),
+                range,
+                (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, back),
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_READ,
+                ),
+                (
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::MEMORY_READ,
+                ),
+            );
+            cmd.memory_barrier(
+                (
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                ),
+                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
+            );
+            Ok(())
+        })?;
+        staging
+            .mapped()
+            .map(<[u8]>::to_vec)
+            .ok_or_else(|| Error::InvalidUsage("readback memory is not host-visible".into()))
+    }
+}
+
+fn image_bytes(image: &Image) -> Result<u64> {
+    let texel = format_texel_size(image.format()).ok_or_else(|| {
+        Error::InvalidUsage(format!(
+            "image `{}`: transfers of {:?} are not supported",
+            image.name(),
+            image.format()
+        ))
+    })?;
+    let [w, h] = image.extent();
+    Ok(u64::from(w) * u64::from(h) * u64::from(texel))
+}
+
+fn copy_region(image: &Image) -> vk::BufferImageCopy {
+    let [width, height] = image.extent();
+    let range = image.full_range();
+    vk::BufferImageCopy {
+        buffer_offset: 0,
+        buffer_row_length: 0,
+        buffer_image_height: 0,
+        image_subresource: vk::ImageSubresourceLayers {
+            aspect_mask: range.aspect_mask,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        },
+        image_offset: vk::Offset3D::default(),
+        image_extent: vk::Extent3D {
+            width,
+            height,
+            depth: 1,
+        },
+    }
+}
