@@ -117,4 +117,14 @@ pub enum GraphError {
         /// The resource.
         resource: String,
     },
+    /// A shader binding that does not exist or does not fit the resource given to it.
+    #[error("pass `{pass}`, binding `{binding}`: {message}")]
+    Binding {
+        /// The pass.
+        pass: String,
+        /// The binding name.
+        binding: String,
+        /// What is wrong.
+        message: String,
+    },
 }

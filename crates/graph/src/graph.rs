@@ -5,6 +5,18 @@ use crate::error::GraphError;
 use crate::handle::{Buffer, Handle, Image, ResourceId, ResourceType};
 use crate::pass::{AccessRecord, Direction, PassDecl, PassId, PassKind, UpdateRate};
 use crate::resource::{AnyDesc, BufferDesc, BufferImport, ImageDesc, ImageImport, Lifetime};
+use crate::work::Work;
+use shine_gpu::vk;
+
+/// The Vulkan objects behind an imported resource.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum External {
+    Image {
+        image: vk::Image,
+        view: vk::ImageView,
+    },
+    Buffer(vk::Buffer),
+}
 
 /// A declared resource.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
@@ -34,6 +46,10 @@ pub struct RenderGraph {
     pub(crate) frame: u64,
     pub(crate) resources: Vec<ResourceDecl>,
     pub(crate) passes: Vec<PassDecl>,
+    /// What each pass records, by pass index.
+    pub(crate) works: Vec<Work>,
+    /// Caller-owned Vulkan objects behind imported resources, by resource index.
+    pub(crate) externals: Vec<Option<External>>,
     /// The halves of history pairs, which share their usage flags.
     pub(crate) pairs: Vec<(ResourceId, ResourceId)>,
     /// Mistakes found while declaring, reported by compilation.
@@ -48,6 +64,8 @@ impl RenderGraph {
             frame,
             resources: Vec::new(),
             passes: Vec::new(),
+            works: Vec::new(),
+            externals: Vec::new(),
             pairs: Vec::new(),
             errors: Vec::new(),
         }
@@ -72,6 +90,7 @@ impl RenderGraph {
             lifetime,
             latest: 0,
         });
+        self.externals.push(None);
         Handle::new(id, desc)
     }
 
@@ -113,6 +132,77 @@ impl RenderGraph {
             AnyDesc::Buffer(desc),
             Lifetime::Imported(import.into()),
         )
+    }
+
+    /// An imported image with the Vulkan objects the executor records with. The caller keeps
+    /// them alive until the GPU is done with the frame; `view` must cover the whole image.
+    pub fn import_vk_image(
+        &mut self,
+        name: &str,
+        desc: ImageDesc,
+        import: ImageImport,
+        image: vk::Image,
+        view: vk::ImageView,
+    ) -> Handle<Image> {
+        let handle = self.import_image(name, desc, import);
+        self.externals[handle.id.0 as usize] = Some(External::Image { image, view });
+        handle
+    }
+
+    /// An imported buffer with the Vulkan buffer the executor records with (kept alive by the
+    /// caller until the GPU is done with the frame).
+    pub fn import_vk_buffer(
+        &mut self,
+        name: &str,
+        desc: BufferDesc,
+        import: BufferImport,
+        buffer: vk::Buffer,
+    ) -> Handle<Buffer> {
+        let handle = self.import_buffer(name, desc, import);
+        self.externals[handle.id.0 as usize] = Some(External::Buffer(buffer));
+        handle
+    }
+
+    /// Imports a shine-gpu buffer (its size and usage describe it).
+    pub fn import_gpu_buffer(
+        &mut self,
+        buffer: &shine_gpu::Buffer,
+        initial: crate::ExternalState,
+        final_state: crate::ExternalState,
+    ) -> Handle<Buffer> {
+        let import = BufferImport {
+            initial,
+            final_state,
+            usage: buffer.usage(),
+            read_only: false,
+        };
+        self.import_vk_buffer(
+            buffer.name(),
+            BufferDesc::new(buffer.size()),
+            import,
+            buffer.raw(),
+        )
+    }
+
+    /// Imports a shine-gpu image (its extent, format, mips, layers and usage describe it).
+    pub fn import_gpu_image(
+        &mut self,
+        image: &shine_gpu::Image,
+        initial: crate::ExternalState,
+        final_state: crate::ExternalState,
+    ) -> Handle<Image> {
+        let range = image.full_range();
+        let [w, h] = image.extent();
+        let desc = ImageDesc::new_2d(image.format(), w, h)
+            .with_mips(range.level_count)
+            .with_layers(range.layer_count);
+        let import = ImageImport {
+            initial,
+            final_state,
+            usage: image.usage(),
+            read_only: false,
+        };
+        self.import_vk_image(image.name(), desc, import, image.raw(), image.view())
     }
 
     /// An image kept across frames under `key`; version 0 holds what the last frame left in it
@@ -173,6 +263,7 @@ impl RenderGraph {
             accesses: Vec::new(),
             rate: UpdateRate::EVERY_FRAME,
         });
+        self.works.push(Work::Declared);
         PassBuilder { graph: self, id }
     }
 
@@ -185,8 +276,8 @@ impl RenderGraph {
 /// Declares the accesses of one pass. Obtained from [`RenderGraph::pass`].
 #[derive(Debug)]
 pub struct PassBuilder<'g> {
-    graph: &'g mut RenderGraph,
-    id: PassId,
+    pub(crate) graph: &'g mut RenderGraph,
+    pub(crate) id: PassId,
 }
 
 impl PassBuilder<'_> {
@@ -212,7 +303,7 @@ impl PassBuilder<'_> {
             });
     }
 
-    fn bump<R: ResourceType>(&mut self, handle: &mut Handle<R>) -> u32 {
+    pub(crate) fn bump<R: ResourceType>(&mut self, handle: &mut Handle<R>) -> u32 {
         let Some(res) = self.graph.resources.get_mut(handle.id.0 as usize) else {
             self.graph.errors.push(GraphError::UnknownResource {
                 resource: handle.id,

@@ -9,6 +9,7 @@ use std::marker::PhantomData;
 
 use crate::access::{AnyAccess, BufferAccess, ImageAccess};
 use crate::resource::{BufferDesc, ImageDesc};
+use shine_gpu::{DescriptorKind, ShaderStage};
 
 /// Index of a resource in its graph.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
@@ -36,6 +37,10 @@ pub trait ResourceType: Copy + 'static {
     type Access: Copy + fmt::Debug;
     /// The access as an [`AnyAccess`].
     fn any_access(access: Self::Access) -> AnyAccess;
+    /// The access a shader binding of `kind` in `stage` makes (`write`: through a writable
+    /// storage binding), or `None` when this kind of resource cannot be bound there.
+    fn shader_access(kind: DescriptorKind, stage: ShaderStage, write: bool)
+    -> Option<Self::Access>;
 }
 
 impl ResourceType for Image {
@@ -44,6 +49,22 @@ impl ResourceType for Image {
     fn any_access(access: ImageAccess) -> AnyAccess {
         AnyAccess::Image(access)
     }
+    fn shader_access(kind: DescriptorKind, stage: ShaderStage, write: bool) -> Option<ImageAccess> {
+        use DescriptorKind as K;
+        use ShaderStage as S;
+        Some(match (kind, stage, write) {
+            (K::SampledImage, S::Compute, false) => ImageAccess::SampledCompute,
+            (K::SampledImage, S::Vertex, false) => ImageAccess::SampledVertex,
+            (K::SampledImage, S::Fragment, false) => ImageAccess::SampledFragment,
+            (K::StorageImage { writable: false }, S::Compute, false) => {
+                ImageAccess::StorageReadCompute
+            }
+            (K::StorageImage { writable: true }, S::Compute, true) => {
+                ImageAccess::StorageReadWriteCompute
+            }
+            _ => return None,
+        })
+    }
 }
 
 impl ResourceType for Buffer {
@@ -51,6 +72,32 @@ impl ResourceType for Buffer {
     type Access = BufferAccess;
     fn any_access(access: BufferAccess) -> AnyAccess {
         AnyAccess::Buffer(access)
+    }
+    fn shader_access(
+        kind: DescriptorKind,
+        stage: ShaderStage,
+        write: bool,
+    ) -> Option<BufferAccess> {
+        use DescriptorKind as K;
+        use ShaderStage as S;
+        Some(match (kind, stage, write) {
+            (K::UniformBuffer, S::Compute, false) => BufferAccess::UniformCompute,
+            (K::UniformBuffer, S::Vertex, false) => BufferAccess::UniformVertex,
+            (K::UniformBuffer, S::Fragment, false) => BufferAccess::UniformFragment,
+            (K::StorageBuffer { writable: false }, S::Compute, false) => {
+                BufferAccess::StorageReadCompute
+            }
+            (K::StorageBuffer { writable: false }, S::Vertex, false) => {
+                BufferAccess::StorageReadVertex
+            }
+            (K::StorageBuffer { writable: false }, S::Fragment, false) => {
+                BufferAccess::StorageReadFragment
+            }
+            (K::StorageBuffer { writable: true }, S::Compute, true) => {
+                BufferAccess::StorageReadWriteCompute
+            }
+            _ => return None,
+        })
     }
 }
 

@@ -1,0 +1,811 @@
+//! Execution: compile (cached), create or reuse the graph's own resources, and record every pass
+//! with its barriers, a debug label and a GPU timestamp scope into the caller's command buffer.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use shine_gpu::{
+    ComputePipeline, Descriptor, DescriptorArena, Device, GraphicsPipeline, GraphicsPipelineDesc,
+    MemoryBlock, PipelineLayout, TimestampPool, vk,
+};
+
+use crate::barrier::Barrier;
+use crate::compiler::Compiler;
+use crate::error::GraphError;
+use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate};
+use crate::graph::{External, RenderGraph};
+use crate::handle::{Buffer, Handle, Image, ResourceId};
+use crate::plan::{Plan, ResourceKind, Usage};
+use crate::resource::AnyDesc;
+use crate::work::{Bound, ComputeWork, Draw, RasterWork, TransferOp, Work};
+
+/// Timestamp scopes one frame may hold (one per pass).
+const SCOPES_PER_FRAME: u32 = 512;
+
+/// Transient sets kept for plans seen recently; older ones are destroyed (after a device wait).
+const KEPT_TRANSIENT_SETS: usize = 8;
+
+/// GPU time of one executed pass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassTiming {
+    /// The pass name.
+    pub name: String,
+    /// Start in ns, relative to the first pass of the frame.
+    pub begin_ns: f64,
+    /// End in ns, same origin.
+    pub end_ns: f64,
+    /// The frame number.
+    pub frame: u64,
+}
+
+/// Why a frame could not be executed.
+#[derive(Debug, thiserror::Error)]
+pub enum ExecuteError {
+    /// The graph does not compile.
+    #[error(transparent)]
+    Graph(#[from] GraphError),
+    /// A Vulkan operation failed.
+    #[error(transparent)]
+    Gpu(#[from] shine_gpu::Error),
+    /// An imported resource was declared without its Vulkan object.
+    #[error(
+        "imported resource `{0}` has no Vulkan object: import it with import_vk_* or import_gpu_*"
+    )]
+    MissingObject(String),
+}
+
+/// What a raw pass gets: the device, the command buffer and the graph's resources.
+pub struct RawContext<'a> {
+    /// The device.
+    pub device: &'a Device,
+    /// The command buffer being recorded.
+    pub cb: vk::CommandBuffer,
+    resources: &'a [Option<GpuResource>],
+}
+
+impl RawContext<'_> {
+    /// The image and view behind a handle (any version).
+    pub fn image(&self, handle: &Handle<Image>) -> Option<(vk::Image, vk::ImageView)> {
+        match self.resources.get(handle.id.0 as usize).copied().flatten() {
+            Some(GpuResource::Image { image, view }) => Some((image, view)),
+            _ => None,
+        }
+    }
+
+    /// The buffer behind a handle (any version).
+    pub fn buffer(&self, handle: &Handle<Buffer>) -> Option<vk::Buffer> {
+        match self.resources.get(handle.id.0 as usize).copied().flatten() {
+            Some(GpuResource::Buffer(b)) => Some(b),
+            _ => None,
+        }
+    }
+}
+
+/// The transients of one plan: memory blocks and the objects bound into them.
+struct TransientSet {
+    plan: Arc<Plan>,
+    /// Keeps the blocks allocated while the objects live.
+    _heaps: Vec<MemoryBlock>,
+    objects: Vec<(ResourceId, RawObject)>,
+}
+
+/// A temporal resource on the GPU.
+struct TemporalObject {
+    desc: AnyDesc,
+    usage: Usage,
+    object: RawObject,
+    _memory: MemoryBlock,
+}
+
+/// Per-slot recording state: descriptor sets and timestamps of one frame in flight.
+struct FrameSlot {
+    descriptors: DescriptorArena,
+    timestamps: TimestampPool,
+    /// The frame recorded with this slot whose timings were not read yet.
+    unread: Option<u64>,
+}
+
+/// Runs render graphs on a device, frame after frame.
+///
+/// The caller owns the command buffers and their submission (so a host engine can embed the
+/// graph). Contract: before `execute` records frame `f`, the submission of frame
+/// `f - frames_in_flight` has completed; [`Executor::timings`] is called only once the frames it
+/// reads have completed.
+pub struct Executor {
+    device: Device,
+    compiler: Compiler,
+    slots: Vec<FrameSlot>,
+    frame: u64,
+    compute_pipelines: HashMap<&'static str, ComputePipeline>,
+    graphics_pipelines: HashMap<String, GraphicsPipeline>,
+    transients: Vec<TransientSet>,
+    temporal: HashMap<String, TemporalObject>,
+    timings: Vec<PassTiming>,
+}
+
+impl std::fmt::Debug for Executor {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Executor")
+            .field("frame", &self.frame)
+            .field("frames_in_flight", &self.slots.len())
+            .finish_non_exhaustive()
+    }
+}
+
+fn pipeline_key(desc: &GraphicsPipelineDesc) -> String {
+    format!(
+        "{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
+        desc.vertex.name,
+        desc.fragment.map(|f| f.name),
+        desc.vertex_buffers,
+        desc.topology,
+        desc.cull_mode,
+        desc.color_targets,
+        desc.depth,
+        desc.depth_bias
+    )
+}
+
+fn image_extent(plan: &Plan, id: ResourceId) -> vk::Extent3D {
+    match plan.resource(id).map(|r| r.desc) {
+        Some(AnyDesc::Image(d)) => d.extent,
+        _ => vk::Extent3D::default(),
+    }
+}
+
+fn image_range(plan: &Plan, id: ResourceId) -> vk::ImageSubresourceRange {
+    match plan.resource(id).map(|r| r.desc) {
+        Some(AnyDesc::Image(d)) => d.full_range(),
+        _ => vk::ImageSubresourceRange::default(),
+    }
+}
+
+fn buffer_size(plan: &Plan, id: ResourceId) -> u64 {
+    match plan.resource(id).map(|r| r.desc) {
+        Some(AnyDesc::Buffer(d)) => d.size,
+        _ => 0,
+    }
+}
+
+/// Everything recording needs besides the pipelines.
+struct Recorder<'a> {
+    device: &'a Device,
+    cb: vk::CommandBuffer,
+    plan: &'a Plan,
+    objects: &'a [Option<GpuResource>],
+}
+
+impl Recorder<'_> {
+    fn image(&self, id: ResourceId) -> (vk::Image, vk::ImageView) {
+        match self.objects[id.0 as usize] {
+            Some(GpuResource::Image { image, view }) => (image, view),
+            _ => (vk::Image::null(), vk::ImageView::null()),
+        }
+    }
+
+    fn buffer(&self, id: ResourceId) -> vk::Buffer {
+        match self.objects[id.0 as usize] {
+            Some(GpuResource::Buffer(b)) => b,
+            _ => vk::Buffer::null(),
+        }
+    }
+
+    fn barriers(&self, barriers: &[Barrier]) {
+        if barriers.is_empty() {
+            return;
+        }
+        let mut images = Vec::new();
+        let mut buffers = Vec::new();
+        for b in barriers {
+            match self.objects[b.resource.0 as usize] {
+                Some(GpuResource::Image { image, .. }) => images.push(
+                    vk::ImageMemoryBarrier2::default()
+                        .src_stage_mask(b.src.stage)
+                        .src_access_mask(b.src.access)
+                        .dst_stage_mask(b.dst.stage)
+                        .dst_access_mask(b.dst.access)
+                        .old_layout(b.old_layout)
+                        .new_layout(b.new_layout)
+                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .image(image)
+                        .subresource_range(image_range(self.plan, b.resource)),
+                ),
+                Some(GpuResource::Buffer(buffer)) => buffers.push(
+                    vk::BufferMemoryBarrier2::default()
+                        .src_stage_mask(b.src.stage)
+                        .src_access_mask(b.src.access)
+                        .dst_stage_mask(b.dst.stage)
+                        .dst_access_mask(b.dst.access)
+                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
+                        .buffer(buffer)
+                        .offset(0)
+                        .size(vk::WHOLE_SIZE),
+                ),
+                None => {}
+            }
+        }
+        let dependency = vk::DependencyInfo::default()
+            .image_memory_barriers(&images)
+            .buffer_memory_barriers(&buffers);
+        // SAFETY: `cb` is recording; every object belongs to this device and lives for the frame.
+        unsafe {
+            self.device
+                .raw()
+                .cmd_pipeline_barrier2(self.cb, &dependency)
+        };
+    }
+
+    fn descriptors(&self, bindings: &[(&'static str, Bound)]) -> Vec<(&'static str, Descriptor)> {
+        bindings
+            .iter()
+            .map(|(name, bound)| {
+                let d = match *bound {
+                    Bound::Sampler(s) => Descriptor::Sampler(s),
+                    Bound::Resource(id, layout) => match self.objects[id.0 as usize] {
+                        Some(GpuResource::Image { view, .. }) => Descriptor::Image { view, layout },
+                        _ => Descriptor::Buffer {
+                            buffer: self.buffer(id),
+                            offset: 0,
+                            range: vk::WHOLE_SIZE,
+                        },
+                    },
+                };
+                (*name, d)
+            })
+            .collect()
+    }
+
+    fn push(&self, layout: &PipelineLayout, data: &[u8]) -> Result<(), ExecuteError> {
+        let (size, stages) = layout.push_constants;
+        if data.len() != size as usize {
+            return Err(shine_gpu::Error::Binding {
+                pipeline: layout.name.clone(),
+                message: format!(
+                    "push constants are {size} bytes in the shader, {} given",
+                    data.len()
+                ),
+            }
+            .into());
+        }
+        if size > 0 {
+            // SAFETY: the range matches the layout's push-constant range.
+            unsafe {
+                self.device
+                    .raw()
+                    .cmd_push_constants(self.cb, layout.raw, stages, 0, data)
+            };
+        }
+        Ok(())
+    }
+
+    fn compute(
+        &self,
+        work: &ComputeWork,
+        pipeline: &ComputePipeline,
+        arena: &mut DescriptorArena,
+    ) -> Result<(), ExecuteError> {
+        let raw = self.device.raw();
+        // SAFETY: `cb` is recording; the pipeline belongs to this device.
+        unsafe { raw.cmd_bind_pipeline(self.cb, vk::PipelineBindPoint::COMPUTE, pipeline.raw()) };
+        arena.bind(
+            self.cb,
+            vk::PipelineBindPoint::COMPUTE,
+            pipeline.layout(),
+            &self.descriptors(&work.bindings),
+        )?;
+        self.push(pipeline.layout(), &work.push)?;
+        let [x, y, z] = work.shader.groups_for(work.threads);
+        // SAFETY: a compute pipeline and its sets are bound.
+        unsafe { raw.cmd_dispatch(self.cb, x, y, z) };
+        Ok(())
+    }
+
+    fn raster(
+        &self,
+        work: &RasterWork,
+        pipeline: &GraphicsPipeline,
+        arena: &mut DescriptorArena,
+        layouts: impl Fn(ResourceId) -> vk::ImageLayout,
+    ) -> Result<(), ExecuteError> {
+        let raw = self.device.raw();
+        let first = work.colors.first().or(work.depth.as_ref());
+        let extent = first.map_or_else(vk::Extent3D::default, |a| {
+            image_extent(self.plan, a.resource)
+        });
+        let area = vk::Rect2D {
+            offset: vk::Offset2D::default(),
+            extent: vk::Extent2D {
+                width: extent.width,
+                height: extent.height,
+            },
+        };
+        let colors: Vec<vk::RenderingAttachmentInfo<'_>> = work
+            .colors
+            .iter()
+            .map(|a| {
+                vk::RenderingAttachmentInfo::default()
+                    .image_view(self.image(a.resource).1)
+                    .image_layout(layouts(a.resource))
+                    .load_op(a.load)
+                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .clear_value(vk::ClearValue {
+                        color: vk::ClearColorValue { float32: a.clear },
+                    })
+            })
+            .collect();
+        let depth = work.depth.map(|a| {
+            let layout = layouts(a.resource);
+            let store = if layout == vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL {
+                vk::AttachmentStoreOp::NONE
+            } else {
+                vk::AttachmentStoreOp::STORE
+            };
+            vk::RenderingAttachmentInfo::default()
+                .image_view(self.image(a.resource).1)
+                .image_layout(layout)
+                .load_op(a.load)
+                .store_op(store)
+                .clear_value(vk::ClearValue {
+                    depth_stencil: vk::ClearDepthStencilValue {
+                        depth: a.clear[0],
+                        stencil: 0,
+                    },
+                })
+        });
+        let mut rendering = vk::RenderingInfo::default()
+            .render_area(area)
+            .layer_count(1)
+            .color_attachments(&colors);
+        if let Some(d) = depth.as_ref() {
+            rendering = rendering.depth_attachment(d);
+        }
+        let viewport = vk::Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: extent.width as f32,
+            height: extent.height as f32,
+            min_depth: 0.0,
+            max_depth: 1.0,
+        };
+        // SAFETY: `cb` is recording outside rendering; attachments are in the planned layouts.
+        unsafe {
+            raw.cmd_begin_rendering(self.cb, &rendering);
+            raw.cmd_bind_pipeline(self.cb, vk::PipelineBindPoint::GRAPHICS, pipeline.raw());
+            raw.cmd_set_viewport(self.cb, 0, &[viewport]);
+            raw.cmd_set_scissor(self.cb, 0, &[area]);
+        }
+        let bound = arena
+            .bind(
+                self.cb,
+                vk::PipelineBindPoint::GRAPHICS,
+                pipeline.layout(),
+                &self.descriptors(&work.bindings),
+            )
+            .map_err(ExecuteError::from)
+            .and_then(|()| self.push(pipeline.layout(), &work.push));
+        if bound.is_ok() {
+            let buffers: Vec<vk::Buffer> = work
+                .vertex_buffers
+                .iter()
+                .map(|&b| self.buffer(b))
+                .collect();
+            let offsets = vec![0; buffers.len()];
+            // SAFETY: the pipeline is bound inside rendering; buffers live for the frame.
+            unsafe {
+                if !buffers.is_empty() {
+                    raw.cmd_bind_vertex_buffers(self.cb, 0, &buffers, &offsets);
+                }
+                if let Some((index, index_type)) = work.index_buffer {
+                    raw.cmd_bind_index_buffer(self.cb, self.buffer(index), 0, index_type);
+                }
+                for draw in &work.draws {
+                    match *draw {
+                        Draw::Vertices { count, instances } => {
+                            raw.cmd_draw(self.cb, count, instances, 0, 0)
+                        }
+                        Draw::Indexed { count, instances } => {
+                            raw.cmd_draw_indexed(self.cb, count, instances, 0, 0, 0)
+                        }
+                    }
+                }
+            }
+        }
+        // SAFETY: rendering was begun above in this command buffer.
+        unsafe { raw.cmd_end_rendering(self.cb) };
+        bound
+    }
+
+    fn transfer(&self, op: TransferOp) {
+        let raw = self.device.raw();
+        let layer0 = |id: ResourceId| {
+            let range = image_range(self.plan, id);
+            vk::ImageSubresourceLayers {
+                aspect_mask: range.aspect_mask,
+                mip_level: 0,
+                base_array_layer: 0,
+                layer_count: 1,
+            }
+        };
+        let corner = |id: ResourceId| {
+            let e = image_extent(self.plan, id);
+            vk::Offset3D {
+                x: e.width as i32,
+                y: e.height as i32,
+                z: e.depth as i32,
+            }
+        };
+        let copy = |image: ResourceId| vk::BufferImageCopy {
+            buffer_offset: 0,
+            buffer_row_length: 0,
+            buffer_image_height: 0,
+            image_subresource: layer0(image),
+            image_offset: vk::Offset3D::default(),
+            image_extent: image_extent(self.plan, image),
+        };
+        let cb = self.cb;
+        // SAFETY: `cb` is recording outside rendering; the plan put every resource in the
+        // layout and scope of its transfer access.
+        unsafe {
+            match op {
+                TransferOp::CopyBuffer { src, dst } => {
+                    let size = buffer_size(self.plan, src).min(buffer_size(self.plan, dst));
+                    let region = vk::BufferCopy {
+                        src_offset: 0,
+                        dst_offset: 0,
+                        size,
+                    };
+                    raw.cmd_copy_buffer(cb, self.buffer(src), self.buffer(dst), &[region]);
+                }
+                TransferOp::CopyImageToBuffer { src, dst } => raw.cmd_copy_image_to_buffer(
+                    cb,
+                    self.image(src).0,
+                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    self.buffer(dst),
+                    &[copy(src)],
+                ),
+                TransferOp::CopyBufferToImage { src, dst } => raw.cmd_copy_buffer_to_image(
+                    cb,
+                    self.buffer(src),
+                    self.image(dst).0,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &[copy(dst)],
+                ),
+                TransferOp::ClearImage { dst, color } => raw.cmd_clear_color_image(
+                    cb,
+                    self.image(dst).0,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    &vk::ClearColorValue { float32: color },
+                    &[image_range(self.plan, dst)],
+                ),
+                TransferOp::FillBuffer { dst, value } => {
+                    raw.cmd_fill_buffer(cb, self.buffer(dst), 0, vk::WHOLE_SIZE, value)
+                }
+                TransferOp::Blit { src, dst, filter } => {
+                    let region = vk::ImageBlit {
+                        src_subresource: layer0(src),
+                        src_offsets: [vk::Offset3D::default(), corner(src)],
+                        dst_subresource: layer0(dst),
+                        dst_offsets: [vk::Offset3D::default(), corner(dst)],
+                    };
+                    raw.cmd_blit_image(
+                        cb,
+                        self.image(src).0,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        self.image(dst).0,
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        &[region],
+                        filter,
+                    )
+                }
+            }
+        }
+    }
+}
+
+impl Executor {
+    /// An executor for `device` with `frames_in_flight` (at least 1) recordings in flight.
+    pub fn new(device: &Device, frames_in_flight: usize) -> Result<Self, ExecuteError> {
+        let slots = (0..frames_in_flight.max(1))
+            .map(|_| {
+                Ok(FrameSlot {
+                    descriptors: DescriptorArena::new(device),
+                    timestamps: TimestampPool::new(device, SCOPES_PER_FRAME)?,
+                    unread: None,
+                })
+            })
+            .collect::<Result<Vec<_>, shine_gpu::Error>>()?;
+        Ok(Self {
+            device: device.clone(),
+            compiler: Compiler::new(),
+            slots,
+            frame: 0,
+            compute_pipelines: HashMap::new(),
+            graphics_pipelines: HashMap::new(),
+            transients: Vec::new(),
+            temporal: HashMap::new(),
+            timings: Vec::new(),
+        })
+    }
+
+    /// An empty graph for the next frame.
+    pub fn begin_frame(&self) -> RenderGraph {
+        RenderGraph::new(self.frame)
+    }
+
+    /// The number of the next frame.
+    pub fn frame(&self) -> u64 {
+        self.frame
+    }
+
+    /// The compiler (plan cache and temporal history).
+    pub fn compiler(&self) -> &Compiler {
+        &self.compiler
+    }
+
+    /// Waits for the device, then destroys `objects`.
+    fn destroy_after_idle(&self, objects: Vec<RawObject>) -> Result<(), ExecuteError> {
+        if !objects.is_empty() {
+            self.device.wait_idle()?;
+            for o in objects {
+                o.destroy(&self.device);
+            }
+        }
+        Ok(())
+    }
+
+    /// The transients of `plan`, created and bound into aliased memory on first use.
+    fn transients_for(&mut self, plan: &Arc<Plan>) -> Result<usize, ExecuteError> {
+        if let Some(i) = self
+            .transients
+            .iter()
+            .position(|t| Arc::ptr_eq(&t.plan, plan))
+        {
+            return Ok(i);
+        }
+        if self.transients.len() >= KEPT_TRANSIENT_SETS {
+            let old = self.transients.remove(0);
+            self.destroy_after_idle(old.objects.into_iter().map(|(_, o)| o).collect())?;
+        }
+        let heaps = plan
+            .memory
+            .heaps
+            .iter()
+            .enumerate()
+            .map(|(i, h)| {
+                allocate(
+                    &self.device,
+                    &format!("graph heap {i}"),
+                    h.size,
+                    h.alignment,
+                    h.type_bits,
+                )
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut objects = Vec::new();
+        for p in &plan.memory.placements {
+            let Some(r) = plan.resource(p.resource) else {
+                continue;
+            };
+            let usage = match r.usage {
+                Usage::Image(u) => u.as_raw(),
+                Usage::Buffer(u) => u.as_raw(),
+            };
+            match RawObject::create(
+                &self.device,
+                &r.name,
+                &r.desc,
+                usage,
+                &heaps[p.heap],
+                p.offset,
+            ) {
+                Ok(o) => objects.push((p.resource, o)),
+                Err(e) => {
+                    self.destroy_after_idle(objects.into_iter().map(|(_, o)| o).collect())?;
+                    return Err(e.into());
+                }
+            }
+        }
+        self.transients.push(TransientSet {
+            plan: Arc::clone(plan),
+            _heaps: heaps,
+            objects,
+        });
+        Ok(self.transients.len() - 1)
+    }
+
+    /// Temporal resources of `plan`, (re)created when new or when their description changed.
+    fn ensure_temporal(&mut self, plan: &Plan) -> Result<(), ExecuteError> {
+        for r in &plan.resources {
+            let ResourceKind::Temporal(key) = &r.kind else {
+                continue;
+            };
+            if self
+                .temporal
+                .get(key)
+                .is_some_and(|t| t.desc == r.desc && t.usage == r.usage)
+            {
+                continue;
+            }
+            let (usage, needs) = match (r.desc, r.usage) {
+                (AnyDesc::Image(d), Usage::Image(u)) => (
+                    u.as_raw(),
+                    crate::MemoryRequirements::image(&DeviceMemory(&self.device), &d, u),
+                ),
+                (AnyDesc::Buffer(d), Usage::Buffer(u)) => (
+                    u.as_raw(),
+                    crate::MemoryRequirements::buffer(&DeviceMemory(&self.device), &d, u),
+                ),
+                _ => continue,
+            };
+            let memory = allocate(
+                &self.device,
+                key,
+                needs.size,
+                needs.alignment,
+                needs.type_bits,
+            )?;
+            let object = RawObject::create(&self.device, key, &r.desc, usage, &memory, 0)?;
+            let new = TemporalObject {
+                desc: r.desc,
+                usage: r.usage,
+                object,
+                _memory: memory,
+            };
+            if let Some(old) = self.temporal.insert(key.clone(), new) {
+                self.destroy_after_idle(vec![old.object])?;
+            }
+        }
+        Ok(())
+    }
+
+    /// Compiles `graph` (cached while its shape is unchanged) and records it into `cb`, which
+    /// must be recording outside a render pass. Returns the plan it ran.
+    pub fn execute(
+        &mut self,
+        cb: vk::CommandBuffer,
+        mut graph: RenderGraph,
+    ) -> Result<Arc<Plan>, ExecuteError> {
+        let plan = self.compiler.compile(&graph, &DeviceMemory(&self.device))?;
+        let set = self.transients_for(&plan)?;
+        self.ensure_temporal(&plan)?;
+
+        let mut objects: Vec<Option<GpuResource>> = vec![None; plan.resources.len()];
+        for (id, o) in &self.transients[set].objects {
+            objects[id.0 as usize] = Some(o.0);
+        }
+        for r in &plan.resources {
+            let slot = &mut objects[r.id.0 as usize];
+            match &r.kind {
+                ResourceKind::Transient => {}
+                ResourceKind::Temporal(key) => *slot = self.temporal.get(key).map(|t| t.object.0),
+                ResourceKind::Imported => {
+                    *slot = graph.externals[r.id.0 as usize].map(|e| match e {
+                        External::Image { image, view } => GpuResource::Image { image, view },
+                        External::Buffer(b) => GpuResource::Buffer(b),
+                    });
+                    if slot.is_none() && r.used {
+                        return Err(ExecuteError::MissingObject(r.name.clone()));
+                    }
+                }
+            }
+        }
+
+        let slot_index = (self.frame % self.slots.len() as u64) as usize;
+        let slot = &mut self.slots[slot_index];
+        if let Some(frame) = slot.unread.take() {
+            self.timings.extend(read_timings(&slot.timestamps, frame)?);
+        }
+        slot.descriptors.reset()?;
+        slot.timestamps.reset(cb);
+
+        let recorder = Recorder {
+            device: &self.device,
+            cb,
+            plan: &plan,
+            objects: &objects,
+        };
+        for pass in &plan.passes {
+            recorder.barriers(&pass.barriers);
+            slot.timestamps.begin(cb, &pass.name)?;
+            self.device.begin_label(cb, &pass.name);
+            let work = std::mem::replace(&mut graph.works[pass.id.0 as usize], Work::Declared);
+            let recorded = match work {
+                Work::Declared => Ok(()),
+                Work::Compute(c) => {
+                    let pipeline = match self.compute_pipelines.entry(c.shader.name) {
+                        std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                        std::collections::hash_map::Entry::Vacant(e) => {
+                            e.insert(ComputePipeline::new(&self.device, c.shader)?)
+                        }
+                    };
+                    recorder.compute(&c, pipeline, &mut slot.descriptors)
+                }
+                Work::Raster(r) => {
+                    let key = pipeline_key(&r.pipeline);
+                    let pipeline = match self.graphics_pipelines.entry(key) {
+                        std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
+                        std::collections::hash_map::Entry::Vacant(e) => {
+                            e.insert(GraphicsPipeline::new(&self.device, &r.pipeline)?)
+                        }
+                    };
+                    let layouts = |id: ResourceId| {
+                        pass.resources
+                            .iter()
+                            .find(|p| p.resource == id)
+                            .map_or(vk::ImageLayout::UNDEFINED, |p| p.info.layout)
+                    };
+                    recorder.raster(&r, pipeline, &mut slot.descriptors, layouts)
+                }
+                Work::Transfer(op) => {
+                    recorder.transfer(op);
+                    Ok(())
+                }
+                Work::Raw(f) => {
+                    let mut ctx = RawContext {
+                        device: &self.device,
+                        cb,
+                        resources: &objects,
+                    };
+                    f(&mut ctx).map_err(ExecuteError::from)
+                }
+            };
+            self.device.end_label(cb);
+            slot.timestamps.end(cb)?;
+            recorded?;
+        }
+        recorder.barriers(&plan.final_barriers);
+        slot.unread = Some(self.frame);
+        self.compiler.finish_frame(&plan);
+        self.frame += 1;
+        Ok(plan)
+    }
+
+    /// Per-pass GPU times of every executed frame not reported yet, oldest first. Call only
+    /// once those frames' submissions have completed.
+    pub fn timings(&mut self) -> Result<Vec<PassTiming>, ExecuteError> {
+        let mut slots: Vec<&mut FrameSlot> = self
+            .slots
+            .iter_mut()
+            .filter(|s| s.unread.is_some())
+            .collect();
+        slots.sort_by_key(|s| s.unread);
+        for slot in slots {
+            if let Some(frame) = slot.unread.take() {
+                self.timings.extend(read_timings(&slot.timestamps, frame)?);
+            }
+        }
+        Ok(std::mem::take(&mut self.timings))
+    }
+}
+
+fn read_timings(pool: &TimestampPool, frame: u64) -> Result<Vec<PassTiming>, ExecuteError> {
+    Ok(pool
+        .read()?
+        .into_iter()
+        .map(|t| PassTiming {
+            name: t.name,
+            begin_ns: t.begin_ns,
+            end_ns: t.end_ns,
+            frame,
+        })
+        .collect())
+}
+
+impl Drop for Executor {
+    fn drop(&mut self) {
+        let mut objects: Vec<RawObject> = self
+            .transients
+            .drain(..)
+            .flat_map(|t| t.objects.into_iter().map(|(_, o)| o))
+            .collect();
+        objects.extend(self.temporal.drain().map(|(_, t)| t.object));
+        // Destruction needs the GPU idle; if waiting fails the device is lost and the objects
+        // are destroyed anyway (nothing can still be using them).
+        let _ = self.device.wait_idle();
+        for o in objects {
+            o.destroy(&self.device);
+        }
+    }
+}
