@@ -64,14 +64,20 @@ impl RenderGraph {
     }
 
     /// Copies a whole buffer into another (sizes must match).
-    pub fn copy_buffer(&mut self, name: &str, src: &Handle<Buffer>, dst: &mut Handle<Buffer>) {
+    pub fn copy_buffer(
+        &mut self,
+        name: &str,
+        src: &Handle<Buffer>,
+        dst: &mut Handle<Buffer>,
+    ) -> PassBuilder<'_> {
         let op = TransferOp::CopyBuffer {
             src: src.id,
             dst: dst.id,
         };
-        self.transfer(name, op)
-            .read(src, BufferAccess::CopySrc)
+        let mut pass = self.transfer(name, op);
+        pass.read(src, BufferAccess::CopySrc)
             .write(dst, BufferAccess::CopyDst);
+        pass
     }
 
     /// Copies mip 0, layer 0 of an image into a buffer, tightly packed.
@@ -80,14 +86,15 @@ impl RenderGraph {
         name: &str,
         src: &Handle<Image>,
         dst: &mut Handle<Buffer>,
-    ) {
+    ) -> PassBuilder<'_> {
         let op = TransferOp::CopyImageToBuffer {
             src: src.id,
             dst: dst.id,
         };
-        self.transfer(name, op)
-            .read(src, ImageAccess::CopySrc)
+        let mut pass = self.transfer(name, op);
+        pass.read(src, ImageAccess::CopySrc)
             .write(dst, BufferAccess::CopyDst);
+        pass
     }
 
     /// Copies a tightly packed buffer into mip 0, layer 0 of an image.
@@ -96,26 +103,41 @@ impl RenderGraph {
         name: &str,
         src: &Handle<Buffer>,
         dst: &mut Handle<Image>,
-    ) {
+    ) -> PassBuilder<'_> {
         let op = TransferOp::CopyBufferToImage {
             src: src.id,
             dst: dst.id,
         };
-        self.transfer(name, op)
-            .read(src, BufferAccess::CopySrc)
+        let mut pass = self.transfer(name, op);
+        pass.read(src, BufferAccess::CopySrc)
             .write(dst, ImageAccess::CopyDst);
+        pass
     }
 
     /// Clears every mip and layer of a colour image.
-    pub fn clear_image(&mut self, name: &str, dst: &mut Handle<Image>, color: [f32; 4]) {
+    pub fn clear_image(
+        &mut self,
+        name: &str,
+        dst: &mut Handle<Image>,
+        color: [f32; 4],
+    ) -> PassBuilder<'_> {
         let op = TransferOp::ClearImage { dst: dst.id, color };
-        self.transfer(name, op).write(dst, ImageAccess::ClearDst);
+        let mut pass = self.transfer(name, op);
+        pass.write(dst, ImageAccess::ClearDst);
+        pass
     }
 
     /// Fills a whole buffer with a repeated 32-bit value.
-    pub fn fill_buffer(&mut self, name: &str, dst: &mut Handle<Buffer>, value: u32) {
+    pub fn fill_buffer(
+        &mut self,
+        name: &str,
+        dst: &mut Handle<Buffer>,
+        value: u32,
+    ) -> PassBuilder<'_> {
         let op = TransferOp::FillBuffer { dst: dst.id, value };
-        self.transfer(name, op).write(dst, BufferAccess::Fill);
+        let mut pass = self.transfer(name, op);
+        pass.write(dst, BufferAccess::Fill);
+        pass
     }
 
     /// Blits mip 0, layer 0 of `src` onto mip 0, layer 0 of `dst`, scaling with `filter`.
@@ -125,15 +147,16 @@ impl RenderGraph {
         src: &Handle<Image>,
         dst: &mut Handle<Image>,
         filter: vk::Filter,
-    ) {
+    ) -> PassBuilder<'_> {
         let op = TransferOp::Blit {
             src: src.id,
             dst: dst.id,
             filter,
         };
-        self.transfer(name, op)
-            .read(src, ImageAccess::BlitSrc)
+        let mut pass = self.transfer(name, op);
+        pass.read(src, ImageAccess::BlitSrc)
             .write(dst, ImageAccess::BlitDst);
+        pass
     }
 }
 

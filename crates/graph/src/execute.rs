@@ -562,7 +562,10 @@ impl Executor {
             .iter()
             .position(|t| Arc::ptr_eq(&t.plan, plan))
         {
-            return Ok(i);
+            // Most recently used last, so eviction takes the least recently used.
+            let set = self.transients.remove(i);
+            self.transients.push(set);
+            return Ok(self.transients.len() - 1);
         }
         if self.transients.len() >= KEPT_TRANSIENT_SETS {
             let old = self.transients.remove(0);

@@ -190,7 +190,8 @@ pub struct ImageImport {
     /// State of the last use before the graph (a write access mask means its contents are
     /// being produced there and must be waited for).
     pub initial: ExternalState,
-    /// State the graph must leave it in: its layout, and the stage/access of the caller's next use.
+    /// State the graph must leave it in: its layout, and the stage/access of the caller's next
+    /// use. An UNDEFINED layout leaves it in the layout of its last use in the graph.
     pub final_state: ExternalState,
     /// Usage flags it was created with; an access needing more is an error.
     pub usage: vk::ImageUsageFlags,

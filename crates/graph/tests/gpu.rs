@@ -269,3 +269,26 @@ fn synchronization_validation_sees_a_missing_barrier() {
         );
     }
 }
+
+#[test]
+fn a_pass_run_every_other_frame_keeps_its_output_in_between() {
+    let device = device();
+    let readback = readback_buffer(&device, "readback", 16);
+    let mut executor = Executor::new(&device, 2).unwrap();
+    let mut seen = Vec::new();
+    for frame in 0..4u32 {
+        let mut rg = executor.begin_frame();
+        let mut cache = rg.temporal_buffer("cache", BufferDesc::new(16));
+        let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+        rg.fill_buffer("slow", &mut cache, frame + 1)
+            .run_every(2, 0);
+        rg.copy_buffer("use", &cache, &mut out);
+        let plan = run(&device, &mut executor, rg);
+        let skipped = frame % 2 == 1;
+        assert_eq!(plan.skipped.len(), usize::from(skipped), "frame {frame}");
+        let bytes = device.read_buffer(&readback).unwrap();
+        seen.push(u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]));
+    }
+    assert_eq!(seen, [1, 1, 3, 3]);
+    assert_clean(&device);
+}
