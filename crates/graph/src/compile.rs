@@ -100,6 +100,11 @@ fn validate(graph: &RenderGraph) -> Result<(), GraphError> {
                     resource: a.resource,
                 });
             };
+            if a.version > res.latest {
+                return Err(GraphError::UnknownResource {
+                    resource: a.resource,
+                });
+            }
             let is_image = matches!(res.desc, AnyDesc::Image(_));
             if is_image != matches!(a.access, crate::AnyAccess::Image(_)) {
                 return Err(GraphError::KindMismatch {

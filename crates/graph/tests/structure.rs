@@ -223,6 +223,26 @@ fn other_declaration_mistakes_are_errors() {
     ));
 }
 
+#[test]
+fn a_handle_from_another_graph_is_an_error() {
+    let mut other = RenderGraph::new(0);
+    let mut foreign = other.create_buffer("foreign", BufferDesc::new(64));
+    for _ in 0..3 {
+        other
+            .pass(&format!("w{}", foreign.version()), PassKind::Compute)
+            .write(&mut foreign, BufferAccess::StorageWriteCompute);
+    }
+    let mut rg = RenderGraph::new(0);
+    let mut out = output_buffer(&mut rg, "out");
+    rg.pass("confused", PassKind::Compute)
+        .read(&foreign, BufferAccess::StorageReadCompute)
+        .write(&mut out, BufferAccess::StorageWriteCompute);
+    assert!(matches!(
+        compile(&rg).unwrap_err(),
+        GraphError::UnknownResource { .. }
+    ));
+}
+
 fn chain(frame: u64, extent: u32) -> RenderGraph {
     let mut rg = RenderGraph::new(frame);
     let mut a = rg.create_image(
