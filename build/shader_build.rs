@@ -421,12 +421,19 @@ fn check_naga_subset(path: &Path, text: &str) -> Result<(), ShaderError> {
     for (index, line) in text.lines().enumerate() {
         let code = line.split("//").next().unwrap_or("");
         for (needle, what) in UNREADABLE_BY_NAGA {
-            // Prefix match at a word start: `sampler2DArray` and `subgroupAdd` count too.
+            // Prefix match at a word start: `sampler2DArray` and `subgroupAdd` count too. A
+            // sampler type followed by `(` is the constructor that combines a separate texture
+            // and sampler at the use site, which naga reads.
             let found = code.match_indices(needle).any(|(at, _)| {
-                !code[..at]
+                let word_start = !code[..at]
                     .chars()
                     .next_back()
-                    .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')
+                    .is_some_and(|c| c.is_ascii_alphanumeric() || c == '_');
+                let rest =
+                    code[at..].trim_start_matches(|c: char| c.is_ascii_alphanumeric() || c == '_');
+                let constructor =
+                    needle.starts_with("sampler") && rest.trim_start().starts_with('(');
+                word_start && !constructor
             });
             if found {
                 return Err(ShaderError {

@@ -1,0 +1,29 @@
+//! Command-line interface: one module per subcommand.
+
+mod info;
+
+use clap::{Parser, Subcommand};
+
+/// Errors a subcommand reports to the user (printed as `error: …`, exit status 1).
+pub type CliError = Box<dyn std::error::Error>;
+
+/// shine: real-time soft global illumination on Vulkan.
+#[derive(Parser, Debug)]
+#[command(version, about)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Print the Vulkan device shine would use and the features it needs or can use.
+    Info(info::InfoArgs),
+}
+
+/// Runs the chosen subcommand.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Info(args) => info::run(&args),
+    }
+}
