@@ -66,7 +66,7 @@ pub enum GpuResource {
     Image {
         /// The image.
         image: vk::Image,
-        /// A view over every mip and layer.
+        /// A view over every mip and layer (null for images only transfers use).
         view: vk::ImageView,
     },
     /// A buffer.
@@ -122,9 +122,23 @@ impl RawObject {
                     .view_type(view_type)
                     .format(d.format)
                     .subresource_range(d.full_range());
+                // Images used only by transfers cannot have a view (and need none).
+                let viewable = vk::ImageUsageFlags::SAMPLED
+                    | vk::ImageUsageFlags::STORAGE
+                    | vk::ImageUsageFlags::COLOR_ATTACHMENT
+                    | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                    | vk::ImageUsageFlags::INPUT_ATTACHMENT;
+                let needs_view = info.usage.intersects(viewable);
                 // SAFETY: the placement lies inside the block; the view covers the image.
-                let view = unsafe { raw.bind_image_memory(image, memory, base + offset) }
-                    .and_then(|()| unsafe { raw.create_image_view(&view_info, None) });
+                let view =
+                    unsafe { raw.bind_image_memory(image, memory, base + offset) }.and_then(|()| {
+                        if needs_view {
+                            // SAFETY: the image has memory bound and a view-capable usage.
+                            unsafe { raw.create_image_view(&view_info, None) }
+                        } else {
+                            Ok(vk::ImageView::null())
+                        }
+                    });
                 match view {
                     Ok(view) => {
                         device.set_name(image, name);
@@ -148,7 +162,9 @@ impl RawObject {
             match self.0 {
                 GpuResource::Buffer(b) => raw.destroy_buffer(b, None),
                 GpuResource::Image { image, view } => {
-                    raw.destroy_image_view(view, None);
+                    if view != vk::ImageView::null() {
+                        raw.destroy_image_view(view, None);
+                    }
                     raw.destroy_image(image, None);
                 }
             }

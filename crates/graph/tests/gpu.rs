@@ -292,3 +292,34 @@ fn a_pass_run_every_other_frame_keeps_its_output_in_between() {
     assert_eq!(seen, [1, 1, 3, 3]);
     assert_clean(&device);
 }
+
+#[test]
+fn aliased_images_through_clear_blits_and_copy() {
+    let device = device();
+    let (w, h) = (8u32, 4u32);
+    let readback = readback_buffer(&device, "readback", u64::from(w * h) * 4);
+    let mut executor = Executor::new(&device, 1).unwrap();
+    let mut rg = executor.begin_frame();
+    let desc = ImageDesc::new_2d(vk::Format::R8G8B8A8_UNORM, w, h);
+    let mut a = rg.create_image("a", desc);
+    let mut b = rg.create_image("b", desc);
+    let mut c = rg.create_image("c", desc);
+    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+    rg.clear_image("clear_a", &mut a, [1.0, 0.0, 1.0, 0.0]);
+    rg.blit_image("a_to_b", &a, &mut b, vk::Filter::NEAREST);
+    rg.blit_image("b_to_c", &b, &mut c, vk::Filter::NEAREST);
+    rg.copy_image_to_buffer("c_out", &c, &mut out);
+    let plan = run(&device, &mut executor, rg);
+    let (pa, pc) = (
+        plan.memory.placement(a.id()).unwrap(),
+        plan.memory.placement(c.id()).unwrap(),
+    );
+    assert!(
+        pa.overlaps_memory(pc),
+        "c should reuse a's memory: {:?}",
+        plan.memory
+    );
+    let bytes = device.read_buffer(&readback).unwrap();
+    assert!(bytes.chunks_exact(4).all(|t| t == [255, 0, 255, 0]));
+    assert_clean(&device);
+}
