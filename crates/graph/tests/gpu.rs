@@ -6,7 +6,8 @@
 
 use shine::shaders;
 use shine_gpu::{
-    Blend, Device, DeviceDesc, GraphicsPipelineDesc, MemoryLocation, Validation, VertexBufferLayout,
+    Blend, DepthState, Device, DeviceDesc, GraphicsPipelineDesc, MemoryLocation, Validation,
+    VertexBufferLayout,
 };
 use shine_graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
 use shine_graph::*;
@@ -321,5 +322,93 @@ fn aliased_images_through_clear_blits_and_copy() {
     );
     let bytes = device.read_buffer(&readback).unwrap();
     assert!(bytes.chunks_exact(4).all(|t| t == [255, 0, 255, 0]));
+    assert_clean(&device);
+}
+
+/// A buffer with contents uploaded before the graph (a finished copy is its last write).
+fn uploaded(
+    device: &Device,
+    name: &str,
+    usage: vk::BufferUsageFlags,
+    data: &[u8],
+) -> shine_gpu::Buffer {
+    let desc = shine_gpu::BufferDesc {
+        name,
+        size: data.len() as u64,
+        usage,
+        location: MemoryLocation::GpuOnly,
+    };
+    shine_gpu::Buffer::with_data(device, &desc, data).unwrap()
+}
+
+#[test]
+fn indexed_depth_pass_then_sampled_in_compute() {
+    let device = device();
+    let (w, h) = (8u32, 8u32);
+    // A far triangle, then a near one over it: the depth test keeps the near depth.
+    let (far, near) = (0.75f32, 0.25f32);
+    let mut positions: Vec<f32> = Vec::new();
+    for z in [far, near] {
+        for (x, y) in [(-1.0, -1.0), (3.0, -1.0), (-1.0, 3.0)] {
+            positions.extend([x, y, z, 0.0]);
+        }
+    }
+    let vertices = uploaded(
+        &device,
+        "vertices",
+        vk::BufferUsageFlags::VERTEX_BUFFER,
+        bytemuck::cast_slice(&positions),
+    );
+    let indices = uploaded(
+        &device,
+        "indices",
+        vk::BufferUsageFlags::INDEX_BUFFER,
+        bytemuck::cast_slice(&[0u32, 1, 2, 3, 4, 5]),
+    );
+    let readback = readback_buffer(&device, "readback", u64::from(w * h) * 4);
+    let sampler = shine_gpu::Sampler::new(&device, &vk::SamplerCreateInfo::default()).unwrap();
+    let uploaded_state = ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::UNDEFINED);
+
+    let mut executor = Executor::new(&device, 1).unwrap();
+    let mut rg = executor.begin_frame();
+    let vb = rg.import_gpu_buffer(&vertices, uploaded_state, ExternalState::UNDEFINED);
+    let ib = rg.import_gpu_buffer(&indices, uploaded_state, ExternalState::UNDEFINED);
+    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+    let mut depth = rg.create_image("depth", ImageDesc::new_2d(vk::Format::D32_SFLOAT, w, h));
+    let pipeline = GraphicsPipelineDesc {
+        vertex: &shaders::TESTS_GRAPH_DEPTH_VERT,
+        fragment: None,
+        vertex_buffers: vec![VertexBufferLayout {
+            stride: 16,
+            per_instance: false,
+            attributes: vec![(0, 0)],
+        }],
+        topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+        cull_mode: vk::CullModeFlags::NONE,
+        color_targets: Vec::new(),
+        depth: Some(DepthState {
+            format: vk::Format::D32_SFLOAT,
+            compare: vk::CompareOp::LESS,
+            write: true,
+        }),
+        depth_bias: None,
+    };
+    rg.raster("depth_only", pipeline)
+        .depth(&mut depth, DepthLoad::Clear(1.0))
+        .vertex_buffer(&vb)
+        .index_buffer(&ib, vk::IndexType::UINT32)
+        .draw_indexed(6, 1);
+    rg.compute("read_depth", &shaders::TESTS_GRAPH_DEPTH_READ_COMP)
+        .read("depth", &depth)
+        .sampler("nearest", sampler.raw())
+        .write("result", &mut out)
+        .push(&[w, h])
+        .dispatch([w, h, 1]);
+    let plan = run(&device, &mut executor, rg);
+    assert_eq!(
+        plan.barriers_before("read_depth")[0].new_layout,
+        L::SHADER_READ_ONLY_OPTIMAL
+    );
+    assert!(floats(&device, &readback).iter().all(|&d| d == near));
     assert_clean(&device);
 }
