@@ -307,7 +307,7 @@ impl Recorder<'_> {
         work: &RasterWork,
         pipeline: &GraphicsPipeline,
         arena: &mut DescriptorArena,
-        layouts: impl Fn(ResourceId) -> vk::ImageLayout,
+        attachment: impl Fn(ResourceId) -> (vk::ImageLayout, vk::AttachmentStoreOp),
     ) -> Result<(), ExecuteError> {
         let raw = self.device.raw();
         let first = work.colors.first().or(work.depth.as_ref());
@@ -325,23 +325,19 @@ impl Recorder<'_> {
             .colors
             .iter()
             .map(|a| {
+                let (layout, store) = attachment(a.resource);
                 vk::RenderingAttachmentInfo::default()
                     .image_view(self.image(a.resource).1)
-                    .image_layout(layouts(a.resource))
+                    .image_layout(layout)
                     .load_op(a.load)
-                    .store_op(vk::AttachmentStoreOp::STORE)
+                    .store_op(store)
                     .clear_value(vk::ClearValue {
                         color: vk::ClearColorValue { float32: a.clear },
                     })
             })
             .collect();
         let depth = work.depth.map(|a| {
-            let layout = layouts(a.resource);
-            let store = if layout == vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL {
-                vk::AttachmentStoreOp::NONE
-            } else {
-                vk::AttachmentStoreOp::STORE
-            };
+            let (layout, store) = attachment(a.resource);
             vk::RenderingAttachmentInfo::default()
                 .image_view(self.image(a.resource).1)
                 .image_layout(layout)
@@ -709,7 +705,7 @@ impl Executor {
             plan: &plan,
             objects: &objects,
         };
-        for pass in &plan.passes {
+        for (position, pass) in plan.passes.iter().enumerate() {
             recorder.barriers(&pass.barriers);
             slot.timestamps.begin(cb, &pass.name)?;
             self.device.begin_label(cb, &pass.name);
@@ -733,13 +729,28 @@ impl Executor {
                             e.insert(GraphicsPipeline::new(&self.device, &r.pipeline)?)
                         }
                     };
-                    let layouts = |id: ResourceId| {
-                        pass.resources
+                    // Store ops follow from the plan: nothing for a read-only depth, don't-care
+                    // at a transient's last use, store otherwise.
+                    let attachment = |id: ResourceId| {
+                        let layout = pass
+                            .resources
                             .iter()
                             .find(|p| p.resource == id)
-                            .map_or(vk::ImageLayout::UNDEFINED, |p| p.info.layout)
+                            .map_or(vk::ImageLayout::UNDEFINED, |p| p.info.layout);
+                        let last_use = plan
+                            .memory
+                            .placement(id)
+                            .is_some_and(|p| p.lifetime.1 == position);
+                        let store = if layout == vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL {
+                            vk::AttachmentStoreOp::NONE
+                        } else if last_use {
+                            vk::AttachmentStoreOp::DONT_CARE
+                        } else {
+                            vk::AttachmentStoreOp::STORE
+                        };
+                        (layout, store)
                     };
-                    recorder.raster(&r, pipeline, &mut slot.descriptors, layouts)
+                    recorder.raster(&r, pipeline, &mut slot.descriptors, attachment)
                 }
                 Work::Transfer(op) => {
                     recorder.transfer(op);

@@ -91,7 +91,11 @@ fn splat_pipeline() -> GraphicsPipelineDesc {
         topology: vk::PrimitiveTopology::TRIANGLE_LIST,
         cull_mode: vk::CullModeFlags::NONE,
         color_targets: vec![(vk::Format::R32G32B32A32_SFLOAT, Blend::Additive)],
-        depth: None,
+        depth: Some(DepthState {
+            format: vk::Format::D32_SFLOAT,
+            compare: vk::CompareOp::ALWAYS,
+            write: false,
+        }),
         depth_bias: None,
     }
 }
@@ -104,6 +108,11 @@ fn splat_graph(executor: &Executor, result: &shine_gpu::Buffer) -> RenderGraph {
         "splats",
         ImageDesc::new_2d(vk::Format::R32G32B32A32_SFLOAT, W, H),
     );
+    // Used by the raster pass only: its store op becomes DONT_CARE.
+    let mut depth = rg.create_image(
+        "splat_depth",
+        ImageDesc::new_2d(vk::Format::D32_SFLOAT, W, H),
+    );
     let mut out = rg.import_gpu_buffer(result, ExternalState::UNDEFINED, read_by_copy());
     rg.compute("emit", &shaders::TESTS_GRAPH_EMIT_COMP)
         .write("vertices", &mut vertices)
@@ -111,6 +120,7 @@ fn splat_graph(executor: &Executor, result: &shine_gpu::Buffer) -> RenderGraph {
         .dispatch([TRIANGLES, 1, 1]);
     rg.raster("splat", splat_pipeline())
         .color(&mut splats, ColorLoad::Clear([0.0; 4]))
+        .depth(&mut depth, DepthLoad::Clear(1.0))
         .vertex_buffer(&vertices)
         .draw(3 * TRIANGLES, 1);
     rg.compute("gather", &shaders::TESTS_GRAPH_GATHER_COMP)
