@@ -44,14 +44,24 @@ fn kind_words(kind: &ResourceKind) -> String {
     }
 }
 
+/// Vulkan flags in words; an empty mask reads NONE.
+fn flags(mask: impl std::fmt::Debug) -> String {
+    let words = format!("{mask:?}");
+    if words.is_empty() {
+        "NONE".into()
+    } else {
+        words
+    }
+}
+
 fn barrier_json(plan: &Plan, b: &Barrier) -> Value {
     json!({
         "resource": b.resource.0,
         "resource_name": plan.resource(b.resource).map(|r| r.name.as_str()),
-        "src_stage": format!("{:?}", b.src.stage),
-        "src_access": format!("{:?}", b.src.access),
-        "dst_stage": format!("{:?}", b.dst.stage),
-        "dst_access": format!("{:?}", b.dst.access),
+        "src_stage": flags(b.src.stage),
+        "src_access": flags(b.src.access),
+        "dst_stage": flags(b.dst.stage),
+        "dst_access": flags(b.dst.access),
         "old_layout": format!("{:?}", b.old_layout),
         "new_layout": format!("{:?}", b.new_layout),
     })
@@ -88,8 +98,8 @@ impl Plan {
                     "barriers": p.barriers.iter().map(|b| barrier_json(self, b)).collect::<Vec<_>>(),
                     "resources": p.resources.iter().map(|r| json!({
                         "resource": r.resource.0,
-                        "stage": format!("{:?}", r.info.stage),
-                        "access": format!("{:?}", r.info.access),
+                        "stage": flags(r.info.stage),
+                        "access": flags(r.info.access),
                         "layout": format!("{:?}", r.info.layout),
                     })).collect::<Vec<_>>(),
                 })
@@ -150,11 +160,11 @@ impl Plan {
                     .find(|b| b.resource == r.resource)
                     .map(|b| {
                         format!(
-                            " label=\"{:?}/{:?} -> {:?}/{:?}\\n{:?} -> {:?}\"",
-                            b.src.stage,
-                            b.src.access,
-                            b.dst.stage,
-                            b.dst.access,
+                            " label=\"{}/{} -> {}/{}\\n{:?} -> {:?}\"",
+                            flags(b.src.stage),
+                            flags(b.src.access),
+                            flags(b.dst.stage),
+                            flags(b.dst.access),
                             b.old_layout,
                             b.new_layout
                         )

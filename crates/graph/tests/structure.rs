@@ -285,6 +285,9 @@ fn the_dumps_describe_order_barriers_and_memory() {
     assert_eq!(b["src_stage"], "COMPUTE_SHADER");
     assert_eq!(b["dst_access"], "SHADER_SAMPLED_READ");
     assert_eq!(b["old_layout"], "GENERAL");
+    let first = &json["passes"][0]["barriers"][0];
+    assert_eq!(first["src_stage"], "NONE");
+    assert_eq!(first["old_layout"], "UNDEFINED");
     assert_eq!(b["new_layout"], "SHADER_READ_ONLY_OPTIMAL");
     assert_eq!(json["memory"]["requested_bytes"], 64 * 64 * 4);
     assert_eq!(json["resources"][0]["kind"], "transient");
