@@ -276,3 +276,70 @@ impl Support {
             .shader_float64(f.shader_float64 == vk::TRUE)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lavapipe_like() -> Support {
+        Support {
+            api_version: vk::make_api_version(0, 1, 3, 230),
+            queue_family: Some(0),
+            timestamp_valid_bits: 64,
+            features: vk::PhysicalDeviceFeatures::default(),
+            synchronization2: true,
+            dynamic_rendering: true,
+            maintenance4: true,
+            host_query_reset: true,
+            scalar_block_layout: true,
+            shader_float16: true,
+            descriptor_indexing: false,
+            ray_query: false,
+            float_atomics: false,
+        }
+    }
+
+    #[test]
+    fn a_complete_device_misses_nothing() {
+        assert!(lavapipe_like().missing().is_empty());
+    }
+
+    #[test]
+    fn every_shortfall_is_named() {
+        let old = Support {
+            api_version: vk::make_api_version(0, 1, 2, 0),
+            timestamp_valid_bits: 0,
+            synchronization2: false,
+            dynamic_rendering: false,
+            ..lavapipe_like()
+        };
+        assert_eq!(
+            old.missing(),
+            [
+                "Vulkan 1.3 (device offers 1.2)",
+                "timestamps (timestampValidBits is 0 on the queue)",
+                "synchronization2 (Vulkan 1.3 feature)",
+                "dynamicRendering (Vulkan 1.3 feature)",
+            ]
+        );
+        let no_queue = Support {
+            queue_family: None,
+            ..lavapipe_like()
+        };
+        assert_eq!(
+            no_queue.missing(),
+            ["a queue family with GRAPHICS and COMPUTE"]
+        );
+    }
+
+    #[test]
+    fn optional_features_never_block() {
+        let report = lavapipe_like().report();
+        let ray_query = report
+            .iter()
+            .find(|f| f.name == "VK_KHR_ray_query")
+            .map(|f| (f.required, f.present));
+        assert_eq!(ray_query, Some((false, false)));
+        assert!(report.iter().filter(|f| f.required).all(|f| f.present));
+    }
+}

@@ -21,6 +21,8 @@ mod timestamps;
 mod transfer;
 mod validation;
 
+/// The ash version shine is built on: a host engine must use the same one to lend its handles.
+pub use ash;
 pub use ash::vk;
 pub use commands::{Commands, SCOPES_PER_RECORDING, Submission};
 pub use descriptors::{Descriptor, DescriptorArena};
