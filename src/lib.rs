@@ -4,6 +4,7 @@
 //! shader under `shaders/` is compiled and reflected at build time into [`shaders`].
 
 pub use shine_gpu as gpu;
+pub use shine_graph as graph;
 
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
 ///

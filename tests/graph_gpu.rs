@@ -4,46 +4,18 @@
 //!
 //! Never skips: without a Vulkan device the tests fail (DESIGN §8).
 
-use shine::shaders;
-use shine_gpu::{
-    Blend, DepthState, Device, DeviceDesc, GraphicsPipelineDesc, MemoryLocation, Validation,
-    VertexBufferLayout,
+mod common;
+
+use common::{assert_clean, device};
+use shine::gpu::{
+    Blend, DepthState, Device, GraphicsPipelineDesc, MemoryLocation, VertexBufferLayout,
 };
-use shine_graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
-use shine_graph::*;
+use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+use shine::graph::*;
+use shine::shaders;
 
-fn device() -> Device {
-    let validation = if std::env::var_os("CI").is_some() {
-        Validation::Required
-    } else {
-        Validation::IfAvailable
-    };
-    let desc = DeviceDesc {
-        validation,
-        ..DeviceDesc::from_env()
-    };
-    Device::new(&desc).unwrap_or_else(|e| {
-        panic!(
-            "GPU tests need a Vulkan 1.3 device and the validation layer: {e}\n\
-             (Debian: apt-get install libvulkan1 mesa-vulkan-drivers vulkan-validationlayers)"
-        )
-    })
-}
-
-fn assert_clean(device: &Device) {
-    device.wait_idle().unwrap();
-    let counts = device.message_counts();
-    assert_eq!(
-        counts.problems(),
-        0,
-        "validation reported problems:\n{}",
-        device.messages().join("\n")
-    );
-}
-
-/// A GPU-only buffer the tests read back with a copy after the graph.
-fn readback_buffer(device: &Device, name: &str, size: u64) -> shine_gpu::Buffer {
-    let desc = shine_gpu::BufferDesc {
+fn readback_buffer(device: &Device, name: &str, size: u64) -> shine::gpu::Buffer {
+    let desc = shine::gpu::BufferDesc {
         name,
         size,
         usage: vk::BufferUsageFlags::STORAGE_BUFFER
@@ -51,7 +23,7 @@ fn readback_buffer(device: &Device, name: &str, size: u64) -> shine_gpu::Buffer 
             | vk::BufferUsageFlags::TRANSFER_DST,
         location: MemoryLocation::GpuOnly,
     };
-    shine_gpu::Buffer::new(device, &desc).unwrap()
+    shine::gpu::Buffer::new(device, &desc).unwrap()
 }
 
 /// The readback copy that follows the graph reads in the COPY stage.
@@ -59,7 +31,7 @@ fn read_by_copy() -> ExternalState {
     ExternalState::new(S::COPY, A::TRANSFER_READ, L::UNDEFINED)
 }
 
-fn floats(device: &Device, buffer: &shine_gpu::Buffer) -> Vec<f32> {
+fn floats(device: &Device, buffer: &shine::gpu::Buffer) -> Vec<f32> {
     let bytes = device.read_buffer(buffer).unwrap();
     bytes
         .chunks_exact(4)
@@ -101,7 +73,7 @@ fn splat_pipeline() -> GraphicsPipelineDesc {
 }
 
 /// compute (emit triangles) → raster (additive splats) → compute (gather into a buffer).
-fn splat_graph(executor: &Executor, result: &shine_gpu::Buffer) -> RenderGraph {
+fn splat_graph(executor: &Executor, result: &shine::gpu::Buffer) -> RenderGraph {
     let mut rg = executor.begin_frame();
     let mut vertices = rg.create_buffer("vertices", BufferDesc::new(u64::from(TRIANGLES) * 3 * 16));
     let mut splats = rg.create_image(
@@ -341,14 +313,14 @@ fn uploaded(
     name: &str,
     usage: vk::BufferUsageFlags,
     data: &[u8],
-) -> shine_gpu::Buffer {
-    let desc = shine_gpu::BufferDesc {
+) -> shine::gpu::Buffer {
+    let desc = shine::gpu::BufferDesc {
         name,
         size: data.len() as u64,
         usage,
         location: MemoryLocation::GpuOnly,
     };
-    shine_gpu::Buffer::with_data(device, &desc, data).unwrap()
+    shine::gpu::Buffer::with_data(device, &desc, data).unwrap()
 }
 
 #[test]
@@ -376,7 +348,7 @@ fn indexed_depth_pass_then_sampled_in_compute() {
         bytemuck::cast_slice(&[0u32, 1, 2, 3, 4, 5]),
     );
     let readback = readback_buffer(&device, "readback", u64::from(w * h) * 4);
-    let sampler = shine_gpu::Sampler::new(&device, &vk::SamplerCreateInfo::default()).unwrap();
+    let sampler = shine::gpu::Sampler::new(&device, &vk::SamplerCreateInfo::default()).unwrap();
     let uploaded_state = ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::UNDEFINED);
 
     let mut executor = Executor::new(&device, 1).unwrap();
