@@ -379,16 +379,18 @@ pub struct MemoryBlock {
 }
 
 impl MemoryBlock {
-    /// Allocates memory satisfying `requirements`.
+    /// Allocates memory satisfying `requirements`. `linear` is true when only buffers (or
+    /// linear images) will be bound, so the allocator respects bufferImageGranularity.
     pub fn new(
         device: &Device,
         name: &str,
         requirements: vk::MemoryRequirements,
         location: MemoryLocation,
+        linear: bool,
     ) -> Result<Self> {
         Ok(Self {
             device: device.clone(),
-            allocation: Some(device.allocate(name, requirements, location, false)?),
+            allocation: Some(device.allocate(name, requirements, location, linear)?),
         })
     }
 

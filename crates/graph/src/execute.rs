@@ -9,6 +9,7 @@ use shine_gpu::{
     MemoryBlock, PipelineLayout, TimestampPool, vk,
 };
 
+use crate::alias::{HeapClass, MemoryNeeds};
 use crate::barrier::Barrier;
 use crate::compiler::Compiler;
 use crate::error::GraphError;
@@ -576,9 +577,12 @@ impl Executor {
                 allocate(
                     &self.device,
                     &format!("graph heap {i}"),
-                    h.size,
-                    h.alignment,
-                    h.type_bits,
+                    MemoryNeeds {
+                        size: h.size,
+                        alignment: h.alignment,
+                        type_bits: h.type_bits,
+                    },
+                    h.class == HeapClass::Buffers,
                 )
             })
             .collect::<Result<Vec<_>, _>>()?;
@@ -641,9 +645,8 @@ impl Executor {
             let memory = allocate(
                 &self.device,
                 key,
-                needs.size,
-                needs.alignment,
-                needs.type_bits,
+                needs,
+                matches!(r.desc, AnyDesc::Buffer(_)),
             )?;
             let object = RawObject::create(&self.device, key, &r.desc, usage, &memory, 0)?;
             let new = TemporalObject {

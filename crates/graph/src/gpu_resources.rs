@@ -172,18 +172,17 @@ impl RawObject {
     }
 }
 
-/// A block of device memory for the given needs.
+/// A block of device memory for the given needs; `linear` for blocks holding only buffers.
 pub(crate) fn allocate(
     device: &Device,
     name: &str,
-    size: u64,
-    alignment: u64,
-    type_bits: u32,
+    needs: MemoryNeeds,
+    linear: bool,
 ) -> Result<MemoryBlock, shine_gpu::Error> {
     let requirements = vk::MemoryRequirements {
-        size,
-        alignment,
-        memory_type_bits: type_bits,
+        size: needs.size,
+        alignment: needs.alignment,
+        memory_type_bits: needs.type_bits,
     };
-    MemoryBlock::new(device, name, requirements, MemoryLocation::GpuOnly)
+    MemoryBlock::new(device, name, requirements, MemoryLocation::GpuOnly, linear)
 }
