@@ -484,7 +484,7 @@ fn glslang_error(
     }
     let rest: Vec<&str> = log
         .lines()
-        .filter(|l| l.starts_with("ERROR:") && *l != first)
+        .filter(|l| l.starts_with("ERROR:") && *l != first && !l.contains("compilation errors"))
         .collect();
     if !rest.is_empty() {
         message.push_str("\n  ");

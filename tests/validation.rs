@@ -127,3 +127,56 @@ fn timestamp_scopes_are_ordered_and_named() {
     assert!(timings.iter().all(|t| t.duration_ns() >= 0.0));
     common::assert_clean(&device);
 }
+
+#[test]
+fn destruction_waits_for_the_submission_that_may_use_the_object() {
+    let device = common::device();
+    let make = |name| {
+        Buffer::new(
+            &device,
+            &BufferDesc {
+                name,
+                size: 256,
+                usage: vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )
+        .expect("buffer")
+    };
+    // Nothing in flight: a drop destroys at once.
+    drop(make("idle"));
+    assert_eq!(device.pending_destructions(), 0);
+
+    let (src, dst) = (make("src"), make("dst"));
+    let mut cmd = device.begin_commands().expect("commands");
+    let raw = device.raw().clone();
+    let cb = cmd.raw();
+    let region = [vk::BufferCopy {
+        src_offset: 0,
+        dst_offset: 0,
+        size: 256,
+    }];
+    // SAFETY: both buffers are alive when recorded; `src` is dropped before submission on
+    // purpose and must survive until the copy has run.
+    unsafe { raw.cmd_copy_buffer(cb, src.raw(), dst.raw(), &region) };
+    drop(src);
+    assert_eq!(
+        device.pending_destructions(),
+        1,
+        "dropped while recorded: deferred"
+    );
+    let submission = device.submit(cmd).expect("submit");
+    assert_eq!(
+        device.pending_destructions(),
+        1,
+        "in flight: still deferred"
+    );
+    submission.wait().expect("wait");
+    assert_eq!(
+        device.pending_destructions(),
+        0,
+        "retired once the fence signalled"
+    );
+    drop(dst);
+    common::assert_clean(&device);
+}

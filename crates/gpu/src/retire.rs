@@ -107,6 +107,11 @@ impl Device {
         }
     }
 
+    /// Objects dropped but not yet destroyed because the GPU may still use them.
+    pub fn pending_destructions(&self) -> usize {
+        lock(&self.inner.tracker).garbage.len()
+    }
+
     /// Polls submissions in flight and destroys or recycles what they no longer use.
     pub fn retire(&self) -> Result<()> {
         let mut tracker = lock(&self.inner.tracker);
