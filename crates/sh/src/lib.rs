@@ -35,6 +35,7 @@
 #![deny(missing_docs)]
 
 pub mod basis;
+pub mod brdf_table;
 
 pub mod hvl;
 pub mod kernels;
