@@ -36,10 +36,13 @@
 
 pub mod basis;
 pub mod brdf_table;
+pub mod exp_log;
 
 pub mod hvl;
 pub mod kernels;
 pub mod legendre;
+mod linalg;
+pub mod product;
 
 pub mod quadrature;
 pub mod rotation;
