@@ -43,9 +43,11 @@ pub mod kernels;
 pub mod legendre;
 mod linalg;
 pub mod product;
+pub mod proxy_indirect;
 
 pub mod quadrature;
 pub mod rotation;
+pub mod sphere_blocker;
 
 pub mod zonal;
 
