@@ -34,21 +34,19 @@
 
 #![deny(missing_docs)]
 
+pub mod aaf;
 pub mod basis;
 pub mod brdf_table;
 pub mod exp_log;
-
 pub mod hvl;
 pub mod kernels;
 pub mod legendre;
 mod linalg;
 pub mod product;
 pub mod proxy_indirect;
-
 pub mod quadrature;
 pub mod rotation;
 pub mod sphere_blocker;
-
 pub mod zonal;
 
 /// Largest band count any function of this crate accepts (degrees `0..MAX_BANDS`).
