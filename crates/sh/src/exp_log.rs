@@ -55,42 +55,69 @@ pub const PS_MAX_MAGNITUDE: f64 = 1.0;
 pub const PS_TAYLOR_ORDER: usize = 3;
 /// HYB: the scaled vector's magnitude bound before OL.
 pub const HYB_MAX_MAGNITUDE: f64 = 0.5;
-/// Number of blocker half-angles sampled to build the OL table.
-const OL_TABLE_SAMPLES: usize = 256;
+/// Number of blocker sizes (`sin θ = i/N`) whose logs are fitted to build the OL table.
+const OL_FIT_BLOCKERS: usize = 512;
+/// Number of uniform magnitude samples of [`OlTable`].
+pub const OL_TABLE_SIZE: usize = 256;
 
 const SQRT_4PI: f64 = 3.544_907_701_811_032;
 
-/// Tabulated OL coefficients `a(m)`, `b(m)` against the magnitude `m = ‖f̂‖`.
+/// Tabulated OL coefficients `a(m)`, `b(m)` at uniform magnitudes `m_i = i · step`,
+/// `i < OL_TABLE_SIZE`, resampled (linearly) from the per-blocker fits; `a(0) = b(0) = 1`.
+///
+/// The uniform grid makes the GPU lookup trivial: `x = m/step`, `i = floor(x)`, lerp; the
+/// GLSL twin embeds the first entries (those covering `m ≤ HYB_MAX_MAGNITUDE`).
 #[derive(Debug, Clone)]
 pub struct OlTable {
-    magnitude: Vec<f64>,
+    step: f64,
     a: Vec<f64>,
     b: Vec<f64>,
 }
 
 impl OlTable {
+    fn from_fits(mags: &[f64], a: &[f64], b: &[f64]) -> Self {
+        let m_max = mags.last().copied().unwrap_or(1.0).max(1e-6);
+        let step = m_max / (OL_TABLE_SIZE - 1) as f64;
+        let mut ra = Vec::with_capacity(OL_TABLE_SIZE);
+        let mut rb = Vec::with_capacity(OL_TABLE_SIZE);
+        for i in 0..OL_TABLE_SIZE {
+            let m = (i as f64 * step).min(m_max);
+            let hi = mags.partition_point(|&x| x < m).clamp(1, mags.len() - 1);
+            let lo = hi - 1;
+            let t = ((m - mags[lo]) / (mags[hi] - mags[lo])).clamp(0.0, 1.0);
+            ra.push(a[lo] + t * (a[hi] - a[lo]));
+            rb.push(b[lo] + t * (b[hi] - b[lo]));
+        }
+        Self { step, a: ra, b: rb }
+    }
+
     /// `(a, b)` at magnitude `m`, linearly interpolated, clamped to the table's range.
     pub fn coefficients(&self, m: f64) -> (f64, f64) {
-        let mags = &self.magnitude;
-        let last = mags.len() - 1;
-        if m.is_nan() || m <= 0.0 {
-            return (self.a[0], self.b[0]);
-        }
-        if m >= mags[last] {
+        let last = self.a.len() - 1;
+        let x = if m.is_nan() {
+            0.0
+        } else {
+            (m / self.step).max(0.0)
+        };
+        if x >= last as f64 {
             return (self.a[last], self.b[last]);
         }
-        let hi = mags.partition_point(|&x| x <= m).clamp(1, last);
-        let lo = hi - 1;
-        let t = (m - mags[lo]) / (mags[hi] - mags[lo]);
+        let i0 = x.floor() as usize;
+        let t = x - i0 as f64;
         (
-            self.a[lo] + t * (self.a[hi] - self.a[lo]),
-            self.b[lo] + t * (self.b[hi] - self.b[lo]),
+            self.a[i0] + t * (self.a[i0 + 1] - self.a[i0]),
+            self.b[i0] + t * (self.b[i0 + 1] - self.b[i0]),
         )
     }
 
-    /// Sample magnitudes `‖f̂‖` (increasing), and the matching `a` and `b`.
-    pub fn samples(&self) -> (&[f64], &[f64], &[f64]) {
-        (&self.magnitude, &self.a, &self.b)
+    /// Magnitude step between samples.
+    pub fn step(&self) -> f64 {
+        self.step
+    }
+
+    /// The `a` and `b` samples (`OL_TABLE_SIZE` each).
+    pub fn samples(&self) -> (&[f64], &[f64]) {
+        (&self.a, &self.b)
     }
 }
 
@@ -140,9 +167,9 @@ impl ShExp {
         let mut a = vec![1.0];
         let mut b = vec![1.0];
         let mut zh = vec![0.0; bands];
-        for s in 1..=OL_TABLE_SAMPLES {
+        for s in 1..=OL_FIT_BLOCKERS {
             // sphere blocker of sin θ = s / N: visibility 1 - cap
-            let alpha = s as f64 / OL_TABLE_SAMPLES as f64;
+            let alpha = s as f64 / OL_FIT_BLOCKERS as f64;
             cap_zh_f64((1.0 - alpha * alpha).sqrt(), bands, &mut zh)?;
             let g_zh: Vec<f64> = zh
                 .iter()
@@ -169,7 +196,7 @@ impl ShExp {
         }
         Ok(Self {
             tensor,
-            ol: OlTable { magnitude, a, b },
+            ol: OlTable::from_fits(&magnitude, &a, &b),
         })
     }
 

@@ -19,7 +19,7 @@ fn smoothstep(x: f64) -> f64 {
 ///
 /// `H = S((ā - clamp(acos(n_x·ω_j), a̲, ā)) / 2a)` with `ā = π/2 + a`, `S` the smoothstep.
 /// **Deviation:** the text prints `a̲ = a - π/2`; with that the argument leaves `[0, 1]`.
-/// Oat's cap-intersection approximation [OS07] that eq. 22 specialises needs the lower bound at
+/// Oat and Sander's cap-intersection approximation (2007) that eq. 22 specialises needs the lower bound at
 /// full containment, `a̲ = π/2 - a` (then `ā - a̲ = 2a`), which we use. `a` is clamped to
 /// `[0, π/2]`; `a = 0` degenerates to the step `acos(n_x·ω_j) < π/2`.
 pub fn hemisphere_cap_fraction(cos_angle: f32, a: f32) -> f32 {
