@@ -76,6 +76,14 @@ pub struct OlTable {
 
 impl OlTable {
     fn from_fits(mags: &[f64], a: &[f64], b: &[f64]) -> Self {
+        if mags.len() < 2 {
+            // one band: f̂ is always empty, exp(f̂) = 1
+            return Self {
+                step: 1.0,
+                a: vec![1.0; OL_TABLE_SIZE],
+                b: vec![1.0; OL_TABLE_SIZE],
+            };
+        }
         let m_max = mags.last().copied().unwrap_or(1.0).max(1e-6);
         let step = m_max / (OL_TABLE_SIZE - 1) as f64;
         let mut ra = Vec::with_capacity(OL_TABLE_SIZE);

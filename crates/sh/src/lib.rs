@@ -38,6 +38,7 @@ pub mod aaf;
 pub mod basis;
 pub mod brdf_table;
 pub mod exp_log;
+pub mod glsl_tables;
 pub mod hvl;
 pub mod kernels;
 pub mod legendre;
