@@ -24,6 +24,13 @@ pub fn eval_basis_f64(d: DVec3, bands: usize, out: &mut [f64]) -> Result<()> {
     if out.len() < n2 {
         return Err(ShError::NotSquare { len: out.len() });
     }
+    recurrence(d, bands, |i, v| out[i] = v);
+    Ok(())
+}
+
+/// The recurrence of the module docs; hands each `(index, Y_lm(d))` to `put` (`bands` checked by
+/// the caller, `d` unit length).
+pub(crate) fn recurrence(d: DVec3, bands: usize, mut put: impl FnMut(usize, f64)) {
     let (x, y, z) = (d.x, d.y, d.z);
     let sqrt2 = std::f64::consts::SQRT_2;
     // (x + iy)^m
@@ -59,14 +66,13 @@ pub fn eval_basis_f64(d: DVec3, bands: usize, out: &mut [f64]) -> Result<()> {
             }
             let base = l * l + l;
             if m == 0 {
-                out[base] = q;
+                put(base, q);
             } else {
-                out[base + m] = sqrt2 * q * cm;
-                out[base - m] = sqrt2 * q * sm;
+                put(base + m, sqrt2 * q * cm);
+                put(base - m, sqrt2 * q * sm);
             }
         }
     }
-    Ok(())
 }
 
 /// Normalises a direction, rejecting zero, infinite and NaN vectors.
@@ -92,11 +98,7 @@ pub fn eval_basis_into(d: Vec3, bands: usize, out: &mut [f32]) -> Result<()> {
     if out.len() < n2 {
         return Err(ShError::NotSquare { len: out.len() });
     }
-    let mut tmp = [0.0f64; num_coeffs(crate::MAX_BANDS)];
-    eval_basis_f64(d, bands, &mut tmp)?;
-    for (o, &t) in out[..n2].iter_mut().zip(&tmp[..n2]) {
-        *o = t as f32;
-    }
+    recurrence(d, bands, |i, v| out[i] = v as f32);
     Ok(())
 }
 
@@ -112,13 +114,9 @@ pub fn eval_basis(d: Vec3, bands: usize) -> Result<Vec<f32>> {
 /// Reconstructs `f(d) = Σ f_lm Y_lm(d)` from the SH vector `coeffs` (band count from its length).
 pub fn evaluate(coeffs: &[f32], d: Vec3) -> Result<f32> {
     let bands = bands_of_len(coeffs.len())?;
-    let mut y = [0.0f64; num_coeffs(crate::MAX_BANDS)];
-    eval_basis_f64(unit_dir(d)?, bands, &mut y)?;
-    Ok(coeffs
-        .iter()
-        .zip(&y)
-        .map(|(&c, &y)| f64::from(c) * y)
-        .sum::<f64>() as f32)
+    let mut sum = 0.0f64;
+    recurrence(unit_dir(d)?, bands, |i, y| sum += f64::from(coeffs[i]) * y);
+    Ok(sum as f32)
 }
 
 #[cfg(test)]

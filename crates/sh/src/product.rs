@@ -31,6 +31,8 @@ pub struct TripleProduct {
     bands: usize,
     /// All ordered non-zeros, sorted by `k`, then `i`, then `j`.
     entries: Vec<TensorEntry>,
+    /// The non-zeros with `i ≤ j` (half the work of a product), same order.
+    pairs: Vec<TensorEntry>,
 }
 
 fn band_of(i: usize) -> usize {
@@ -94,7 +96,12 @@ impl TripleProduct {
             }
         }
         entries.sort_by_key(|e| (e.k, e.i, e.j));
-        Ok(Self { bands, entries })
+        let pairs = entries.iter().filter(|e| e.i <= e.j).copied().collect();
+        Ok(Self {
+            bands,
+            entries,
+            pairs,
+        })
     }
 
     /// Band count.
@@ -121,8 +128,13 @@ impl TripleProduct {
     /// `(a ∗ b)` in `f64` (both of this tensor's band count; unchecked lengths are a bug).
     pub(crate) fn product_f64(&self, a: &[f64], b: &[f64]) -> Vec<f64> {
         let mut out = vec![0.0; a.len()];
-        for e in &self.entries {
-            out[e.k as usize] += e.value * a[e.i as usize] * b[e.j as usize];
+        for e in &self.pairs {
+            let (i, j) = (e.i as usize, e.j as usize);
+            out[e.k as usize] += if i == j {
+                e.value * a[i] * b[i]
+            } else {
+                e.value * (a[i] * b[j] + a[j] * b[i])
+            };
         }
         out
     }

@@ -5,7 +5,7 @@
 
 use glam::Vec3;
 
-use crate::basis::{eval_basis_f64, unit_dir};
+use crate::basis::{recurrence, unit_dir};
 use crate::legendre::legendre_all;
 use crate::{MAX_BANDS, Result, ShError, check_bands, check_range, num_coeffs};
 
@@ -61,15 +61,15 @@ pub fn cap_zh(a: f32, bands: usize) -> Result<Vec<f32>> {
 pub fn rotate_zh(zh: &[f32], dir: Vec3) -> Result<Vec<f32>> {
     let bands = check_bands(zh.len())?;
     let d = unit_dir(dir)?;
-    let mut y = [0.0f64; num_coeffs(MAX_BANDS)];
-    eval_basis_f64(d, bands, &mut y)?;
-    let mut out = vec![0.0f32; num_coeffs(bands)];
-    for (l, &g) in zh.iter().enumerate() {
-        let k = zh_factor(l) * f64::from(g);
-        for i in l * l..(l + 1) * (l + 1) {
-            out[i] = (k * y[i]) as f32;
-        }
+    let mut k = [0.0f64; MAX_BANDS];
+    for (l, (kl, &g)) in k.iter_mut().zip(zh).enumerate() {
+        *kl = zh_factor(l) * f64::from(g);
     }
+    let mut out = vec![0.0f32; num_coeffs(bands)];
+    recurrence(d, bands, |i, y| {
+        let l = (i as f64).sqrt() as usize;
+        out[i] = (k[l] * y) as f32;
+    });
     Ok(out)
 }
 
@@ -93,7 +93,7 @@ pub fn sphere_half_angle(distance: f32, radius: f32) -> Result<f32> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::basis::eval_basis;
+    use crate::basis::{eval_basis, eval_basis_f64};
     use crate::quadrature::{SphereQuadrature, gauss_legendre};
     use glam::DVec3;
 
