@@ -24,13 +24,13 @@ pub fn eval_basis_f64(d: DVec3, bands: usize, out: &mut [f64]) -> Result<()> {
     if out.len() < n2 {
         return Err(ShError::NotSquare { len: out.len() });
     }
-    recurrence(d, bands, |i, v| out[i] = v);
+    recurrence(d, bands, |_, i, v| out[i] = v);
     Ok(())
 }
 
-/// The recurrence of the module docs; hands each `(index, Y_lm(d))` to `put` (`bands` checked by
-/// the caller, `d` unit length).
-pub(crate) fn recurrence(d: DVec3, bands: usize, mut put: impl FnMut(usize, f64)) {
+/// The recurrence of the module docs; hands each `(l, index, Y_lm(d))` to `put` (`bands` checked
+/// by the caller, `d` unit length).
+pub(crate) fn recurrence(d: DVec3, bands: usize, mut put: impl FnMut(usize, usize, f64)) {
     let (x, y, z) = (d.x, d.y, d.z);
     let sqrt2 = std::f64::consts::SQRT_2;
     // (x + iy)^m
@@ -66,10 +66,10 @@ pub(crate) fn recurrence(d: DVec3, bands: usize, mut put: impl FnMut(usize, f64)
             }
             let base = l * l + l;
             if m == 0 {
-                put(base, q);
+                put(l, base, q);
             } else {
-                put(base + m, sqrt2 * q * cm);
-                put(base - m, sqrt2 * q * sm);
+                put(l, base + m, sqrt2 * q * cm);
+                put(l, base - m, sqrt2 * q * sm);
             }
         }
     }
@@ -98,7 +98,7 @@ pub fn eval_basis_into(d: Vec3, bands: usize, out: &mut [f32]) -> Result<()> {
     if out.len() < n2 {
         return Err(ShError::NotSquare { len: out.len() });
     }
-    recurrence(d, bands, |i, v| out[i] = v as f32);
+    recurrence(d, bands, |_, i, v| out[i] = v as f32);
     Ok(())
 }
 
@@ -115,7 +115,9 @@ pub fn eval_basis(d: Vec3, bands: usize) -> Result<Vec<f32>> {
 pub fn evaluate(coeffs: &[f32], d: Vec3) -> Result<f32> {
     let bands = bands_of_len(coeffs.len())?;
     let mut sum = 0.0f64;
-    recurrence(unit_dir(d)?, bands, |i, y| sum += f64::from(coeffs[i]) * y);
+    recurrence(unit_dir(d)?, bands, |_, i, y| {
+        sum += f64::from(coeffs[i]) * y
+    });
     Ok(sum as f32)
 }
 

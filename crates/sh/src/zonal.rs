@@ -44,13 +44,7 @@ pub fn cap_zh_f64(cos_a: f64, bands: usize, out: &mut [f64]) -> Result<()> {
 /// ZH vector (length `bands`) of a unit-radiance spherical cap of half-angle `a` (radians,
 /// `0 ≤ a ≤ π`) centred on +z: paper 003 eq. 14.
 pub fn cap_zh(a: f32, bands: usize) -> Result<Vec<f32>> {
-    let a = check_range(
-        "cap half-angle",
-        f64::from(a),
-        0.0,
-        std::f64::consts::PI + 1e-6,
-        "0 ≤ a ≤ π radians",
-    )?;
+    let a = check_half_angle(a)?;
     let mut out = vec![0.0; check_bands(bands)?];
     cap_zh_f64(a.cos(), bands, &mut out)?;
     Ok(out.into_iter().map(|c| c as f32).collect())
@@ -65,17 +59,37 @@ pub fn rotate_zh(zh: &[f32], dir: Vec3) -> Result<Vec<f32>> {
     for (l, (kl, &g)) in k.iter_mut().zip(zh).enumerate() {
         *kl = zh_factor(l) * f64::from(g);
     }
-    let mut out = vec![0.0f32; num_coeffs(bands)];
-    recurrence(d, bands, |i, y| {
-        let l = (i as f64).sqrt() as usize;
-        out[i] = (k[l] * y) as f32;
-    });
-    Ok(out)
+    Ok(rotate_scaled(&k, d, bands))
 }
 
 /// SH vector of a unit-radiance cap of half-angle `a` around `dir` (eq. 14 then eq. 15).
 pub fn cap_sh(dir: Vec3, a: f32, bands: usize) -> Result<Vec<f32>> {
-    rotate_zh(&cap_zh(a, bands)?, dir)
+    let a = check_half_angle(a)?;
+    let d = unit_dir(dir)?;
+    check_bands(bands)?;
+    let mut k = [0.0f64; MAX_BANDS];
+    cap_zh_f64(a.cos(), bands, &mut k)?;
+    for (l, kl) in k.iter_mut().enumerate().take(bands) {
+        *kl *= zh_factor(l);
+    }
+    Ok(rotate_scaled(&k, d, bands))
+}
+
+/// `out_lm = k_l Y_lm(d)` for unit `d` (`k` already holds `sqrt(4π/(2l+1)) g_l`).
+fn rotate_scaled(k: &[f64], d: glam::DVec3, bands: usize) -> Vec<f32> {
+    let mut out = vec![0.0f32; num_coeffs(bands)];
+    recurrence(d, bands, |l, i, y| out[i] = (k[l] * y) as f32);
+    out
+}
+
+fn check_half_angle(a: f32) -> Result<f64> {
+    check_range(
+        "cap half-angle",
+        f64::from(a),
+        0.0,
+        std::f64::consts::PI + 1e-6,
+        "0 ≤ a ≤ π radians",
+    )
 }
 
 /// Half-angle subtended by a sphere of radius `radius` whose centre is at `distance`:
