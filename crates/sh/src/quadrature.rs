@@ -157,4 +157,21 @@ mod tests {
         assert!((q.integrate(|d| d.z * d.z) - 4.0 * std::f64::consts::PI / 3.0).abs() < 1e-12);
         assert!(q.integrate(|d| d.x * d.y).abs() < 1e-12);
     }
+
+    /// `z² = 1/3 + (2/3) P_2(z)`: projection has `f_00 = sqrt(4π)/3`,
+    /// `f_20 = (2/3) sqrt(4π/5)`, all else 0.
+    #[test]
+    fn projection_of_a_polynomial() {
+        let q = SphereQuadrature::for_degree(8);
+        let f = q.project_f64(4, |d| d.z * d.z).unwrap();
+        let pi4 = 4.0 * std::f64::consts::PI;
+        assert!((f[0] - pi4.sqrt() / 3.0).abs() < 1e-12);
+        assert!((f[6] - 2.0 / 3.0 * (pi4 / 5.0).sqrt()).abs() < 1e-12);
+        for (i, c) in f.iter().enumerate() {
+            if i != 0 && i != 6 {
+                assert!(c.abs() < 1e-12, "coefficient {i} = {c}");
+            }
+        }
+        assert!(q.project(0, |_| 1.0).is_err());
+    }
 }
