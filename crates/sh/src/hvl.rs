@@ -1,0 +1,197 @@
+//! Paper 003 (Harmonics Virtual Lights): geometric factor with the hemisphere-cap term
+//! (eq. 21–22) and the HVL radius heuristics r1 (eq. 23) and r2 (eq. 24–26).
+
+use glam::Vec3;
+
+use crate::basis::unit_dir;
+use crate::{Result, ShError, check_range};
+
+/// Smoothstep `S(x) = 3x² - 2x³` on `[0, 1]` (paper 003 eq. 22).
+#[inline]
+fn smoothstep(x: f64) -> f64 {
+    let x = x.clamp(0.0, 1.0);
+    x * x * (3.0 - 2.0 * x)
+}
+
+/// Paper 003 eq. 22: `H(n_x, ω_j)`, the fraction of an HVL (a cap of half-angle `a`) that lies in
+/// the receiver's hemisphere, from `cos_angle = n_x · ω_j` (`ω_j`: unit direction from the
+/// receiver to the HVL centre).
+///
+/// `H = S((ā - clamp(acos(n_x·ω_j), a̲, ā)) / 2a)` with `ā = π/2 + a`, `S` the smoothstep.
+/// **Deviation:** the text prints `a̲ = a - π/2`; with that the argument leaves `[0, 1]`.
+/// Oat and Sander's cap-intersection approximation (2007) that eq. 22 specialises needs the lower bound at
+/// full containment, `a̲ = π/2 - a` (then `ā - a̲ = 2a`), which we use. `a` is clamped to
+/// `[0, π/2]`; `a = 0` degenerates to the step `acos(n_x·ω_j) < π/2`.
+pub fn hemisphere_cap_fraction(cos_angle: f32, a: f32) -> f32 {
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    let a = f64::from(a).clamp(0.0, half_pi);
+    let theta = f64::from(cos_angle).clamp(-1.0, 1.0).acos();
+    if a <= 1e-9 {
+        return if theta < half_pi { 1.0 } else { 0.0 };
+    }
+    let upper = half_pi + a; // ā, eq. 22
+    let lower = half_pi - a; // a̲ (see deviation note)
+    smoothstep((upper - theta.clamp(lower, upper)) / (2.0 * a)) as f32
+}
+
+/// Paper 003 eq. 21: `G_j(-ω_j) = max(0, n_j · -ω_j) H(n_x, ω_j) / (π r_j²)`.
+///
+/// * `to_hvl`: direction from the receiver `x` to the HVL centre (`ω_j`, normalised here),
+/// * `hvl_normal`: `n_j`, `receiver_normal`: `n_x` (both normalised here),
+/// * `radius`: `r_j > 0`, `half_angle`: `a`, the half-angle the HVL subtends at `x`.
+pub fn geometric_factor(
+    to_hvl: Vec3,
+    hvl_normal: Vec3,
+    receiver_normal: Vec3,
+    radius: f32,
+    half_angle: f32,
+) -> Result<f32> {
+    let w = unit_dir(to_hvl)?;
+    let nj = unit_dir(hvl_normal)?;
+    let nx = unit_dir(receiver_normal)?;
+    let r = check_range("HVL radius", f64::from(radius), 1e-30, f64::MAX, "> 0")?;
+    let facing = (-nj.dot(w)).max(0.0);
+    let h = f64::from(hemisphere_cap_fraction(nx.dot(w) as f32, half_angle));
+    Ok((facing * h / (std::f64::consts::PI * r * r)) as f32)
+}
+
+/// A neighbour of an HVL for heuristic r1: its world position `p_n` and distance `d_n` to the
+/// primary light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HvlNeighbour {
+    /// World-space position `p_n`.
+    pub position: Vec3,
+    /// Distance `d_n` from the neighbour to its primary light.
+    pub light_distance: f32,
+}
+
+/// Paper 003 eq. 23: `r1 = Σ w_n ‖p - p_n‖ / Σ w_n`, `w_n = 1 / (|d - d_n| + ε)` over the
+/// (8-connected) neighbours in the HVL cache. The paper scales the result by a user constant
+/// `k` in [1, 2]; the caller applies it. `ε > 0`; no neighbours is an error.
+pub fn radius_r1(
+    position: Vec3,
+    light_distance: f32,
+    neighbours: &[HvlNeighbour],
+    epsilon: f32,
+) -> Result<f32> {
+    let eps = check_range("epsilon", f64::from(epsilon), 1e-30, f64::MAX, "> 0")?;
+    if neighbours.is_empty() {
+        return Err(ShError::OutOfRange {
+            name: "neighbour count",
+            value: 0.0,
+            expected: "at least one neighbour",
+        });
+    }
+    let (mut num, mut den) = (0.0f64, 0.0f64);
+    for n in neighbours {
+        let w = 1.0 / ((f64::from(light_distance) - f64::from(n.light_distance)).abs() + eps);
+        num += w * f64::from(position.distance(n.position));
+        den += w;
+    }
+    Ok((num / den) as f32)
+}
+
+/// Paper 003 eq. 24: `γ = sqrt(2) λ / sqrt(M)`, the angle between diagonal neighbours of a square
+/// RSM of field of view `λ` (radians) holding `M` HVLs.
+pub fn diagonal_angle(fov: f32, hvl_count: u32) -> Result<f32> {
+    let l = check_range(
+        "RSM field of view",
+        f64::from(fov),
+        0.0,
+        std::f64::consts::PI,
+        "0..=π radians",
+    )?;
+    if hvl_count == 0 {
+        return Err(ShError::OutOfRange {
+            name: "HVL count",
+            value: 0.0,
+            expected: "≥ 1",
+        });
+    }
+    Ok((std::f64::consts::SQRT_2 * l / f64::from(hvl_count).sqrt()) as f32)
+}
+
+/// Paper 003 eq. 25: `r2 = d tan(γ)` (exact form), `d`: distance HVL–primary light.
+pub fn radius_r2_exact(light_distance: f32, fov: f32, hvl_count: u32) -> Result<f32> {
+    let g = f64::from(diagonal_angle(fov, hvl_count)?);
+    Ok((f64::from(light_distance) * g.tan()) as f32)
+}
+
+/// Paper 003 eq. 26: `r2 ≈ d (γ + γ³/3)`, the Taylor form used on the GPU (error < 0.01 of
+/// `tan` for `γ ≲ 0.58`, i.e. `λ/√M ≲ 0.2`). The user scale `k` (1–2) is applied by the caller.
+pub fn radius_r2(light_distance: f32, fov: f32, hvl_count: u32) -> Result<f32> {
+    let g = f64::from(diagonal_angle(fov, hvl_count)?);
+    Ok((f64::from(light_distance) * (g + g * g * g / 3.0)) as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quadrature::SphereQuadrature;
+    use glam::DVec3;
+
+    /// Exact fraction of a cap (half-angle `a` around direction at angle `theta` from the normal)
+    /// that lies above the horizon, by quadrature over the cap.
+    fn exact_fraction(theta: f64, a: f64) -> f64 {
+        let axis = DVec3::new(theta.sin(), 0.0, theta.cos());
+        let q = SphereQuadrature::cap(axis, a.cos(), 200, 400);
+        let total = q.integrate(|_| 1.0);
+        q.integrate(|s| if s.z >= 0.0 { 1.0 } else { 0.0 }) / total
+    }
+
+    #[test]
+    fn cap_term_against_exact_overlap() {
+        let mut worst = 0.0f64;
+        for &a in &[0.05f64, 0.2, 0.5, 1.0] {
+            for i in 0..=30 {
+                let theta = std::f64::consts::PI * i as f64 / 30.0;
+                let h = f64::from(hemisphere_cap_fraction(theta.cos() as f32, a as f32));
+                let e = exact_fraction(theta, a);
+                worst = worst.max((h - e).abs());
+            }
+        }
+        // Oat's smoothstep is an approximation: measured worst 0.058 over these cases.
+        assert!(worst < 0.07, "worst {worst}");
+        assert_eq!(hemisphere_cap_fraction(1.0, 0.3), 1.0);
+        assert_eq!(hemisphere_cap_fraction(-1.0, 0.3), 0.0);
+        assert!((hemisphere_cap_fraction(0.0, 0.3) - 0.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn geometric_factor_cases() {
+        // HVL facing the receiver, above it.
+        let g = geometric_factor(Vec3::Z, -Vec3::Z, Vec3::Z, 0.5, 0.1).unwrap();
+        assert!((g - 1.0 / (std::f32::consts::PI * 0.25)).abs() < 1e-5);
+        // HVL turned away.
+        assert_eq!(
+            geometric_factor(Vec3::Z, Vec3::Z, Vec3::Z, 0.5, 0.1),
+            Ok(0.0)
+        );
+        assert!(geometric_factor(Vec3::Z, Vec3::Z, Vec3::Z, 0.0, 0.1).is_err());
+    }
+
+    #[test]
+    fn radius_heuristics() {
+        let n = [
+            HvlNeighbour {
+                position: Vec3::new(1.0, 0.0, 0.0),
+                light_distance: 2.0,
+            },
+            HvlNeighbour {
+                position: Vec3::new(0.0, 3.0, 0.0),
+                light_distance: 5.0,
+            },
+        ];
+        // weights 1/(0+1) and 1/(3+1): (1·1 + 0.25·3) / 1.25 = 1.4
+        assert!((radius_r1(Vec3::ZERO, 2.0, &n, 1.0).unwrap() - 1.4).abs() < 1e-6);
+        assert!(radius_r1(Vec3::ZERO, 2.0, &[], 1.0).is_err());
+        // Eq. 26 within 0.01 of eq. 25 where the paper says so (λ/√M ≤ 0.2).
+        let fov = std::f32::consts::FRAC_PI_2;
+        for m in [64u32, 400, 10_000] {
+            let exact = radius_r2_exact(1.0, fov, m).unwrap();
+            let approx = radius_r2(1.0, fov, m).unwrap();
+            assert!((exact - approx).abs() < 0.01, "M={m}: {exact} vs {approx}");
+        }
+        assert!(diagonal_angle(1.0, 0).is_err());
+    }
+}
