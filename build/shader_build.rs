@@ -195,6 +195,19 @@ pub fn build_all(root: &Path) -> Result<Output, ShaderError> {
             let mut includes = Includes::new(&include_dir);
             let shader = compile_one(path, &relative, &text, &variant, &mut includes)?;
             inputs.extend(includes.read);
+            if let Some(other) = shaders
+                .iter()
+                .find(|s: &&CompiledShader| s.ident == shader.ident)
+            {
+                return Err(ShaderError {
+                    file: path.clone(),
+                    line: None,
+                    message: format!(
+                        "`{}` and `{}` both become `shaders::{}`: rename one",
+                        shader.name, other.name, shader.ident
+                    ),
+                });
+            }
             shaders.push(shader);
         }
     }
@@ -269,10 +282,12 @@ fn variants(path: &Path, text: &str) -> Result<Vec<Variant>, ShaderError> {
     Ok(out)
 }
 
-/// Resolves `#include "x.glsl"` against shaders/include/ and remembers what it read.
+/// Resolves `#include "x.glsl"` against shaders/include/, remembers what it read and checks
+/// each include for constructs naga cannot read.
 struct Includes {
     dir: PathBuf,
     read: Vec<PathBuf>,
+    unreadable: Option<ShaderError>,
 }
 
 impl Includes {
@@ -280,6 +295,7 @@ impl Includes {
         Self {
             dir: dir.to_path_buf(),
             read: Vec::new(),
+            unreadable: None,
         }
     }
 }
@@ -294,6 +310,9 @@ impl glslang::include::IncludeHandler for Includes {
     ) -> Option<glslang::include::IncludeResult> {
         let path = self.dir.join(header_name);
         let data = std::fs::read_to_string(&path).ok()?;
+        if self.unreadable.is_none() {
+            self.unreadable = check_naga_subset(&path, &data).err();
+        }
         self.read.push(path);
         Some(glslang::include::IncludeResult {
             name: header_name.to_string(),
@@ -351,10 +370,13 @@ fn compile_one(
         Some(includes),
     )
     .map_err(|e| error(None, format!("glslang rejected the input: {e}")))?;
-    let spirv = compiler
+    let compiled = compiler
         .create_shader(input)
-        .and_then(|shader| shader.compile())
-        .map_err(|e| glslang_error(path, &includes_dir, &e))?;
+        .and_then(|shader| shader.compile());
+    if let Some(unreadable) = includes.unreadable.take() {
+        return Err(unreadable);
+    }
+    let spirv = compiled.map_err(|e| glslang_error(path, &includes_dir, &e))?;
 
     let module = naga::front::spv::parse_u8_slice(
         bytemuck_words(&spirv).as_slice(),

@@ -196,3 +196,29 @@ fn malformed_variant_line_is_located() {
     let message = error_of(&tree);
     assert!(message.contains("v.comp:2:"), "{message}");
 }
+
+#[test]
+fn unreadable_construct_in_an_include_names_the_include() {
+    let tree = Tree::new("include_subset");
+    tree.file(
+        "include/atomics.glsl",
+        "// shared helpers\nvoid bump(uint x) {\n    uint y = imageAtomicAdd(x);\n}\n",
+    )
+    .file(
+        "user.comp",
+        "#version 460\n#extension GL_GOOGLE_include_directive : require\n#include \"atomics.glsl\"\n\
+         layout(local_size_x = 1) in;\nvoid main() {}\n",
+    );
+    let message = error_of(&tree);
+    assert!(message.contains("atomics.glsl:3:"), "{message}");
+    assert!(message.contains("imageAtomic"), "{message}");
+}
+
+#[test]
+fn colliding_names_are_reported() {
+    let tree = Tree::new("collide");
+    let shader = "#version 460\nlayout(local_size_x = 1) in;\nvoid main() {}\n";
+    tree.file("a_b.comp", shader).file("a/b.comp", shader);
+    let message = error_of(&tree);
+    assert!(message.contains("A_B_COMP"), "{message}");
+}

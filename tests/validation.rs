@@ -180,3 +180,44 @@ fn destruction_waits_for_the_submission_that_may_use_the_object() {
     drop(dst);
     common::assert_clean(&device);
 }
+
+#[test]
+fn an_object_dropped_during_a_recording_outlives_other_submissions() {
+    let device = common::device();
+    let make = |name| {
+        Buffer::new(
+            &device,
+            &BufferDesc {
+                name,
+                size: 256,
+                usage: vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )
+        .expect("buffer")
+    };
+    let (src, dst) = (make("src"), make("dst"));
+    let mut frame = device.begin_commands().expect("frame recording");
+    let raw = device.raw().clone();
+    let cb = frame.raw();
+    let region = [vk::BufferCopy {
+        src_offset: 0,
+        dst_offset: 0,
+        size: 256,
+    }];
+    // SAFETY: both buffers are alive when recorded; `src` must survive until the frame runs.
+    unsafe { raw.cmd_copy_buffer(cb, src.raw(), dst.raw(), &region) };
+    drop(src);
+    // Another submission (an upload) goes first and completes.
+    device.upload_buffer(&dst, 0, &[7u8; 16]).expect("upload");
+    // `src` and the upload's staging buffer (dropped while the frame was open, so held too).
+    assert_eq!(
+        device.pending_destructions(),
+        2,
+        "still needed by the open recording"
+    );
+    device.submit(frame).expect("submit").wait().expect("wait");
+    assert_eq!(device.pending_destructions(), 0);
+    drop(dst);
+    common::assert_clean(&device);
+}

@@ -118,7 +118,8 @@ impl Device {
             Ok::<(), Error>(())
         })();
         if let Err(e) = prepared {
-            context.destroy(raw);
+            // Its previous submission has completed: keep it for the next attempt.
+            lock(&self.inner.tracker).free_contexts.push(context);
             return Err(e);
         }
         lock(&self.inner.tracker).recording += 1;
@@ -137,10 +138,10 @@ impl Device {
         };
         let raw = self.raw();
         let mut tracker = lock(&self.inner.tracker);
-        tracker.recording = tracker.recording.saturating_sub(1);
         // SAFETY: the command buffer is recording.
         if let Err(e) = unsafe { raw.end_command_buffer(context.cb) } {
             tracker.free_contexts.push(context);
+            tracker.recording_closed();
             return Err(Error::vk("ending a command buffer", e));
         }
         let cb_info = [vk::CommandBufferSubmitInfo::default().command_buffer(context.cb)];
@@ -152,6 +153,7 @@ impl Device {
         };
         if let Err(e) = result {
             // The fence never got a signal operation: wait for the queue before reuse.
+            tracker.recording_closed();
             drop(tracker);
             let _ = self.wait_idle();
             lock(&self.inner.tracker).free_contexts.push(context);
@@ -160,6 +162,7 @@ impl Device {
         tracker.submitted += 1;
         let serial = tracker.submitted;
         tracker.in_flight.push_back((serial, context.fence));
+        tracker.recording_closed();
         drop(tracker);
         Ok(Submission {
             device: self.clone(),
@@ -211,8 +214,9 @@ impl Commands {
     pub fn end_scope(&mut self) -> Result<()> {
         let device = self.device.clone();
         let context = self.context();
+        context.timestamps.end(context.cb)?;
         device.end_label(context.cb);
-        context.timestamps.end(context.cb)
+        Ok(())
     }
 
     /// Binds a compute pipeline and its resources (matched to reflected bindings by name).
@@ -337,8 +341,8 @@ impl Drop for Commands {
         // Abandoned without submitting: nothing of it reached the GPU.
         if let Some(context) = self.context.take() {
             let mut tracker = lock(&self.device.inner.tracker);
-            tracker.recording = tracker.recording.saturating_sub(1);
             tracker.free_contexts.push(context);
+            tracker.recording_closed();
         }
     }
 }
@@ -372,8 +376,17 @@ impl Submission {
             return Err(Error::vk("waiting for a submission", e));
         }
         let timings = context.timestamps.read();
-        self.device.retire()?;
-        lock(&self.device.inner.tracker).free_contexts.push(context);
+        // Retire first: it removes this submission's fence from the in-flight list (fences of
+        // one queue signal in submission order), so the context may be reused.
+        match self.device.retire() {
+            Ok(()) => lock(&self.device.inner.tracker).free_contexts.push(context),
+            Err(e) => {
+                lock(&self.device.inner.tracker)
+                    .orphaned
+                    .push((self.serial, context));
+                return Err(e);
+            }
+        }
         timings
     }
 }

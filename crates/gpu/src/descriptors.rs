@@ -151,7 +151,8 @@ impl DescriptorArena {
 
     fn allocate(&mut self, layout: vk::DescriptorSetLayout) -> Result<vk::DescriptorSet> {
         loop {
-            if self.current == self.pools.len() {
+            let fresh = self.current == self.pools.len();
+            if fresh {
                 let pool = self.new_pool()?;
                 self.pools.push(pool);
             }
@@ -166,10 +167,20 @@ impl DescriptorArena {
                         Error::InvalidUsage("the driver returned no descriptor set".into())
                     });
                 }
-                Err(vk::Result::ERROR_OUT_OF_POOL_MEMORY | vk::Result::ERROR_FRAGMENTED_POOL) => {
+                Err(vk::Result::ERROR_OUT_OF_POOL_MEMORY | vk::Result::ERROR_FRAGMENTED_POOL)
+                    if !fresh =>
+                {
                     self.current += 1;
                 }
-                Err(e) => return Err(Error::vk("allocating a descriptor set", e)),
+                Err(e) => {
+                    return Err(Error::vk(
+                        format!(
+                            "allocating a descriptor set (a pool holds {SETS_PER_POOL} sets and \
+                             {DESCRIPTORS_PER_TYPE} descriptors of each type)"
+                        ),
+                        e,
+                    ));
+                }
             }
         }
     }

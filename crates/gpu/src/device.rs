@@ -49,7 +49,8 @@ pub struct RawDevice {
     pub queue_family_index: u32,
     /// A queue shine may submit to. The host must not submit to it concurrently with shine.
     pub queue: vk::Queue,
-    /// Whether the host enabled VK_EXT_debug_utils on the instance (labels, names).
+    /// Whether the host enabled VK_EXT_debug_utils on the instance (labels, names). Must be
+    /// false unless it really is enabled: its functions are called when true.
     pub debug_utils: bool,
 }
 
@@ -190,10 +191,7 @@ impl Device {
             None
         };
         let owned = Owned { debug_instance };
-        let mut owned_guard = OwnedGuard {
-            instance: instance_ref.clone(),
-            owned: Some(owned),
-        };
+        let mut owned_guard = OwnedGuard { owned: Some(owned) };
 
         let adapters = list_adapters(instance_ref)?;
         let (adapter, physical) = choose(&adapters, desc.selector.as_deref())?;
@@ -328,6 +326,12 @@ impl Device {
         };
         let support = Support::query(&parts.instance, parts.physical);
         // SAFETY: the physical device belongs to the instance.
+        let families = unsafe {
+            parts
+                .instance
+                .get_physical_device_queue_family_properties(parts.physical)
+        };
+        // SAFETY: as above.
         let properties = unsafe {
             parts
                 .instance
@@ -365,7 +369,9 @@ impl Device {
                 vk::api_version_patch(properties.api_version)
             ),
             timestamp_period_ns: properties.limits.timestamp_period,
-            timestamp_valid_bits: support.timestamp_valid_bits,
+            timestamp_valid_bits: families
+                .get(parts.queue_family as usize)
+                .map_or(0, |f| f.timestamp_valid_bits),
             max_push_constants_size: properties.limits.max_push_constants_size,
             max_storage_buffer_range: properties.limits.max_storage_buffer_range,
             subgroup_size: subgroup.subgroup_size,
@@ -670,9 +676,8 @@ impl Drop for InstanceGuard {
     }
 }
 
-/// Destroys the messenger if device creation fails part-way.
+/// Destroys the messenger if device creation fails part-way (before the instance guard runs).
 struct OwnedGuard {
-    instance: ash::Instance,
     owned: Option<Owned>,
 }
 
@@ -682,8 +687,7 @@ impl Drop for OwnedGuard {
             debug_instance: Some((loader, messenger)),
         }) = self.owned.take()
         {
-            let _ = &self.instance;
-            // SAFETY: created by shine on this instance, which is still alive.
+            // SAFETY: created by shine on the instance, which outlives this guard.
             unsafe { loader.destroy_debug_utils_messenger(messenger, None) };
         }
     }
@@ -691,8 +695,19 @@ impl Drop for OwnedGuard {
 
 impl Drop for Inner {
     fn drop(&mut self) {
-        // SAFETY: waiting on our own device handle.
-        let _ = unsafe { self.raw.device_wait_idle() };
+        if self.owned.is_some() {
+            // SAFETY: shine owns the device and every queue on it.
+            let _ = unsafe { self.raw.device_wait_idle() };
+        } else {
+            // A host device: its other queues are not ours to synchronise; ours is enough,
+            // since shine submits only to it.
+            let queue = self
+                .queue
+                .get_mut()
+                .unwrap_or_else(std::sync::PoisonError::into_inner);
+            // SAFETY: the queue is externally synchronised through `&mut self`.
+            let _ = unsafe { self.raw.queue_wait_idle(*queue) };
+        }
         {
             let tracker = self
                 .tracker

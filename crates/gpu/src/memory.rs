@@ -86,14 +86,12 @@ impl Buffer {
         })
     }
 
-    /// Creates a buffer initialised with `data`, through a staging copy when it is not
-    /// host-visible.
+    /// Creates a buffer (at least `data.len()` bytes, with `TRANSFER_DST` added) initialised
+    /// with `data` through a staging copy.
     pub fn with_data(device: &Device, desc: &BufferDesc<'_>, data: &[u8]) -> Result<Self> {
         let mut desc = *desc;
         desc.size = desc.size.max(data.len() as u64);
-        if desc.location == MemoryLocation::GpuOnly {
-            desc.usage |= vk::BufferUsageFlags::TRANSFER_DST;
-        }
+        desc.usage |= vk::BufferUsageFlags::TRANSFER_DST;
         let buffer = Self::new(device, &desc)?;
         device.upload_buffer(&buffer, 0, data)?;
         Ok(buffer)

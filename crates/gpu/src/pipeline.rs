@@ -16,8 +16,9 @@ pub struct LayoutBinding {
     pub stages: vk::ShaderStageFlags,
 }
 
-/// The reflected layout shared by every pipeline kind.
+/// The reflected layout shared by every pipeline kind. Destroyed (deferred) when dropped.
 pub struct PipelineLayout {
+    device: Device,
     /// Name for messages (the shader names).
     pub name: String,
     /// Vulkan pipeline layout.
@@ -86,16 +87,19 @@ impl PipelineLayout {
         }
 
         let set_count = bindings.last().map_or(0, |b| b.desc.set + 1);
-        let raw_device = device.raw();
-        let mut set_layouts = Vec::with_capacity(set_count as usize);
-        let destroy_sets = |layouts: &[vk::DescriptorSetLayout]| {
-            for l in layouts {
-                // SAFETY: created just above, never used.
-                unsafe { raw_device.destroy_descriptor_set_layout(*l, None) };
-            }
+        // Built empty first so that Drop cleans up whatever an error leaves behind.
+        let mut layout = Self {
+            device: device.clone(),
+            name,
+            raw: vk::PipelineLayout::null(),
+            set_layouts: Vec::with_capacity(set_count as usize),
+            bindings,
+            push_constants: (push_size, push_stages),
         };
+        let raw_device = device.raw();
         for set in 0..set_count {
-            let vk_bindings: Vec<_> = bindings
+            let vk_bindings: Vec<_> = layout
+                .bindings
                 .iter()
                 .filter(|b| b.desc.set == set)
                 .map(|b| {
@@ -108,13 +112,9 @@ impl PipelineLayout {
                 .collect();
             let info = vk::DescriptorSetLayoutCreateInfo::default().bindings(&vk_bindings);
             // SAFETY: valid create info on a live device.
-            match unsafe { raw_device.create_descriptor_set_layout(&info, None) } {
-                Ok(l) => set_layouts.push(l),
-                Err(e) => {
-                    destroy_sets(&set_layouts);
-                    return Err(Error::vk(format!("creating set layouts of `{name}`"), e));
-                }
-            }
+            let set_layout = unsafe { raw_device.create_descriptor_set_layout(&info, None) }
+                .ctx(&format!("creating set layouts of `{}`", layout.name))?;
+            layout.set_layouts.push(set_layout);
         }
         let ranges = [vk::PushConstantRange {
             stage_flags: push_stages,
@@ -122,23 +122,21 @@ impl PipelineLayout {
             size: push_size,
         }];
         let info = vk::PipelineLayoutCreateInfo::default()
-            .set_layouts(&set_layouts)
+            .set_layouts(&layout.set_layouts)
             .push_constant_ranges(if push_size > 0 { &ranges } else { &[] });
         // SAFETY: valid create info on a live device.
-        let raw = match unsafe { raw_device.create_pipeline_layout(&info, None) } {
-            Ok(l) => l,
-            Err(e) => {
-                destroy_sets(&set_layouts);
-                return Err(Error::vk(format!("creating the layout of `{name}`"), e));
-            }
-        };
-        Ok(Self {
-            name,
-            raw,
-            set_layouts,
-            bindings,
-            push_constants: (push_size, push_stages),
-        })
+        layout.raw = unsafe { raw_device.create_pipeline_layout(&info, None) }
+            .ctx(&format!("creating the layout of `{}`", layout.name))?;
+        Ok(layout)
+    }
+}
+
+impl Drop for PipelineLayout {
+    fn drop(&mut self) {
+        self.device.defer(Garbage::PipelineLayout(
+            self.raw,
+            std::mem::take(&mut self.set_layouts),
+        ));
     }
 }
 
@@ -200,11 +198,6 @@ impl ComputePipeline {
         let raw = match result {
             Ok(p) => p.first().copied().unwrap_or_default(),
             Err((_, e)) => {
-                device.defer(Garbage::Pipeline(
-                    vk::Pipeline::null(),
-                    layout.raw,
-                    layout.set_layouts.clone(),
-                ));
                 return Err(Error::vk(
                     format!("creating compute pipeline `{}`", shader.name),
                     e,
@@ -238,11 +231,7 @@ impl ComputePipeline {
 
 impl Drop for ComputePipeline {
     fn drop(&mut self) {
-        self.device.defer(Garbage::Pipeline(
-            self.raw,
-            self.layout.raw,
-            std::mem::take(&mut self.layout.set_layouts),
-        ));
+        self.device.defer(Garbage::Pipeline(self.raw));
     }
 }
 
@@ -470,11 +459,6 @@ impl GraphicsPipeline {
         let raw = match result {
             Ok(p) => p.first().copied().unwrap_or_default(),
             Err((_, e)) => {
-                device.defer(Garbage::Pipeline(
-                    vk::Pipeline::null(),
-                    layout.raw,
-                    layout.set_layouts.clone(),
-                ));
                 return Err(Error::vk(format!("creating graphics pipeline `{name}`"), e));
             }
         };
@@ -499,10 +483,6 @@ impl GraphicsPipeline {
 
 impl Drop for GraphicsPipeline {
     fn drop(&mut self) {
-        self.device.defer(Garbage::Pipeline(
-            self.raw,
-            self.layout.raw,
-            std::mem::take(&mut self.layout.set_layouts),
-        ));
+        self.device.defer(Garbage::Pipeline(self.raw));
     }
 }

@@ -1,9 +1,14 @@
 //! Deferred destruction: a dropped resource is destroyed only once every submission that was
 //! recorded before the drop has completed on the GPU.
 //!
-//! Each submission gets a serial. A dropped object is tagged with the newest serial handed out;
-//! [`Device::retire`] polls the fences of submissions in flight, advances the completed serial
-//! and destroys what is old enough.
+//! Each submission gets a serial. A dropped object is tagged with the newest serial handed out
+//! (or, while a command buffer is being recorded, held until every open recording has been
+//! submitted or abandoned); [`Device::retire`] polls the fences of submissions in flight,
+//! advances the completed serial and destroys what is old enough.
+//!
+//! Only submissions made through [`Device::submit`] are known here. A host that records shine
+//! work into its own command buffers must keep shine objects alive until that work completes
+//! (the render graph's executor does this for its own resources).
 
 use crate::commands::Context;
 use crate::device::{Device, lock};
@@ -17,11 +22,8 @@ pub(crate) enum Garbage {
     Buffer(vk::Buffer, Option<Allocation>),
     Image(vk::Image, vk::ImageView, Option<Allocation>),
     Memory(Allocation),
-    Pipeline(
-        vk::Pipeline,
-        vk::PipelineLayout,
-        Vec<vk::DescriptorSetLayout>,
-    ),
+    Pipeline(vk::Pipeline),
+    PipelineLayout(vk::PipelineLayout, Vec<vk::DescriptorSetLayout>),
     Sampler(vk::Sampler),
 }
 
@@ -47,8 +49,8 @@ impl Garbage {
             Self::Memory(a) => {
                 let _ = allocator.free(a);
             }
-            Self::Pipeline(pipeline, layout, set_layouts) => unsafe {
-                device.destroy_pipeline(pipeline, None);
+            Self::Pipeline(pipeline) => unsafe { device.destroy_pipeline(pipeline, None) },
+            Self::PipelineLayout(layout, set_layouts) => unsafe {
                 device.destroy_pipeline_layout(layout, None);
                 for l in set_layouts {
                     device.destroy_descriptor_set_layout(l, None);
@@ -69,6 +71,8 @@ pub(crate) struct Tracker {
     /// Fences of submissions not yet seen complete, oldest first.
     pub in_flight: VecDeque<(u64, vk::Fence)>,
     garbage: Vec<(u64, Garbage)>,
+    /// Dropped while a recording was open: stamped with a serial once none is.
+    held: Vec<Garbage>,
     /// Contexts ready for reuse.
     pub free_contexts: Vec<Context>,
     /// Contexts of submissions dropped without waiting, with their serial.
@@ -78,9 +82,28 @@ pub(crate) struct Tracker {
 }
 
 impl Tracker {
+    /// A recording was submitted (`submitted` already counts it) or abandoned. Once no
+    /// recording is open, everything dropped meanwhile can only be used by submissions up to
+    /// the newest one.
+    pub(crate) fn recording_closed(&mut self) {
+        self.recording = self.recording.saturating_sub(1);
+        if self.recording == 0 {
+            let serial = self.submitted;
+            let held = std::mem::take(&mut self.held);
+            self.garbage.extend(held.into_iter().map(|g| (serial, g)));
+        }
+    }
+}
+
+impl Tracker {
     /// Destroys everything; the device must be idle.
     pub(crate) fn destroy_all(&mut self, device: &ash::Device, allocator: &mut Allocator) {
-        for (_, g) in self.garbage.drain(..) {
+        let garbage = self
+            .garbage
+            .drain(..)
+            .map(|(_, g)| g)
+            .chain(self.held.drain(..));
+        for g in garbage {
             g.destroy(device, allocator);
         }
         let contexts = self
@@ -97,19 +120,22 @@ impl Device {
     /// Hands an object over for destruction once the GPU can no longer be using it.
     pub(crate) fn defer(&self, garbage: Garbage) {
         let mut tracker = lock(&self.inner.tracker);
-        if tracker.completed == tracker.submitted && tracker.recording == 0 {
+        if tracker.recording > 0 {
+            // An open recording may use it; its serial is known only once it is submitted.
+            tracker.held.push(garbage);
+        } else if tracker.completed == tracker.submitted {
             drop(tracker);
             garbage.destroy(&self.inner.raw, &mut self.allocator());
         } else {
-            // A command buffer still being recorded will be submitted with the next serial.
-            let serial = tracker.submitted + u64::from(tracker.recording > 0);
+            let serial = tracker.submitted;
             tracker.garbage.push((serial, garbage));
         }
     }
 
     /// Objects dropped but not yet destroyed because the GPU may still use them.
     pub fn pending_destructions(&self) -> usize {
-        lock(&self.inner.tracker).garbage.len()
+        let tracker = lock(&self.inner.tracker);
+        tracker.garbage.len() + tracker.held.len()
     }
 
     /// Polls submissions in flight and destroys or recycles what they no longer use.

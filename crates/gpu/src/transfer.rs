@@ -6,6 +6,28 @@ use crate::error::{Error, Result};
 use crate::memory::{Buffer, BufferDesc, Image, MemoryLocation, format_texel_size};
 use ash::vk;
 
+/// Any earlier or later GPU access: transfers here are rare and synchronous, so they fence
+/// themselves off from everything.
+const ANY_ACCESS: (vk::PipelineStageFlags2, vk::AccessFlags2) = (
+    vk::PipelineStageFlags2::ALL_COMMANDS,
+    vk::AccessFlags2::from_raw(
+        vk::AccessFlags2::MEMORY_READ.as_raw() | vk::AccessFlags2::MEMORY_WRITE.as_raw(),
+    ),
+);
+/// The copy's write.
+const COPY_WRITE: (vk::PipelineStageFlags2, vk::AccessFlags2) = (
+    vk::PipelineStageFlags2::COPY,
+    vk::AccessFlags2::TRANSFER_WRITE,
+);
+/// The copy's read.
+const COPY_READ: (vk::PipelineStageFlags2, vk::AccessFlags2) = (
+    vk::PipelineStageFlags2::COPY,
+    vk::AccessFlags2::TRANSFER_READ,
+);
+/// The host reading a readback.
+const HOST_READ: (vk::PipelineStageFlags2, vk::AccessFlags2) =
+    (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ);
+
 impl Device {
     fn staging(
         &self,
@@ -29,8 +51,8 @@ impl Device {
     /// needs `TRANSFER_DST`); host-visible buffers can also be written through
     /// [`Buffer::mapped_mut`].
     pub fn upload_buffer(&self, buffer: &Buffer, offset: u64, data: &[u8]) -> Result<()> {
-        let end = offset + data.len() as u64;
-        if end > buffer.size() {
+        let end = offset.checked_add(data.len() as u64);
+        if end.is_none_or(|end| end > buffer.size()) {
             return Err(Error::InvalidUsage(format!(
                 "upload of {} bytes at {offset} overflows `{}` ({} bytes)",
                 data.len(),
@@ -57,10 +79,12 @@ impl Device {
             size: data.len() as u64,
         }];
         self.run_once(|cmd| {
+            cmd.memory_barrier(ANY_ACCESS, COPY_WRITE);
             let raw = cmd.device().raw().clone();
             let cb = cmd.raw();
             // SAFETY: both buffers are alive and the region lies inside both.
             unsafe { raw.cmd_copy_buffer(cb, staging.raw(), buffer.raw(), &region) };
+            cmd.memory_barrier(COPY_WRITE, ANY_ACCESS);
             Ok(())
         })?;
         Ok(())
@@ -80,27 +104,12 @@ impl Device {
             size: buffer.size(),
         }];
         self.run_once(|cmd| {
-            cmd.memory_barrier(
-                (
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    vk::AccessFlags2::MEMORY_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_READ,
-                ),
-            );
+            cmd.memory_barrier(ANY_ACCESS, COPY_READ);
             let raw = cmd.device().raw().clone();
             let cb = cmd.raw();
             // SAFETY: both buffers are alive and the region lies inside both.
             unsafe { raw.cmd_copy_buffer(cb, buffer.raw(), staging.raw(), &region) };
-            cmd.memory_barrier(
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            cmd.memory_barrier(COPY_WRITE, HOST_READ);
             Ok(())
         })?;
         staging
@@ -144,11 +153,8 @@ impl Device {
                     vk::ImageLayout::UNDEFINED,
                     vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 ),
-                (vk::PipelineStageFlags2::NONE, vk::AccessFlags2::NONE),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
+                ANY_ACCESS,
+                COPY_WRITE,
             );
             let region = [copy_region(image)];
             let raw = cmd.device().raw().clone();
@@ -167,14 +173,8 @@ impl Device {
                 image.raw(),
                 range,
                 (vk::ImageLayout::TRANSFER_DST_OPTIMAL, final_layout),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    vk::AccessFlags2::MEMORY_READ,
-                ),
+                COPY_WRITE,
+                ANY_ACCESS,
             );
             Ok(())
         })?;
@@ -197,14 +197,8 @@ impl Device {
                 image.raw(),
                 range,
                 (layout, vk::ImageLayout::TRANSFER_SRC_OPTIMAL),
-                (
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    vk::AccessFlags2::MEMORY_WRITE,
-                ),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_READ,
-                ),
+                ANY_ACCESS,
+                COPY_READ,
             );
             let region = [copy_region(image)];
             let raw = cmd.device().raw().clone();
@@ -228,22 +222,10 @@ impl Device {
                 image.raw(),
                 range,
                 (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, back),
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_READ,
-                ),
-                (
-                    vk::PipelineStageFlags2::ALL_COMMANDS,
-                    vk::AccessFlags2::MEMORY_READ,
-                ),
+                COPY_READ,
+                ANY_ACCESS,
             );
-            cmd.memory_barrier(
-                (
-                    vk::PipelineStageFlags2::COPY,
-                    vk::AccessFlags2::TRANSFER_WRITE,
-                ),
-                (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ),
-            );
+            cmd.memory_barrier(COPY_WRITE, HOST_READ);
             Ok(())
         })?;
         staging

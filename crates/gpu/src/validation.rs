@@ -127,6 +127,14 @@ pub(crate) unsafe extern "system" fn callback(
         }
         // SAFETY: user_data is the MessageLog owned by the device, alive while the messenger is.
         let log = unsafe { &*(user_data as *const MessageLog) };
+        let problem = severity.intersects(
+            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
+                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
+        );
+        if !problem {
+            log.record(severity, String::new());
+            return;
+        }
         let text = if data.is_null() {
             String::from("(no message data)")
         } else {
@@ -141,12 +149,7 @@ pub(crate) unsafe extern "system" fn callback(
                     .into_owned()
             }
         };
-        if severity.intersects(
-            vk::DebugUtilsMessageSeverityFlagsEXT::ERROR
-                | vk::DebugUtilsMessageSeverityFlagsEXT::WARNING,
-        ) {
-            eprintln!("[vulkan {severity:?} {kind:?}] {text}");
-        }
+        eprintln!("[vulkan {severity:?} {kind:?}] {text}");
         log.record(severity, text);
     });
     vk::FALSE
