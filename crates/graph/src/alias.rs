@@ -105,9 +105,10 @@ pub struct MemoryPlan {
 }
 
 impl MemoryPlan {
-    /// Bytes aliasing saves: requested minus allocated.
+    /// Bytes aliasing saves: requested minus allocated, or 0 when alignment padding makes the
+    /// heaps larger than the sum of their residents.
     pub fn saved_bytes(&self) -> u64 {
-        self.requested_bytes - self.allocated_bytes
+        self.requested_bytes.saturating_sub(self.allocated_bytes)
     }
 
     /// The placement of a resource, if it is an allocated transient.

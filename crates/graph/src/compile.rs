@@ -452,14 +452,26 @@ pub(crate) fn compile(
                 ResourceKind::Imported
             }
             Lifetime::Temporal(key) => {
-                temporal_end.push((
-                    key.clone(),
-                    TemporalState {
-                        desc: decl.desc,
-                        usage: usage[i],
-                        track: end.next_frame(),
-                    },
-                ));
+                // A temporal no declared pass touches has no usage and is not created; what is
+                // kept under its key stays as it was.
+                if usage[i] != 0 {
+                    let before = temporal
+                        .get(key, &decl.desc, usage[i])
+                        .is_some_and(|s| s.written);
+                    let now = merged
+                        .iter()
+                        .flat_map(|(_, rs)| rs)
+                        .any(|r| r.resource == id && r.info.is_write());
+                    temporal_end.push((
+                        key.clone(),
+                        TemporalState {
+                            desc: decl.desc,
+                            usage: usage[i],
+                            track: end.next_frame(),
+                            written: before || now,
+                        },
+                    ));
+                }
                 ResourceKind::Temporal(key.clone())
             }
         };

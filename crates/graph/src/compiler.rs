@@ -10,7 +10,7 @@ use crate::graph::{RenderGraph, ResourceDecl};
 use crate::handle::ResourceId;
 use crate::pass::PassDecl;
 use crate::plan::Plan;
-use crate::resource::Lifetime;
+use crate::resource::{AnyDesc, Lifetime};
 use crate::temporal::{TemporalState, TemporalStore};
 
 /// Everything a plan depends on; two graphs with equal shapes get the same plan.
@@ -88,9 +88,14 @@ impl Compiler {
         self.temporal.commit(&plan.temporal_end);
     }
 
-    /// Whether a temporal resource under `key` holds contents from an earlier frame.
-    pub fn has_history(&self, key: &str) -> bool {
-        self.temporal.contains(key)
+    /// Whether the temporal resource under `key`, described by `desc`, holds contents that a
+    /// pass of an earlier executed frame wrote. False before its first write (a periodic writer
+    /// that has not run yet), and after a change of description (a resize), which recreates it
+    /// with undefined contents. A change of usage flags (different passes declared on it) also
+    /// recreates it; its first frame then reads undefined contents, so keep the passes declared
+    /// on a temporal resource the same from frame to frame.
+    pub fn has_history(&self, key: &str, desc: impl Into<AnyDesc>) -> bool {
+        self.temporal.written(key, &desc.into())
     }
 
     /// How many graphs were compiled rather than taken from the cache.

@@ -61,18 +61,7 @@ impl ImageDesc {
 
     /// The aspects of the format: depth and/or stencil for depth formats, colour otherwise.
     pub fn aspect(&self) -> vk::ImageAspectFlags {
-        match self.format {
-            vk::Format::D16_UNORM | vk::Format::D32_SFLOAT | vk::Format::X8_D24_UNORM_PACK32 => {
-                vk::ImageAspectFlags::DEPTH
-            }
-            vk::Format::S8_UINT => vk::ImageAspectFlags::STENCIL,
-            vk::Format::D16_UNORM_S8_UINT
-            | vk::Format::D24_UNORM_S8_UINT
-            | vk::Format::D32_SFLOAT_S8_UINT => {
-                vk::ImageAspectFlags::DEPTH | vk::ImageAspectFlags::STENCIL
-            }
-            _ => vk::ImageAspectFlags::COLOR,
-        }
+        shine_gpu::format_aspect(self.format)
     }
 
     /// The whole image as a subresource range (every mip and layer of every aspect).
@@ -127,6 +116,18 @@ pub enum AnyDesc {
     Image(ImageDesc),
     /// A buffer.
     Buffer(BufferDesc),
+}
+
+impl From<ImageDesc> for AnyDesc {
+    fn from(desc: ImageDesc) -> Self {
+        AnyDesc::Image(desc)
+    }
+}
+
+impl From<BufferDesc> for AnyDesc {
+    fn from(desc: BufferDesc) -> Self {
+        AnyDesc::Buffer(desc)
+    }
 }
 
 impl AnyDesc {

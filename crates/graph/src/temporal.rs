@@ -14,6 +14,9 @@ pub(crate) struct TemporalState {
     pub usage: u32,
     /// Its synchronization state at the end of the last frame that used it.
     pub track: Track,
+    /// Whether a pass that ran has written it since it was (re)created: its contents are
+    /// defined.
+    pub written: bool,
 }
 
 /// Temporal states by key.
@@ -35,9 +38,12 @@ impl TemporalStore {
         self.states.get(key)
     }
 
-    /// Whether anything is kept under `key`.
-    pub fn contains(&self, key: &str) -> bool {
-        self.states.contains_key(key)
+    /// Whether the resource under `key`, described by `desc`, holds contents written by an
+    /// earlier frame.
+    pub fn written(&self, key: &str, desc: &AnyDesc) -> bool {
+        self.states
+            .get(key)
+            .is_some_and(|s| s.desc == *desc && s.written)
     }
 
     /// Remember the end-of-frame states.

@@ -164,7 +164,7 @@ fn history_pairs_carry_layouts_and_hazards_across_frames() {
         compiler.finish_frame(&plan);
         plans.push((plan, h));
     }
-    assert!(compiler.has_history("sum#0") && compiler.has_history("sum#1"));
+    assert!(compiler.has_history("sum#0", image()) && compiler.has_history("sum#1", image()));
     // Frame 0: both halves are fresh.
     let (plan, h) = &plans[0];
     assert_eq!(
@@ -272,6 +272,117 @@ fn a_periodic_pass_is_skipped_and_its_output_persists() {
             (S::COMPUTE_SHADER, A::NONE),
             (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
             (L::SHADER_READ_ONLY_OPTIMAL, L::GENERAL),
+        )]
+    );
+}
+
+#[test]
+fn alignment_padding_saves_nothing_and_dumps_fine() {
+    // Two 100-byte buffers alive together at 256-byte alignment: the heap (356 bytes) is larger
+    // than the 200 bytes requested.
+    let mut rg = RenderGraph::new(0);
+    let mut a = rg.create_buffer("a", BufferDesc::new(100));
+    let mut b = rg.create_buffer("b", BufferDesc::new(100));
+    let mut out = output_buffer(&mut rg, "out");
+    rg.pass("fill", PassKind::Compute)
+        .write(&mut a, BufferAccess::StorageWriteCompute)
+        .write(&mut b, BufferAccess::StorageWriteCompute);
+    rg.pass("use", PassKind::Compute)
+        .read(&a, BufferAccess::StorageReadCompute)
+        .read(&b, BufferAccess::StorageReadCompute)
+        .write(&mut out, BufferAccess::StorageWriteCompute);
+    let plan = compile(&rg).unwrap();
+    assert_no_live_overlap(&plan);
+    assert_eq!(plan.memory.requested_bytes, 200);
+    assert_eq!(plan.memory.allocated_bytes, 356);
+    assert_eq!(plan.memory.saved_bytes(), 0);
+    let dump = plan.dump();
+    assert!(dump.json.contains("\"saved_bytes\": 0"), "{}", dump.json);
+}
+
+/// One frame of a cache that a pass writes every other frame (on odd frames) at `size`×`size`,
+/// and that a second pass reads every frame.
+fn periodic_cache(frame: u64, size: u32) -> RenderGraph {
+    let mut rg = RenderGraph::new(frame);
+    let desc = ImageDesc::new_2d(vk::Format::R8G8B8A8_UNORM, size, size);
+    let mut cache = rg.temporal_image("cache", desc);
+    let mut out = output_buffer(&mut rg, "out");
+    rg.pass("gi", PassKind::Compute)
+        .write(&mut cache, ImageAccess::StorageWriteCompute)
+        .run_every(2, 1);
+    rg.pass("shade", PassKind::Compute)
+        .read(&cache, ImageAccess::SampledCompute)
+        .write(&mut out, BufferAccess::StorageWriteCompute);
+    rg
+}
+
+#[test]
+fn history_exists_only_once_written_with_the_same_description() {
+    let small = ImageDesc::new_2d(vk::Format::R8G8B8A8_UNORM, 32, 32);
+    let mut compiler = Compiler::new();
+    let run = |compiler: &mut Compiler, frame: u64, size: u32| {
+        let plan = compiler
+            .compile(&periodic_cache(frame, size), &FakeMemory)
+            .unwrap();
+        compiler.finish_frame(&plan);
+    };
+    // Frame 0: the writer does not run yet; the cache exists but holds nothing.
+    run(&mut compiler, 0, 64);
+    assert!(!compiler.has_history("cache", image()));
+    // Frame 1: written.
+    run(&mut compiler, 1, 64);
+    assert!(compiler.has_history("cache", image()));
+    assert!(!compiler.has_history("cache", small));
+    assert!(!compiler.has_history("other", image()));
+    // Frame 2: the writer skips; the contents persist.
+    run(&mut compiler, 2, 64);
+    assert!(compiler.has_history("cache", image()));
+    // Frame 4: resized on a frame its writer skips: recreated, undefined again.
+    run(&mut compiler, 4, 32);
+    assert!(!compiler.has_history("cache", small));
+    assert!(!compiler.has_history("cache", image()));
+    // Frame 5: written at the new size.
+    run(&mut compiler, 5, 32);
+    assert!(compiler.has_history("cache", small));
+}
+
+#[test]
+fn a_temporal_no_pass_touches_keeps_its_history() {
+    let graph = |frame, touch: bool| {
+        let mut rg = RenderGraph::new(frame);
+        let mut cache = rg.temporal_image("cache", image());
+        let mut out = output_buffer(&mut rg, "out");
+        if touch {
+            rg.pass("gi", PassKind::Compute)
+                .write(&mut cache, ImageAccess::StorageWriteCompute);
+        }
+        rg.pass("shade", PassKind::Compute)
+            .write(&mut out, BufferAccess::StorageWriteCompute);
+        (rg, cache)
+    };
+    let mut compiler = Compiler::new();
+    let (rg, _) = graph(0, true);
+    let written = compiler.compile(&rg, &FakeMemory).unwrap();
+    compiler.finish_frame(&written);
+    let (rg, cache) = graph(1, false);
+    let idle = compiler.compile(&rg, &FakeMemory).unwrap();
+    compiler.finish_frame(&idle);
+    // Declared but untouched: no usage (the executor creates nothing for it), and what frame 0
+    // wrote is still the history.
+    let r = idle.resource(cache.id()).unwrap();
+    assert_eq!(r.usage, Usage::Image(vk::ImageUsageFlags::empty()));
+    assert!(!r.used);
+    assert!(compiler.has_history("cache", image()));
+    let (rg, cache) = graph(2, true);
+    let again = compiler.compile(&rg, &FakeMemory).unwrap();
+    // Frame 2 continues from frame 0's state: GENERAL, waiting for its write.
+    assert_eq!(
+        again.barriers_before("gi"),
+        [barrier(
+            cache.id(),
+            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+            (S::COMPUTE_SHADER, A::SHADER_STORAGE_WRITE),
+            (L::GENERAL, L::GENERAL),
         )]
     );
 }
