@@ -68,11 +68,14 @@ impl bevy_mikktspace::Geometry for MikkInput<'_> {
             .to_array()
     }
     fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-        self.uvs
+        // glTF's v runs down the image while its normal maps have +Y up the image, so the
+        // bitangent must follow -v: MikkTSpace sees v flipped.
+        let uv = self
+            .uvs
             .get(self.vertex(face, vert))
             .copied()
-            .unwrap_or_default()
-            .to_array()
+            .unwrap_or_default();
+        [uv.x, 1.0 - uv.y]
     }
     fn set_tangent(
         &mut self,
@@ -98,7 +101,8 @@ pub(crate) struct VertexData {
     pub(crate) indices: Vec<u32>,
 }
 
-/// MikkTSpace tangents. MikkTSpace works per triangle corner; where the corners sharing a
+/// MikkTSpace tangents in glTF's convention (bitangent = cross(normal, tangent) * w points
+/// up the image, i.e. towards decreasing v). MikkTSpace works per triangle corner; where the corners sharing a
 /// vertex disagree (UV seams, mirrored UVs) the vertex is duplicated so every corner keeps
 /// its own tangent. Corners MikkTSpace leaves undefined (degenerate triangles) get a tangent
 /// perpendicular to the normal.
