@@ -66,15 +66,21 @@ pub fn load(path: impl AsRef<Path>) -> Result<Scene> {
 /// Loads glTF JSON or GLB bytes. `base_dir` resolves relative URIs (`None`: only embedded
 /// and data-URI resources are allowed); `name` names the data in messages.
 pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<Scene> {
-    let gltf = gltf::Gltf::from_slice(bytes).map_err(|source| Error::Gltf {
+    let gltf_error = |source| Error::Gltf {
         file: name.to_string(),
         source,
-    })?;
+    };
+    let parsed = gltf::Gltf::from_slice_without_validation(bytes).map_err(gltf_error)?;
     let mut ctx = Ctx {
         file: name,
         warnings: Vec::new(),
     };
-    let doc = &gltf.document;
+    // gltf-json 1.4's validation indexes `accessors` by a primitive's POSITION index without a
+    // bounds check (a panic on bad input), so attribute references are checked here first.
+    check_attribute_accessors(&ctx, parsed.document.as_json())?;
+    let document = gltf::Document::from_json(parsed.document.into_json()).map_err(gltf_error)?;
+    let blob = parsed.blob;
+    let doc = &document;
 
     for ext in doc.extensions_required() {
         if !SUPPORTED_EXTENSIONS.contains(&ext) {
@@ -96,8 +102,9 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
             );
         }
     }
-    let buffers = load_buffers(&ctx, doc, gltf.blob.as_deref(), base_dir)?;
+    let buffers = load_buffers(&ctx, doc, blob.as_deref(), base_dir)?;
     let mut textures = TextureLoader {
+        root: doc.as_json(),
         base_dir,
         images: HashMap::new(),
         textures: Vec::new(),
@@ -180,6 +187,44 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
     Ok(scene)
 }
 
+fn check_attribute_accessors(ctx: &Ctx, root: &gltf::json::Root) -> Result<()> {
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    let semantic = match semantic {
+                        Checked::Valid(s) => semantic_name(s),
+                        Checked::Invalid => "(invalid semantic)".to_string(),
+                    };
+                    return Err(ctx.invalid(
+                        format!("meshes[{m}].primitives[{p}].attributes.{semantic}"),
+                        format!(
+                            "accessor {} does not exist ({} accessors)",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The glTF spelling of an attribute semantic (`POSITION`, `TEXCOORD_0`, ...).
+fn semantic_name(s: &gltf::Semantic) -> String {
+    match s {
+        gltf::Semantic::Positions => "POSITION".to_string(),
+        gltf::Semantic::Normals => "NORMAL".to_string(),
+        gltf::Semantic::Tangents => "TANGENT".to_string(),
+        gltf::Semantic::Colors(i) => format!("COLOR_{i}"),
+        gltf::Semantic::TexCoords(i) => format!("TEXCOORD_{i}"),
+        gltf::Semantic::Joints(i) => format!("JOINTS_{i}"),
+        gltf::Semantic::Weights(i) => format!("WEIGHTS_{i}"),
+        gltf::Semantic::Extras(name) => format!("_{name}"),
+    }
+}
+
 /// Loading context: the file name for messages and the warnings so far.
 struct Ctx<'a> {
     file: &'a str,
@@ -237,6 +282,7 @@ fn load_buffers(
 
 /// Decodes images on first use and makes one [`Texture`] per (image, colour space).
 struct TextureLoader<'a> {
+    root: &'a gltf::json::Root,
     base_dir: Option<&'a Path>,
     /// Decoded RGBA8 per image index (`None`: failed, already warned).
     images: HashMap<usize, Option<Texture>>,
@@ -282,40 +328,42 @@ impl TextureLoader<'_> {
 
     /// The image decoded to RGBA8 (`srgb` is set per use by the caller).
     fn decode(&self, buffers: &Buffers, image: &gltf::image::Image<'_>) -> Result<Texture, String> {
-        let (bytes, name) = match image.source() {
-            gltf::image::Source::View { view, .. } => {
+        // From the JSON: gltf 1.4's `Image::source` unwraps a missing mimeType or uri.
+        let index = image.index();
+        let json = self.root;
+        let def = json.images.get(index).ok_or("the image does not exist")?;
+        let default_name = || def.name.clone().unwrap_or_else(|| format!("image{index}"));
+        let (bytes, name) = match (&def.buffer_view, &def.uri) {
+            (Some(view), _) => {
+                let v = json
+                    .buffer_views
+                    .get(view.value())
+                    .ok_or("its bufferView does not exist")?;
                 let buffer = buffers
                     .data
-                    .get(view.buffer().index())
+                    .get(v.buffer.value())
                     .ok_or("its buffer is missing")?;
-                let end = view
-                    .offset()
-                    .checked_add(view.length())
+                let start = v.byte_offset.map_or(0, |o| o.0 as usize);
+                let end = start
+                    .checked_add(v.byte_length.0 as usize)
                     .ok_or("bufferView range overflows")?;
-                let bytes = buffer.get(view.offset()..end).ok_or_else(|| {
+                let bytes = buffer.get(start..end).ok_or_else(|| {
                     format!(
                         "bufferViews[{}] runs past the end of its buffer",
-                        view.index()
+                        view.value()
                     )
                 })?;
-                (
-                    bytes.to_vec(),
-                    image
-                        .name()
-                        .map_or_else(|| format!("image{}", image.index()), str::to_string),
-                )
+                (bytes.to_vec(), default_name())
             }
-            gltf::image::Source::Uri { uri, .. } => {
+            (None, Some(uri)) => {
                 let name = if uri.starts_with("data:") {
-                    format!("image{}", image.index())
+                    default_name()
                 } else {
-                    uri.to_string()
+                    uri.clone()
                 };
-                (
-                    uri::fetch(uri, self.base_dir)?,
-                    image.name().map_or(name, str::to_string),
-                )
+                (uri::fetch(uri, self.base_dir)?, name)
             }
+            (None, None) => return Err("the image has neither a uri nor a bufferView".to_string()),
         };
         let decoded = image::ImageReader::new(std::io::Cursor::new(bytes))
             .with_guessed_format()
@@ -436,7 +484,11 @@ fn load_primitive(
                 None => Ok(None),
                 Some(acc) => buffers.read_rows(&acc, dims).map(Some).map_err(|m| {
                     ctx.invalid(
-                        format!("{element} {semantic:?} (accessors[{}])", acc.index()),
+                        format!(
+                            "{element} {} (accessors[{}])",
+                            semantic_name(&semantic),
+                            acc.index()
+                        ),
                         m,
                     )
                 }),
@@ -712,36 +764,54 @@ fn load_animations(
     doc: &gltf::Document,
 ) -> Result<Vec<Animation>> {
     let mut out = Vec::new();
-    for anim in doc.animations() {
+    // Read from the JSON: gltf 1.4's animation wrappers unwrap the target path and node,
+    // which its validation does not check.
+    let json = doc.as_json();
+    for (ai, anim) in json.animations.iter().enumerate() {
         let name = anim
-            .name()
-            .map_or_else(|| format!("animation{}", anim.index()), str::to_string);
+            .name
+            .clone()
+            .unwrap_or_else(|| format!("animation{ai}"));
         let mut channels = Vec::new();
-        for ch in anim.channels() {
-            let element = format!(
-                "animations[{}] {name:?} channels[{}]",
-                anim.index(),
-                ch.index()
-            );
-            let property = match ch.target().property() {
-                gltf::animation::Property::Translation => Property::Translation,
-                gltf::animation::Property::Rotation => Property::Rotation,
-                gltf::animation::Property::Scale => Property::Scale,
-                gltf::animation::Property::MorphTargetWeights => {
+        for (ci, ch) in anim.channels.iter().enumerate() {
+            let element = format!("animations[{ai}] {name:?} channels[{ci}]");
+            use gltf::json::animation::{Interpolation as I, Property as P};
+            let property = match &ch.target.path {
+                Checked::Valid(P::Translation) => Property::Translation,
+                Checked::Valid(P::Rotation) => Property::Rotation,
+                Checked::Valid(P::Scale) => Property::Scale,
+                Checked::Valid(P::MorphTargetWeights) => {
                     ctx.warn(
                         &element,
                         "animates morph target weights, which shine ignores",
                     );
                     continue;
                 }
+                Checked::Invalid => return Err(ctx.invalid(&element, "unknown target path")),
             };
-            let sampler = ch.sampler();
-            let interpolation = match sampler.interpolation() {
-                gltf::animation::Interpolation::Step => Interpolation::Step,
-                gltf::animation::Interpolation::Linear => Interpolation::Linear,
-                gltf::animation::Interpolation::CubicSpline => Interpolation::CubicSpline,
+            let node = ch.target.node.value();
+            if node >= json.nodes.len() {
+                return Err(ctx.invalid(&element, format!("target node {node} does not exist")));
+            }
+            let sampler = anim.samplers.get(ch.sampler.value()).ok_or_else(|| {
+                ctx.invalid(
+                    &element,
+                    format!("sampler {} does not exist", ch.sampler.value()),
+                )
+            })?;
+            let interpolation = match &sampler.interpolation {
+                Checked::Valid(I::Step) => Interpolation::Step,
+                Checked::Valid(I::Linear) => Interpolation::Linear,
+                Checked::Valid(I::CubicSpline) => Interpolation::CubicSpline,
+                Checked::Invalid => return Err(ctx.invalid(&element, "unknown interpolation")),
             };
-            let input = sampler.input();
+            let accessor = |index: usize, what: &str| {
+                doc.accessors().nth(index).ok_or_else(|| {
+                    ctx.invalid(&element, format!("{what} accessor {index} does not exist"))
+                })
+            };
+            let input = accessor(sampler.input.value(), "input")?;
+            let output = accessor(sampler.output.value(), "output")?;
             let times = buffers.read_rows(&input, Dimensions::Scalar).map_err(|m| {
                 ctx.invalid(format!("{element} input (accessors[{}])", input.index()), m)
             })?;
@@ -754,7 +824,6 @@ fn load_animations(
                     "key times must be finite, strictly increasing and at least one",
                 ));
             }
-            let output = sampler.output();
             let dims = if property == Property::Rotation { 4 } else { 3 };
             let (values, got) = buffers.read_f32(&output).map_err(|m| {
                 ctx.invalid(
@@ -788,7 +857,7 @@ fn load_animations(
                 Vec4::new(c[0], c[1], c[2], c.get(3).copied().unwrap_or(0.0))
             })?;
             channels.push(Channel {
-                node: ch.target().node().index(),
+                node,
                 property,
                 interpolation,
                 times,
