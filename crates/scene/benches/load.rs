@@ -1,8 +1,9 @@
 //! Loading a scene of about one million triangles, and building its BVH.
 //!
 //! `cargo bench -p shine-scene --bench load`. The scene is 16 meshes of 65 536 triangles
-//! (wavy 256×128-quad grids) with positions, normals, UVs and indices; the "tangents in
-//! file" variant also carries MikkTSpace tangents, the other makes the loader generate them.
+//! (wavy 256×128-quad grids) with positions, normals, UVs and indices. Variants: tangents in
+//! the file; no tangents and no normal map (cheap perpendicular tangents); no tangents under
+//! a normal map (the loader runs MikkTSpace).
 
 use std::hint::black_box;
 use std::time::Duration;
@@ -42,9 +43,26 @@ fn grid(nx: u32, nz: u32, phase: f32) -> MeshData {
     m
 }
 
-fn million_triangles(with_tangents: bool) -> Vec<u8> {
+/// The million-triangle scene; `normal_mapped` gives its material a (tiny) normal map, so
+/// missing tangents are generated with MikkTSpace.
+fn million_triangles(with_tangents: bool, normal_mapped: bool) -> Vec<u8> {
     let mut w = GlbWriter::new();
-    let mat = w.push("materials", json!({"name": "grey"}));
+    let mut material = json!({"name": "grey"});
+    if normal_mapped {
+        let mut png = Vec::new();
+        let encoder = image::codecs::png::PngEncoder::new(&mut png);
+        image::ImageEncoder::write_image(
+            encoder,
+            &[128, 128, 255],
+            1,
+            1,
+            image::ExtendedColorType::Rgb8,
+        )
+        .expect("1×1 PNG encodes");
+        let tex = w.png_texture("flat", &png);
+        material["normalTexture"] = json!({"index": tex});
+    }
+    let mat = w.push("materials", material);
     let mut roots = Vec::new();
     for i in 0..16 {
         let g = grid(256, 128, i as f32);
@@ -65,11 +83,16 @@ fn bench(c: &mut Criterion) {
         .sample_size(10)
         .measurement_time(Duration::from_secs(10))
         .warm_up_time(Duration::from_secs(1));
-    for (name, tangents) in [
-        ("load, tangents in file", true),
-        ("load, tangents generated", false),
+    for (name, tangents, normal_mapped) in [
+        ("load, tangents in file", true, true),
+        ("load, no normal map, no tangents", false, false),
+        (
+            "load, normal-mapped, MikkTSpace tangents generated",
+            false,
+            true,
+        ),
     ] {
-        let glb = million_triangles(tangents);
+        let glb = million_triangles(tangents, normal_mapped);
         let scene =
             shine_scene::load_slice(&glb, None, "million.glb").expect("benchmark scene loads");
         assert_eq!(scene.triangle_count(), 16 * 256 * 128 * 2);
@@ -77,8 +100,8 @@ fn bench(c: &mut Criterion) {
             b.iter(|| shine_scene::load_slice(black_box(&glb), None, "million.glb"))
         });
     }
-    let scene =
-        shine_scene::load_slice(&million_triangles(true), None, "million.glb").expect("loads");
+    let scene = shine_scene::load_slice(&million_triangles(true, false), None, "million.glb")
+        .expect("loads");
     let world = scene.rest_world_transforms();
     group.bench_function("BVH build", |b| {
         b.iter(|| Bvh::from_scene(black_box(&scene), &world))
@@ -88,18 +111,21 @@ fn bench(c: &mut Criterion) {
         .iter()
         .map(|m| glam::Mat4::from_translation(Vec3::Y * 0.1) * *m)
         .collect();
+    let poses = [moved, world.clone()];
+    let mut k = 0;
     group.bench_function("BVH refit (all instances moved)", |b| {
         b.iter(|| {
-            bvh.refit(
-                &scene,
-                if bvh.instances[0].world == world[0].to_cols_array_2d() {
-                    &moved
-                } else {
-                    &world
-                },
-            );
+            k ^= 1;
+            bvh.refit(&scene, &poses[k]);
         })
     });
+    let start = std::time::Instant::now();
+    bvh.refit(&scene, &poses[k ^ 1]);
+    println!(
+        "one refit of {} triangles: {:?}",
+        bvh.triangles.len(),
+        start.elapsed()
+    );
     group.finish();
 }
 

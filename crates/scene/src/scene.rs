@@ -134,7 +134,8 @@ pub struct Node {
 /// One drawable piece of a mesh: one glTF primitive with one material, as indexed triangles.
 ///
 /// All vertex arrays have the same length. Normals are unit length; tangents are unit `xyz`
-/// with the bitangent sign in `w` (MikkTSpace, generated when the file has none).
+/// with the bitangent sign in `w`, glTF convention. When the file has none they are generated:
+/// MikkTSpace for normal-mapped materials, an arbitrary perpendicular otherwise.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Primitive {
     /// Positions in the node's local space (metres).

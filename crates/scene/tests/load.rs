@@ -77,17 +77,46 @@ fn missing_camera_and_light_get_documented_defaults_with_warnings() {
 
 #[test]
 fn generated_normals_and_tangents_when_missing() {
-    let mut j = common::gltf_json(&common::triangle());
+    // A 2×2 flat normal map makes the material normal-mapped, so tangents follow MikkTSpace.
+    let mut png = Vec::new();
+    image::ImageEncoder::write_image(
+        image::codecs::png::PngEncoder::new(&mut png),
+        &[128, 128, 255].repeat(4),
+        2,
+        2,
+        image::ExtendedColorType::Rgb8,
+    )
+    .unwrap();
+    let mut w = common::triangle();
+    let tex = w.png_texture("flat normal", &png);
+    let mut j = common::gltf_json(&w);
+    j["materials"][0]["normalTexture"] = json!({"index": tex});
     let attrs = j["meshes"][0]["primitives"][0]["attributes"]
         .as_object_mut()
         .unwrap();
     attrs.remove("NORMAL");
     let s = load_slice(j.to_string().as_bytes(), None, "no-normals.gltf").unwrap();
+    assert!(
+        s.warnings.iter().all(|w| !w.contains("images")),
+        "{:?}",
+        s.warnings
+    );
     let p = &s.meshes[0].primitives[0];
     for (n, t) in p.normals.iter().zip(&p.tangents) {
         assert!((*n - Vec3::Z).length() < 1e-6, "{n:?}");
         assert!((t.truncate() - Vec3::X).length() < 1e-5, "{t:?}");
+        // u runs along +X and v down the image along -Y: bitangent = N × T · w = +Y.
         assert_eq!(t.w, 1.0);
+    }
+    // Without the normal map the tangents are only well-formed perpendiculars.
+    j["materials"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("normalTexture");
+    let s = load_slice(j.to_string().as_bytes(), None, "no-normals.gltf").unwrap();
+    let p = &s.meshes[0].primitives[0];
+    for (n, t) in p.normals.iter().zip(&p.tangents) {
+        assert!(n.dot(t.truncate()).abs() < 1e-6 && (t.truncate().length() - 1.0).abs() < 1e-6);
     }
 }
 

@@ -16,7 +16,9 @@
 //!   environment (see [`crate::environment`]) and no punctual light is lit by the environment
 //!   alone, without a warning.
 //! - missing normals: smooth (area-weighted) normals over shared vertex indices.
-//! - missing tangents: MikkTSpace tangents (from UV0), or any perpendicular when there is no UV0.
+//! - missing tangents: MikkTSpace tangents (from UV0) when the primitive's material has a
+//!   normal map; otherwise (no normal map, or no UV0) any unit vector perpendicular to the
+//!   normal, as tangents then only need to be well-formed.
 //! - missing material: the glTF default material (appended last in [`Scene::materials`]).
 
 mod accessor;
@@ -140,7 +142,12 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
                 .index()
                 .map_or(default_material, |i| i as u32);
             uses_default |= material == default_material;
-            if let Some(p) = load_primitive(&mut ctx, &buffers, &prim, &element, material)? {
+            let normal_mapped = materials
+                .get(material as usize)
+                .is_some_and(|m| m.normal_texture != NO_TEXTURE);
+            if let Some(p) =
+                load_primitive(&mut ctx, &buffers, &prim, &element, material, normal_mapped)?
+            {
                 primitives.push(p);
             }
         }
@@ -466,6 +473,7 @@ fn load_primitive(
     prim: &gltf::Primitive<'_>,
     element: &str,
     material: u32,
+    normal_mapped: bool,
 ) -> Result<Option<Primitive>> {
     let mode = prim.mode();
     if !matches!(
@@ -625,7 +633,9 @@ fn load_primitive(
     };
     let tangents = match tangents {
         Some(t) => t,
-        None if has_uvs => geometry::mikktspace_tangents(&mut v),
+        // Tangents only matter under a normal map; elsewhere a perpendicular will do and
+        // MikkTSpace's cost (about 2.5 s per million triangles) is not paid.
+        None if has_uvs && normal_mapped => geometry::mikktspace_tangents(&mut v),
         None => v
             .normals
             .iter()
