@@ -124,12 +124,14 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
     let default_material = materials.len() as u32;
     let mut uses_default = false;
 
+    // Primitives are independent: decode them (and generate normals and tangents) on all
+    // cores, then gather results, warnings and the first error in file order.
+    let mut jobs = Vec::new();
     let mut meshes = Vec::new();
     for mesh in doc.meshes() {
         let mesh_name = mesh
             .name()
             .map_or_else(|| format!("mesh{}", mesh.index()), str::to_string);
-        let mut primitives = Vec::new();
         for prim in mesh.primitives() {
             let element = format!(
                 "meshes[{}] {:?} primitives[{}]",
@@ -145,16 +147,24 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
             let normal_mapped = materials
                 .get(material as usize)
                 .is_some_and(|m| m.normal_texture != NO_TEXTURE);
-            if let Some(p) =
-                load_primitive(&mut ctx, &buffers, &prim, &element, material, normal_mapped)?
-            {
-                primitives.push(p);
-            }
+            jobs.push(PrimitiveJob {
+                mesh: meshes.len(),
+                prim,
+                element,
+                material,
+                normal_mapped,
+            });
         }
         meshes.push(Mesh {
             name: mesh_name,
-            primitives,
+            primitives: Vec::new(),
         });
+    }
+    for (job, (result, warnings)) in jobs.iter().zip(load_primitives(name, &buffers, &jobs)) {
+        ctx.warnings.extend(warnings);
+        if let (Some(p), Some(mesh)) = (result?, meshes.get_mut(job.mesh)) {
+            mesh.primitives.push(p);
+        }
     }
     if uses_default {
         materials.push(Material::default());
@@ -441,6 +451,87 @@ fn load_material(
     if let Some(info) = m.emissive_texture() {
         check_info(ctx, "emissiveTexture", info.tex_coord());
         out.emissive_texture = tex.texture(ctx, buffers, &info.texture(), true, &element);
+    }
+    out
+}
+
+/// A loaded primitive (or `None`: skipped with a warning) and the warnings met.
+type PrimitiveResult = (Result<Option<Primitive>>, Vec<String>);
+
+/// One primitive to load, with what it needs to know about its mesh and material.
+struct PrimitiveJob<'d> {
+    mesh: usize,
+    prim: gltf::Primitive<'d>,
+    element: String,
+    material: u32,
+    normal_mapped: bool,
+}
+
+/// Loads every job, on up to `available_parallelism` threads; results in job order, each
+/// with its warnings.
+fn load_primitives(
+    file: &str,
+    buffers: &Buffers,
+    jobs: &[PrimitiveJob<'_>],
+) -> Vec<PrimitiveResult> {
+    let run = |job: &PrimitiveJob<'_>| {
+        let mut ctx = Ctx {
+            file,
+            warnings: Vec::new(),
+        };
+        let result = load_primitive(
+            &mut ctx,
+            buffers,
+            &job.prim,
+            &job.element,
+            job.material,
+            job.normal_mapped,
+        );
+        (result, ctx.warnings)
+    };
+    let threads = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .min(jobs.len());
+    if threads <= 1 {
+        return jobs.iter().map(run).collect();
+    }
+    let next = std::sync::atomic::AtomicUsize::new(0);
+    let mut done: Vec<(usize, PrimitiveResult)> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..threads)
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut out = Vec::new();
+                    loop {
+                        let i = next.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                        let Some(job) = jobs.get(i) else { break };
+                        out.push((i, run(job)));
+                    }
+                    out
+                })
+            })
+            .collect();
+        // A worker only panics if loading panicked, which the loader must never do; its
+        // jobs are then reported as failed rather than lost silently.
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap_or_default())
+            .collect()
+    });
+    done.sort_by_key(|(i, _)| *i);
+    let mut out: Vec<PrimitiveResult> = Vec::with_capacity(jobs.len());
+    let mut results = done.into_iter().peekable();
+    for (i, job) in jobs.iter().enumerate() {
+        match results.next_if(|(k, _)| *k == i) {
+            Some((_, r)) => out.push(r),
+            None => out.push((
+                Err(Error::Invalid {
+                    file: file.to_string(),
+                    element: job.element.clone(),
+                    message: "loading this primitive failed unexpectedly".to_string(),
+                }),
+                Vec::new(),
+            )),
+        }
     }
     out
 }
