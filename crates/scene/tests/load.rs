@@ -196,3 +196,45 @@ fn lights_cameras_and_emissive_strength_are_read_in_their_units() {
         Vec3::new(0.0, 1.0, 5.0)
     );
 }
+
+fn base64(bytes: &[u8]) -> String {
+    const A: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut out = String::new();
+    for c in bytes.chunks(3) {
+        let n = (u32::from(c[0]) << 16)
+            | (u32::from(*c.get(1).unwrap_or(&0)) << 8)
+            | u32::from(*c.get(2).unwrap_or(&0));
+        for k in 0..4 {
+            out.push(if k <= c.len() {
+                A[((n >> (18 - 6 * k)) & 63) as usize] as char
+            } else {
+                '='
+            });
+        }
+    }
+    out
+}
+
+#[test]
+fn sparse_accessors_substitute_their_values() {
+    let mut j = common::gltf_json(&common::triangle());
+    // Replace vertex 2 of POSITION with (5, 6, 7) through a sparse accessor.
+    let mut data = vec![2u8, 0, 0, 0];
+    for v in [5.0f32, 6.0, 7.0] {
+        data.extend(v.to_le_bytes());
+    }
+    j["buffers"].as_array_mut().unwrap().push(
+        json!({"byteLength": data.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&data))}),
+    );
+    let views = j["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 1, "byteOffset": 0, "byteLength": 1}));
+    views.push(json!({"buffer": 1, "byteOffset": 4, "byteLength": 12}));
+    let (iv, vv) = (views.len() - 2, views.len() - 1);
+    j["accessors"][0]["sparse"] = json!({"count": 1, "indices": {"bufferView": iv, "componentType": 5121},
+                                         "values": {"bufferView": vv}});
+    j["accessors"][0]["max"] = json!([5.0, 6.0, 7.0]);
+    let s = load_slice(j.to_string().as_bytes(), None, "sparse.gltf").unwrap();
+    let p = &s.meshes[0].primitives[0].positions;
+    assert_eq!(p[2], Vec3::new(5.0, 6.0, 7.0));
+    assert_eq!(p[1], Vec3::X);
+}
