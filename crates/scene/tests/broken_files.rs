@@ -155,6 +155,18 @@ fn cases() -> Vec<(&'static str, Vec<u8>, Expect)> {
         Expect::Error(&["POSITION", "accessors[0]", "do not fit"]),
     ));
     let mut j = tri();
+    j["accessors"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("bufferView");
+    j["accessors"][0]["count"] = json!(1u64 << 40);
+    j["accessors"][0]["sparse"] = json!({"count": 1, "indices": {"bufferView": 0, "componentType": 5121}, "values": {"bufferView": 0}});
+    out.push((
+        "huge-viewless-accessor.gltf",
+        text(&j),
+        Expect::Error(&["POSITION", "no bufferView"]),
+    ));
+    let mut j = tri();
     j["bufferViews"][0]["byteStride"] = json!(4);
     out.push((
         "stride-too-small.gltf",

@@ -9,6 +9,10 @@ pub(crate) struct Buffers {
     pub(crate) data: Vec<Vec<u8>>,
 }
 
+/// Largest element count accepted for an accessor without a bufferView (all zeros, usually
+/// a base for sparse values).
+const MAX_VIEWLESS_ELEMENTS: usize = 1 << 26;
+
 fn component_size(t: DataType) -> usize {
     match t {
         DataType::I8 | DataType::U8 => 1,
@@ -134,7 +138,15 @@ impl Buffers {
                 }
                 out
             }
-            None => vec![0.0; count.checked_mul(dims).ok_or("accessor count overflows")?],
+            // No data to bound the count: refuse absurd sizes instead of aborting on the
+            // allocation.
+            None if count > MAX_VIEWLESS_ELEMENTS => {
+                return Err(format!(
+                    "accessor {} has no bufferView and {count} elements (more than {MAX_VIEWLESS_ELEMENTS})",
+                    acc.index()
+                ));
+            }
+            None => vec![0.0; count * dims],
         };
         if let Some(sparse) = acc.sparse() {
             let n = sparse.count();
