@@ -204,9 +204,19 @@ impl Bvh {
         if n == 0 {
             return Bvh::default();
         }
-        let boxes: Vec<Aabb> = triangles.iter().map(BvhTriangle::aabb).collect();
-        let centroids: Vec<Vec3> = boxes.iter().map(Aabb::center).collect();
-        let mut order: Vec<u32> = (0..n as u32).collect();
+        // Triangles as contiguous items, partitioned in place: no indirection while binning.
+        let mut items: Vec<Item> = triangles
+            .iter()
+            .enumerate()
+            .map(|(i, t)| {
+                let bounds = t.aabb();
+                Item {
+                    bounds,
+                    centroid: bounds.center(),
+                    index: i as u32,
+                }
+            })
+            .collect();
         let mut nodes: Vec<BvhNode> = Vec::with_capacity(2 * n / MAX_LEAF.max(1) + 1);
         // (start, end, parent whose right child this is)
         let mut stack: Vec<(usize, usize, Option<usize>)> = vec![(0, n, None)];
@@ -215,14 +225,12 @@ impl Bvh {
             if let Some(parent) = right_of.and_then(|p| nodes.get_mut(p)) {
                 parent.left_or_first = index as u32;
             }
-            let ids = order.get(start..end).unwrap_or_default();
+            let range = items.get_mut(start..end).unwrap_or_default();
             let mut bounds = Aabb::EMPTY;
             let mut cbounds = Aabb::EMPTY;
-            for &i in ids {
-                if let (Some(b), Some(c)) = (boxes.get(i as usize), centroids.get(i as usize)) {
-                    bounds = bounds.union(b);
-                    cbounds.grow(*c);
-                }
+            for item in range.iter() {
+                bounds = bounds.union(&item.bounds);
+                cbounds.grow(item.centroid);
             }
             let mut node = BvhNode {
                 min: [0.0; 3],
@@ -231,26 +239,20 @@ impl Bvh {
                 count: (end - start) as u32,
             };
             node.set_aabb(&bounds);
-            let split = if end - start <= 2 {
+            let split = if range.len() <= 2 {
                 None
             } else {
-                sah_split(ids, &boxes, &centroids, &cbounds, bounds.area())
+                sah_split(range, &cbounds, bounds.area())
             };
             let partitioned = split.and_then(|(axis, pos)| {
-                let slice = order.get_mut(start..end).unwrap_or_default();
                 let mut left = 0;
-                for k in 0..slice.len() {
-                    let c = slice
-                        .get(k)
-                        .and_then(|&i| centroids.get(i as usize))
-                        .copied()
-                        .unwrap_or_default();
-                    if c[axis] < pos {
-                        slice.swap(left, k);
+                for k in 0..range.len() {
+                    if range.get(k).is_some_and(|item| item.centroid[axis] < pos) {
+                        range.swap(left, k);
                         left += 1;
                     }
                 }
-                (left > 0 && left < slice.len()).then_some(start + left)
+                (left > 0 && left < range.len()).then_some(start + left)
             });
             // Too many triangles for a leaf but no useful split (e.g. identical centroids):
             // halve the range so leaves stay small.
@@ -266,9 +268,9 @@ impl Bvh {
                 None => nodes.push(node),
             }
         }
-        let triangles = order
+        let triangles = items
             .iter()
-            .filter_map(|&i| triangles.get(i as usize).copied())
+            .filter_map(|item| triangles.get(item.index as usize).copied())
             .collect();
         Bvh {
             nodes,
@@ -456,32 +458,39 @@ impl Bvh {
     }
 }
 
-/// The best SAH split of `ids` as `(axis, position)`, or `None` when a leaf is cheaper.
-fn sah_split(
-    ids: &[u32],
-    boxes: &[Aabb],
-    centroids: &[Vec3],
-    cbounds: &Aabb,
-    parent_area: f32,
-) -> Option<(usize, f32)> {
+/// A triangle while building: its box, centroid and index in the input.
+#[derive(Clone, Copy)]
+struct Item {
+    bounds: Aabb,
+    centroid: Vec3,
+    index: u32,
+}
+
+/// The best SAH split of `items` as `(axis, position)`, or `None` when a leaf is cheaper.
+/// All three axes are binned in one pass.
+fn sah_split(items: &[Item], cbounds: &Aabb, parent_area: f32) -> Option<(usize, f32)> {
     let extent = cbounds.extent();
-    let leaf_cost = ids.len() as f32;
+    let scale = Vec3::select(
+        extent.cmpgt(Vec3::ZERO),
+        Vec3::splat(BINS as f32) / extent,
+        Vec3::ZERO,
+    );
+    let mut bins = [[(Aabb::EMPTY, 0u32); BINS]; 3];
+    for item in items {
+        let k = ((item.centroid - cbounds.min) * scale)
+            .as_uvec3()
+            .min(glam::UVec3::splat(BINS as u32 - 1));
+        for (axis, axis_bins) in bins.iter_mut().enumerate() {
+            let bin = &mut axis_bins[k[axis] as usize];
+            bin.0 = bin.0.union(&item.bounds);
+            bin.1 += 1;
+        }
+    }
+    let leaf_cost = items.len() as f32;
     let mut best: Option<(f32, usize, f32)> = None;
-    for axis in 0..3 {
+    for (axis, bins) in bins.iter().enumerate() {
         if extent[axis] <= 0.0 {
             continue;
-        }
-        let scale = BINS as f32 / extent[axis];
-        let mut bins = [(Aabb::EMPTY, 0u32); BINS];
-        for &i in ids {
-            let (Some(c), Some(b)) = (centroids.get(i as usize), boxes.get(i as usize)) else {
-                continue;
-            };
-            let k = (((c[axis] - cbounds.min[axis]) * scale) as usize).min(BINS - 1);
-            if let Some(bin) = bins.get_mut(k) {
-                bin.0 = bin.0.union(b);
-                bin.1 += 1;
-            }
         }
         // Sweep from the right to get the cost of every right side, then from the left.
         let mut right_cost = [0.0f32; BINS];
@@ -495,18 +504,18 @@ fn sah_split(
         for k in 1..BINS {
             lb = lb.union(&bins[k - 1].0);
             ln += bins[k - 1].1;
-            if ln == 0 || ln as usize == ids.len() {
+            if ln == 0 || ln as usize == items.len() {
                 continue;
             }
             let cost = lb.area() * ln as f32 + right_cost[k];
             if best.is_none_or(|(c, _, _)| cost < c) {
-                best = Some((cost, axis, cbounds.min[axis] + k as f32 / scale));
+                best = Some((cost, axis, cbounds.min[axis] + k as f32 / scale[axis]));
             }
         }
     }
     let (cost, axis, pos) = best?;
     let split_cost = TRAVERSAL_COST + cost / parent_area.max(f32::MIN_POSITIVE);
-    (split_cost < leaf_cost || ids.len() > MAX_LEAF).then_some((axis, pos))
+    (split_cost < leaf_cost || items.len() > MAX_LEAF).then_some((axis, pos))
 }
 
 #[cfg(test)]
