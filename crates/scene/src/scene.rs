@@ -417,6 +417,23 @@ impl Scene {
         world
     }
 
+    /// For each node, whether it is in the displayed scene (reachable from [`Scene::roots`]).
+    /// Lights, cameras and proxies of other nodes are not loaded.
+    pub fn shown_nodes(&self) -> Vec<bool> {
+        let mut shown = vec![false; self.nodes.len()];
+        let mut stack = self.roots.clone();
+        while let Some(n) = stack.pop() {
+            match shown.get_mut(n) {
+                Some(s) if !*s => *s = true,
+                _ => continue,
+            }
+            if let Some(node) = self.nodes.get(n) {
+                stack.extend(&node.children);
+            }
+        }
+        shown
+    }
+
     /// Instances (one per node with a mesh in the displayed scene) for the given world matrices.
     pub fn instances(&self, world: &[Mat4]) -> Vec<Instance> {
         let mut out = Vec::new();

@@ -171,9 +171,12 @@ fn lights_cameras_and_emissive_strength_are_read_in_their_units() {
                       "extensions": {"KHR_lights_punctual": {"light": 0}}}));
     nodes.push(json!({"name": "sun", "extensions": {"KHR_lights_punctual": {"light": 1}}}));
     nodes.push(json!({"name": "cam", "camera": 0, "translation": [0.0, 1.0, 5.0]}));
+    // A light on a node outside the displayed scene is not loaded.
+    nodes.push(json!({"name": "stray", "extensions": {"KHR_lights_punctual": {"light": 0}}}));
     j["scenes"][0]["nodes"] = json!([0, 1, 2, 3]);
     let s = load_slice(j.to_string().as_bytes(), None, "lights.gltf").unwrap();
     assert!(s.warnings.is_empty(), "{:?}", s.warnings);
+    assert_eq!(s.lights.len(), 2);
     let spot = s.lights[0];
     assert_eq!(spot.light_kind(), Some(LightKind::Spot));
     assert_eq!(

@@ -983,6 +983,7 @@ fn load_lights(
         .and_then(|e| e.khr_lights_punctual.as_ref())
         .map(|l| l.lights.as_slice())
         .unwrap_or(&[]);
+    let shown = scene.shown_nodes();
     for (i, node) in json.nodes.iter().enumerate() {
         let Some(light_ref) = node
             .extensions
@@ -991,6 +992,9 @@ fn load_lights(
         else {
             continue;
         };
+        if !shown.get(i).copied().unwrap_or(false) {
+            continue;
+        }
         let li = light_ref.light.value();
         let element = format!("nodes[{i}] KHR_lights_punctual.light {li}");
         let def = defs
@@ -1051,8 +1055,12 @@ fn load_lights(
 }
 
 fn load_cameras(ctx: &Ctx, doc: &gltf::Document, scene: &mut Scene, world: &[Mat4]) -> Result<()> {
+    let shown = scene.shown_nodes();
     for node in doc.nodes() {
         let Some(cam) = node.camera() else { continue };
+        if !shown.get(node.index()).copied().unwrap_or(false) {
+            continue;
+        }
         let element = format!(
             "cameras[{}] {:?} (on nodes[{}])",
             cam.index(),
@@ -1122,8 +1130,12 @@ fn load_cameras(ctx: &Ctx, doc: &gltf::Document, scene: &mut Scene, world: &[Mat
 
 fn load_proxies(ctx: &Ctx, doc: &gltf::Document, scene: &Scene) -> Result<Vec<NodeProxies>> {
     let mut out = Vec::new();
+    let shown = scene.shown_nodes();
     for node in doc.nodes() {
         let i = node.index();
+        if !shown.get(i).copied().unwrap_or(false) {
+            continue;
+        }
         let explicit = match node.extras() {
             Some(raw) => {
                 let element = format!("nodes[{i}] {:?} extras", node.name().unwrap_or(""));
