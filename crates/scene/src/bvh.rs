@@ -217,57 +217,8 @@ impl Bvh {
                 }
             })
             .collect();
-        let mut nodes: Vec<BvhNode> = Vec::with_capacity(2 * n / MAX_LEAF.max(1) + 1);
-        // (start, end, parent whose right child this is)
-        let mut stack: Vec<(usize, usize, Option<usize>)> = vec![(0, n, None)];
-        while let Some((start, end, right_of)) = stack.pop() {
-            let index = nodes.len();
-            if let Some(parent) = right_of.and_then(|p| nodes.get_mut(p)) {
-                parent.left_or_first = index as u32;
-            }
-            let range = items.get_mut(start..end).unwrap_or_default();
-            let mut bounds = Aabb::EMPTY;
-            let mut cbounds = Aabb::EMPTY;
-            for item in range.iter() {
-                bounds = bounds.union(&item.bounds);
-                cbounds.grow(item.centroid);
-            }
-            let mut node = BvhNode {
-                min: [0.0; 3],
-                left_or_first: start as u32,
-                max: [0.0; 3],
-                count: (end - start) as u32,
-            };
-            node.set_aabb(&bounds);
-            let split = if range.len() <= 2 {
-                None
-            } else {
-                sah_split(range, &cbounds, bounds.area())
-            };
-            let partitioned = split.and_then(|(axis, pos)| {
-                let mut left = 0;
-                for k in 0..range.len() {
-                    if range.get(k).is_some_and(|item| item.centroid[axis] < pos) {
-                        range.swap(left, k);
-                        left += 1;
-                    }
-                }
-                (left > 0 && left < range.len()).then_some(start + left)
-            });
-            // Too many triangles for a leaf but no useful split (e.g. identical centroids):
-            // halve the range so leaves stay small.
-            let mid = partitioned
-                .or_else(|| (end - start > MAX_LEAF).then_some(start + (end - start) / 2));
-            match mid {
-                Some(mid) => {
-                    node.count = 0;
-                    nodes.push(node);
-                    stack.push((mid, end, Some(index)));
-                    stack.push((start, mid, None));
-                }
-                None => nodes.push(node),
-            }
-        }
+        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+        let nodes = build_subtree(&mut items, 0, threads);
         let triangles = items
             .iter()
             .filter_map(|item| triangles.get(item.index as usize).copied())
@@ -458,6 +409,104 @@ impl Bvh {
     }
 }
 
+/// Subtrees smaller than this are not worth a thread.
+const PARALLEL_MIN: usize = 32 * 1024;
+
+/// Bounds of `items` and, when it should be split, where (relative to `items`) after
+/// partitioning them. The node's `left_or_first`/`count` describe a leaf of `items` starting
+/// at triangle `base`.
+fn split_node(items: &mut [Item], base: usize) -> (BvhNode, Option<usize>) {
+    let mut bounds = Aabb::EMPTY;
+    let mut cbounds = Aabb::EMPTY;
+    for item in items.iter() {
+        bounds = bounds.union(&item.bounds);
+        cbounds.grow(item.centroid);
+    }
+    let mut node = BvhNode {
+        min: [0.0; 3],
+        left_or_first: base as u32,
+        max: [0.0; 3],
+        count: items.len() as u32,
+    };
+    node.set_aabb(&bounds);
+    let split = if items.len() <= 2 {
+        None
+    } else {
+        sah_split(items, &cbounds, bounds.area())
+    };
+    let partitioned = split.and_then(|(axis, pos)| {
+        let mut left = 0;
+        for k in 0..items.len() {
+            if items.get(k).is_some_and(|item| item.centroid[axis] < pos) {
+                items.swap(left, k);
+                left += 1;
+            }
+        }
+        (left > 0 && left < items.len()).then_some(left)
+    });
+    // Too many triangles for a leaf but no useful split (e.g. identical centroids): halve the
+    // range so leaves stay small.
+    let mid = partitioned.or_else(|| (items.len() > MAX_LEAF).then_some(items.len() / 2));
+    (node, mid)
+}
+
+/// Builds the depth-first nodes over `items` (triangles `base..base + items.len()`), with
+/// interior nodes' right-child indices relative to the returned vector. With `threads > 1`
+/// large subtrees are built on separate threads.
+fn build_subtree(items: &mut [Item], base: usize, threads: usize) -> Vec<BvhNode> {
+    if threads > 1 && items.len() >= PARALLEL_MIN {
+        let (mut root, mid) = split_node(items, base);
+        let Some(mid) = mid else { return vec![root] };
+        let (l, r) = items.split_at_mut(mid);
+        let (left, right) = std::thread::scope(|scope| {
+            let left = scope.spawn(|| build_subtree(l, base, threads / 2));
+            let right = build_subtree(r, base + mid, threads - threads / 2);
+            (left.join(), right)
+        });
+        // Building never panics on any input; if it did, the panic carries on here.
+        let left = left.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        let shift = |n: BvhNode, by: usize| {
+            if n.count == 0 {
+                BvhNode {
+                    left_or_first: n.left_or_first + by as u32,
+                    ..n
+                }
+            } else {
+                n
+            }
+        };
+        root.count = 0;
+        root.left_or_first = (1 + left.len()) as u32;
+        let mut nodes = Vec::with_capacity(1 + left.len() + right.len());
+        nodes.push(root);
+        let right_base = 1 + left.len();
+        nodes.extend(left.into_iter().map(|n| shift(n, 1)));
+        nodes.extend(right.into_iter().map(|n| shift(n, right_base)));
+        return nodes;
+    }
+    let mut nodes: Vec<BvhNode> = Vec::with_capacity(2 * items.len() / MAX_LEAF + 1);
+    // (start, end, parent whose right child this is), relative to `items`
+    let mut stack: Vec<(usize, usize, Option<usize>)> = vec![(0, items.len(), None)];
+    while let Some((start, end, right_of)) = stack.pop() {
+        let index = nodes.len();
+        if let Some(parent) = right_of.and_then(|p| nodes.get_mut(p)) {
+            parent.left_or_first = index as u32;
+        }
+        let (mut node, mid) =
+            split_node(items.get_mut(start..end).unwrap_or_default(), base + start);
+        match mid {
+            Some(mid) => {
+                node.count = 0;
+                nodes.push(node);
+                stack.push((start + mid, end, Some(index)));
+                stack.push((start, start + mid, None));
+            }
+            None => nodes.push(node),
+        }
+    }
+    nodes
+}
+
 /// A triangle while building: its box, centroid and index in the input.
 #[derive(Clone, Copy)]
 struct Item {
@@ -609,6 +658,43 @@ mod tests {
             hits > 200,
             "only {hits} rays hit; the test rays are too sparse"
         );
+    }
+
+    #[test]
+    fn parallel_build_equals_sequential_build() {
+        let mut rng = Rng(0x0F0F_1234_ABCD_9876);
+        let tris = soup(&mut rng, 3 * PARALLEL_MIN);
+        let items = |tris: &[BvhTriangle]| -> Vec<Item> {
+            tris.iter()
+                .enumerate()
+                .map(|(i, t)| Item {
+                    bounds: t.aabb(),
+                    centroid: t.aabb().center(),
+                    index: i as u32,
+                })
+                .collect()
+        };
+        let (mut a, mut b) = (items(&tris), items(&tris));
+        let sequential = build_subtree(&mut a, 0, 1);
+        let parallel = build_subtree(&mut b, 0, 4);
+        assert_eq!(sequential, parallel);
+        assert!(a.iter().zip(&b).all(|(x, y)| x.index == y.index));
+        let bvh = Bvh::build(tris);
+        check_structure(&bvh);
+        for _ in 0..50 {
+            let ray = Ray {
+                origin: rng.v() * 14.0,
+                dir: rng.v(),
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            };
+            let e = brute(&bvh.triangles, &ray);
+            let g = bvh.intersect(&ray).map(|h| h.t);
+            assert_eq!(e.is_some(), g.is_some());
+            if let (Some(e), Some(g)) = (e, g) {
+                assert!((e - g).abs() <= 1e-4 * e.max(1.0));
+            }
+        }
     }
 
     #[test]
