@@ -6,7 +6,7 @@
 //! `CUBICSPLINE` evaluates the Hermite spline from the in/out tangents. Rotations are
 //! renormalised. Morph-target weights are not animated (the loader warns about them).
 
-use glam::{Mat4, Quat, Vec3, Vec4};
+use glam::{Mat4, Quat, Vec4};
 
 use crate::scene::{Scene, Transform};
 
@@ -190,11 +190,6 @@ impl Scene {
         }
         false
     }
-}
-
-/// Translation of `v` as a key value.
-pub fn vec3_key(v: Vec3) -> Vec4 {
-    v.extend(0.0)
 }
 
 #[cfg(test)]

@@ -399,12 +399,19 @@ impl Scene {
         self.world_from_locals(&locals)
     }
 
-    /// World matrices from local matrices, one per node (parents before or after children).
+    /// World matrices from local matrices, one per node. Nodes outside the displayed scene get
+    /// the identity; a node reached twice (only possible in a hand-built, cyclic `Scene`) is
+    /// visited once.
     pub fn world_from_locals(&self, locals: &[Mat4]) -> Vec<Mat4> {
         let mut world = vec![Mat4::IDENTITY; self.nodes.len()];
         let mut stack: Vec<(usize, Mat4)> =
             self.roots.iter().map(|&r| (r, Mat4::IDENTITY)).collect();
+        let mut visited = vec![false; self.nodes.len()];
         while let Some((n, parent)) = stack.pop() {
+            match visited.get_mut(n) {
+                Some(v) if !*v => *v = true,
+                _ => continue,
+            }
             let (Some(node), Some(local)) = (self.nodes.get(n), locals.get(n)) else {
                 continue;
             };
@@ -434,11 +441,17 @@ impl Scene {
         shown
     }
 
-    /// Instances (one per node with a mesh in the displayed scene) for the given world matrices.
+    /// Instances (one per node with a mesh in the displayed scene) for the given world
+    /// matrices, in depth-first order of the scene (roots and children in file order).
     pub fn instances(&self, world: &[Mat4]) -> Vec<Instance> {
         let mut out = Vec::new();
-        let mut stack: Vec<usize> = self.roots.clone();
+        let mut visited = vec![false; self.nodes.len()];
+        let mut stack: Vec<usize> = self.roots.iter().rev().copied().collect();
         while let Some(n) = stack.pop() {
+            match visited.get_mut(n) {
+                Some(v) if !*v => *v = true,
+                _ => continue,
+            }
             let Some(node) = self.nodes.get(n) else {
                 continue;
             };
