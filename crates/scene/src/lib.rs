@@ -1,1 +1,30 @@
 //! shine-scene: everything the engine needs to know about a scene, as plain data. No GPU.
+//!
+//! - [`load`] / [`load_slice`]: glTF 2.0 (`.gltf` + `.bin`, `.glb`, data URIs) into a [`Scene`]
+//!   of flat arrays: meshes, instances, materials, RGBA8 textures, lights, cameras,
+//!   animations, environment, proxy spheres, and the warnings met on the way.
+//! - [`builtin`]: the procedural scenes `cornell-box`, `spheres` and `room`, written as GLB by
+//!   [`builtin::export`].
+//! - [`bvh`]: a binned-SAH bounding volume hierarchy over all triangles, flattened for the
+//!   GPU and refittable after animation.
+//! - [`proxies`]: proxy spheres for dynamic objects (paper 002).
+//! - [`animation`]: node animation evaluated at any time.
+
+pub mod animation;
+pub mod builtin;
+pub mod bvh;
+pub mod environment;
+mod error;
+pub mod glb_writer;
+mod load;
+pub mod proxies;
+mod scene;
+
+pub use error::{Error, Result};
+pub use load::{
+    DEFAULT_SUN_DIRECTION, DEFAULT_SUN_LUX, DEFAULT_YFOV, SUPPORTED_EXTENSIONS, load, load_slice,
+};
+pub use scene::{
+    Aabb, Camera, Instance, Light, LightKind, Material, Mesh, NO_TEXTURE, Node, Primitive,
+    Projection, Scene, Texture, Transform,
+};
