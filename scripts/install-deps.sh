@@ -5,6 +5,10 @@
 set -euo pipefail
 
 packages=(libvulkan1 mesa-vulkan-drivers vulkan-validationlayers)
+# Node.js runs the Khronos glTF validator over the built-in scenes (crates/scene/tests).
+if ! command -v npm >/dev/null 2>&1; then
+    packages+=(nodejs npm)
+fi
 missing=()
 for p in "${packages[@]}"; do
     if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
@@ -18,4 +22,10 @@ if [ ${#missing[@]} -gt 0 ]; then
     if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
     $sudo apt-get update
     DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y "${missing[@]}"
+fi
+
+# The validator itself, pinned by crates/scene/tests/validator/package-lock.json.
+validator="$(dirname "$0")/../crates/scene/tests/validator"
+if [ ! -d "$validator/node_modules/gltf-validator" ]; then
+    npm ci --prefix "$validator" --no-audit --no-fund
 fi

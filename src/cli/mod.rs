@@ -1,6 +1,7 @@
 //! Command-line interface: one module per subcommand.
 
 mod info;
+mod scene;
 
 use clap::{Parser, Subcommand};
 
@@ -19,11 +20,14 @@ pub struct Cli {
 enum Command {
     /// Print the Vulkan device shine would use and the features it needs or can use.
     Info(info::InfoArgs),
+    /// Built-in scenes: list them or export one as .glb.
+    Scene(scene::SceneArgs),
 }
 
 /// Runs the chosen subcommand.
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Info(args) => info::run(&args),
+        Command::Scene(args) => scene::run(&args),
     }
 }

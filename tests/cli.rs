@@ -1,5 +1,5 @@
-//! `shine info` as a user runs it: the lavapipe (or real) device and the feature report, and a
-//! clear failure without a Vulkan driver.
+//! The `shine` binary as a user runs it: `shine info` (the device and the feature report, and a
+//! clear failure without a Vulkan driver) and `shine scene export`.
 
 use std::process::Command;
 
@@ -53,4 +53,39 @@ fn info_with_an_unknown_device_names_the_available_ones() {
         stderr.contains("no-such-gpu") && stderr.contains("available: 0:"),
         "{stderr}"
     );
+}
+
+#[test]
+fn scene_export_writes_the_committed_asset() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_scene_export");
+    std::fs::create_dir_all(&dir).expect("tmp dir");
+    for name in ["cornell-box", "spheres", "room"] {
+        let out = dir.join(format!("{name}.glb"));
+        let status = shine()
+            .args(["scene", "export", name])
+            .arg(&out)
+            .status()
+            .expect("run shine scene export");
+        assert!(status.success());
+        let asset = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("assets")
+            .join(format!("{name}.glb"));
+        assert_eq!(
+            std::fs::read(&out).expect("exported"),
+            std::fs::read(asset).expect("asset"),
+            "{name}: export differs from assets/"
+        );
+    }
+}
+
+#[test]
+fn scene_export_of_an_unknown_scene_lists_the_known_ones() {
+    let out = shine()
+        .args(["scene", "export", "nope", "/tmp/never.glb"])
+        .output()
+        .expect("run");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains("cornell-box"), "{stderr}");
+    assert!(!std::path::Path::new("/tmp/never.glb").exists());
 }
