@@ -506,7 +506,12 @@ fn glslang_error(
     }
     let rest: Vec<&str> = log
         .lines()
-        .filter(|l| l.starts_with("ERROR:") && *l != first && !l.contains("compilation errors"))
+        .filter(|l| {
+            l.starts_with("ERROR:")
+                && *l != first
+                && !l.contains("compilation errors")
+                && !l.contains("compilation terminated")
+        })
         .collect();
     if !rest.is_empty() {
         message.push_str("\n  ");

@@ -6,6 +6,10 @@
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
+pub mod gpu_scene;
+pub mod passes;
+pub mod renderer;
+
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
 ///
 /// One `pub static` per shader (and per `//! variant` of it), named after its path:

@@ -118,15 +118,15 @@ impl Device {
             .ok_or_else(|| Error::InvalidUsage("readback memory is not host-visible".into()))
     }
 
-    /// Uploads mip 0, layer 0 of `image` from tightly packed texels and leaves the image in
-    /// `final_layout` (it needs `TRANSFER_DST`).
+    /// Uploads mip 0 of every layer of `image` from tightly packed texels (layer after layer)
+    /// and leaves the image in `final_layout` (it needs `TRANSFER_DST`).
     pub fn upload_image(
         &self,
         image: &Image,
         data: &[u8],
         final_layout: vk::ImageLayout,
     ) -> Result<()> {
-        let expected = image_bytes(image)?;
+        let expected = image_bytes(image)? * u64::from(image.full_range().layer_count);
         if data.len() as u64 != expected {
             return Err(Error::InvalidUsage(format!(
                 "image `{}` needs {expected} bytes, {} given",
@@ -156,7 +156,8 @@ impl Device {
                 ANY_ACCESS,
                 COPY_WRITE,
             );
-            let region = [copy_region(image)];
+            let mut region = [copy_region(image)];
+            region[0].image_subresource.layer_count = range.layer_count;
             let raw = cmd.device().raw().clone();
             let cb = cmd.raw();
             // SAFETY: the image is in TRANSFER_DST_OPTIMAL and the region lies inside both.

@@ -1,0 +1,62 @@
+// Material evaluation shared by the G-buffer and RSM fragment shaders: textures, normal
+// mapping (glTF convention: bitangent = cross(n, t) * w).
+#ifndef SURFACE_GLSL
+#define SURFACE_GLSL
+#include "scene.glsl"
+
+layout(set = 0, binding = 0, std430) readonly buffer Materials {
+    Material m[];
+} materials;
+layout(set = 0, binding = 1) uniform texture2DArray srgb_textures;
+layout(set = 0, binding = 2) uniform texture2DArray linear_textures;
+layout(set = 0, binding = 3) uniform sampler texture_sampler;
+
+struct Surface {
+    vec3 base_color;
+    vec3 normal;
+    float roughness;
+    float metallic;
+    vec3 emissive;
+};
+
+Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 uv, bool front) {
+    // Field by field: a whole-struct copy out of a buffer is OpCopyLogical, which naga
+    // cannot read.
+    uint i = material_index;
+    Surface s;
+    s.base_color = materials.m[i].base_color.rgb;
+    uint base_tex = materials.m[i].base_color_texture;
+    if (base_tex != NO_TEXTURE) {
+        s.base_color *= texture(sampler2DArray(srgb_textures, texture_sampler), vec3(uv, float(base_tex))).rgb;
+    }
+    s.roughness = materials.m[i].roughness;
+    s.metallic = materials.m[i].metallic;
+    uint mr_tex = materials.m[i].metallic_roughness_texture;
+    if (mr_tex != NO_TEXTURE) {
+        vec4 mr = texture(sampler2DArray(linear_textures, texture_sampler), vec3(uv, float(mr_tex)));
+        s.roughness *= mr.g;
+        s.metallic *= mr.b;
+    }
+    s.emissive = materials.m[i].emissive;
+    uint emissive_tex = materials.m[i].emissive_texture;
+    if (emissive_tex != NO_TEXTURE) {
+        s.emissive *= texture(sampler2DArray(srgb_textures, texture_sampler), vec3(uv, float(emissive_tex))).rgb;
+    }
+    uint normal_tex = materials.m[i].normal_texture;
+    float normal_scale = materials.m[i].normal_scale;
+    vec3 n = normalize(geometric_normal);
+    if (!front) {
+        n = -n;
+    }
+    if (normal_tex != NO_TEXTURE) {
+        vec3 t = normalize(tangent.xyz - n * dot(n, tangent.xyz));
+        vec3 b = cross(n, t) * tangent.w;
+        vec3 tn = texture(sampler2DArray(linear_textures, texture_sampler), vec3(uv, float(normal_tex))).xyz * 2.0 - 1.0;
+        tn.xy *= normal_scale;
+        n = normalize(tn.x * t + tn.y * b + tn.z * n);
+    }
+    s.normal = n;
+    return s;
+}
+
+#endif

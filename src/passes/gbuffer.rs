@@ -1,0 +1,348 @@
+//! `gbuffer` and `rsm`: the scene rasterised from the camera into the G-buffer, and from the
+//! primary light into the reflective shadow map whose depth is also the shadow map.
+
+use crate::gpu_scene::{GpuScene, Vertex};
+use crate::shaders;
+use glam::{Mat4, Vec3};
+use shine_gpu::{Blend, DepthState, GraphicsPipelineDesc, VertexBufferLayout, vk};
+use shine_graph::{ColorLoad, DepthLoad, Handle, Image, ImageDesc, RenderGraph};
+use shine_scene::LightKind;
+
+/// Push constants of `view.glsl` (112 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ViewConstants {
+    /// World to clip (Vulkan clip space: y down, depth 0..1).
+    pub view_proj: [[f32; 4]; 4],
+    /// Linear view depth of p is `dot(xyz, p) + w`.
+    pub depth_plane: [f32; 4],
+    /// Eye position (camera or light).
+    pub eye: [f32; 4],
+    /// RSM parameters (see view.glsl).
+    pub params: [f32; 4],
+}
+
+/// A view of the scene: the camera or a light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct View {
+    /// World to view (right-handed, looking down -Z).
+    pub view: Mat4,
+    /// View to clip, Vulkan conventions.
+    pub proj: Mat4,
+    /// Eye position.
+    pub eye: Vec3,
+    /// Orthographic projection (directional light).
+    pub orthographic: bool,
+    /// Full vertical field of view in radians (perspective) or full width in metres (ortho).
+    pub extent: f32,
+}
+
+impl View {
+    /// World to clip.
+    pub fn view_proj(&self) -> Mat4 {
+        self.proj * self.view
+    }
+
+    /// Push constants for this view; `rsm` carries the RSM size and light index.
+    pub fn constants(&self, rsm: Option<(u32, u32)>) -> ViewConstants {
+        let row = self.view.row(2);
+        let params = match rsm {
+            Some((size, light)) => {
+                let per_texel = if self.orthographic {
+                    // Texel footprint area perpendicular to the light.
+                    (self.extent / size as f32).powi(2)
+                } else {
+                    // Solid angle of a texel on the axis: (2 tan(fov/2) / S)^2.
+                    (2.0 * (0.5 * self.extent).tan() / size as f32).powi(2)
+                };
+                [
+                    per_texel,
+                    f32::from(u8::from(self.orthographic)),
+                    light as f32,
+                    0.0,
+                ]
+            }
+            None => [0.0; 4],
+        };
+        ViewConstants {
+            view_proj: self.view_proj().to_cols_array_2d(),
+            depth_plane: (-row).to_array(),
+            eye: self.eye.extend(1.0).to_array(),
+            params,
+        }
+    }
+}
+
+/// Vulkan clip space from a right-handed GL-style projection: y points down.
+fn flip_y(mut proj: Mat4) -> Mat4 {
+    proj.y_axis.y = -proj.y_axis.y;
+    proj
+}
+
+/// The camera view for a `width`×`height` image.
+pub fn camera_view(scene: &GpuScene, width: u32, height: u32) -> View {
+    let aspect = width as f32 / height.max(1) as f32;
+    let view = scene.camera_world.inverse();
+    let eye = scene.camera_world.transform_point3(Vec3::ZERO);
+    match scene.projection {
+        shine_scene::Projection::Perspective {
+            yfov, znear, zfar, ..
+        } => View {
+            view,
+            proj: flip_y(match zfar {
+                Some(far) => Mat4::perspective_rh(yfov, aspect, znear, far),
+                None => Mat4::perspective_infinite_rh(yfov, aspect, znear),
+            }),
+            eye,
+            orthographic: false,
+            extent: yfov,
+        },
+        shine_scene::Projection::Orthographic {
+            ymag, znear, zfar, ..
+        } => View {
+            view,
+            proj: flip_y(Mat4::orthographic_rh(
+                -ymag * aspect,
+                ymag * aspect,
+                -ymag,
+                ymag,
+                znear,
+                zfar,
+            )),
+            eye,
+            orthographic: true,
+            extent: 2.0 * ymag,
+        },
+    }
+}
+
+/// The primary light's view (the RSM and shadow map): a perspective frustum along a spot
+/// light's axis covering its outer cone, an orthographic box around the scene for a
+/// directional light, or a frustum from a point light towards the scene's centre.
+pub fn light_view(scene: &GpuScene, light_index: usize) -> Option<View> {
+    let light = scene.light_list.get(light_index)?;
+    let (lo, hi) = scene.bounds;
+    let center = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let up_for = |dir: Vec3| if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    match light.light_kind()? {
+        LightKind::Directional => {
+            let dir = Vec3::from(light.direction).normalize_or(Vec3::NEG_Y);
+            let eye = center - dir * radius * 2.0;
+            Some(View {
+                view: Mat4::look_to_rh(eye, dir, up_for(dir)),
+                proj: flip_y(Mat4::orthographic_rh(
+                    -radius,
+                    radius,
+                    -radius,
+                    radius,
+                    0.0,
+                    radius * 4.0,
+                )),
+                eye,
+                orthographic: true,
+                extent: 2.0 * radius,
+            })
+        }
+        kind => {
+            let eye = Vec3::from(light.position);
+            let (dir, fov) = if kind == LightKind::Spot {
+                let dir = Vec3::from(light.direction).normalize_or(Vec3::NEG_Y);
+                (dir, (2.0 * light.outer_cone_angle).clamp(0.1, 2.9))
+            } else {
+                let to_center = center - eye;
+                let distance = to_center.length().max(1e-3);
+                let fov = 2.0 * (radius / distance).min(1.0).asin().max(0.3);
+                (to_center / distance, fov.min(2.9))
+            };
+            let far = (eye - center).length() + radius * 2.0;
+            let near = (far * 1e-3).max(1e-3);
+            Some(View {
+                view: Mat4::look_to_rh(eye, dir, up_for(dir)),
+                proj: flip_y(Mat4::perspective_rh(fov, 1.0, near, far)),
+                eye,
+                orthographic: false,
+                extent: fov,
+            })
+        }
+    }
+}
+
+/// The full-resolution G-buffer images (docs/frame.md).
+#[derive(Clone, Copy, Debug)]
+pub struct GBuffer {
+    /// World position, w = linear view depth (0 on background).
+    pub position: Handle<Image>,
+    /// World shading normal.
+    pub normal: Handle<Image>,
+    /// Linear base colour.
+    pub albedo: Handle<Image>,
+    /// r = roughness, g = metallic.
+    pub material: Handle<Image>,
+    /// Emitted radiance.
+    pub emissive: Handle<Image>,
+    /// Hardware depth.
+    pub depth: Handle<Image>,
+    /// Width and height.
+    pub extent: [u32; 2],
+}
+
+/// The reflective shadow map of the primary light (docs/frame.md); its depth is the shadow map.
+#[derive(Clone, Copy, Debug)]
+pub struct Rsm {
+    /// World position, w = 1 where something is seen.
+    pub position: Handle<Image>,
+    /// World normal.
+    pub normal: Handle<Image>,
+    /// Reflected flux per texel.
+    pub flux: Handle<Image>,
+    /// Light-space depth (the shadow map).
+    pub depth: Handle<Image>,
+    /// The light's view.
+    pub view: View,
+    /// Index of the light in the scene's lights.
+    pub light: u32,
+    /// Edge in texels.
+    pub size: u32,
+}
+
+/// Scene resources imported into a frame graph.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneHandles {
+    /// Vertex buffer.
+    pub vertices: Handle<shine_graph::Buffer>,
+    /// Index buffer.
+    pub indices: Handle<shine_graph::Buffer>,
+    /// Materials.
+    pub materials: Handle<shine_graph::Buffer>,
+    /// Lights.
+    pub lights: Handle<shine_graph::Buffer>,
+    /// sRGB texture array.
+    pub srgb_textures: Handle<Image>,
+    /// Linear texture array.
+    pub linear_textures: Handle<Image>,
+    /// Index count of the single draw.
+    pub index_count: u32,
+}
+
+fn scene_pipeline(
+    fragment: &'static shine_gpu::ShaderDesc,
+    colors: &[vk::Format],
+    depth_bias: Option<(f32, f32)>,
+) -> GraphicsPipelineDesc {
+    GraphicsPipelineDesc {
+        vertex: &shaders::GBUFFER_VERT,
+        fragment: Some(fragment),
+        vertex_buffers: vec![VertexBufferLayout {
+            stride: std::mem::size_of::<Vertex>() as u32,
+            per_instance: false,
+            attributes: vec![(0, 0), (1, 12), (2, 16), (3, 32), (4, 48)],
+        }],
+        topology: vk::PrimitiveTopology::TRIANGLE_LIST,
+        cull_mode: vk::CullModeFlags::NONE,
+        color_targets: colors.iter().map(|f| (*f, Blend::Replace)).collect(),
+        depth: Some(DepthState {
+            format: vk::Format::D32_SFLOAT,
+            compare: vk::CompareOp::LESS_OR_EQUAL,
+            write: true,
+        }),
+        depth_bias,
+    }
+}
+
+/// Rasterises the scene from the camera into a new G-buffer.
+pub fn gbuffer(
+    rg: &mut RenderGraph,
+    scene: &SceneHandles,
+    view: &View,
+    extent: [u32; 2],
+    sampler: vk::Sampler,
+) -> GBuffer {
+    let [w, h] = extent;
+    let image =
+        |rg: &mut RenderGraph, name, format| rg.create_image(name, ImageDesc::new_2d(format, w, h));
+    let mut g = GBuffer {
+        position: image(rg, "gb_position", vk::Format::R32G32B32A32_SFLOAT),
+        normal: image(rg, "gb_normal", vk::Format::R16G16B16A16_SFLOAT),
+        albedo: image(rg, "gb_albedo", vk::Format::R8G8B8A8_UNORM),
+        material: image(rg, "gb_material", vk::Format::R8G8B8A8_UNORM),
+        emissive: image(rg, "gb_emissive", vk::Format::R16G16B16A16_SFLOAT),
+        depth: image(rg, "depth", vk::Format::D32_SFLOAT),
+        extent,
+    };
+    let pipeline = scene_pipeline(
+        &shaders::GBUFFER_FRAG,
+        &[
+            vk::Format::R32G32B32A32_SFLOAT,
+            vk::Format::R16G16B16A16_SFLOAT,
+            vk::Format::R8G8B8A8_UNORM,
+            vk::Format::R8G8B8A8_UNORM,
+            vk::Format::R16G16B16A16_SFLOAT,
+        ],
+        None,
+    );
+    rg.raster("gbuffer", pipeline)
+        .color(&mut g.position, ColorLoad::Clear([0.0; 4]))
+        .color(&mut g.normal, ColorLoad::Clear([0.0; 4]))
+        .color(&mut g.albedo, ColorLoad::Clear([0.0; 4]))
+        .color(&mut g.material, ColorLoad::Clear([0.0; 4]))
+        .color(&mut g.emissive, ColorLoad::Clear([0.0; 4]))
+        .depth(&mut g.depth, DepthLoad::Clear(1.0))
+        .read("materials", &scene.materials)
+        .read("srgb_textures", &scene.srgb_textures)
+        .read("linear_textures", &scene.linear_textures)
+        .sampler("texture_sampler", sampler)
+        .vertex_buffer(&scene.vertices)
+        .index_buffer(&scene.indices, vk::IndexType::UINT32)
+        .push(&view.constants(None))
+        .draw_indexed(scene.index_count, 1);
+    g
+}
+
+/// Rasterises the scene from the primary light into a new `size`² RSM.
+pub fn rsm(
+    rg: &mut RenderGraph,
+    scene: &SceneHandles,
+    view: View,
+    light: u32,
+    size: u32,
+    sampler: vk::Sampler,
+) -> Rsm {
+    let image = |rg: &mut RenderGraph, name, format| {
+        rg.create_image(name, ImageDesc::new_2d(format, size, size))
+    };
+    let mut r = Rsm {
+        position: image(rg, "rsm_position", vk::Format::R32G32B32A32_SFLOAT),
+        normal: image(rg, "rsm_normal", vk::Format::R16G16B16A16_SFLOAT),
+        flux: image(rg, "rsm_flux", vk::Format::R32G32B32A32_SFLOAT),
+        depth: image(rg, "rsm_depth", vk::Format::D32_SFLOAT),
+        view,
+        light,
+        size,
+    };
+    let pipeline = scene_pipeline(
+        &shaders::RSM_FRAG,
+        &[
+            vk::Format::R32G32B32A32_SFLOAT,
+            vk::Format::R16G16B16A16_SFLOAT,
+            vk::Format::R32G32B32A32_SFLOAT,
+        ],
+        // Slope-scaled bias against shadow acne (constant in depth units, slope factor).
+        Some((1.0, 1.5)),
+    );
+    rg.raster("rsm", pipeline)
+        .color(&mut r.position, ColorLoad::Clear([0.0; 4]))
+        .color(&mut r.normal, ColorLoad::Clear([0.0; 4]))
+        .color(&mut r.flux, ColorLoad::Clear([0.0; 4]))
+        .depth(&mut r.depth, DepthLoad::Clear(1.0))
+        .read("materials", &scene.materials)
+        .read("srgb_textures", &scene.srgb_textures)
+        .read("linear_textures", &scene.linear_textures)
+        .read("lights", &scene.lights)
+        .sampler("texture_sampler", sampler)
+        .vertex_buffer(&scene.vertices)
+        .index_buffer(&scene.indices, vk::IndexType::UINT32)
+        .push(&view.constants(Some((size, light))))
+        .draw_indexed(scene.index_count, 1);
+    r
+}
