@@ -7,7 +7,10 @@ use crate::gpu_scene::{GpuScene, SceneUploadError};
 use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
-use shine_graph::{ExecuteError, Executor, ExternalState, Handle, Image, PassTiming, RenderGraph};
+use shine_graph::{
+    ExecuteError, Executor, ExternalState, Handle, Image, ImageDesc, ImageImport, PassTiming,
+    RenderGraph,
+};
 use shine_scene::Scene;
 
 /// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
@@ -72,6 +75,25 @@ pub struct FrameImage {
     pub rgba: Vec<f32>,
     /// GPU time of every pass of the frames rendered since the last readback.
     pub timings: Vec<PassTiming>,
+}
+
+/// A host engine's image that a frame is recorded into (see [`Renderer::record`]).
+#[derive(Clone, Copy, Debug)]
+pub struct HostTarget {
+    /// The image (2D, one mip, one layer); needs `TRANSFER_DST`.
+    pub image: vk::Image,
+    /// A view of it (kept for the graph's bookkeeping; not sampled).
+    pub view: vk::ImageView,
+    /// Its format (a blit converts the frame's HDR radiance to it).
+    pub format: vk::Format,
+    /// Width and height; the frame is rendered at this size.
+    pub extent: [u32; 2],
+    /// Its usage flags.
+    pub usage: vk::ImageUsageFlags,
+    /// Layout, stage and access of the host's last use before the frame.
+    pub before: ExternalState,
+    /// Layout, stage and access of the host's next use: the frame leaves it so.
+    pub after: ExternalState,
 }
 
 /// Renders scenes on a [`Device`].
@@ -167,6 +189,47 @@ impl Renderer {
             rgba: halves.iter().map(|h| f16_to_f32(*h)).collect(),
             timings,
         })
+    }
+
+    /// Records a frame into a host command buffer, ending with the frame blitted into the
+    /// host's image, which is left in `target.after`. The host submits `cb`; it must not record
+    /// more than the executor's frames in flight (2) ahead of the GPU, and must keep the scene
+    /// and this renderer alive until its submissions complete. Per-pass GPU times of earlier
+    /// frames come from [`Renderer::timings`].
+    pub fn record(
+        &mut self,
+        cb: vk::CommandBuffer,
+        target: &HostTarget,
+        params: &FrameParams,
+    ) -> Result<(), RenderError> {
+        let [width, height] = target.extent;
+        let params = FrameParams {
+            width,
+            height,
+            ..*params
+        };
+        let mut rg = self.executor.begin_frame();
+        let frame = self.declare_frame(&mut rg, &params)?;
+        let mut host = rg.import_vk_image(
+            "host target",
+            ImageDesc::new_2d(target.format, width, height),
+            ImageImport {
+                initial: target.before,
+                final_state: target.after,
+                usage: target.usage,
+                read_only: false,
+            },
+            target.image,
+            target.view,
+        );
+        rg.blit_image("to host", &frame, &mut host, vk::Filter::NEAREST);
+        self.executor.execute(cb, rg)?;
+        Ok(())
+    }
+
+    /// GPU times of the passes of frames whose timestamps are available.
+    pub fn timings(&mut self) -> Result<Vec<PassTiming>, RenderError> {
+        Ok(self.executor.timings()?)
     }
 
     /// Declares every pass of a frame; returns the final HDR image.

@@ -238,3 +238,119 @@ fn requirements_name_what_a_host_must_enable() {
         (vk::TRUE, vk::TRUE)
     );
 }
+
+#[test]
+fn a_frame_recorded_into_a_host_command_buffer_lands_in_the_host_image() {
+    let host = Host::new();
+    let device = Device::from_raw(RawDevice {
+        entry: host.entry.clone(),
+        instance: host.instance.clone(),
+        physical_device: host.physical,
+        device: host.device.clone(),
+        queue_family_index: host.family,
+        queue: host.queue,
+        debug_utils: true,
+    })
+    .expect("wrap the host device");
+    let scene = shine_scene::Scene::builtin("cornell-box").expect("scene");
+    let params = shine::renderer::FrameParams {
+        width: 32,
+        height: 32,
+        rsm_size: 64,
+        ..Default::default()
+    };
+    let mut renderer = shine::renderer::Renderer::new(&device).expect("renderer");
+    renderer.set_scene(&scene, 0.0).expect("upload");
+    let reference = renderer.render(&params).expect("reference frame");
+
+    let target = shine::gpu::Image::new(
+        &device,
+        &shine::gpu::ImageDesc::new_2d(
+            "host target",
+            [32, 32],
+            vk::Format::R8G8B8A8_UNORM,
+            vk::ImageUsageFlags::TRANSFER_DST | vk::ImageUsageFlags::TRANSFER_SRC,
+        ),
+    )
+    .expect("target");
+    let after = shine::graph::ExternalState::new(
+        vk::PipelineStageFlags2::COPY,
+        vk::AccessFlags2::TRANSFER_READ,
+        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+    );
+    // SAFETY: host-side command pool, buffer and fence, destroyed below after the wait.
+    unsafe {
+        let pool = host
+            .device
+            .create_command_pool(
+                &vk::CommandPoolCreateInfo::default().queue_family_index(host.family),
+                None,
+            )
+            .expect("pool");
+        let cb = host
+            .device
+            .allocate_command_buffers(
+                &vk::CommandBufferAllocateInfo::default()
+                    .command_pool(pool)
+                    .level(vk::CommandBufferLevel::PRIMARY)
+                    .command_buffer_count(1),
+            )
+            .expect("cb")[0];
+        host.device
+            .begin_command_buffer(cb, &vk::CommandBufferBeginInfo::default())
+            .expect("begin");
+        renderer
+            .record(
+                cb,
+                &shine::renderer::HostTarget {
+                    image: target.raw(),
+                    view: target.view(),
+                    format: target.format(),
+                    extent: [32, 32],
+                    usage: target.usage(),
+                    before: shine::graph::ExternalState::UNDEFINED,
+                    after,
+                },
+                &params,
+            )
+            .expect("record");
+        host.device.end_command_buffer(cb).expect("end");
+        let fence = host
+            .device
+            .create_fence(&vk::FenceCreateInfo::default(), None)
+            .expect("fence");
+        let cbs = [cb];
+        host.device
+            .queue_submit(
+                host.queue,
+                &[vk::SubmitInfo::default().command_buffers(&cbs)],
+                fence,
+            )
+            .expect("submit");
+        host.device
+            .wait_for_fences(&[fence], true, u64::MAX)
+            .expect("wait");
+        host.device.destroy_fence(fence, None);
+        host.device.destroy_command_pool(pool, None);
+    }
+    let pixels = device
+        .read_image(&target, vk::ImageLayout::TRANSFER_SRC_OPTIMAL)
+        .expect("read target");
+    for (i, (&got, &want)) in pixels.iter().zip(&reference.rgba).enumerate() {
+        // The blit converts RGBA16F to UNORM: clamp to [0, 1] and round.
+        let expected = (want.clamp(0.0, 1.0) * 255.0).round();
+        assert!(
+            (f32::from(got) - expected).abs() <= 1.0,
+            "texel {i}: host image {got}, rendered {want}"
+        );
+    }
+    assert!(pixels.iter().any(|&p| p > 0), "the host image stayed black");
+    drop((renderer, target));
+    device.wait_idle().expect("idle");
+    drop(device);
+    assert_eq!(
+        HOST_PROBLEMS.load(Ordering::Relaxed),
+        0,
+        "the host's validation layer reported problems"
+    );
+}

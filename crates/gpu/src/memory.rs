@@ -279,7 +279,19 @@ impl Image {
         // SAFETY: memory from the allocator fits the requirements of `raw`.
         let bound =
             unsafe { raw_device.bind_image_memory(raw, allocation.memory(), allocation.offset()) };
+        // Views exist only for usages that read or write through one (a transfer-only image
+        // may not have a view at all).
+        let viewable = desc.usage.intersects(
+            vk::ImageUsageFlags::SAMPLED
+                | vk::ImageUsageFlags::STORAGE
+                | vk::ImageUsageFlags::COLOR_ATTACHMENT
+                | vk::ImageUsageFlags::DEPTH_STENCIL_ATTACHMENT
+                | vk::ImageUsageFlags::INPUT_ATTACHMENT,
+        );
         let view = bound.and_then(|()| {
+            if !viewable {
+                return Ok(vk::ImageView::null());
+            }
             let view_info = vk::ImageViewCreateInfo::default()
                 .image(raw)
                 .view_type(if desc.array_layers > 1 {
@@ -325,7 +337,8 @@ impl Image {
         self.raw
     }
 
-    /// The view over every mip and layer.
+    /// The view over every mip and layer; null for an image whose usage needs no view
+    /// (transfer only).
     pub fn view(&self) -> vk::ImageView {
         self.view
     }
