@@ -2,10 +2,10 @@
 //! `Device::requirements()`), lends them to shine with `Device::from_raw`, runs shine work, and
 //! still owns working handles after every shine object is gone.
 
+mod common;
+
 use shine::gpu::ash;
-use shine::gpu::{
-    Buffer, BufferDesc, ComputePipeline, Descriptor, Device, MemoryLocation, RawDevice, vk,
-};
+use shine::gpu::{Device, RawDevice, vk};
 use std::ffi::{CStr, c_void};
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -133,6 +133,22 @@ impl Host {
     }
 }
 
+impl Host {
+    /// shine's view of the host's objects.
+    fn lend(&self) -> Device {
+        Device::from_raw(RawDevice {
+            entry: self.entry.clone(),
+            instance: self.instance.clone(),
+            physical_device: self.physical,
+            device: self.device.clone(),
+            queue_family_index: self.family,
+            queue: self.queue,
+            debug_utils: true,
+        })
+        .expect("wrap the host device")
+    }
+}
+
 impl Drop for Host {
     fn drop(&mut self) {
         // SAFETY: the host destroys what it created, after shine's objects are gone.
@@ -150,57 +166,9 @@ impl Drop for Host {
 fn shine_runs_on_a_host_device_and_leaves_it_alive() {
     let host = Host::new();
     {
-        let device = Device::from_raw(RawDevice {
-            entry: host.entry.clone(),
-            instance: host.instance.clone(),
-            physical_device: host.physical,
-            device: host.device.clone(),
-            queue_family_index: host.family,
-            queue: host.queue,
-            debug_utils: true,
-        })
-        .expect("wrap the host device");
-        let pipeline =
-            ComputePipeline::new(&device, &shine::shaders::SH_EVAL_COMP_BANDS1).expect("pipeline");
+        let device = host.lend();
         let dirs: [[f32; 4]; 2] = [[0.0, 0.0, 1.0, 0.0], [1.0, 0.0, 0.0, 0.0]];
-        let input = Buffer::with_data(
-            &device,
-            &BufferDesc {
-                name: "dirs",
-                size: 0,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                location: MemoryLocation::GpuOnly,
-            },
-            bytemuck::cast_slice(&dirs),
-        )
-        .expect("input");
-        let output = Buffer::new(
-            &device,
-            &BufferDesc {
-                name: "y",
-                size: 8,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-                location: MemoryLocation::GpuOnly,
-            },
-        )
-        .expect("output");
-        let count = 2u32;
-        device
-            .run_once(|cmd| {
-                cmd.bind_compute(
-                    &pipeline,
-                    &[
-                        ("directions", Descriptor::from(&input)),
-                        ("coefficients", Descriptor::from(&output)),
-                    ],
-                )?;
-                cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
-                cmd.dispatch_threads(&pipeline, [count, 1, 1]);
-                Ok(())
-            })
-            .expect("dispatch");
-        let y: Vec<f32> =
-            bytemuck::cast_slice(&device.read_buffer(&output).expect("read")).to_vec();
+        let y = common::sh_eval(&device, &shine::shaders::SH_EVAL_COMP_BANDS1, &dirs, 1);
         assert!(y.iter().all(|v| (v - 0.282_094_8).abs() < 1e-6), "{y:?}");
         device.wait_idle().expect("idle");
     }
@@ -242,16 +210,7 @@ fn requirements_name_what_a_host_must_enable() {
 #[test]
 fn a_frame_recorded_into_a_host_command_buffer_lands_in_the_host_image() {
     let host = Host::new();
-    let device = Device::from_raw(RawDevice {
-        entry: host.entry.clone(),
-        instance: host.instance.clone(),
-        physical_device: host.physical,
-        device: host.device.clone(),
-        queue_family_index: host.family,
-        queue: host.queue,
-        debug_utils: true,
-    })
-    .expect("wrap the host device");
+    let device = host.lend();
     let scene = shine_scene::Scene::builtin("cornell-box").expect("scene");
     let params = shine::renderer::FrameParams {
         width: 32,

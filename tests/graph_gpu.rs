@@ -394,3 +394,140 @@ fn indexed_depth_pass_then_sampled_in_compute() {
     assert!(floats(&device, &readback).iter().all(|&d| d == near));
     assert_clean(&device);
 }
+
+/// Frame `frame`: fill a transient with `frame + 1`, then a raw pass copies it into `readback`
+/// and notes which Vulkan buffer the transient was.
+fn fill_through_a_transient(
+    executor: &Executor,
+    readback: &shine::gpu::Buffer,
+    seen: &std::rc::Rc<std::cell::RefCell<Vec<vk::Buffer>>>,
+) -> RenderGraph {
+    let mut rg = executor.begin_frame();
+    let value = executor.frame() as u32 + 1;
+    let mut scratch = rg.create_buffer("scratch", BufferDesc::new(16));
+    let mut out = rg.import_gpu_buffer(readback, ExternalState::UNDEFINED, read_by_copy());
+    rg.fill_buffer("fill", &mut scratch, value);
+    let (src, dst, seen) = (scratch, out, std::rc::Rc::clone(seen));
+    rg.raw_pass("copy_out", move |ctx| {
+        if let (Some(src), Some(dst)) = (ctx.buffer(&src), ctx.buffer(&dst)) {
+            seen.borrow_mut().push(src);
+            let region = vk::BufferCopy {
+                src_offset: 0,
+                dst_offset: 0,
+                size: 16,
+            };
+            // SAFETY: both buffers live for the frame; the graph put them in copy scope.
+            unsafe {
+                ctx.device
+                    .raw()
+                    .cmd_copy_buffer(ctx.cb, src, dst, &[region])
+            };
+        }
+        Ok(())
+    })
+    .read(&scratch, BufferAccess::CopySrc)
+    .write(&mut out, BufferAccess::CopyDst);
+    rg
+}
+
+#[test]
+fn frames_in_flight_never_share_transient_memory() {
+    let device = device();
+    // One name for both, so that every frame has the same shape (and plan).
+    let readbacks = [
+        readback_buffer(&device, "readback", 16),
+        readback_buffer(&device, "readback", 16),
+    ];
+    let seen = std::rc::Rc::new(std::cell::RefCell::new(Vec::new()));
+    let mut executor = Executor::new(&device, 2).unwrap();
+    // Frames 0 and 1 are both submitted before either is waited for.
+    let mut submissions = Vec::new();
+    for readback in &readbacks {
+        let graph = fill_through_a_transient(&executor, readback, &seen);
+        let mut commands = device.begin_commands().unwrap();
+        executor.execute(commands.raw(), graph).unwrap();
+        submissions.push(device.submit(commands).unwrap());
+    }
+    for s in submissions {
+        s.wait().unwrap();
+    }
+    let first = |b: &shine::gpu::Buffer| {
+        let bytes = device.read_buffer(b).unwrap();
+        u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])
+    };
+    assert_eq!([first(&readbacks[0]), first(&readbacks[1])], [1, 2]);
+    // Frame 2 (frame 0 has completed) takes frame 0's slot and its transients back.
+    let graph = fill_through_a_transient(&executor, &readbacks[0], &seen);
+    run(&device, &mut executor, graph);
+    assert_eq!(first(&readbacks[0]), 3);
+    let seen = seen.borrow();
+    assert_ne!(seen[0], seen[1], "frames 0 and 1 shared a transient");
+    assert_eq!(seen[2], seen[0]);
+    assert_eq!(executor.compiler().compilations(), 1);
+    assert_clean(&device);
+}
+
+#[test]
+fn a_temporal_no_pass_touches_is_not_created() {
+    let device = device();
+    let readback = readback_buffer(&device, "readback", 16);
+    let mut executor = Executor::new(&device, 1).unwrap();
+    let mut rg = executor.begin_frame();
+    let idle = rg.temporal_image("idle", ImageDesc::new_2d(vk::Format::R8G8B8A8_UNORM, 4, 4));
+    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+    rg.fill_buffer("fill", &mut out, 7);
+    let plan = run(&device, &mut executor, rg);
+    assert!(!plan.resource(idle.id()).unwrap().used);
+    assert_eq!(device.read_buffer(&readback).unwrap()[0], 7);
+    assert_clean(&device);
+}
+
+#[test]
+fn a_pipeline_that_fails_leaves_the_command_buffer_untouched() {
+    let device = device();
+    let readback = readback_buffer(&device, "readback", u64::from(W * H) * 16);
+    let mut executor = Executor::new(&device, 1).unwrap();
+    // A raw pass first, then a raster pass whose pipeline has an attribute at a location its
+    // vertex shader lacks: creating that pipeline fails.
+    let mut broken = splat_pipeline();
+    broken.vertex_buffers[0].attributes = vec![(7, 0)];
+    broken.depth = None;
+    let recorded = std::rc::Rc::new(std::cell::Cell::new(false));
+    let mut rg = executor.begin_frame();
+    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+    let flag = std::rc::Rc::clone(&recorded);
+    rg.raw_pass("mark", move |_| {
+        flag.set(true);
+        Ok(())
+    })
+    .write(&mut out, BufferAccess::Fill);
+    let mut splats = rg.create_image(
+        "splats",
+        ImageDesc::new_2d(vk::Format::R32G32B32A32_SFLOAT, W, H),
+    );
+    rg.raster("splat", broken)
+        .color(&mut splats, ColorLoad::Clear([0.0; 4]))
+        .draw(3, 1);
+    rg.compute("gather", &shaders::TESTS_GRAPH_GATHER_COMP)
+        .read("splats", &splats)
+        .write("result", &mut out)
+        .push(&[W, H])
+        .dispatch([W, H, 1]);
+    let mut commands = device.begin_commands().unwrap();
+    let error = executor.execute(commands.raw(), rg).unwrap_err();
+    assert!(
+        matches!(error, ExecuteError::Gpu(shine::gpu::Error::Binding { .. })),
+        "{error}"
+    );
+    assert!(!recorded.get(), "a pass was recorded before the failure");
+    assert_eq!(executor.frame(), 0);
+    // Nothing was recorded: submitting the empty recording is valid.
+    device.submit(commands).unwrap().wait().unwrap();
+    let mut rg = executor.begin_frame();
+    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+    rg.fill_buffer("fill", &mut out, 2);
+    run(&device, &mut executor, rg);
+    assert_eq!(device.read_buffer(&readback).unwrap()[0], 2);
+    assert_eq!(executor.timings().unwrap().len(), 1);
+    assert_clean(&device);
+}

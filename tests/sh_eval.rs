@@ -3,7 +3,6 @@
 
 mod common;
 
-use shine::gpu::{Buffer, BufferDesc, ComputePipeline, Descriptor, MemoryLocation, vk};
 use shine::shaders;
 
 /// Directions covering the sphere (Fibonacci lattice) plus the six axes and the poles' sides.
@@ -66,54 +65,6 @@ fn sh_reference(l: u32, m: i32, d: [f64; 3]) -> f64 {
     }
 }
 
-fn run_gpu(
-    device: &shine::gpu::Device,
-    shader: &'static shine::gpu::ShaderDesc,
-    dirs: &[[f32; 4]],
-    coeffs: usize,
-) -> Vec<f32> {
-    let pipeline = ComputePipeline::new(device, shader).expect("pipeline");
-    let input = Buffer::with_data(
-        device,
-        &BufferDesc {
-            name: "directions",
-            size: 0,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::GpuOnly,
-        },
-        bytemuck::cast_slice(dirs),
-    )
-    .expect("input buffer");
-    let output = Buffer::new(
-        device,
-        &BufferDesc {
-            name: "coefficients",
-            size: (dirs.len() * coeffs * 4) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-            location: MemoryLocation::GpuOnly,
-        },
-    )
-    .expect("output buffer");
-    let count = dirs.len() as u32;
-    device
-        .run_once(|cmd| {
-            cmd.begin_scope("sh_eval")?;
-            cmd.bind_compute(
-                &pipeline,
-                &[
-                    ("directions", Descriptor::from(&input)),
-                    ("coefficients", Descriptor::from(&output)),
-                ],
-            )?;
-            cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
-            cmd.dispatch_threads(&pipeline, [count, 1, 1]);
-            cmd.end_scope()
-        })
-        .expect("dispatch");
-    let bytes = device.read_buffer(&output).expect("readback");
-    bytemuck::cast_slice(&bytes).to_vec()
-}
-
 #[test]
 fn sh_eval_matches_cpu_basis_for_bands_1_to_8() {
     let device = common::device();
@@ -132,7 +83,7 @@ fn sh_eval_matches_cpu_basis_for_bands_1_to_8() {
     for (index, shader) in variants.into_iter().enumerate() {
         let bands = index as u32 + 1;
         let coeffs = (bands * bands) as usize;
-        let gpu = run_gpu(&device, shader, &dirs, coeffs);
+        let gpu = common::sh_eval(&device, shader, &dirs, coeffs);
         for (i, d) in dirs.iter().enumerate() {
             let d64 = [d[0] as f64, d[1] as f64, d[2] as f64];
             for l in 0..bands {
@@ -164,7 +115,7 @@ fn condon_shortley_phase_on_the_gpu() {
         [0.0, 1.0, 0.0, 0.0],
         [0.0, 0.0, 1.0, 0.0],
     ];
-    let y = run_gpu(&device, &shaders::SH_EVAL_COMP_BANDS2, &dirs, 4);
+    let y = common::sh_eval(&device, &shaders::SH_EVAL_COMP_BANDS2, &dirs, 4);
     let c1 = 0.488_602_5_f32;
     let expect = |got: f32, want: f32| assert!((got - want).abs() < 1e-6, "{got} vs {want}");
     expect(y[3], -c1); // +x: Y(1,1) = -c1 x

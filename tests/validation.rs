@@ -4,7 +4,7 @@
 
 mod common;
 
-use shine::gpu::{Buffer, BufferDesc, ComputePipeline, Descriptor, MemoryLocation, vk};
+use shine::gpu::{ComputePipeline, Descriptor, vk};
 
 #[test]
 fn a_missing_barrier_is_reported_as_a_sync_hazard() {
@@ -18,18 +18,7 @@ fn a_missing_barrier_is_reported_as_a_sync_hazard() {
     let usage = vk::BufferUsageFlags::STORAGE_BUFFER
         | vk::BufferUsageFlags::TRANSFER_SRC
         | vk::BufferUsageFlags::TRANSFER_DST;
-    let buffer = |name| {
-        Buffer::new(
-            &device,
-            &BufferDesc {
-                name,
-                size: 1024,
-                usage,
-                location: MemoryLocation::GpuOnly,
-            },
-        )
-        .expect("buffer")
-    };
+    let buffer = |name| common::buffer(&device, name, 1024, usage);
     let (input, output, copy) = (buffer("in"), buffer("out"), buffer("copy"));
     let count = 16u32;
     device
@@ -71,16 +60,7 @@ fn bad_bindings_are_errors_not_panics() {
     let device = common::device();
     let pipeline =
         ComputePipeline::new(&device, &shine::shaders::SH_EVAL_COMP_BANDS1).expect("pipeline");
-    let buffer = Buffer::new(
-        &device,
-        &BufferDesc {
-            name: "b",
-            size: 64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::GpuOnly,
-        },
-    )
-    .expect("buffer");
+    let buffer = common::buffer(&device, "b", 64, vk::BufferUsageFlags::STORAGE_BUFFER);
     let mut cmd = device.begin_commands().expect("commands");
     let missing = cmd.bind_compute(&pipeline, &[("directions", Descriptor::from(&buffer))]);
     let message = missing
@@ -131,18 +111,8 @@ fn timestamp_scopes_are_ordered_and_named() {
 #[test]
 fn destruction_waits_for_the_submission_that_may_use_the_object() {
     let device = common::device();
-    let make = |name| {
-        Buffer::new(
-            &device,
-            &BufferDesc {
-                name,
-                size: 256,
-                usage: vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuOnly,
-            },
-        )
-        .expect("buffer")
-    };
+    let usage = vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
+    let make = |name| common::buffer(&device, name, 256, usage);
     // Nothing in flight: a drop destroys at once.
     drop(make("idle"));
     assert_eq!(device.pending_destructions(), 0);
@@ -184,18 +154,8 @@ fn destruction_waits_for_the_submission_that_may_use_the_object() {
 #[test]
 fn an_object_dropped_during_a_recording_outlives_other_submissions() {
     let device = common::device();
-    let make = |name| {
-        Buffer::new(
-            &device,
-            &BufferDesc {
-                name,
-                size: 256,
-                usage: vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuOnly,
-            },
-        )
-        .expect("buffer")
-    };
+    let usage = vk::BufferUsageFlags::TRANSFER_SRC | vk::BufferUsageFlags::TRANSFER_DST;
+    let make = |name| common::buffer(&device, name, 256, usage);
     let (src, dst) = (make("src"), make("dst"));
     let mut frame = device.begin_commands().expect("frame recording");
     let raw = device.raw().clone();

@@ -1,6 +1,11 @@
-//! Shared set-up of the GPU tests: a validated device that fails loudly when absent.
+//! Shared set-up of the GPU tests: a validated device that fails loudly when absent, and the
+//! small resources and dispatches several tests share. (Each test crate uses a subset.)
+#![allow(dead_code)]
 
-use shine::gpu::{Device, DeviceDesc, Validation};
+use shine::gpu::{
+    Buffer, BufferDesc, ComputePipeline, Descriptor, Device, DeviceDesc, MemoryLocation,
+    ShaderDesc, Validation, vk,
+};
 
 /// Creates the test device with the validation layer (synchronization validation on).
 ///
@@ -39,4 +44,68 @@ pub fn assert_clean(device: &Device) {
         counts.warnings,
         device.messages().join("\n")
     );
+}
+
+/// A device-local buffer of `size` bytes.
+pub fn buffer(device: &Device, name: &str, size: u64, usage: vk::BufferUsageFlags) -> Buffer {
+    Buffer::new(
+        device,
+        &BufferDesc {
+            name,
+            size,
+            usage,
+            location: MemoryLocation::GpuOnly,
+        },
+    )
+    .expect("buffer")
+}
+
+/// A device-local storage buffer holding `data`.
+pub fn storage_with(device: &Device, name: &str, data: &[u8]) -> Buffer {
+    Buffer::with_data(
+        device,
+        &BufferDesc {
+            name,
+            size: 0,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+            location: MemoryLocation::GpuOnly,
+        },
+        data,
+    )
+    .expect("storage buffer")
+}
+
+/// Runs a `sh_eval.comp` variant of `coeffs` coefficients over `dirs`; returns the basis values.
+pub fn sh_eval(
+    device: &Device,
+    shader: &'static ShaderDesc,
+    dirs: &[[f32; 4]],
+    coeffs: usize,
+) -> Vec<f32> {
+    let pipeline = ComputePipeline::new(device, shader).expect("pipeline");
+    let input = storage_with(device, "directions", bytemuck::cast_slice(dirs));
+    let output = buffer(
+        device,
+        "coefficients",
+        (dirs.len() * coeffs * 4) as u64,
+        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+    );
+    let count = dirs.len() as u32;
+    device
+        .run_once(|cmd| {
+            cmd.begin_scope("sh_eval")?;
+            cmd.bind_compute(
+                &pipeline,
+                &[
+                    ("directions", Descriptor::from(&input)),
+                    ("coefficients", Descriptor::from(&output)),
+                ],
+            )?;
+            cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
+            cmd.dispatch_threads(&pipeline, [count, 1, 1]);
+            cmd.end_scope()
+        })
+        .expect("dispatch");
+    let bytes = device.read_buffer(&output).expect("readback");
+    bytemuck::cast_slice(&bytes).to_vec()
 }
