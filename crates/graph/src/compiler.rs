@@ -64,6 +64,10 @@ impl Compiler {
 
     /// The plan of `graph`: from the cache when a graph of the same shape was compiled before,
     /// compiled otherwise. `memory` answers the memory needs of transients (for aliasing).
+    ///
+    /// The cache key is the graph's shape only: it assumes `memory` answers alike on every call.
+    /// Use one compiler per device (each [`crate::Executor`] has its own); a compiler asked with
+    /// another device's requirements would return plans whose memory layout fits the first.
     pub fn compile(
         &mut self,
         graph: &RenderGraph,
