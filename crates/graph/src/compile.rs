@@ -230,6 +230,21 @@ fn order(
     Ok(out)
 }
 
+/// The one layout that serves two uses of an image in the same pass, if there is one: their
+/// common layout, or DEPTH_STENCIL_READ_ONLY_OPTIMAL for a depth attachment that is only tested
+/// while shaders sample it (both uses read-only).
+fn shared_layout(first: vk::ImageLayout, second: vk::ImageLayout) -> Option<vk::ImageLayout> {
+    use vk::ImageLayout as L;
+    match (first, second) {
+        _ if first == second => Some(first),
+        (L::DEPTH_STENCIL_READ_ONLY_OPTIMAL, L::SHADER_READ_ONLY_OPTIMAL)
+        | (L::SHADER_READ_ONLY_OPTIMAL, L::DEPTH_STENCIL_READ_ONLY_OPTIMAL) => {
+            Some(L::DEPTH_STENCIL_READ_ONLY_OPTIMAL)
+        }
+        _ => None,
+    }
+}
+
 /// The pass's accesses merged per resource, in first-use order.
 fn merge(graph: &RenderGraph, pass: &PassDecl) -> Result<Vec<PassResource>, GraphError> {
     let mut out: Vec<PassResource> = Vec::new();
@@ -241,14 +256,15 @@ fn merge(graph: &RenderGraph, pass: &PassDecl) -> Result<Vec<PassResource>, Grap
                 info,
             }),
             Some(r) => {
-                if r.info.layout != info.layout {
+                let Some(layout) = shared_layout(r.info.layout, info.layout) else {
                     return Err(GraphError::LayoutConflict {
                         pass: pass.name.clone(),
                         resource: resource_name(graph, a.resource),
                         first: format!("{:?}", r.info.layout),
                         second: format!("{:?}", info.layout),
                     });
-                }
+                };
+                r.info.layout = layout;
                 r.info.stage |= info.stage;
                 r.info.access |= info.access;
                 r.info.usage |= info.usage;

@@ -2,11 +2,12 @@
 //! with its barriers, a debug label and a GPU timestamp scope into the caller's command buffer.
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
 use shine_gpu::{
     ComputePipeline, Descriptor, DescriptorArena, Device, GraphicsPipeline, GraphicsPipelineDesc,
-    MemoryBlock, PipelineLayout, TimestampPool, vk,
+    MemoryBlock, PipelineLayout, ShaderDesc, TimestampPool, vk,
 };
 
 use crate::alias::{HeapClass, MemoryNeeds};
@@ -16,14 +17,15 @@ use crate::error::GraphError;
 use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate};
 use crate::graph::{External, RenderGraph};
 use crate::handle::{Buffer, Handle, Image, ResourceId};
-use crate::plan::{Plan, ResourceKind, Usage};
+use crate::plan::{Plan, PlannedPass, ResourceKind, Usage};
 use crate::resource::AnyDesc;
 use crate::work::{Bound, ComputeWork, Draw, RasterWork, TransferOp, Work};
 
 /// Timestamp scopes one frame may hold (one per pass).
 const SCOPES_PER_FRAME: u32 = 512;
 
-/// Transient sets kept for plans seen recently; older ones are destroyed (after a device wait).
+/// Transient sets kept per frame slot for plans seen recently; older ones are destroyed (after a
+/// device wait).
 const KEPT_TRANSIENT_SETS: usize = 8;
 
 /// GPU time of one executed pass.
@@ -82,9 +84,12 @@ impl RawContext<'_> {
     }
 }
 
-/// The transients of one plan: memory blocks and the objects bound into them.
+/// The transients of one plan for one frame slot: memory blocks and the objects bound into them.
+/// Frames in flight use different slots, so they never share transient memory; a slot is reused
+/// only once its previous frame has completed (the [`Executor`] contract).
 struct TransientSet {
     plan: Arc<Plan>,
+    slot: usize,
     /// Keeps the blocks allocated while the objects live.
     _heaps: Vec<MemoryBlock>,
     objects: Vec<(ResourceId, RawObject)>,
@@ -111,7 +116,8 @@ struct FrameSlot {
 /// The caller owns the command buffers and their submission (so a host engine can embed the
 /// graph). Contract: before `execute` records frame `f`, the submission of frame
 /// `f - frames_in_flight` has completed; [`Executor::timings`] is called only once the frames it
-/// reads have completed.
+/// reads have completed. Frame `f` records with slot `f % frames_in_flight`: its own transient
+/// resources, descriptor sets and timestamps, so frames in flight share none of them.
 pub struct Executor {
     device: Device,
     compiler: Compiler,
@@ -145,6 +151,30 @@ fn pipeline_key(desc: &GraphicsPipelineDesc) -> String {
         desc.depth,
         desc.depth_bias
     )
+}
+
+/// The compute pipeline of `shader`, created on first use.
+fn compute_pipeline<'a>(
+    device: &Device,
+    cache: &'a mut HashMap<&'static str, ComputePipeline>,
+    shader: &'static ShaderDesc,
+) -> Result<&'a ComputePipeline, ExecuteError> {
+    Ok(match cache.entry(shader.name) {
+        Entry::Occupied(e) => e.into_mut(),
+        Entry::Vacant(e) => e.insert(ComputePipeline::new(device, shader)?),
+    })
+}
+
+/// The graphics pipeline of `desc`, created on first use.
+fn graphics_pipeline<'a>(
+    device: &Device,
+    cache: &'a mut HashMap<String, GraphicsPipeline>,
+    desc: &GraphicsPipelineDesc,
+) -> Result<&'a GraphicsPipeline, ExecuteError> {
+    Ok(match cache.entry(pipeline_key(desc)) {
+        Entry::Occupied(e) => e.into_mut(),
+        Entry::Vacant(e) => e.insert(GraphicsPipeline::new(device, desc)?),
+    })
 }
 
 fn image_extent(plan: &Plan, id: ResourceId) -> vk::Extent3D {
@@ -238,14 +268,28 @@ impl Recorder<'_> {
         };
     }
 
-    fn descriptors(&self, bindings: &[(&'static str, Bound)]) -> Vec<(&'static str, Descriptor)> {
+    /// The descriptors of `bindings`. An image is described in the layout the plan gives it
+    /// in `pass` (a sampled depth attachment is in DEPTH_STENCIL_READ_ONLY_OPTIMAL), which is
+    /// the binding's own layout otherwise.
+    fn descriptors(
+        &self,
+        pass: &PlannedPass,
+        bindings: &[(&'static str, Bound)],
+    ) -> Vec<(&'static str, Descriptor)> {
         bindings
             .iter()
             .map(|(name, bound)| {
                 let d = match *bound {
                     Bound::Sampler(s) => Descriptor::Sampler(s),
-                    Bound::Resource(id, layout) => match self.objects[id.0 as usize] {
-                        Some(GpuResource::Image { view, .. }) => Descriptor::Image { view, layout },
+                    Bound::Resource(id, bound_layout) => match self.objects[id.0 as usize] {
+                        Some(GpuResource::Image { view, .. }) => Descriptor::Image {
+                            view,
+                            layout: pass
+                                .resources
+                                .iter()
+                                .find(|r| r.resource == id)
+                                .map_or(bound_layout, |r| r.info.layout),
+                        },
                         _ => Descriptor::Buffer {
                             buffer: self.buffer(id),
                             offset: 0,
@@ -283,6 +327,7 @@ impl Recorder<'_> {
 
     fn compute(
         &self,
+        pass: &PlannedPass,
         work: &ComputeWork,
         pipeline: &ComputePipeline,
         arena: &mut DescriptorArena,
@@ -294,7 +339,7 @@ impl Recorder<'_> {
             self.cb,
             vk::PipelineBindPoint::COMPUTE,
             pipeline.layout(),
-            &self.descriptors(&work.bindings),
+            &self.descriptors(pass, &work.bindings),
         )?;
         self.push(pipeline.layout(), &work.push)?;
         let [x, y, z] = work.shader.groups_for(work.threads);
@@ -305,6 +350,7 @@ impl Recorder<'_> {
 
     fn raster(
         &self,
+        pass: &PlannedPass,
         work: &RasterWork,
         pipeline: &GraphicsPipeline,
         arena: &mut DescriptorArena,
@@ -378,7 +424,7 @@ impl Recorder<'_> {
                 self.cb,
                 vk::PipelineBindPoint::GRAPHICS,
                 pipeline.layout(),
-                &self.descriptors(&work.bindings),
+                &self.descriptors(pass, &work.bindings),
             )
             .map_err(ExecuteError::from)
             .and_then(|()| self.push(pipeline.layout(), &work.push));
@@ -552,20 +598,22 @@ impl Executor {
         Ok(())
     }
 
-    /// The transients of `plan`, created and bound into aliased memory on first use.
-    fn transients_for(&mut self, plan: &Arc<Plan>) -> Result<usize, ExecuteError> {
+    /// The transients of `plan` for frame slot `slot`, created and bound into aliased memory on
+    /// first use.
+    fn transients_for(&mut self, plan: &Arc<Plan>, slot: usize) -> Result<usize, ExecuteError> {
         if let Some(i) = self
             .transients
             .iter()
-            .position(|t| Arc::ptr_eq(&t.plan, plan))
+            .position(|t| t.slot == slot && Arc::ptr_eq(&t.plan, plan))
         {
             // Most recently used last, so eviction takes the least recently used.
             let set = self.transients.remove(i);
             self.transients.push(set);
             return Ok(self.transients.len() - 1);
         }
-        if self.transients.len() >= KEPT_TRANSIENT_SETS {
+        if self.transients.len() >= KEPT_TRANSIENT_SETS * self.slots.len() {
             let old = self.transients.remove(0);
+            // The objects go first, then (when `old` drops) the memory they were bound to.
             self.destroy_after_idle(old.objects.into_iter().map(|(_, o)| o).collect())?;
         }
         let heaps = plan
@@ -612,6 +660,7 @@ impl Executor {
         }
         self.transients.push(TransientSet {
             plan: Arc::clone(plan),
+            slot,
             _heaps: heaps,
             objects,
         });
@@ -624,10 +673,17 @@ impl Executor {
             let ResourceKind::Temporal(key) = &r.kind else {
                 continue;
             };
-            if self
-                .temporal
-                .get(key)
-                .is_some_and(|t| t.desc == r.desc && t.usage == r.usage)
+            // No declared pass touches it: nothing to create (usage 0 is invalid in Vulkan), and
+            // whatever is kept under the key stays.
+            let untouched = match r.usage {
+                Usage::Image(u) => u.is_empty(),
+                Usage::Buffer(u) => u.is_empty(),
+            };
+            if untouched
+                || self
+                    .temporal
+                    .get(key)
+                    .is_some_and(|t| t.desc == r.desc && t.usage == r.usage)
             {
                 continue;
             }
@@ -656,6 +712,7 @@ impl Executor {
                 _memory: memory,
             };
             if let Some(old) = self.temporal.insert(key.clone(), new) {
+                // The object goes first, then (when `old` drops) its memory.
                 self.destroy_after_idle(vec![old.object])?;
             }
         }
@@ -664,14 +721,32 @@ impl Executor {
 
     /// Compiles `graph` (cached while its shape is unchanged) and records it into `cb`, which
     /// must be recording outside a render pass. Returns the plan it ran.
+    ///
+    /// Compilation, resource creation and pipeline creation happen before anything is recorded:
+    /// an error from them leaves `cb` untouched. An error while recording (a raw pass's, a
+    /// binding or push-constant mismatch) leaves every debug label and timestamp scope closed
+    /// but the frame half recorded: don't submit `cb` after any error, and the frame is not
+    /// counted.
     pub fn execute(
         &mut self,
         cb: vk::CommandBuffer,
         mut graph: RenderGraph,
     ) -> Result<Arc<Plan>, ExecuteError> {
         let plan = self.compiler.compile(&graph, &DeviceMemory(&self.device))?;
-        let set = self.transients_for(&plan)?;
+        let slot_index = (self.frame % self.slots.len() as u64) as usize;
+        let set = self.transients_for(&plan, slot_index)?;
         self.ensure_temporal(&plan)?;
+        for pass in &plan.passes {
+            match &graph.works[pass.id.0 as usize] {
+                Work::Compute(c) => {
+                    compute_pipeline(&self.device, &mut self.compute_pipelines, c.shader)?;
+                }
+                Work::Raster(r) => {
+                    graphics_pipeline(&self.device, &mut self.graphics_pipelines, &r.pipeline)?;
+                }
+                Work::Declared | Work::Transfer(_) | Work::Raw(_) => {}
+            }
+        }
 
         let mut objects: Vec<Option<GpuResource>> = vec![None; plan.resources.len()];
         for (id, o) in &self.transients[set].objects {
@@ -681,7 +756,13 @@ impl Executor {
             let slot = &mut objects[r.id.0 as usize];
             match &r.kind {
                 ResourceKind::Transient => {}
-                ResourceKind::Temporal(key) => *slot = self.temporal.get(key).map(|t| t.object.0),
+                ResourceKind::Temporal(key) => {
+                    *slot = self
+                        .temporal
+                        .get(key)
+                        .filter(|t| t.desc == r.desc && t.usage == r.usage)
+                        .map(|t| t.object.0)
+                }
                 ResourceKind::Imported => {
                     *slot = graph.externals[r.id.0 as usize].map(|e| match e {
                         External::Image { image, view } => GpuResource::Image { image, view },
@@ -694,7 +775,6 @@ impl Executor {
             }
         }
 
-        let slot_index = (self.frame % self.slots.len() as u64) as usize;
         let slot = &mut self.slots[slot_index];
         if let Some(frame) = slot.unread.take() {
             self.timings.extend(read_timings(&slot.timestamps, frame)?);
@@ -715,23 +795,12 @@ impl Executor {
             let work = std::mem::replace(&mut graph.works[pass.id.0 as usize], Work::Declared);
             let recorded = match work {
                 Work::Declared => Ok(()),
+                // The pipelines were created above; an error here still closes the scopes.
                 Work::Compute(c) => {
-                    let pipeline = match self.compute_pipelines.entry(c.shader.name) {
-                        std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-                        std::collections::hash_map::Entry::Vacant(e) => {
-                            e.insert(ComputePipeline::new(&self.device, c.shader)?)
-                        }
-                    };
-                    recorder.compute(&c, pipeline, &mut slot.descriptors)
+                    compute_pipeline(&self.device, &mut self.compute_pipelines, c.shader)
+                        .and_then(|p| recorder.compute(pass, &c, p, &mut slot.descriptors))
                 }
                 Work::Raster(r) => {
-                    let key = pipeline_key(&r.pipeline);
-                    let pipeline = match self.graphics_pipelines.entry(key) {
-                        std::collections::hash_map::Entry::Occupied(e) => e.into_mut(),
-                        std::collections::hash_map::Entry::Vacant(e) => {
-                            e.insert(GraphicsPipeline::new(&self.device, &r.pipeline)?)
-                        }
-                    };
                     // Store ops follow from the plan: nothing for a read-only depth, don't-care
                     // at a transient's last use, store otherwise.
                     let attachment = |id: ResourceId| {
@@ -753,7 +822,10 @@ impl Executor {
                         };
                         (layout, store)
                     };
-                    recorder.raster(&r, pipeline, &mut slot.descriptors, attachment)
+                    graphics_pipeline(&self.device, &mut self.graphics_pipelines, &r.pipeline)
+                        .and_then(|p| {
+                            recorder.raster(pass, &r, p, &mut slot.descriptors, attachment)
+                        })
                 }
                 Work::Transfer(op) => {
                     recorder.transfer(op);
@@ -812,17 +884,18 @@ fn read_timings(pool: &TimestampPool, frame: u64) -> Result<Vec<PassTiming>, Exe
 
 impl Drop for Executor {
     fn drop(&mut self) {
-        let mut objects: Vec<RawObject> = self
-            .transients
-            .drain(..)
-            .flat_map(|t| t.objects.into_iter().map(|(_, o)| o))
-            .collect();
-        objects.extend(self.temporal.drain().map(|(_, t)| t.object));
-        // Destruction needs the GPU idle; if waiting fails the device is lost and the objects
-        // are destroyed anyway (nothing can still be using them).
+        // Wait first: freeing memory (a `MemoryBlock` drop) does not wait for submissions the
+        // caller made itself. If waiting fails the device is lost and nothing can still be
+        // using the objects.
         let _ = self.device.wait_idle();
-        for o in objects {
-            o.destroy(&self.device);
+        for set in self.transients.drain(..) {
+            for (_, o) in set.objects {
+                o.destroy(&self.device);
+            }
+            // The set's memory blocks are freed here, after the objects bound to them.
+        }
+        for (_, t) in self.temporal.drain() {
+            t.object.destroy(&self.device);
         }
     }
 }

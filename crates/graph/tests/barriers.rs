@@ -357,3 +357,43 @@ fn two_accesses_of_one_pass_merge_into_one_barrier() {
         )]
     );
 }
+
+#[test]
+fn a_tested_depth_attachment_can_be_sampled_in_the_same_pass() {
+    let mut rg = RenderGraph::new(0);
+    let mut depth = rg.create_image("depth", ImageDesc::new_2d(vk::Format::D32_SFLOAT, 64, 64));
+    let mut color = rg.create_image("color", image());
+    let mut out = output_buffer(&mut rg, "out");
+    rg.pass("prepass", PassKind::Raster)
+        .write(&mut depth, ImageAccess::DepthAttachmentWrite);
+    rg.pass("decals", PassKind::Raster)
+        .read(&depth, ImageAccess::DepthAttachmentRead)
+        .read(&depth, ImageAccess::SampledFragment)
+        .write(&mut color, ImageAccess::ColorAttachmentWrite);
+    rg.pass("resolve", PassKind::Compute)
+        .read(&color, ImageAccess::SampledCompute)
+        .write(&mut out, BufferAccess::StorageWriteCompute);
+    let plan = compile(&rg).unwrap();
+    // Both reads share DEPTH_STENCIL_READ_ONLY_OPTIMAL, reached in one barrier.
+    let tests = S::EARLY_FRAGMENT_TESTS | S::LATE_FRAGMENT_TESTS;
+    assert_eq!(
+        plan.barriers_before("decals")[0],
+        barrier(
+            depth.id(),
+            (tests, A::DEPTH_STENCIL_ATTACHMENT_WRITE),
+            (
+                tests | S::FRAGMENT_SHADER,
+                A::DEPTH_STENCIL_ATTACHMENT_READ | A::SHADER_SAMPLED_READ
+            ),
+            (
+                L::DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+                L::DEPTH_STENCIL_READ_ONLY_OPTIMAL
+            ),
+        )
+    );
+    use vk::ImageUsageFlags as U;
+    assert_eq!(
+        plan.resource(depth.id()).unwrap().usage,
+        Usage::Image(U::DEPTH_STENCIL_ATTACHMENT | U::SAMPLED)
+    );
+}
