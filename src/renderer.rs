@@ -138,9 +138,15 @@ impl Renderer {
         })
     }
 
-    /// Uploads `scene` as it is at time `t` (seconds).
+    /// Uploads `scene` as it is at time `t` (seconds). Replacing a scene first waits for the
+    /// queue to go idle: frames a host recorded with [`Renderer::record`] may still read the
+    /// old one, and shine cannot see host submissions.
     pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
-        self.scene = Some(GpuScene::upload(&self.device, scene, t)?);
+        let uploaded = GpuScene::upload(&self.device, scene, t)?;
+        if self.scene.is_some() {
+            self.device.wait_idle()?;
+        }
+        self.scene = Some(uploaded);
         Ok(())
     }
 
