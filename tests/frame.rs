@@ -3,8 +3,52 @@
 
 mod common;
 
+use glam::{Mat4, Vec3};
 use shine::renderer::{FrameParams, Renderer};
-use shine_scene::Scene;
+use shine_scene::{LightKind, Scene};
+
+/// An upper bound on any pixel's radiance: the brightest emission, plus for every light the
+/// radiance of a white Lambertian receiving it head-on at the closest distance any vertex of
+/// the scene comes to it, times 2 for a specular peak of a normal-incidence GGX lobe with
+/// F0 = 1 at roughness 1 (which stays below 1/π·2). Not tight; catches runaway energy.
+fn radiance_bound(scene: &Scene) -> f32 {
+    let world = scene.rest_world_transforms();
+    let positions: Vec<Vec3> = scene
+        .instances(&world)
+        .iter()
+        .flat_map(|i| {
+            let m = Mat4::from_cols_array_2d(&i.world);
+            scene.meshes[i.mesh as usize]
+                .primitives
+                .iter()
+                .flat_map(move |p| p.positions.iter().map(move |v| m.transform_point3(*v)))
+        })
+        .collect();
+    let emission = scene
+        .materials
+        .iter()
+        .map(|m| m.emissive.iter().copied().fold(0.0, f32::max))
+        .fold(0.0, f32::max);
+    let lights: f32 = scene
+        .lights_at(&world)
+        .iter()
+        .map(|l| {
+            let power = l.intensity * l.color.iter().copied().fold(0.0, f32::max);
+            match l.light_kind() {
+                Some(LightKind::Directional) => power,
+                _ => {
+                    let d = positions
+                        .iter()
+                        .map(|p| p.distance(Vec3::from(l.position)))
+                        .fold(f32::MAX, f32::min)
+                        .max(1e-3);
+                    power / (d * d)
+                }
+            }
+        })
+        .sum();
+    emission + 2.0 * lights / std::f32::consts::PI
+}
 
 fn render(name: &str, params: &FrameParams) -> shine::renderer::FrameImage {
     let device = common::device();
@@ -29,6 +73,10 @@ fn cornell_box_direct_light_is_finite_lit_and_repeatable() {
     assert!(a.rgba.iter().all(|v| v.is_finite()), "non-finite radiance");
     let mean: f32 = a.rgba.chunks(4).map(|p| p[0] + p[1] + p[2]).sum::<f32>() / (64.0 * 64.0);
     assert!(mean > 1e-3, "the frame is black (mean {mean})");
+    let bound = radiance_bound(&Scene::builtin("cornell-box").expect("scene"));
+    let max = a.rgba.iter().copied().fold(0.0, f32::max);
+    eprintln!("max radiance {max}, bound {bound}");
+    assert!(max <= bound, "a pixel of radiance {max} exceeds the energy bound {bound}");
     let b = render("cornell-box", &params);
     assert_eq!(a.rgba, b.rgba, "two runs differ");
     let names: Vec<_> = a.timings.iter().map(|t| t.name.as_str()).collect();
