@@ -6,6 +6,7 @@
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
+pub mod image_io;
 pub mod settings;
 
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
