@@ -7,7 +7,9 @@ pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
 pub mod image_io;
+pub mod passes;
 pub mod settings;
+pub mod tonemap;
 
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
 ///

@@ -1,0 +1,5 @@
+//! The passes of a frame (DESIGN §4, docs/frame.md): one module per pass, each adding its work
+//! to a [`crate::graph::RenderGraph`] and returning its output handles, with a CPU reference of
+//! the same computation for its GPU test.
+
+pub mod composite;
