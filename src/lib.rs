@@ -8,6 +8,7 @@ pub use shine_graph as graph;
 
 pub mod image_io;
 pub mod passes;
+pub mod profile_report;
 pub mod settings;
 pub mod tonemap;
 
