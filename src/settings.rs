@@ -495,8 +495,9 @@ impl Default for UpsampleSettings {
 /// The receiver-buffer scales allowed (DESIGN §4).
 pub const RECEIVER_SCALES: [u32; 3] = [1, 2, 4];
 
-/// Rejects `value` outside `range` (NaN included) with the field's name.
-fn check<T: PartialOrd + fmt::Display>(
+/// Rejects `value` outside `range` (NaN included) with the field's name. Values print with
+/// `Debug` so that floats keep their decimal point (`1.0..=2.0`).
+fn check<T: PartialOrd + fmt::Debug>(
     field: &'static str,
     value: T,
     range: RangeInclusive<T>,
@@ -506,8 +507,8 @@ fn check<T: PartialOrd + fmt::Display>(
     } else {
         Err(SettingsError::OutOfRange {
             field,
-            value: value.to_string(),
-            allowed: format!("{}..={}", range.start(), range.end()),
+            value: format!("{value:?}"),
+            allowed: format!("{:?}..={:?}", range.start(), range.end()),
         })
     }
 }
@@ -561,11 +562,13 @@ impl Settings {
             .and_then(|mut t| t.remove("v"))
             .unwrap_or_else(|| toml::Value::String(value.to_owned()));
         let mut slot = &mut table;
+        let mut section = String::from("the top level");
         let mut parts = key.split('.').peekable();
         while let Some(part) = parts.next() {
-            let entry = slot
-                .get_mut(part)
-                .ok_or_else(|| refuse(format!("no setting named `{part}` here")))?;
+            let known = slot.keys().cloned().collect::<Vec<_>>().join(", ");
+            let entry = slot.get_mut(part).ok_or_else(|| {
+                refuse(format!("no setting `{part}` in {section} (known: {known})"))
+            })?;
             if parts.peek().is_none() {
                 if entry.is_table() {
                     return Err(refuse(format!("`{key}` is a section, not a setting")));
@@ -576,6 +579,7 @@ impl Settings {
             slot = entry
                 .as_table_mut()
                 .ok_or_else(|| refuse(format!("`{part}` is a setting, not a section")))?;
+            section = format!("[{part}]");
         }
         *self = table
             .try_into()
@@ -645,10 +649,10 @@ mod tests {
             ("height", "0", |s| s.height = 0),
             ("height", "20000", |s| s.height = 20000),
             ("frames", "0", |s| s.frames = 0),
-            ("time", "-1", |s| s.time = -1.0),
+            ("time", "-1.0", |s| s.time = -1.0),
             ("time", "NaN", |s| s.time = f32::NAN),
             ("receiver_scale", "3", |s| s.receiver_scale = 3),
-            ("output.exposure", "0", |s| s.output.exposure = 0.0),
+            ("output.exposure", "0.0", |s| s.output.exposure = 0.0),
             ("output.exposure", "inf", |s| {
                 s.output.exposure = f32::INFINITY
             }),
@@ -662,16 +666,16 @@ mod tests {
             ("hvl.emission_bands", "0", |s| s.hvl.emission_bands = 0),
             ("rsm.size", "8", |s| s.rsm.size = 8),
             ("shadow.size", "32", |s| s.shadow.size = 32),
-            ("shadow.filter_radius", "-1", |s| {
+            ("shadow.filter_radius", "-1.0", |s| {
                 s.shadow.filter_radius = -1.0
             }),
-            ("upsample.depth_epsilon", "0", |s| {
+            ("upsample.depth_epsilon", "0.0", |s| {
                 s.upsample.depth_epsilon = 0.0
             }),
             ("upsample.normal_power", "0.5", |s| {
                 s.upsample.normal_power = 0.5
             }),
-            ("upsample.normal_power", "1000", |s| {
+            ("upsample.normal_power", "1000.0", |s| {
                 s.upsample.normal_power = 1000.0
             }),
         ];
@@ -738,6 +742,26 @@ mod tests {
     }
 
     #[test]
+    fn files_load_and_errors_name_them() {
+        let dir = std::env::temp_dir();
+        let good = dir.join(format!("shine-settings-{}-good.toml", std::process::id()));
+        let bad = dir.join(format!("shine-settings-{}-bad.toml", std::process::id()));
+        std::fs::write(&good, "height = 64\n[rsm]\nsize = 256\n").unwrap();
+        std::fs::write(&bad, "[shadow]\nsize = \"big\"\n").unwrap();
+        let loaded = Settings::load(&good);
+        let refused = Settings::load(&bad).unwrap_err().to_string();
+        std::fs::remove_file(&good).unwrap();
+        std::fs::remove_file(&bad).unwrap();
+        let loaded = loaded.unwrap();
+        assert_eq!((loaded.height, loaded.rsm.size), (64, 256));
+        assert!(refused.contains(&bad.display().to_string()), "{refused}");
+        assert!(refused.contains("size"), "{refused}");
+        let missing = dir.join("shine-no-such-settings.toml");
+        let message = Settings::load(&missing).unwrap_err().to_string();
+        assert!(message.contains("shine-no-such-settings.toml"), "{message}");
+    }
+
+    #[test]
     fn unknown_fields_are_rejected() {
         let top = Settings::from_toml_str("widht = 64")
             .unwrap_err()
@@ -751,6 +775,17 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(section.contains("hlv"), "{section}");
+    }
+
+    #[test]
+    fn float_ranges_keep_their_decimal_point() {
+        let message = Settings::from_toml_str("[hvl]\nradius_scale = 2.5")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(
+            message,
+            "setting `hvl.radius_scale` = 2.5 is out of range: allowed 1.0..=2.0"
+        );
     }
 
     #[test]
@@ -838,5 +873,10 @@ mod tests {
             assert!(message.contains(key), "{key}: {message}");
         }
         assert_eq!(settings, Settings::default());
+        let message = settings.set("hvl.cuont", "5").unwrap_err().to_string();
+        assert!(
+            message.contains("no setting `cuont` in [hvl] (known: convolution_bands, count,"),
+            "{message}"
+        );
     }
 }
