@@ -319,8 +319,8 @@ fn csv_field(text: &str) -> String {
 
 /// One event of a Chrome trace (the Trace Event Format Perfetto and chrome://tracing read).
 #[derive(Serialize)]
-struct TraceEvent<'a> {
-    name: &'a str,
+struct TraceEvent {
+    name: String,
     cat: &'static str,
     ph: &'static str,
     /// Microseconds.
@@ -337,13 +337,13 @@ struct TraceEvent<'a> {
 /// The whole trace document.
 #[derive(Serialize)]
 #[serde(rename_all = "camelCase")]
-struct Trace<'a> {
-    trace_events: Vec<TraceEvent<'a>>,
+struct Trace {
+    trace_events: Vec<TraceEvent>,
     display_time_unit: &'static str,
 }
 
 /// The timings as Chrome trace JSON: one track ("GPU"), one complete (`ph: "X"`) event per
-/// pass inside one event per frame, `ts`/`dur` in microseconds.
+/// pass inside one `frame N` event per frame, `ts`/`dur` in microseconds.
 ///
 /// GPU timestamps are relative to each frame's first pass, so frames are laid end to end in
 /// the order given (the idle time between frames is not measured).
@@ -351,7 +351,7 @@ pub fn chrome_trace(timings: &[PassTiming]) -> Result<String, ProfileError> {
     let frames = frames(timings)?;
     let (pid, tid) = (1, 1);
     let metadata = |name: &'static str, value: &str| TraceEvent {
-        name,
+        name: name.to_owned(),
         cat: "__metadata",
         ph: "M",
         ts: None,
@@ -367,7 +367,7 @@ pub fn chrome_trace(timings: &[PassTiming]) -> Result<String, ProfileError> {
     let mut offset_ns = 0.0;
     for frame in &frames {
         events.push(TraceEvent {
-            name: "frame",
+            name: format!("frame {}", frame.frame),
             cat: "frame",
             ph: "X",
             ts: Some(offset_ns / 1e3),
@@ -378,7 +378,7 @@ pub fn chrome_trace(timings: &[PassTiming]) -> Result<String, ProfileError> {
         });
         for t in timings.iter().filter(|t| t.frame == frame.frame) {
             events.push(TraceEvent {
-                name: &t.name,
+                name: t.name.clone(),
                 cat: "pass",
                 ph: "X",
                 ts: Some((offset_ns + t.begin_ns - frame.begin) / 1e3),
@@ -559,6 +559,7 @@ mod tests {
             .map(|e| e["dur"].as_f64().unwrap())
             .collect();
         assert_eq!(frames, [2500.0, 3500.0, 4500.0, 5500.0, 11500.0]);
+        assert_eq!(complete[0]["name"], "frame 7");
         assert_eq!(complete[0]["args"]["frame"], 7);
     }
 
