@@ -7,8 +7,12 @@ pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
 pub mod gpu_scene;
+pub mod image_io;
 pub mod passes;
+pub mod profile_report;
 pub mod renderer;
+pub mod settings;
+pub mod tonemap;
 
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
 ///

@@ -1,5 +1,7 @@
-//! The passes of a frame (DESIGN §4), one module each: a function that adds the pass to a
-//! render graph and returns its output handles. Formats and units: docs/frame.md.
+//! The passes of a frame (DESIGN §4, docs/frame.md): one module per pass, each adding its work
+//! to a [`crate::graph::RenderGraph`] and returning its output handles, with a CPU reference of
+//! the same computation for its GPU test where one exists.
 
+pub mod composite;
 pub mod direct;
 pub mod gbuffer;

@@ -1,0 +1,158 @@
+//! `composite`: direct + indirect radiance × exposure → the HDR frame (RGBA32F, linear) and
+//! the LDR frame (RGBA8, tonemapped and sRGB-encoded) — docs/frame.md, "Direct light and
+//! composition".
+//!
+//! The HDR frame is what EXR output writes (never tonemapped, negative values kept as they
+//! are); the LDR frame is what PNG output writes. Alpha is 1 in both.
+
+use glam::Vec3;
+
+use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::settings::OutputSettings;
+use crate::shaders;
+use crate::tonemap::{self, Tonemap};
+
+/// Format of the `hdr` output: linear radiance, exposure applied.
+pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+/// Format of the `ldr` output: tonemapped, sRGB-encoded values stored as plain UNORM.
+pub const LDR_FORMAT: vk::Format = vk::Format::R8G8B8A8_UNORM;
+/// Format of the `direct` and `indirect_full` inputs.
+pub const INPUT_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+/// What the composite does with the summed radiance.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CompositeParams {
+    /// Linear factor applied to radiance before it is written and tonemapped.
+    pub exposure: f32,
+    /// Operator of the LDR frame.
+    pub tonemap: Tonemap,
+}
+
+impl CompositeParams {
+    /// The parameters chosen by the `[output]` settings.
+    pub fn from_settings(output: &OutputSettings) -> Self {
+        Self {
+            exposure: output.exposure,
+            tonemap: output.tonemap,
+        }
+    }
+}
+
+/// The push constants of `composite.comp` (its `Push` block, 16 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CompositePush {
+    /// Image size in pixels; invocations outside it do nothing.
+    pub extent: [u32; 2],
+    /// [`CompositeParams::exposure`].
+    pub exposure: f32,
+    /// [`Tonemap::shader_id`] of the operator.
+    pub op: u32,
+}
+
+/// The images the composite writes.
+#[derive(Debug)]
+pub struct CompositeOutputs {
+    /// Linear HDR frame, [`HDR_FORMAT`].
+    pub hdr: Handle<Image>,
+    /// Tonemapped LDR frame, [`LDR_FORMAT`].
+    pub ldr: Handle<Image>,
+}
+
+/// Adds the composite pass: reads `direct` and, when given, `indirect` (both [`INPUT_FORMAT`],
+/// `extent`), writes new transient `hdr` and `ldr` images of the same extent.
+///
+/// Without `indirect` the frame is direct light only (`--gi none`).
+pub fn composite(
+    rg: &mut RenderGraph,
+    direct: &Handle<Image>,
+    indirect: Option<&Handle<Image>>,
+    extent: [u32; 2],
+    params: &CompositeParams,
+) -> CompositeOutputs {
+    let [width, height] = extent;
+    let mut hdr = rg.create_image("hdr", ImageDesc::new_2d(HDR_FORMAT, width, height));
+    let mut ldr = rg.create_image("ldr", ImageDesc::new_2d(LDR_FORMAT, width, height));
+    let push = CompositePush {
+        extent,
+        exposure: params.exposure,
+        op: params.tonemap.shader_id(),
+    };
+    let shader = match indirect {
+        Some(_) => &shaders::COMPOSITE_COMP_WITH_INDIRECT,
+        None => &shaders::COMPOSITE_COMP_DIRECT_ONLY,
+    };
+    let mut pass = rg.compute("composite", shader);
+    pass.read("direct", direct);
+    if let Some(indirect) = indirect {
+        pass.read("indirect_full", indirect);
+    }
+    pass.write("hdr", &mut hdr)
+        .write("ldr", &mut ldr)
+        .push(&push)
+        .dispatch([width, height, 1]);
+    CompositeOutputs { hdr, ldr }
+}
+
+/// The CPU reference of one composite texel: the HDR value and the LDR texel.
+///
+/// `direct` and `indirect` are the values the GPU reads (already rounded to half floats).
+pub fn composite_texel(
+    direct: [f32; 4],
+    indirect: Option<[f32; 4]>,
+    params: &CompositeParams,
+) -> ([f32; 4], [u8; 4]) {
+    let mut radiance = Vec3::from_slice(&direct[..3]);
+    if let Some(indirect) = indirect {
+        radiance += Vec3::from_slice(&indirect[..3]);
+    }
+    let exposed = radiance * params.exposure;
+    (
+        exposed.extend(1.0).to_array(),
+        tonemap::encode_ldr(params.tonemap, exposed),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn push_constants_match_the_shader() {
+        for shader in [
+            &shaders::COMPOSITE_COMP_WITH_INDIRECT,
+            &shaders::COMPOSITE_COMP_DIRECT_ONLY,
+        ] {
+            assert_eq!(
+                shader.push_constant_size as usize,
+                std::mem::size_of::<CompositePush>(),
+                "{}",
+                shader.name
+            );
+        }
+        assert!(
+            shaders::COMPOSITE_COMP_WITH_INDIRECT
+                .binding("indirect_full")
+                .is_some()
+        );
+        assert!(
+            shaders::COMPOSITE_COMP_DIRECT_ONLY
+                .binding("indirect_full")
+                .is_none()
+        );
+    }
+
+    #[test]
+    fn reference_adds_then_exposes() {
+        let params = CompositeParams {
+            exposure: 0.5,
+            tonemap: Tonemap::None,
+        };
+        let (hdr, ldr) =
+            composite_texel([1.0, 0.25, 0.0, 0.0], Some([1.0, 0.0, 0.5, 0.0]), &params);
+        assert_eq!(hdr, [1.0, 0.125, 0.25, 1.0]);
+        assert_eq!(ldr[0], 255);
+        let (direct_only, _) = composite_texel([1.0, 0.25, 0.0, 0.0], None, &params);
+        assert_eq!(direct_only, [0.5, 0.125, 0.0, 1.0]);
+    }
+}
