@@ -7,7 +7,8 @@
 
 use shine::gpu::{Device, Image, ImageDesc, RawDevice, ash, vk};
 use shine::graph::ExternalState;
-use shine::renderer::{FrameParams, HostTarget, Renderer};
+use shine::renderer::{HostTarget, Renderer};
+use shine::settings::Settings;
 use std::error::Error;
 
 fn main() -> Result<(), Box<dyn Error>> {
@@ -113,7 +114,11 @@ fn main() -> Result<(), Box<dyn Error>> {
                         vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
                     ),
                 },
-                &FrameParams::default(),
+                &Settings {
+                    width,
+                    height,
+                    ..Settings::default()
+                },
             )?;
             device.end_command_buffer(cb)?;
             let fence = device.create_fence(&vk::FenceCreateInfo::default(), None)?;

@@ -4,17 +4,23 @@
 //! (cached while the shape is unchanged), records it and times every pass.
 
 use crate::gpu_scene::{GpuScene, SceneUploadError};
+use crate::image_io::{HdrImage, ImageIoError, LdrImage};
+use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
 use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
+use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
-    ExecuteError, Executor, ExternalState, Handle, Image, ImageDesc, ImageImport, PassTiming,
-    RenderGraph,
+    ExecuteError, Executor, ExternalState, ImageDesc, ImageImport, PassTiming, RenderGraph,
 };
 use shine_scene::Scene;
 
 /// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
 const FRAMES_IN_FLIGHT: usize = 2;
+/// Shadow-map depth bias in NDC depth units, on top of the raster slope bias.
+const SHADOW_DEPTH_BIAS: f32 = 1e-4;
+/// Receiver offset along its normal in shadow-map texels (removes acne at grazing angles).
+const SHADOW_NORMAL_OFFSET: f32 = 1.5;
 
 /// What can go wrong while rendering.
 #[derive(Debug, thiserror::Error)]
@@ -28,6 +34,12 @@ pub enum RenderError {
     /// The scene could not be uploaded.
     #[error(transparent)]
     Scene(#[from] SceneUploadError),
+    /// The settings are invalid.
+    #[error(transparent)]
+    Settings(#[from] SettingsError),
+    /// A read-back frame did not match its expected size.
+    #[error(transparent)]
+    Image(#[from] ImageIoError),
     /// `render` was called before `set_scene`.
     #[error("no scene: call set_scene first")]
     NoScene,
@@ -36,43 +48,13 @@ pub enum RenderError {
     Invalid(String),
 }
 
-/// Per-frame parameters of the first frame (direct light, RSM, shadows).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FrameParams {
-    /// Output width in pixels.
-    pub width: u32,
-    /// Output height in pixels.
-    pub height: u32,
-    /// Edge of the reflective shadow map (and shadow map) in texels.
-    pub rsm_size: u32,
-    /// Shadow filtering.
-    pub shadow: ShadowParams,
-}
-
-impl Default for FrameParams {
-    fn default() -> Self {
-        Self {
-            width: 256,
-            height: 256,
-            rsm_size: 512,
-            shadow: ShadowParams {
-                pcf_radius: 2,
-                bias: 1e-4,
-                normal_offset: 1.5,
-            },
-        }
-    }
-}
-
 /// A rendered frame read back to the CPU.
 #[derive(Clone, Debug)]
 pub struct FrameImage {
-    /// Width in pixels.
-    pub width: u32,
-    /// Height in pixels.
-    pub height: u32,
-    /// Linear HDR radiance, RGBA, row-major from the top-left.
-    pub rgba: Vec<f32>,
+    /// Linear HDR radiance after exposure (what EXR files hold).
+    pub hdr: HdrImage,
+    /// Tonemapped, sRGB-encoded (what PNG files hold).
+    pub ldr: LdrImage,
     /// GPU time of every pass of the frames rendered since the last readback.
     pub timings: Vec<PassTiming>,
 }
@@ -150,51 +132,98 @@ impl Renderer {
         Ok(())
     }
 
-    /// Renders one frame and reads its HDR radiance back.
-    pub fn render(&mut self, params: &FrameParams) -> Result<FrameImage, RenderError> {
-        let FrameParams { width, height, .. } = *params;
-        if width == 0 || height == 0 || params.rsm_size == 0 {
-            return Err(RenderError::Invalid(format!(
-                "image {width}×{height} and RSM size {} must be positive",
-                params.rsm_size
-            )));
-        }
-        let texel_bytes = 8u64; // RGBA16F
-        let readback = Buffer::new(
-            &self.device,
-            &BufferDesc {
-                name: "frame readback",
-                size: u64::from(width) * u64::from(height) * texel_bytes,
-                usage: vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
-                location: MemoryLocation::GpuOnly,
-            },
-        )?;
+    /// Renders one frame with `settings` and reads its HDR and LDR images back.
+    pub fn render(&mut self, settings: &Settings) -> Result<FrameImage, RenderError> {
+        settings.validate()?;
+        let (width, height) = (settings.width, settings.height);
+        let pixels = u64::from(width) * u64::from(height);
+        let readback = |name, bytes_per_texel: u64| {
+            Buffer::new(
+                &self.device,
+                &BufferDesc {
+                    name,
+                    size: pixels * bytes_per_texel,
+                    usage: vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
+        };
+        let (hdr_buffer, ldr_buffer) =
+            (readback("hdr readback", 16)?, readback("ldr readback", 4)?);
         let mut rg = self.executor.begin_frame();
-        let output = self.declare_frame(&mut rg, params)?;
-        let mut out = rg.import_gpu_buffer(
-            &readback,
-            ExternalState::UNDEFINED,
-            ExternalState::new(
-                vk::PipelineStageFlags2::COPY,
-                vk::AccessFlags2::TRANSFER_READ,
-                vk::ImageLayout::UNDEFINED,
-            ),
+        let frame = self.declare_frame(&mut rg, settings)?;
+        let read_by_copy = ExternalState::new(
+            vk::PipelineStageFlags2::COPY,
+            vk::AccessFlags2::TRANSFER_READ,
+            vk::ImageLayout::UNDEFINED,
         );
-        rg.copy_image_to_buffer("readback", &output, &mut out);
+        let mut hdr_out = rg.import_gpu_buffer(&hdr_buffer, ExternalState::UNDEFINED, read_by_copy);
+        let mut ldr_out = rg.import_gpu_buffer(&ldr_buffer, ExternalState::UNDEFINED, read_by_copy);
+        rg.copy_image_to_buffer("readback hdr", &frame.hdr, &mut hdr_out);
+        rg.copy_image_to_buffer("readback ldr", &frame.ldr, &mut ldr_out);
+        self.run(rg)?;
+        let timings = self.executor.timings()?;
+        Ok(FrameImage {
+            hdr: HdrImage::from_rgba32f_bytes(
+                width,
+                height,
+                &self.device.read_buffer(&hdr_buffer)?,
+            )?,
+            ldr: LdrImage::from_rgba8_bytes(width, height, &self.device.read_buffer(&ldr_buffer)?)?,
+            timings,
+        })
+    }
 
+    /// Renders `count` frames without reading them back (profiling); returns the pass timings
+    /// of every frame.
+    pub fn render_timed(
+        &mut self,
+        settings: &Settings,
+        count: u32,
+    ) -> Result<Vec<PassTiming>, RenderError> {
+        settings.validate()?;
+        let mut timings = Vec::new();
+        for _ in 0..count {
+            let mut rg = self.executor.begin_frame();
+            let frame = self.declare_frame(&mut rg, settings)?;
+            // The frame's outputs must reach something outside the graph, or every pass is
+            // culled: the LDR image is handed to a throw-away import.
+            let sink = self.sink(settings)?;
+            let mut out = rg.import_gpu_image(
+                &sink,
+                ExternalState::UNDEFINED,
+                ExternalState::new(
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::MEMORY_READ,
+                    vk::ImageLayout::GENERAL,
+                ),
+            );
+            rg.blit_image("present", &frame.ldr, &mut out, vk::Filter::NEAREST);
+            self.run(rg)?;
+            timings.extend(self.executor.timings()?);
+        }
+        Ok(timings)
+    }
+
+    fn sink(&self, settings: &Settings) -> Result<shine_gpu::Image, RenderError> {
+        Ok(shine_gpu::Image::new(
+            &self.device,
+            &shine_gpu::ImageDesc::new_2d(
+                "profile sink",
+                [settings.width, settings.height],
+                composite::LDR_FORMAT,
+                vk::ImageUsageFlags::TRANSFER_DST,
+            ),
+        )?)
+    }
+
+    /// Records, submits and waits for one frame graph.
+    fn run(&mut self, rg: RenderGraph) -> Result<(), RenderError> {
         let mut commands = self.device.begin_commands()?;
         let cb = commands.raw();
         self.executor.execute(cb, rg)?;
         self.device.submit(commands)?.wait()?;
-        let timings = self.executor.timings()?;
-        let bytes = self.device.read_buffer(&readback)?;
-        let halves: &[u16] = bytemuck::cast_slice(&bytes);
-        Ok(FrameImage {
-            width,
-            height,
-            rgba: halves.iter().map(|h| f16_to_f32(*h)).collect(),
-            timings,
-        })
+        Ok(())
     }
 
     /// Records a frame into a host command buffer, ending with the frame blitted into the
@@ -206,16 +235,17 @@ impl Renderer {
         &mut self,
         cb: vk::CommandBuffer,
         target: &HostTarget,
-        params: &FrameParams,
+        settings: &Settings,
     ) -> Result<(), RenderError> {
         let [width, height] = target.extent;
-        let params = FrameParams {
+        let settings = Settings {
             width,
             height,
-            ..*params
+            ..settings.clone()
         };
+        settings.validate()?;
         let mut rg = self.executor.begin_frame();
-        let frame = self.declare_frame(&mut rg, &params)?;
+        let frame = self.declare_frame(&mut rg, &settings)?;
         let mut host = rg.import_vk_image(
             "host target",
             ImageDesc::new_2d(target.format, width, height),
@@ -228,7 +258,13 @@ impl Renderer {
             target.image,
             target.view,
         );
-        rg.blit_image("to host", &frame, &mut host, vk::Filter::NEAREST);
+        // The tonemapped image for a UNORM/sRGB target, the HDR one for a float target.
+        let source = if is_float(target.format) {
+            frame.hdr
+        } else {
+            frame.ldr
+        };
+        rg.blit_image("to host", &source, &mut host, vk::Filter::NEAREST);
         self.executor.execute(cb, rg)?;
         Ok(())
     }
@@ -238,12 +274,12 @@ impl Renderer {
         Ok(self.executor.timings()?)
     }
 
-    /// Declares every pass of a frame; returns the final HDR image.
+    /// Declares every pass of a frame; returns its HDR and LDR images.
     fn declare_frame(
         &self,
         rg: &mut RenderGraph,
-        params: &FrameParams,
-    ) -> Result<Handle<Image>, RenderError> {
+        settings: &Settings,
+    ) -> Result<CompositeOutputs, RenderError> {
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
         let read_only = ExternalState::new(
             vk::PipelineStageFlags2::ALL_COMMANDS,
@@ -264,51 +300,51 @@ impl Renderer {
             linear_textures: rg.import_gpu_image(&scene.linear_textures, read_only, read_only),
             index_count: scene.index_count,
         };
-        let camera = gbuffer::camera_view(scene, params.width, params.height);
-        let g = gbuffer::gbuffer(
-            rg,
-            &handles,
-            &camera,
-            [params.width, params.height],
-            self.linear.raw(),
-        );
-        let rsm = scene
+        let extent = [settings.width, settings.height];
+        let camera = gbuffer::camera_view(scene, settings.width, settings.height);
+        let g = gbuffer::gbuffer(rg, &handles, &camera, extent, self.linear.raw());
+        let primary = scene
             .primary_light()
-            .and_then(|i| Some((i, gbuffer::light_view(scene, i)?)))
-            .map(|(i, view)| {
-                gbuffer::rsm(
-                    rg,
-                    &handles,
-                    view,
-                    i as u32,
-                    params.rsm_size,
-                    self.linear.raw(),
-                )
-            });
+            .and_then(|i| Some((i as u32, gbuffer::light_view(scene, i)?)));
+        let shadow_map = primary
+            .map(|(i, view)| gbuffer::shadow_map(rg, &handles, view, i, settings.shadow.size));
         let light_count = u32::try_from(scene.light_list.len())
             .map_err(|_| RenderError::Invalid("too many lights".into()))?;
-        Ok(direct::direct(
+        let shadow = ShadowParams {
+            // The setting is a radius in texels; the kernel covers whole texels around it.
+            pcf_radius: settings.shadow.filter_radius.round() as u32,
+            bias: SHADOW_DEPTH_BIAS,
+            normal_offset: SHADOW_NORMAL_OFFSET,
+        };
+        let direct = direct::direct(
             rg,
             &g,
             &handles,
             light_count,
-            rsm.as_ref(),
+            shadow_map.as_ref(),
             camera.eye,
-            params.shadow,
+            shadow,
             self.nearest.raw(),
+        );
+        Ok(composite::composite(
+            rg,
+            &direct,
+            None,
+            extent,
+            &CompositeParams::from_settings(&settings.output),
         ))
     }
 }
 
-/// IEEE 754 half to single precision (RGBA16F readback).
-fn f16_to_f32(h: u16) -> f32 {
-    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let exponent = i32::from((h >> 10) & 0x1f);
-    let mantissa = f32::from(h & 0x3ff);
-    match exponent {
-        0 => sign * mantissa * 2f32.powi(-24),
-        31 if mantissa == 0.0 => sign * f32::INFINITY,
-        31 => f32::NAN,
-        e => sign * (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
-    }
+/// Whether a format holds floats (the HDR image is blitted to it) rather than normalised
+/// integers (the tonemapped image is).
+fn is_float(format: vk::Format) -> bool {
+    matches!(
+        format,
+        vk::Format::R16G16B16A16_SFLOAT
+            | vk::Format::R32G32B32A32_SFLOAT
+            | vk::Format::B10G11R11_UFLOAT_PACK32
+            | vk::Format::R16G16B16_SFLOAT
+            | vk::Format::R32G32B32_SFLOAT
+    )
 }

@@ -4,7 +4,8 @@
 mod common;
 
 use glam::{Mat4, Vec3};
-use shine::renderer::{FrameParams, Renderer};
+use shine::renderer::Renderer;
+use shine::settings::{GiTechniques, Settings};
 use shine_scene::{LightKind, Scene};
 
 /// An upper bound on any pixel's radiance: the brightest emission, plus for every light the
@@ -50,37 +51,49 @@ fn radiance_bound(scene: &Scene) -> f32 {
     emission + 2.0 * lights / std::f32::consts::PI
 }
 
-fn render(name: &str, params: &FrameParams) -> shine::renderer::FrameImage {
+fn render(name: &str, settings: &Settings) -> shine::renderer::FrameImage {
     let device = common::device();
     let scene = Scene::builtin(name).expect("built-in scene");
     let mut renderer = Renderer::new(&device).expect("renderer");
     renderer.set_scene(&scene, 0.0).expect("upload");
-    let frame = renderer.render(params).expect("frame");
+    let frame = renderer.render(settings).expect("frame");
     drop(renderer);
     common::assert_clean(&device);
     frame
 }
 
-#[test]
-fn cornell_box_direct_light_is_finite_lit_and_repeatable() {
-    let params = FrameParams {
+/// 64×64, direct light only, small shadow map.
+fn small_direct_only() -> Settings {
+    let mut s = Settings {
         width: 64,
         height: 64,
-        rsm_size: 64,
-        ..FrameParams::default()
+        gi: GiTechniques::none(),
+        ..Settings::default()
     };
-    let a = render("cornell-box", &params);
-    assert!(a.rgba.iter().all(|v| v.is_finite()), "non-finite radiance");
-    let mean: f32 = a.rgba.chunks(4).map(|p| p[0] + p[1] + p[2]).sum::<f32>() / (64.0 * 64.0);
+    s.shadow.size = 256;
+    s
+}
+
+#[test]
+fn cornell_box_direct_light_is_finite_lit_and_repeatable() {
+    let settings = small_direct_only();
+    let a = render("cornell-box", &settings);
+    let hdr: Vec<f32> = a.hdr.texels.iter().flatten().copied().collect();
+    assert!(hdr.iter().all(|v| v.is_finite()), "non-finite radiance");
+    let mean: f32 = a.hdr.texels.iter().map(|p| p[0] + p[1] + p[2]).sum::<f32>() / (64.0 * 64.0);
     assert!(mean > 1e-3, "the frame is black (mean {mean})");
     let bound = radiance_bound(&Scene::builtin("cornell-box").expect("scene"));
-    let max = a.rgba.iter().copied().fold(0.0, f32::max);
+    let max = hdr.iter().copied().fold(0.0, f32::max);
     eprintln!("max radiance {max}, bound {bound}");
-    assert!(max <= bound, "a pixel of radiance {max} exceeds the energy bound {bound}");
-    let b = render("cornell-box", &params);
-    assert_eq!(a.rgba, b.rgba, "two runs differ");
+    assert!(
+        max <= bound,
+        "a pixel of radiance {max} exceeds the energy bound {bound}"
+    );
+    let b = render("cornell-box", &settings);
+    assert_eq!(a.hdr.texels, b.hdr.texels, "two runs differ (HDR)");
+    assert_eq!(a.ldr.texels, b.ldr.texels, "two runs differ (LDR)");
     let names: Vec<_> = a.timings.iter().map(|t| t.name.as_str()).collect();
-    for pass in ["gbuffer", "rsm", "direct"] {
+    for pass in ["gbuffer", "shadow", "direct", "composite"] {
         assert!(names.contains(&pass), "no timing for {pass}: {names:?}");
     }
 }

@@ -1,7 +1,7 @@
 //! `direct`: the punctual lights on the G-buffer (Lambert + GGX), the primary light shadowed
 //! through the RSM depth with a PCF kernel, plus emission (docs/frame.md).
 
-use super::gbuffer::{GBuffer, Rsm, SceneHandles};
+use super::gbuffer::{GBuffer, SceneHandles, ShadowMap};
 use crate::shaders;
 use shine_gpu::vk;
 use shine_graph::{Handle, Image, ImageDesc, RenderGraph};
@@ -39,7 +39,7 @@ pub fn direct(
     gbuffer: &GBuffer,
     scene: &SceneHandles,
     light_count: u32,
-    rsm: Option<&Rsm>,
+    shadow_map: Option<&ShadowMap>,
     eye: glam::Vec3,
     shadow: ShadowParams,
     sampler: vk::Sampler,
@@ -49,13 +49,13 @@ pub fn direct(
         "direct",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
-    // Without an RSM the shadow binding still needs an image: the G-buffer depth is bound
+    // Without a shadow map the shadow binding still needs an image: the G-buffer depth is bound
     // and ignored (counts.w = 0).
-    let (shadow_depth, view_proj, primary, has_shadow) = match rsm {
+    let (shadow_depth, view_proj, primary, has_shadow) = match shadow_map {
         Some(r) => (r.depth, r.view.view_proj(), r.light, 1),
         None => (gbuffer.depth, glam::Mat4::IDENTITY, u32::MAX, 0),
     };
-    let (texel, orthographic) = match rsm {
+    let (texel, orthographic) = match shadow_map {
         Some(r) if r.view.orthographic => (r.view.extent / r.size as f32, 1.0),
         Some(r) => (2.0 * (0.5 * r.view.extent).tan() / r.size as f32, 0.0),
         None => (0.0, 0.0),

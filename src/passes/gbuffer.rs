@@ -187,7 +187,50 @@ pub struct GBuffer {
     pub extent: [u32; 2],
 }
 
-/// The reflective shadow map of the primary light (docs/frame.md); its depth is the shadow map.
+/// The primary light's shadow map: depth only, from the same view as the RSM but at its own
+/// (usually higher) resolution.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowMap {
+    /// Light-space depth.
+    pub depth: Handle<Image>,
+    /// The light's view.
+    pub view: View,
+    /// Index of the light in the scene's lights.
+    pub light: u32,
+    /// Edge in texels.
+    pub size: u32,
+}
+
+/// Rasterises the scene's depth from the primary light into a new `size`² shadow map.
+pub fn shadow_map(
+    rg: &mut RenderGraph,
+    scene: &SceneHandles,
+    view: View,
+    light: u32,
+    size: u32,
+) -> ShadowMap {
+    let mut depth = rg.create_image(
+        "shadow_depth",
+        ImageDesc::new_2d(vk::Format::D32_SFLOAT, size, size),
+    );
+    // Slope-scaled bias against acne (constant in depth units, slope factor); the direct pass
+    // adds a normal offset on top.
+    let pipeline = scene_pipeline(None, &[], Some((1.0, 1.5)));
+    rg.raster("shadow", pipeline)
+        .depth(&mut depth, DepthLoad::Clear(1.0))
+        .vertex_buffer(&scene.vertices)
+        .index_buffer(&scene.indices, vk::IndexType::UINT32)
+        .push(&view.constants(None))
+        .draw_indexed(scene.index_count, 1);
+    ShadowMap {
+        depth,
+        view,
+        light,
+        size,
+    }
+}
+
+/// The reflective shadow map of the primary light (docs/frame.md).
 #[derive(Clone, Copy, Debug)]
 pub struct Rsm {
     /// World position, w = 1 where something is seen.
@@ -196,7 +239,7 @@ pub struct Rsm {
     pub normal: Handle<Image>,
     /// Reflected flux per texel.
     pub flux: Handle<Image>,
-    /// Light-space depth (the shadow map).
+    /// Light-space depth.
     pub depth: Handle<Image>,
     /// The light's view.
     pub view: View,
@@ -226,13 +269,13 @@ pub struct SceneHandles {
 }
 
 fn scene_pipeline(
-    fragment: &'static shine_gpu::ShaderDesc,
+    fragment: Option<&'static shine_gpu::ShaderDesc>,
     colors: &[vk::Format],
     depth_bias: Option<(f32, f32)>,
 ) -> GraphicsPipelineDesc {
     GraphicsPipelineDesc {
         vertex: &shaders::GBUFFER_VERT,
-        fragment: Some(fragment),
+        fragment,
         vertex_buffers: vec![VertexBufferLayout {
             stride: std::mem::size_of::<Vertex>() as u32,
             per_instance: false,
@@ -271,7 +314,7 @@ pub fn gbuffer(
         extent,
     };
     let pipeline = scene_pipeline(
-        &shaders::GBUFFER_FRAG,
+        Some(&shaders::GBUFFER_FRAG),
         &[
             vk::Format::R32G32B32A32_SFLOAT,
             vk::Format::R16G16B16A16_SFLOAT,
@@ -321,14 +364,13 @@ pub fn rsm(
         size,
     };
     let pipeline = scene_pipeline(
-        &shaders::RSM_FRAG,
+        Some(&shaders::RSM_FRAG),
         &[
             vk::Format::R32G32B32A32_SFLOAT,
             vk::Format::R16G16B16A16_SFLOAT,
             vk::Format::R32G32B32A32_SFLOAT,
         ],
-        // Slope-scaled bias against shadow acne (constant in depth units, slope factor).
-        Some((1.0, 1.5)),
+        None,
     );
     rg.raster("rsm", pipeline)
         .color(&mut r.position, ColorLoad::Clear([0.0; 4]))
