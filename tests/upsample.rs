@@ -286,8 +286,19 @@ fn bad_scales_extents_and_parameters_are_errors() {
         ..UpsampleParams::default()
     };
     assert!(upsample(&mut rg, &r.position, &r, &g, &bad).is_err());
-    // The radiance must be at the receiver extent.
-    assert!(upsample(&mut rg, &h, &r, &g, &UpsampleParams::default()).is_err());
+    // The radiance must be RGBA16F at the receiver extent.
+    let params = UpsampleParams::default();
+    assert!(upsample(&mut rg, &h, &r, &g, &params).is_err());
+    let wrong_size = rg.create_image(
+        "wrong_size",
+        shine::graph::ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, 8, 8),
+    );
+    assert!(upsample(&mut rg, &wrong_size, &r, &g, &params).is_err());
+    let right = rg.create_image(
+        "right",
+        shine::graph::ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, 4, 4),
+    );
+    assert!(upsample(&mut rg, &right, &r, &g, &params).is_ok());
 }
 
 #[test]

@@ -32,6 +32,14 @@ pub enum ReceiverError {
         /// The extent it must have.
         expected: [u32; 2],
     },
+    /// An image has the wrong format.
+    #[error("`{name}` is {found:?}, expected R16G16B16A16_SFLOAT")]
+    Format {
+        /// The offending image.
+        name: &'static str,
+        /// Its format.
+        found: vk::Format,
+    },
     /// A tuning parameter is out of its range.
     #[error("upsample parameter {0}")]
     Parameter(&'static str),

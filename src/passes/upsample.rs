@@ -31,8 +31,9 @@ use crate::shaders;
 pub const NORMAL_POWER_N: f32 = 32.0;
 
 /// σ_z: the relative depth difference `|z_p − z_i| / z_p` that halves `w^z` (eq. 11, paper
-/// 002, whose ε this scales with depth). 1 %: a depth ratio of 2 across an edge weighs a
-/// sample from the other side about 1/50 to 1/100 of one from the same side.
+/// 002, whose ε this scales with depth). 1 %: across an edge with a depth ratio of 2 a
+/// receiver from the other side has `w^z` ≈ 1/50 to 1/100, below [`MIN_MATCH_MU`]; along a
+/// sloped floor seen at 1080p, neighbouring 1/4-resolution receivers differ by about 1–6 %.
 pub const DEPTH_SIGMA: f32 = 0.01;
 
 /// μ: the match `w^z · w^N` a receiver needs to "sufficiently match" the target (§4.2, paper
@@ -114,7 +115,14 @@ pub fn upsample(
             expected,
         });
     }
-    let extent = radiance.desc().extent;
+    let desc = radiance.desc();
+    if desc.format != vk::Format::R16G16B16A16_SFLOAT {
+        return Err(ReceiverError::Format {
+            name: "radiance",
+            found: desc.format,
+        });
+    }
+    let extent = desc.extent;
     if [extent.width, extent.height] != expected {
         return Err(ReceiverError::Extent {
             name: "radiance",
