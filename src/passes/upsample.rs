@@ -255,13 +255,13 @@ pub fn upsample_cpu(
                 } else {
                     0.0
                 };
-                for (s, v) in sum.iter_mut().zip(texel(inputs.radiance, c)) {
-                    *s += weight * v;
+                for (acc, v) in sum.iter_mut().zip(texel(inputs.radiance, c)) {
+                    *acc += weight * v;
                 }
                 weight_sum += weight;
             }
             let result = if weight_sum > 0.0 {
-                sum.map(|s| s / weight_sum)
+                sum.map(|v| v / weight_sum)
             } else {
                 // Fallback: the best match among the 3×3 around p's own receiver (own on ties).
                 let own = [(x / s) as i64, (y / s) as i64];
