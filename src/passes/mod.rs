@@ -5,3 +5,5 @@
 pub mod composite;
 pub mod direct;
 pub mod gbuffer;
+pub mod receivers;
+pub mod upsample;

@@ -1,0 +1,291 @@
+//! `upsample`: joint bilateral upsampling of a receiver-resolution result to full resolution
+//! (paper 002 §4.2, eq. 11; docs/frame.md "Upsample").
+//!
+//! Each full-resolution pixel p blends the 2×2 nearest receiver samples i with
+//! `w̃_i = w_i^b · w_i^z · w_i^N`, normalised (eq. 11):
+//!
+//! - `w_i^b`: the standard bilinear weight of p between the receiver sample centres (receiver
+//!   texel coordinate `u = (x + 0.5) / s − 0.5`, indices clamped to the edge);
+//! - `w_i^z = 1 / (1 + |z_p − z_i| / (σ_z z_p))`: eq. 11's `1 / (ε + |z_p − z_i|)` with
+//!   `ε = σ_z z_p`, so the weight is 1 at equal depth and halves at a relative depth
+//!   difference of σ_z (scale-invariant);
+//! - `w_i^N = max(0, N_p · N_i)^n`, n = 32 in the paper;
+//! - `w̃_i = 0` for a receiver that does not "sufficiently match" p (§4.2), i.e. whose
+//!   `m_i = w_i^z · w_i^N < μ`, and for a background receiver (`w == 0`): the hyperbolic
+//!   `w^z` alone would leak a few per cent across every silhouette (12 % at s = 4 for a depth
+//!   ratio of 2, measured by tests/upsample.rs).
+//!
+//! Fallback (§4.2, "no coarse sample sufficiently matches"): when no receiver of the 2×2
+//! matches (`Σ w̃_i = 0`), p takes the radiance of the valid receiver with the
+//! largest `m` among the 3×3 receivers around its own (the receiver of its s×s block; own on
+//! ties, then row-major order), 0 when all nine are background. The 3×3 search finds the
+//! other side of an edge that the 2×2 misses: with the foreground-biased receivers, a
+//! background pixel next to a silhouette can have only foreground receivers in its 2×2.
+//! Background pixels (`w == 0`) get 0. With s = 1 the output is an exact copy of the radiance.
+
+use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::receivers::{GBuffer, ReceiverError, Receivers, receiver_extent};
+use crate::shaders;
+
+/// The paper's normal-weight exponent n in `w^N = (N_p · N_i)^n` (eq. 11, paper 002).
+pub const NORMAL_POWER_N: f32 = 32.0;
+
+/// σ_z: the relative depth difference `|z_p − z_i| / z_p` that halves `w^z` (eq. 11, paper
+/// 002, whose ε this scales with depth). 1 %: across an edge with a depth ratio of 2 a
+/// receiver from the other side has `w^z` ≈ 1/50 to 1/100, below [`MIN_MATCH_MU`]; along a
+/// sloped floor seen at 1080p, neighbouring 1/4-resolution receivers differ by about 1–6 %.
+pub const DEPTH_SIGMA: f32 = 0.01;
+
+/// μ: the match `w^z · w^N` a receiver needs to "sufficiently match" the target (§4.2, paper
+/// 002) and enter the blend; when none of the 2×2 does, the fallback is used. 0.05 is reached at a
+/// relative depth difference of 19 σ_z (19 %) or normals 24° apart (`cos(24°)^32 ≈ 0.05`).
+pub const MIN_MATCH_MU: f32 = 0.05;
+
+/// Tuning of the bilateral weights, passed to the shader as push constants.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct UpsampleParams {
+    /// σ_z (> 0), see [`DEPTH_SIGMA`].
+    pub depth_sigma: f32,
+    /// n (≥ 0), see [`NORMAL_POWER_N`].
+    pub normal_power: f32,
+    /// μ (≥ 0), see [`MIN_MATCH_MU`].
+    pub min_match: f32,
+}
+
+impl Default for UpsampleParams {
+    fn default() -> Self {
+        Self {
+            depth_sigma: DEPTH_SIGMA,
+            normal_power: NORMAL_POWER_N,
+            min_match: MIN_MATCH_MU,
+        }
+    }
+}
+
+impl UpsampleParams {
+    /// Checks the ranges (finite, σ_z > 0, n ≥ 0, μ ≥ 0).
+    pub fn validate(&self) -> Result<(), ReceiverError> {
+        if !(self.depth_sigma.is_finite() && self.depth_sigma > 0.0) {
+            return Err(ReceiverError::Parameter(
+                "depth_sigma must be finite and > 0",
+            ));
+        }
+        if !(self.normal_power.is_finite() && self.normal_power >= 0.0) {
+            return Err(ReceiverError::Parameter(
+                "normal_power must be finite and ≥ 0",
+            ));
+        }
+        if !(self.min_match.is_finite() && self.min_match >= 0.0) {
+            return Err(ReceiverError::Parameter("min_match must be finite and ≥ 0"));
+        }
+        Ok(())
+    }
+}
+
+/// Push constants of `shaders/upsample.comp` (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct UpsamplePush {
+    /// Full-resolution extent.
+    pub extent: [u32; 2],
+    /// Receiver extent.
+    pub recv_extent: [u32; 2],
+    /// Block size s.
+    pub scale: u32,
+    /// The weights' parameters.
+    pub params: UpsampleParams,
+}
+
+/// Adds the `upsample` pass: `radiance` (RGBA16F at the receiver extent) to a new transient
+/// full-resolution RGBA16F image, guided by `receivers` and `gbuffer` positions and normals.
+pub fn upsample(
+    rg: &mut RenderGraph,
+    radiance: &Handle<Image>,
+    receivers: &Receivers,
+    gbuffer: &GBuffer,
+    params: &UpsampleParams,
+) -> Result<Handle<Image>, ReceiverError> {
+    params.validate()?;
+    let expected = receiver_extent(gbuffer.extent, receivers.scale)?;
+    if receivers.extent != expected {
+        return Err(ReceiverError::Extent {
+            name: "receivers",
+            found: receivers.extent,
+            expected,
+        });
+    }
+    let desc = radiance.desc();
+    if desc.format != vk::Format::R16G16B16A16_SFLOAT {
+        return Err(ReceiverError::Format {
+            name: "radiance",
+            found: desc.format,
+        });
+    }
+    let extent = desc.extent;
+    if [extent.width, extent.height] != expected {
+        return Err(ReceiverError::Extent {
+            name: "radiance",
+            found: [extent.width, extent.height],
+            expected,
+        });
+    }
+    let [w, h] = gbuffer.extent;
+    let mut out = rg.create_image(
+        "upsampled",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    let push = UpsamplePush {
+        extent: gbuffer.extent,
+        recv_extent: expected,
+        scale: receivers.scale,
+        params: *params,
+    };
+    rg.compute("upsample", &shaders::UPSAMPLE_COMP)
+        .read("radiance", radiance)
+        .read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("gb_position", &gbuffer.position)
+        .read("gb_normal", &gbuffer.normal)
+        .write("upsampled", &mut out)
+        .push(&push)
+        .dispatch([w, h, 1]);
+    Ok(out)
+}
+
+/// Inputs of [`upsample_cpu`]: RGBA floats, 4 per pixel, row-major.
+#[derive(Debug, Clone, Copy)]
+pub struct UpsampleInputs<'a> {
+    /// Receiver-resolution radiance.
+    pub radiance: &'a [f32],
+    /// `recv_position`.
+    pub recv_position: &'a [f32],
+    /// `recv_normal`.
+    pub recv_normal: &'a [f32],
+    /// Full-resolution `gb_position`.
+    pub position: &'a [f32],
+    /// Full-resolution `gb_normal`.
+    pub normal: &'a [f32],
+    /// Full-resolution extent W×H.
+    pub extent: [u32; 2],
+    /// Block size s.
+    pub scale: u32,
+}
+
+/// CPU reference of `upsample` (same weights, order and fallback as the shader): the
+/// full-resolution RGBA result, 4 floats per pixel, row-major.
+pub fn upsample_cpu(
+    inputs: &UpsampleInputs<'_>,
+    params: &UpsampleParams,
+) -> Result<Vec<f32>, ReceiverError> {
+    params.validate()?;
+    let recv = receiver_extent(inputs.extent, inputs.scale)?;
+    let [w, h] = inputs.extent.map(|v| v as usize);
+    let [rw, rh] = recv.map(|v| v as usize);
+    for (name, data, len, expected) in [
+        ("radiance", inputs.radiance, rw * rh, recv),
+        ("recv_position", inputs.recv_position, rw * rh, recv),
+        ("recv_normal", inputs.recv_normal, rw * rh, recv),
+        ("gb_position", inputs.position, w * h, inputs.extent),
+        ("gb_normal", inputs.normal, w * h, inputs.extent),
+    ] {
+        if data.len() != len * 4 {
+            return Err(ReceiverError::Extent {
+                name,
+                found: [(data.len() / 4) as u32, 1],
+                expected,
+            });
+        }
+    }
+    let texel = |data: &[f32], i: usize| -> [f32; 4] {
+        [
+            data[i * 4],
+            data[i * 4 + 1],
+            data[i * 4 + 2],
+            data[i * 4 + 3],
+        ]
+    };
+    let dot3 = |a: [f32; 4], b: [f32; 4]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+    let scale = inputs.scale as f32;
+    let s = inputs.scale as usize;
+    // Receiver index of texel coordinates, clamped to the edge.
+    let index = |cx: i64, cy: i64| -> usize {
+        cy.clamp(0, rh as i64 - 1) as usize * rw + cx.clamp(0, rw as i64 - 1) as usize
+    };
+    let mut out = vec![0.0f32; w * h * 4];
+    for y in 0..h {
+        for x in 0..w {
+            let p = y * w + x;
+            let target = texel(inputs.position, p);
+            if target[3] <= 0.0 {
+                continue;
+            }
+            if inputs.scale == 1 {
+                out[p * 4..p * 4 + 4].copy_from_slice(&texel(inputs.radiance, p));
+                continue;
+            }
+            let normal = texel(inputs.normal, p);
+            // w^z · w^N of receiver c (eq. 11); -1 for a background receiver.
+            let match_weight = |c: usize| -> f32 {
+                let position = texel(inputs.recv_position, c);
+                if position[3] <= 0.0 {
+                    return -1.0;
+                }
+                let wz = 1.0
+                    / (1.0 + (target[3] - position[3]).abs() / (params.depth_sigma * target[3]));
+                let n = texel(inputs.recv_normal, c);
+                wz * dot3(normal, n).max(0.0).powf(params.normal_power)
+            };
+            let u = [
+                (x as f32 + 0.5) / scale - 0.5,
+                (y as f32 + 0.5) / scale - 0.5,
+            ];
+            let base = u.map(f32::floor);
+            let f = [u[0] - base[0], u[1] - base[1]];
+            let mut sum = [0.0f32; 4];
+            let mut weight_sum = 0.0f32;
+            for k in 0..4 {
+                let (ox, oy) = (k & 1, k >> 1);
+                let c = index(base[0] as i64 + ox, base[1] as i64 + oy);
+                let wx = if ox == 1 { f[0] } else { 1.0 - f[0] };
+                let wy = if oy == 1 { f[1] } else { 1.0 - f[1] };
+                let m = match_weight(c);
+                let weight = if m >= params.min_match {
+                    wx * wy * m
+                } else {
+                    0.0
+                };
+                for (acc, v) in sum.iter_mut().zip(texel(inputs.radiance, c)) {
+                    *acc += weight * v;
+                }
+                weight_sum += weight;
+            }
+            let result = if weight_sum > 0.0 {
+                sum.map(|v| v / weight_sum)
+            } else {
+                // Fallback: the best match among the 3×3 around p's own receiver (own on ties).
+                let own = [(x / s) as i64, (y / s) as i64];
+                let own_index = index(own[0], own[1]);
+                let mut best = match_weight(own_index);
+                let mut result = if best >= 0.0 {
+                    texel(inputs.radiance, own_index)
+                } else {
+                    [0.0; 4]
+                };
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let c = index(own[0] + dx, own[1] + dy);
+                        let m = match_weight(c);
+                        if m > best {
+                            best = m;
+                            result = texel(inputs.radiance, c);
+                        }
+                    }
+                }
+                result
+            };
+            out[p * 4..p * 4 + 4].copy_from_slice(&result);
+        }
+    }
+    Ok(out)
+}
