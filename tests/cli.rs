@@ -89,3 +89,103 @@ fn scene_export_of_an_unknown_scene_lists_the_known_ones() {
     assert!(stderr.contains("cornell-box"), "{stderr}");
     assert!(!std::path::Path::new("/tmp/never.glb").exists());
 }
+
+#[test]
+fn render_writes_png_and_exr_and_refuses_bad_requests_before_work() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_render");
+    std::fs::create_dir_all(&dir).expect("tmp dir");
+    for file in ["cb.png", "cb.exr"] {
+        let out = dir.join(file);
+        let _ = std::fs::remove_file(&out);
+        let run = shine()
+            .args([
+                "render",
+                "builtin:cornell-box",
+                "--width",
+                "32",
+                "--height",
+                "32",
+            ])
+            .args(["--gi", "none", "--set", "shadow.size=128", "-o"])
+            .arg(&out)
+            .output()
+            .expect("run shine render");
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let bytes = std::fs::read(&out).expect("output written");
+        let magic: &[u8] = if file.ends_with(".png") {
+            b"\x89PNG"
+        } else {
+            b"\x76\x2f\x31\x01"
+        };
+        assert!(
+            bytes.starts_with(magic),
+            "{file} is not a {} file",
+            &file[3..]
+        );
+    }
+    for (args, message) in [
+        (vec!["-o", "cb.jpg"], ".png"),
+        (vec!["-o", "cb.png", "--set", "hvl.count=5"], "hvl.count"),
+        (vec!["-o", "cb.png", "--set", "nonsense=1"], "nonsense"),
+        (vec!["-o", "cb.png", "--gi", "magic"], "magic"),
+    ] {
+        let run = shine()
+            .current_dir(&dir)
+            .args(["render", "builtin:cornell-box"])
+            .args(&args)
+            .output()
+            .expect("run shine render");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{args:?}: {stderr}");
+        assert!(stderr.contains(message), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+    assert!(!dir.join("cb.jpg").exists());
+}
+
+#[test]
+fn profile_reports_every_pass_as_json() {
+    let run = shine()
+        .args([
+            "profile",
+            "builtin:cornell-box",
+            "--frames",
+            "3",
+            "--warmup",
+            "1",
+        ])
+        .args([
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--gi",
+            "none",
+            "--set",
+            "shadow.size=128",
+        ])
+        .args(["--format", "json"])
+        .output()
+        .expect("run shine profile");
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON report");
+    assert_eq!(report["frames"], 3, "{stdout}");
+    let passes: Vec<_> = report["passes"]
+        .as_array()
+        .expect("passes")
+        .iter()
+        .filter_map(|p| p["name"].as_str())
+        .collect();
+    for pass in ["gbuffer", "shadow", "direct", "composite"] {
+        assert!(passes.contains(&pass), "{pass} missing from {passes:?}");
+    }
+}

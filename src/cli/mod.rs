@@ -1,6 +1,9 @@
 //! Command-line interface: one module per subcommand.
 
+mod frame_args;
 mod info;
+mod profile;
+mod render;
 mod scene;
 
 use clap::{Parser, Subcommand};
@@ -20,6 +23,10 @@ pub struct Cli {
 enum Command {
     /// Print the Vulkan device shine would use and the features it needs or can use.
     Info(info::InfoArgs),
+    /// Render a scene headless to a PNG (tonemapped) or EXR (linear HDR) image.
+    Render(render::RenderArgs),
+    /// Per-pass GPU times of a scene over many frames.
+    Profile(profile::ProfileArgs),
     /// Built-in scenes: list them or export one as .glb.
     Scene(scene::SceneArgs),
 }
@@ -28,6 +35,8 @@ enum Command {
 pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Info(args) => info::run(&args),
+        Command::Render(args) => render::run(&args),
+        Command::Profile(args) => profile::run(&args),
         Command::Scene(args) => scene::run(&args),
     }
 }

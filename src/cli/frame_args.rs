@@ -1,0 +1,78 @@
+//! What `shine render` and `shine profile` share: the scene argument and the settings flags.
+
+use super::CliError;
+use shine::settings::Settings;
+use shine_scene::Scene;
+use std::path::PathBuf;
+
+/// Settings from a TOML file, then flags over it (DESIGN: one serde struct, file and flags).
+#[derive(clap::Args, Debug)]
+pub struct SettingsArgs {
+    /// Settings file (TOML); flags override it.
+    #[arg(long)]
+    settings: Option<PathBuf>,
+    /// Image width in pixels.
+    #[arg(long)]
+    width: Option<u32>,
+    /// Image height in pixels.
+    #[arg(long)]
+    height: Option<u32>,
+    /// Scene time in seconds (animations).
+    #[arg(long)]
+    time: Option<f32>,
+    /// GI techniques: `hvl` (default), `none`; later `proxy`, `igi`, `aaf`, combined with commas.
+    #[arg(long)]
+    gi: Option<String>,
+    /// Tonemapping: none, aces, pbr-neutral.
+    #[arg(long)]
+    tonemap: Option<String>,
+    /// Linear exposure factor.
+    #[arg(long)]
+    exposure: Option<f32>,
+    /// Any setting by its TOML key, e.g. `--set hvl.count=2000` (repeatable).
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    overrides: Vec<String>,
+}
+
+impl SettingsArgs {
+    /// The file's settings (or the defaults) with every flag applied, validated.
+    pub fn resolve(&self) -> Result<Settings, CliError> {
+        let mut settings = match &self.settings {
+            Some(path) => Settings::load(path)?,
+            None => Settings::default(),
+        };
+        let flags = [
+            ("width", self.width.map(|v| v.to_string())),
+            ("height", self.height.map(|v| v.to_string())),
+            ("time", self.time.map(|v| v.to_string())),
+            ("gi", self.gi.clone()),
+            ("output.tonemap", self.tonemap.clone()),
+            ("output.exposure", self.exposure.map(|v| v.to_string())),
+        ];
+        for (key, value) in flags {
+            if let Some(value) = value {
+                settings.set(key, &value)?;
+            }
+        }
+        for assignment in &self.overrides {
+            let (key, value) = assignment
+                .split_once('=')
+                .ok_or_else(|| format!("--set expects KEY=VALUE, got `{assignment}`"))?;
+            settings.set(key.trim(), value.trim())?;
+        }
+        settings.validate()?;
+        Ok(settings)
+    }
+}
+
+/// Loads `builtin:NAME` or a .gltf/.glb path, printing the loader's warnings.
+pub fn load_scene(argument: &str) -> Result<Scene, CliError> {
+    let scene = match argument.strip_prefix("builtin:") {
+        Some(name) => Scene::builtin(name)?,
+        None => shine_scene::load(argument)?,
+    };
+    for warning in &scene.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(scene)
+}

@@ -1,0 +1,56 @@
+//! `shine profile`: per-pass GPU time over N frames after a warm-up, as a table, JSON or CSV,
+//! and optionally a Chrome trace (Perfetto opens it).
+
+use super::CliError;
+use super::frame_args::{SettingsArgs, load_scene};
+use shine::gpu::{Device, DeviceDesc};
+use shine::profile_report::{ProfileReport, ReportFormat, write_chrome_trace};
+use shine::renderer::Renderer;
+use std::path::PathBuf;
+
+/// Arguments of `shine profile`.
+#[derive(clap::Args, Debug)]
+pub struct ProfileArgs {
+    /// Scene: a .gltf/.glb file or `builtin:NAME`.
+    scene: String,
+    /// Frames measured.
+    #[arg(long, default_value_t = 60)]
+    frames: u32,
+    /// Frames rendered first and not measured (pipeline creation, first-dispatch costs).
+    #[arg(long, default_value_t = 5)]
+    warmup: u32,
+    /// Report format: table, json or csv.
+    #[arg(long, default_value = "table")]
+    format: String,
+    /// Also write a Chrome trace (JSON) of the measured frames.
+    #[arg(long)]
+    trace: Option<PathBuf>,
+    #[command(flatten)]
+    settings: SettingsArgs,
+}
+
+/// Renders warm-up + measured frames and reports the measured ones.
+pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
+    let format: ReportFormat = args.format.parse()?;
+    if args.frames == 0 {
+        return Err("--frames must be at least 1".into());
+    }
+    let settings = args.settings.resolve()?;
+    let scene = load_scene(&args.scene)?;
+    let device = Device::new(&DeviceDesc::from_env())?;
+    let mut renderer = Renderer::new(&device)?;
+    renderer.set_scene(&scene, settings.time)?;
+    let timings = renderer.render_timed(&settings, args.warmup + args.frames)?;
+    let first_frame = timings.iter().map(|t| t.frame).min().unwrap_or(0);
+    let measured: Vec<_> = timings
+        .into_iter()
+        .filter(|t| t.frame >= first_frame + u64::from(args.warmup))
+        .collect();
+    let report = ProfileReport::from_timings(&measured)?;
+    println!("{}", report.format(format)?);
+    if let Some(path) = &args.trace {
+        write_chrome_trace(path, &measured)?;
+        eprintln!("wrote {}", path.display());
+    }
+    Ok(())
+}
