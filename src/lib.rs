@@ -6,6 +6,9 @@
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
+pub mod hvl_reference;
+pub mod passes;
+
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
 ///
 /// One `pub static` per shader (and per `//! variant` of it), named after its path:
