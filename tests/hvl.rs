@@ -94,7 +94,7 @@ fn bytes_unorm8(texels: &[Vec4]) -> Vec<u8> {
 // ---------------------------------------------------------------------------------------------
 
 /// A 16×16 RSM of a spot light at (0, 3, 0): a floor (y = 0) on most texels, a tilted patch,
-/// four empty texels, and colourful fluxes; `flux_scale` multiplies every flux.
+/// five empty texels (one whole 2×2 cell of the 64-HVL grid), and colourful fluxes; `flux_scale` multiplies every flux.
 fn synthetic_rsm(flux_scale: f32) -> RsmData {
     let s = RSM_SIZE;
     let mut rsm = RsmData {
@@ -109,7 +109,7 @@ fn synthetic_rsm(flux_scale: f32) -> RsmData {
         for i in 0..s {
             let u = (i as f32 + 0.5) / s as f32 * 4.0 - 2.0;
             let v = (j as f32 + 0.5) / s as f32 * 4.0 - 2.0;
-            let empty = (i == 3 && j == 3) || (i == 12 && (2..5).contains(&j));
+            let empty = (i == 3 && j == 3) || ((12..14).contains(&i) && (2..4).contains(&j));
             let tilted = i >= 10 && j >= 10;
             let (p, n) = if tilted {
                 (
@@ -503,8 +503,11 @@ fn cache_matches_the_cpu_reference() {
         let cpu = reference::build_cache(&rsm, &p).unwrap();
         let gpu = gpu_cache(&device, &rsm, &p);
         assert_eq!(gpu.len(), cpu.len());
-        // The empty texel (3, 3) leaves cell (1, 1) with 3 valid texels: still a light.
-        assert!(cpu.iter().all(Hvl::is_valid));
+        // The empty texel (3, 3) leaves cell (1, 1) with 3 valid texels: still a light; cell
+        // (6, 1) is all empty: an invalid record the gather and r1 skip.
+        assert!(cpu[9].is_valid());
+        assert!(!cpu[8 + 6].is_valid());
+        assert_eq!(cpu.iter().filter(|h| h.is_valid()).count(), 63);
         for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
             let fields = [
                 (g.position_radius, c.position_radius),
@@ -530,7 +533,7 @@ fn cache_matches_the_cpu_reference() {
     assert_clean(&device);
 }
 
-/// hvl_gather on the GPU against the CPU gather, four variants, 16×16 receivers and
+/// hvl_gather on the GPU against the CPU gather, three variants, 16×16 receivers and
 /// the 64 HVLs of the synthetic RSM. Tolerance: RGBA16F output (2⁻¹¹ relative) plus the GPU's
 /// f32 acos/asin (≈ 2e-4 relative, sh.glsl header): 2e-3 of the value plus 1e-3 of the image's
 /// largest value.
@@ -540,13 +543,9 @@ fn gather_matches_the_cpu_reference() {
     let rsm = synthetic_rsm(1.0);
     let receivers = synthetic_receivers();
     let hvls = reference::build_cache(&rsm, &params(Path::Full, 5, 3)).unwrap();
-    // Four of the compiled variants (each costs a shader compile and a table build in debug).
-    for (path, conv, emission) in [
-        (Path::Full, 3, 3),
-        (Path::Full, 5, 5),
-        (Path::Full, 10, 5),
-        (Path::Zonal, 5, 3),
-    ] {
+    // Three of the compiled variants: a lavapipe compile of the 9- and 10-band variants costs
+    // seconds each (the 9-band ones are checked against the quadrature below).
+    for (path, conv, emission) in [(Path::Full, 3, 3), (Path::Full, 5, 5), (Path::Zonal, 5, 3)] {
         let p = params(path, conv, emission);
         let brdf = tables(conv, [12, 24]);
         let cpu = reference::gather(&receivers, &hvls, &brdf, CAMERA, &p).unwrap();
