@@ -8,7 +8,9 @@
 //     with L = cap SH of the sphere (eq. 14-15) in the receiver frame (normal z, omega_o in
 //     the xz half-plane), F rows of the BRDF SH tables interpolated at theta_o (eq. 18);
 //   zonal path (O(n)): L_j * kd * sum_l cap_l (cc_l / pi) P_l(n . omega_j) (Lambert only).
-// kd = albedo (1 - metallic), ks = mix(1, albedo, metallic). CPU twin: shine::hvl_reference.
+// kd = albedo (1 - metallic), ks = mix(1, albedo, metallic). Each HVL's contribution is clamped
+// at 0 per channel (band-limited ringing must not go negative in the RGBA16F output; the
+// paper's sinc window is not applied). CPU twin: shine::hvl_reference.
 //! variant full_c3_e3 HVL_FULL=1 SH_BANDS=3 EMISSION_BANDS=3
 //! variant full_c5_e3 HVL_FULL=1 SH_BANDS=5 EMISSION_BANDS=3
 //! variant full_c5_e5 HVL_FULL=1 SH_BANDS=5 EMISSION_BANDS=5
@@ -143,11 +145,11 @@ void main() {
 #ifdef HVL_FULL
         float cap[SH_COEFFS];
         sh_cap(normalize(vec3(dot(wj, t), dot(wj, b), dot(wj, n))), cos_a, cap);
-        sum += lj * (kd * sh_dot(cap, f_lambert) + ks * sh_dot(cap, f_glossy));
+        sum += max(vec3(0.0), lj * (kd * sh_dot(cap, f_lambert) + ks * sh_dot(cap, f_glossy)));
 #else
         float cap[SH_BANDS];
         sh_cap_zh(cos_a, cap);
-        sum += lj * kd * (hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI);
+        sum += max(vec3(0.0), lj * kd * (hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
 #endif
     }
     imageStore(indirect, px, vec4(sum, 0.0));

@@ -284,7 +284,8 @@ pub fn hvl_incoming(hvl: &Hvl, x: Vec3, n: Vec3, emission: Emission) -> Option<(
 }
 
 /// Outgoing radiance towards `camera` at one receiver from all `hvls`, as `hvl_gather` computes
-/// it (`brdf` is used by the full path only).
+/// it (`brdf` is used by the full path only); each HVL's contribution is clamped at 0 per
+/// channel (band-limited ringing).
 pub fn shade(
     receiver: &Receiver,
     hvls: &[Hvl],
@@ -312,7 +313,7 @@ pub fn shade(
                 let cap = cap_sh(local, a, bands)?;
                 let diffuse = shine_sh::dot(&cap, &f_lambert)?;
                 let glossy = shine_sh::dot(&cap, &f_glossy)?;
-                sum += lj * (kd * diffuse + ks * glossy);
+                sum += (lj * (kd * diffuse + ks * glossy)).max(Vec3::ZERO);
             }
         }
         Path::Zonal => {
@@ -325,7 +326,7 @@ pub fn shade(
                     continue;
                 };
                 let cap = cap_zh(a, bands)?;
-                sum += lj * kd * zh_dot(&cap, &cc, n.dot(wj));
+                sum += (lj * kd * zh_dot(&cap, &cc, n.dot(wj))).max(Vec3::ZERO);
             }
         }
     }

@@ -23,6 +23,8 @@
 //!   Each record stores it (5 bands), the gather reconstructs `F'·Y(-ω_j)` to the emission band
 //!   count of its variant and clamps it at 0 (band-limited ringing).
 //! * **Visibility** is not computed: HVLs are unshadowed, as in the paper's results (§6).
+//! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
+//!   never makes `indirect` negative; the paper's sinc window (§4.2) is not applied.
 //! * **Receiver BRDF.** `kd = albedo (1 - metallic)` times Lambert, `ks = mix(1, albedo,
 //!   metallic)` times ONE glossy table (GGX of a fixed α and η, built by [`GatherBrdf::build`]);
 //!   the receiver's roughness does not select a table yet (the paper indexes one table per
