@@ -38,7 +38,7 @@
 //! over 8 receivers, GGX α = 0.5 glossy): the SH truncation of the convolution alone is 4.9% at
 //! 3 bands, 2.9% at 5, 0.8% at 9 (zonal: 5.8% at 3, 0.8% at 9); with the exact Lambert emission
 //! as reference the total is 31–33% with 3 emission bands (the band-limited `F'·Y` overshoots
-//! near the sender's normal, the paper's choice) and 19% with 5.
+//! near the sender's normal, the paper's choice) and 19–21% with 5.
 
 use glam::Vec3;
 use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
