@@ -208,7 +208,8 @@ fn tables(conv_bands: u32, sampling: [usize; 2]) -> GatherBrdf {
 // GPU plumbing.
 // ---------------------------------------------------------------------------------------------
 
-const COPY_DONE: ExternalState = ExternalState::UNDEFINED;
+/// Final state of inputs nothing uses after the graph.
+const UNUSED_AFTER: ExternalState = ExternalState::UNDEFINED;
 
 fn uploaded_state() -> ExternalState {
     ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::GENERAL)
@@ -286,7 +287,7 @@ impl RsmImages {
         let [p, n, f] = self
             .0
             .each_ref()
-            .map(|i| rg.import_gpu_image(i, uploaded_state(), COPY_DONE));
+            .map(|i| rg.import_gpu_image(i, uploaded_state(), UNUSED_AFTER));
         Rsm {
             position: p,
             normal: n,
@@ -340,7 +341,7 @@ impl ReceiverImages {
         let [p, n, a, m] = self
             .0
             .each_ref()
-            .map(|i| rg.import_gpu_image(i, uploaded_state(), COPY_DONE));
+            .map(|i| rg.import_gpu_image(i, uploaded_state(), UNUSED_AFTER));
         Receivers {
             position: p,
             normal: n,
@@ -399,8 +400,9 @@ fn gpu_gather(
     let mut executor = Executor::new(device, 1).unwrap();
     let mut rg = executor.begin_frame();
     let recv = images.import(&mut rg, receivers.extent);
-    let hvl_handle: Handle<Buffer> = rg.import_gpu_buffer(&hvl_buffer, uploaded_state(), COPY_DONE);
-    let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), COPY_DONE);
+    let hvl_handle: Handle<Buffer> =
+        rg.import_gpu_buffer(&hvl_buffer, uploaded_state(), UNUSED_AFTER);
+    let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
     let indirect = hvl_gather(&mut rg, &recv, &hvl_handle, &brdf_handle, camera, params).unwrap();
     read_indirect(&mut rg, &indirect, &readback);
     run(device, &mut executor, rg);
@@ -702,7 +704,7 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
         let mut rg = executor.begin_frame();
         let rsm_handles = rsm_images.import(&mut rg, &rsm);
         let recv = recv_images.import(&mut rg, RECV);
-        let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), COPY_DONE);
+        let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
         let hvls = hvl_cache(&mut rg, &rsm_handles, &p).unwrap();
         let indirect = hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, CAMERA, &p).unwrap();
         read_indirect(&mut rg, &indirect, &readback);

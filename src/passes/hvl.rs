@@ -12,8 +12,8 @@
 //!
 //! # Decisions and deviations from paper 003
 //!
-//! * **Construction.** The paper makes every RSM ("cache") texel an HVL; we sample the RSM on a
-//!   regular K×K grid (K = √M): each cell gives one HVL at its valid texel nearest the cell
+//! * **Construction.** The paper renders HVL data into the RSM (its "HVL cache", e.g. 1024²
+//!   texels for 400 HVLs) and takes M HVLs from it; we sample the RSM on a regular K×K grid (K = √M): each cell gives one HVL at its valid texel nearest the cell
 //!   centre, carrying the summed flux of all the cell's valid texels (so the reflected power
 //!   is the same for every M; the paper's Φ_j is "the light's power divided by the number of
 //!   HVLs"). r1's "8-connected neighbours in the cache" are the neighbours in this grid.
