@@ -7,6 +7,7 @@ pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
 pub mod gpu_scene;
+pub mod hvl_reference;
 pub mod image_io;
 pub mod passes;
 pub mod profile_report;

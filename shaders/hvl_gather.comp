@@ -1,0 +1,156 @@
+// HVL gather (paper 003 §5.1, eq. 1, 3, 19-22): outgoing radiance towards the camera at each
+// receiver from every HVL of the cache (brute force, as the paper's prototype). Visibility is
+// not computed: HVLs are unshadowed (the paper's renderings do the same, §6).
+//
+// Per HVL j at receiver x (omega_j: unit direction x -> y_j, a: half-angle of the sphere):
+//   L_j = Phi_j * max(0, F'_j . Y(-omega_j)) * G_j(-omega_j)               eq. 20, 21, 22
+//   full path (O(n^2)):  L_j * (kd * L . F_lambert(theta_o) + ks * L . F_glossy(theta_o))  eq. 19
+//     with L = cap SH of the sphere (eq. 14-15) in the receiver frame (normal z, omega_o in
+//     the xz half-plane), F rows of the BRDF SH tables interpolated at theta_o (eq. 18);
+//   zonal path (O(n)): L_j * kd * sum_l cap_l (cc_l / pi) P_l(n . omega_j) (Lambert only).
+// kd = albedo (1 - metallic), ks = mix(1, albedo, metallic). Each HVL's contribution is clamped
+// at 0 per channel (band-limited ringing must not go negative in the RGBA16F output; the
+// paper's sinc window is not applied). CPU twin: shine::hvl_reference.
+//! variant full_c3_e3 HVL_FULL=1 SH_BANDS=3 EMISSION_BANDS=3
+//! variant full_c5_e3 HVL_FULL=1 SH_BANDS=5 EMISSION_BANDS=3
+//! variant full_c5_e5 HVL_FULL=1 SH_BANDS=5 EMISSION_BANDS=5
+//! variant full_c9_e3 HVL_FULL=1 SH_BANDS=9 EMISSION_BANDS=3
+//! variant full_c10_e5 HVL_FULL=1 SH_BANDS=10 EMISSION_BANDS=5
+//! variant zonal_c3_e3 HVL_ZONAL=1 SH_BANDS=3 EMISSION_BANDS=3
+//! variant zonal_c5_e3 HVL_ZONAL=1 SH_BANDS=5 EMISSION_BANDS=3
+//! variant zonal_c9_e3 HVL_ZONAL=1 SH_BANDS=9 EMISSION_BANDS=3
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "sh.glsl"
+#include "hvl.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
+layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
+layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_albedo;
+layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
+
+layout(set = 0, binding = 4, std430) readonly buffer Hvls {
+    Hvl h[];
+} hvls;
+
+#ifdef HVL_FULL
+// shine::passes::hvl::GatherBrdf::gpu_data: F of Lambert (albedo 1) then F of the glossy BRDF,
+// each 90 rows of SH_COEFFS floats (shine_sh::brdf_table layout)
+layout(set = 0, binding = 5, std430) readonly buffer Brdf {
+    float f[];
+} brdf;
+#endif
+
+layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
+
+// shine::passes::hvl::GatherPush
+layout(push_constant) uniform Push {
+    // xyz: camera position; w unused
+    vec4 camera;
+    // receiver buffer size
+    uvec2 extent;
+    // HVLs in the cache
+    uint hvl_count;
+    uint pad;
+} push;
+
+// Receivers closer than this to an HVL centre get nothing from it (metres).
+const float HVL_MIN_DISTANCE = 1e-6;
+// shine_sh::brdf_table::THETA_SAMPLES
+const int HVL_THETA_SAMPLES = 90;
+
+#ifdef HVL_FULL
+// shine_sh::brdf_table::BrdfTable::lookup_f: linear interpolation between 1-degree rows
+void brdf_row(int table, float theta_o, out float f[SH_COEFFS]) {
+    float x = clamp(degrees(theta_o) - 0.5, 0.0, float(HVL_THETA_SAMPLES - 1));
+    int i0 = int(floor(x));
+    int i1 = min(i0 + 1, HVL_THETA_SAMPLES - 1);
+    float t = x - float(i0);
+    int base = table * HVL_THETA_SAMPLES * SH_COEFFS;
+    for (int k = 0; k < SH_COEFFS; ++k) {
+        f[k] = brdf.f[base + i0 * SH_COEFFS + k] * (1.0 - t) + brdf.f[base + i1 * SH_COEFFS + k] * t;
+    }
+}
+#endif
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
+        return;
+    }
+    vec4 position = imageLoad(recv_position, px);
+    if (position.w == 0.0) {
+        imageStore(indirect, px, vec4(0.0));
+        return;
+    }
+    vec3 x = position.xyz;
+    vec3 n = normalize(imageLoad(recv_normal, px).xyz);
+    vec3 albedo = imageLoad(recv_albedo, px).rgb;
+    float metallic = imageLoad(recv_material, px).g;
+    vec3 kd = albedo * (1.0 - metallic);
+#ifdef HVL_FULL
+    vec3 ks = mix(vec3(1.0), albedo, metallic);
+    vec3 wo = normalize(push.camera.xyz - x);
+    float cos_o = dot(n, wo);
+    if (cos_o <= 0.0) {
+        imageStore(indirect, px, vec4(0.0));
+        return;
+    }
+    // Receiver frame of the tables: z = n, omega_o in the xz half-plane (phi_o = 0, eq. 17).
+    vec3 t = wo - n * cos_o;
+    if (dot(t, t) < 1e-12) {
+        t = abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+        t -= n * dot(n, t);
+    }
+    t = normalize(t);
+    vec3 b = cross(n, t);
+    float theta_o = acos(min(cos_o, 1.0));
+    float f_lambert[SH_COEFFS];
+    float f_glossy[SH_COEFFS];
+    brdf_row(0, theta_o, f_lambert);
+    brdf_row(1, theta_o, f_glossy);
+#else
+    float cc[SH_BANDS];
+    sh_clamped_cosine_zh(cc);
+#endif
+    vec3 sum = vec3(0.0);
+    for (uint j = 0u; j < push.hvl_count; ++j) {
+        // Field by field: naga cannot read the OpCopyLogical of a whole-struct load.
+        vec4 position_radius = hvls.h[j].position_radius;
+        float r = position_radius.w;
+        if (!(r > 0.0)) {
+            continue;
+        }
+        vec3 hvl_normal = hvls.h[j].normal_distance.xyz;
+        vec3 v = position_radius.xyz - x;
+        float dist = length(v);
+        if (dist < HVL_MIN_DISTANCE) {
+            continue;
+        }
+        vec3 wj = v / dist;
+        float a = hvl_sphere_half_angle(dist, r);
+        float g = hvl_geometric_factor(wj, hvl_normal, n, r, a);
+        if (!(g > 0.0)) {
+            continue;
+        }
+        float emission[8];
+        for (int l = 0; l < 8; ++l) {
+            emission[l] = hvls.h[j].emission[l];
+        }
+        float e = max(0.0, hvl_zh_eval(emission, EMISSION_BANDS, dot(normalize(hvl_normal), -wj)));
+        vec3 lj = hvls.h[j].flux.rgb * (e * g);
+        float cos_a = cos(a);
+#ifdef HVL_FULL
+        float cap[SH_COEFFS];
+        sh_cap(normalize(vec3(dot(wj, t), dot(wj, b), dot(wj, n))), cos_a, cap);
+        sum += max(vec3(0.0), lj * (kd * sh_dot(cap, f_lambert) + ks * sh_dot(cap, f_glossy)));
+#else
+        float cap[SH_BANDS];
+        sh_cap_zh(cos_a, cap);
+        sum += max(vec3(0.0), lj * kd * (hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
+#endif
+    }
+    imageStore(indirect, px, vec4(sum, 0.0));
+}

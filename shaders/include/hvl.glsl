@@ -1,0 +1,58 @@
+// Harmonics Virtual Lights (paper 003): the HVL cache record and the zonal helpers the HVL
+// passes share. Include after sh.glsl (SH_BANDS defined). Every function mirrors a Rust
+// function named in its comment (shine::hvl_reference or shine-sh) with the same formula.
+#ifndef HVL_GLSL
+#define HVL_GLSL
+
+#ifndef SH_GLSL
+#error "include sh.glsl before hvl.glsl"
+#endif
+
+// Most emission bands an HVL record stores (paper 003 §3: 0-5 bands for the emission).
+#define HVL_EMISSION_MAX_BANDS 5
+
+// One HVL of the cache, std430, 80 bytes: shine::passes::hvl::Hvl.
+struct Hvl {
+    // xyz: world position y_j of the HVL centre; w: radius r_j (scaled), 0 for an empty cell
+    vec4 position_radius;
+    // xyz: unit normal n_j; w: distance d_j to the primary light
+    vec4 normal_distance;
+    // rgb: flux Phi_j (W); a: 1 for a valid HVL, 0 for an empty cell
+    vec4 flux;
+    // ZH coefficients (about n_j) of the sender's F' (paper 003 eq. 20), 5 used, 3 padding
+    float emission[8];
+};
+
+// shine_sh::zonal::sphere_half_angle: asin(r / d), pi when the point is inside the sphere
+float hvl_sphere_half_angle(float distance, float radius) {
+    if (distance <= radius) {
+        return SH_PI;
+    }
+    return asin(radius / distance);
+}
+
+// shine::hvl_reference::zh_eval: a ZH vector (about axis a) evaluated at direction b,
+// cos_angle = a . b: sum_l zh_l sqrt((2l+1)/(4 pi)) P_l(cos_angle), first `bands` bands.
+float hvl_zh_eval(float zh[8], int bands, float cos_angle) {
+    float p[SH_BANDS + 1];
+    sh_legendre_all(clamp(cos_angle, -1.0, 1.0), p);
+    float s = 0.0;
+    for (int l = 0; l < bands; ++l) {
+        s += zh[l] * sqrt(float(2 * l + 1) / (4.0 * SH_PI)) * p[l];
+    }
+    return s;
+}
+
+// shine::hvl_reference::zh_dot: dot product of two ZH vectors rotated to axes at cos_angle,
+// sum_l f_l g_l P_l(cos_angle) (the O(n) zonal path of paper 003 §6.3)
+float hvl_zh_dot(float f[SH_BANDS], float g[SH_BANDS], float cos_angle) {
+    float p[SH_BANDS + 1];
+    sh_legendre_all(clamp(cos_angle, -1.0, 1.0), p);
+    float s = 0.0;
+    for (int l = 0; l < SH_BANDS; ++l) {
+        s += f[l] * g[l] * p[l];
+    }
+    return s;
+}
+
+#endif // HVL_GLSL

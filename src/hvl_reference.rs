@@ -1,0 +1,432 @@
+//! CPU reference of the HVL passes (paper 003): the cache construction and the gather exactly
+//! as `shaders/hvl_cache.comp` and `shaders/hvl_gather.comp` compute them (f32, same order of
+//! operations where it matters), plus a numerical integration of eq. 3 with eq. 19–21 for one
+//! HVL, the ground truth the SH gather approximates. Used by `tests/hvl.rs`.
+//!
+//! New formulas of the HVL passes with a GLSL twin in `shaders/include/hvl.glsl`:
+//! [`zh_eval`] (a rotated ZH vector evaluated at a direction) and [`zh_dot`] (dot product of two
+//! rotated ZH vectors, the O(n) zonal path). Everything else calls shine-sh.
+
+use glam::{DVec3, Vec3, Vec4};
+use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
+use shine_sh::hvl::{HvlNeighbour, geometric_factor, radius_r1, radius_r2};
+use shine_sh::kernels::clamped_cosine_zh;
+use shine_sh::legendre::legendre_all;
+use shine_sh::quadrature::SphereQuadrature;
+use shine_sh::zonal::{cap_sh, cap_zh, sphere_half_angle};
+
+use crate::passes::hvl::{
+    EMISSION_MAX_BANDS, GatherBrdf, Hvl, HvlError, HvlParams, Path, RadiusHeuristic,
+};
+
+/// ε of the r1 weights `w_n = 1 / (|d - d_n| + ε)`, metres (eq. 23, paper 003); the GLSL
+/// constant `HVL_R1_EPSILON` has the same value.
+pub const R1_EPSILON: f32 = 1e-3;
+
+/// Receivers closer than this to an HVL centre get nothing from it (metres), as the GLSL
+/// constant `HVL_MIN_DISTANCE`.
+pub const MIN_DISTANCE: f32 = 1e-6;
+
+/// An RSM on the CPU: `size²` texels, row-major, in the units of docs/frame.md.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RsmData {
+    /// Side S.
+    pub size: u32,
+    /// `rsm_position` texels (w = 1 valid, 0 empty).
+    pub position: Vec<Vec4>,
+    /// `rsm_normal` texels.
+    pub normal: Vec<Vec4>,
+    /// `rsm_flux` texels.
+    pub flux: Vec<Vec4>,
+    /// Primary light position.
+    pub light_position: Vec3,
+    /// RSM field of view λ, radians.
+    pub fov: f32,
+}
+
+/// The receiver buffer on the CPU: row-major texels, unorm channels already as floats.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReceiverData {
+    /// Width and height.
+    pub extent: [u32; 2],
+    /// `recv_position` (w = 0: background).
+    pub position: Vec<Vec4>,
+    /// `recv_normal`.
+    pub normal: Vec<Vec4>,
+    /// `recv_albedo`.
+    pub albedo: Vec<Vec4>,
+    /// `recv_material` (g = metallic).
+    pub material: Vec<Vec4>,
+}
+
+/// One receiver: what the gather reads at a pixel.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Receiver {
+    /// World position x.
+    pub position: Vec3,
+    /// Unit normal `n_x`.
+    pub normal: Vec3,
+    /// Linear albedo.
+    pub albedo: Vec3,
+    /// Metallic in [0, 1].
+    pub metallic: f32,
+}
+
+impl Receiver {
+    /// Diffuse weight `kd = albedo (1 - metallic)`.
+    pub fn kd(&self) -> Vec3 {
+        self.albedo * (1.0 - self.metallic)
+    }
+
+    /// Glossy weight `ks = mix(1, albedo, metallic)`.
+    pub fn ks(&self) -> Vec3 {
+        Vec3::ONE.lerp(self.albedo, self.metallic)
+    }
+}
+
+/// ZH coefficients (about the HVL normal) of the Lambert sender's `F'` (eq. 20), taken from the
+/// shine-sh BRDF table of Lambert with albedo 1 (every θ_o row is the same): `bands` ≤ 5.
+pub fn sender_emission_zh(bands: usize) -> Result<Vec<f32>, HvlError> {
+    // A polynomial in cos θ of degree < 2·16 and trigonometric terms of order < 16: exact.
+    let sampling = HemisphereSampling {
+        n_theta: 16,
+        n_phi: 16,
+    };
+    let table = BrdfTable::build_with(BrdfModel::Lambert { albedo: 1.0 }, bands, sampling)?;
+    let row = &table.f_prime()[..bands * bands];
+    Ok((0..bands).map(|l| row[shine_sh::index(l, 0)]).collect())
+}
+
+/// `Σ_l zh_l √((2l+1)/4π) P_l(cos_angle)`: the ZH vector `zh` about axis `a`, rotated to `a`
+/// (eq. 15) and evaluated at a direction `b` with `a·b = cos_angle` (GLSL `hvl_zh_eval`).
+pub fn zh_eval(zh: &[f32], cos_angle: f32) -> f32 {
+    let mut p = vec![0.0f64; zh.len() + 1];
+    legendre_all(f64::from(cos_angle.clamp(-1.0, 1.0)), &mut p);
+    zh.iter()
+        .enumerate()
+        .map(|(l, &z)| {
+            f64::from(z) * ((2 * l + 1) as f64 / (4.0 * std::f64::consts::PI)).sqrt() * p[l]
+        })
+        .sum::<f64>() as f32
+}
+
+/// `Σ_l f_l g_l P_l(cos_angle)`: the SH dot product of two ZH vectors rotated (eq. 15) to axes
+/// at `cos_angle` from each other (GLSL `hvl_zh_dot`; the O(n) path of paper 003 §6.3).
+pub fn zh_dot(f: &[f32], g: &[f32], cos_angle: f32) -> f32 {
+    let mut p = vec![0.0f64; f.len() + 1];
+    legendre_all(f64::from(cos_angle.clamp(-1.0, 1.0)), &mut p);
+    f.iter()
+        .zip(g)
+        .enumerate()
+        .map(|(l, (&a, &b))| f64::from(a) * f64::from(b) * p[l])
+        .sum::<f64>() as f32
+}
+
+/// The HVL cache built from `rsm` as `hvl_cache` does (see [`crate::passes::hvl`]).
+pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlError> {
+    let k = params.validate_cache(rsm.size)?;
+    let s = rsm.size;
+    let texels = (s * s) as usize;
+    if rsm.position.len() != texels || rsm.normal.len() != texels || rsm.flux.len() != texels {
+        return Err(HvlError::Size {
+            name: "RsmData",
+            actual: format!("{} texels", rsm.position.len()),
+            expected: format!("{texels} texels in each image"),
+        });
+    }
+    let count = params.count;
+    let r2 = |d: f32| radius_r2(d, rsm.fov, count);
+    let mut emission = [0.0f32; 8];
+    emission[..EMISSION_MAX_BANDS].copy_from_slice(&sender_emission_zh(EMISSION_MAX_BANDS)?);
+    let mut hvls = Vec::with_capacity(count as usize);
+    for cy in 0..k {
+        for cx in 0..k {
+            let (lo, hi) = (
+                [cx * s / k, cy * s / k],
+                [(cx + 1) * s / k, (cy + 1) * s / k],
+            );
+            let centre = [0.5 * (lo[0] + hi[0]) as f32, 0.5 * (lo[1] + hi[1]) as f32];
+            let mut best = f32::MAX;
+            let mut rep = None;
+            let mut flux = Vec3::ZERO;
+            for y in lo[1]..hi[1] {
+                for x in lo[0]..hi[0] {
+                    let t = (y * s + x) as usize;
+                    if rsm.position[t].w == 0.0 {
+                        continue;
+                    }
+                    flux += rsm.flux[t].truncate();
+                    let off = [x as f32 + 0.5 - centre[0], y as f32 + 0.5 - centre[1]];
+                    let d2 = off[0] * off[0] + off[1] * off[1];
+                    if d2 < best {
+                        best = d2;
+                        rep = Some(t);
+                    }
+                }
+            }
+            let hvl = match rep {
+                None => Hvl {
+                    position_radius: [0.0; 4],
+                    normal_distance: [0.0; 4],
+                    flux: [0.0; 4],
+                    emission: [0.0; 8],
+                },
+                Some(t) => {
+                    let p = rsm.position[t].truncate();
+                    let n = rsm.normal[t].truncate().normalize();
+                    let d = p.distance(rsm.light_position);
+                    let r = match params.radius {
+                        RadiusHeuristic::R2 => r2(d)? * params.radius_scale,
+                        RadiusHeuristic::R1 => 0.0,
+                    };
+                    Hvl {
+                        position_radius: p.extend(r).to_array(),
+                        normal_distance: n.extend(d).to_array(),
+                        flux: flux.extend(1.0).to_array(),
+                        emission,
+                    }
+                }
+            };
+            hvls.push(hvl);
+        }
+    }
+    if params.radius == RadiusHeuristic::R1 {
+        let source = hvls.clone();
+        for cy in 0..k as i32 {
+            for cx in 0..k as i32 {
+                let h = &mut hvls[(cy * k as i32 + cx) as usize];
+                if !h.is_valid() {
+                    continue;
+                }
+                let mut neighbours = Vec::with_capacity(8);
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let (qx, qy) = (cx + dx, cy + dy);
+                        let inside = qx >= 0 && qy >= 0 && qx < k as i32 && qy < k as i32;
+                        if (dx == 0 && dy == 0) || !inside {
+                            continue;
+                        }
+                        let n = &source[(qy * k as i32 + qx) as usize];
+                        if n.is_valid() {
+                            neighbours.push(HvlNeighbour {
+                                position: Vec4::from(n.position_radius).truncate(),
+                                light_distance: n.normal_distance[3],
+                            });
+                        }
+                    }
+                }
+                let p = Vec4::from(h.position_radius).truncate();
+                let d = h.normal_distance[3];
+                let r = match radius_r1(p, d, &neighbours, R1_EPSILON) {
+                    Ok(r) if r > 0.0 => r,
+                    _ => r2(d)?,
+                };
+                h.position_radius[3] = r * params.radius_scale;
+            }
+        }
+    }
+    Ok(hvls)
+}
+
+/// The receiver frame of the BRDF tables: tangent `t` with `ω_o` in the xz half-plane
+/// (φ_o = 0, eq. 17), bitangent `n × t`, and θ_o; `None` when the camera is below the surface.
+pub fn receiver_frame(normal: Vec3, wo: Vec3) -> Option<(Vec3, Vec3, f32)> {
+    let cos_o = normal.dot(wo);
+    if cos_o <= 0.0 {
+        return None;
+    }
+    let mut t = wo - normal * cos_o;
+    if t.dot(t) < 1e-12 {
+        t = if normal.x.abs() < 0.9 {
+            Vec3::X
+        } else {
+            Vec3::Y
+        };
+        t -= normal * normal.dot(t);
+    }
+    let t = t.normalize();
+    Some((t, normal.cross(t), cos_o.min(1.0).acos()))
+}
+
+/// How the reference evaluates the HVL's emission `F'·Y(-ω_j)` of eq. 20.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Emission {
+    /// The exact Lambert sender: `1/π` (the HVL's albedo is in its flux).
+    Exact,
+    /// The stored ZH, reconstructed to this many bands and clamped at 0, as the GPU does.
+    Sh(usize),
+}
+
+/// What one HVL sends to a receiver: the incoming radiance `L_j(x, ω_j)` (eq. 20–22), the unit
+/// direction `ω_j` and the half-angle `a`; `None` when it sends nothing.
+pub fn hvl_incoming(hvl: &Hvl, x: Vec3, n: Vec3, emission: Emission) -> Option<(Vec3, Vec3, f32)> {
+    let r = hvl.position_radius[3];
+    if r.is_nan() || r <= 0.0 {
+        return None;
+    }
+    let v = Vec4::from(hvl.position_radius).truncate() - x;
+    let dist = v.length();
+    if dist < MIN_DISTANCE {
+        return None;
+    }
+    let wj = v / dist;
+    let a = sphere_half_angle(dist, r).ok()?;
+    let hvl_n = Vec4::from(hvl.normal_distance).truncate();
+    let g = geometric_factor(wj, hvl_n, n, r, a).ok()?;
+    if g.is_nan() || g <= 0.0 {
+        return None;
+    }
+    let e = match emission {
+        Emission::Exact => std::f32::consts::FRAC_1_PI,
+        Emission::Sh(bands) => zh_eval(&hvl.emission[..bands], hvl_n.normalize().dot(-wj)).max(0.0),
+    };
+    Some((Vec4::from(hvl.flux).truncate() * (e * g), wj, a))
+}
+
+/// Outgoing radiance towards `camera` at one receiver from all `hvls`, as `hvl_gather` computes
+/// it (`brdf` is used by the full path only); each HVL's contribution is clamped at 0 per
+/// channel (band-limited ringing).
+pub fn shade(
+    receiver: &Receiver,
+    hvls: &[Hvl],
+    brdf: &GatherBrdf,
+    camera: Vec3,
+    params: &HvlParams,
+) -> Result<Vec3, HvlError> {
+    let bands = params.conv_bands as usize;
+    let emission = Emission::Sh(params.emission_bands as usize);
+    let (x, n) = (receiver.position, receiver.normal.normalize());
+    let (kd, ks) = (receiver.kd(), receiver.ks());
+    let mut sum = Vec3::ZERO;
+    match params.path {
+        Path::Full => {
+            let Some((t, b, theta_o)) = receiver_frame(n, (camera - x).normalize()) else {
+                return Ok(Vec3::ZERO);
+            };
+            let f_lambert = brdf.lambert.lookup_f(theta_o);
+            let f_glossy = brdf.glossy.lookup_f(theta_o);
+            for hvl in hvls {
+                let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
+                    continue;
+                };
+                let local = Vec3::new(wj.dot(t), wj.dot(b), wj.dot(n)).normalize();
+                let cap = cap_sh(local, a, bands)?;
+                let diffuse = shine_sh::dot(&cap, &f_lambert)?;
+                let glossy = shine_sh::dot(&cap, &f_glossy)?;
+                sum += (lj * (kd * diffuse + ks * glossy)).max(Vec3::ZERO);
+            }
+        }
+        Path::Zonal => {
+            let cc: Vec<f32> = clamped_cosine_zh(bands)?
+                .iter()
+                .map(|c| c / std::f32::consts::PI)
+                .collect();
+            for hvl in hvls {
+                let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
+                    continue;
+                };
+                let cap = cap_zh(a, bands)?;
+                sum += (lj * kd * zh_dot(&cap, &cc, n.dot(wj))).max(Vec3::ZERO);
+            }
+        }
+    }
+    Ok(sum)
+}
+
+/// The gather over a whole receiver buffer (row-major RGBA, a = 0; background black).
+pub fn gather(
+    receivers: &ReceiverData,
+    hvls: &[Hvl],
+    brdf: &GatherBrdf,
+    camera: Vec3,
+    params: &HvlParams,
+) -> Result<Vec<Vec4>, HvlError> {
+    params.validate_gather()?;
+    let texels = (receivers.extent[0] * receivers.extent[1]) as usize;
+    let mut out = Vec::with_capacity(texels);
+    for i in 0..texels {
+        let p = receivers.position[i];
+        if p.w == 0.0 {
+            out.push(Vec4::ZERO);
+            continue;
+        }
+        let receiver = Receiver {
+            position: p.truncate(),
+            normal: receivers.normal[i].truncate(),
+            albedo: receivers.albedo[i].truncate(),
+            metallic: receivers.material[i].y,
+        };
+        let count = (params.count as usize).min(hvls.len());
+        out.push(shade(&receiver, &hvls[..count], brdf, camera, params)?.extend(0.0));
+    }
+    Ok(out)
+}
+
+/// Numerical integration of eq. 3 for one HVL: `L_j(x, ω_j) ∫_{Q_j} (kd/π + ks f_glossy)
+/// cos θ_i dω_i`, with `L_j` from eq. 20–22 (`emission` exact or band-limited) and the BRDF
+/// evaluated exactly (no SH) over the cap `Q_j` by a Gauss–Legendre × uniform-φ rule of
+/// `n_z × n_phi` nodes. This is what the gather's SH convolution approximates.
+pub fn integrate_hvl(
+    hvl: &Hvl,
+    receiver: &Receiver,
+    camera: Vec3,
+    glossy: BrdfModel,
+    emission: Emission,
+    nodes: [usize; 2],
+) -> Vec3 {
+    let (x, n) = (receiver.position, receiver.normal.normalize());
+    let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
+        return Vec3::ZERO;
+    };
+    let Some((t, b, _)) = receiver_frame(n, (camera - x).normalize()) else {
+        return Vec3::ZERO;
+    };
+    let to_local = |w: DVec3| {
+        DVec3::new(
+            w.dot(t.as_dvec3()),
+            w.dot(b.as_dvec3()),
+            w.dot(n.as_dvec3()),
+        )
+    };
+    let wo = to_local((camera - x).normalize().as_dvec3());
+    let q = SphereQuadrature::cap(wj.as_dvec3(), f64::from(a).cos(), nodes[0], nodes[1]);
+    let lambert = BrdfModel::Lambert { albedo: 1.0 };
+    let diffuse = q.integrate(|w| {
+        let wi = to_local(w);
+        lambert.eval(wi, wo) * wi.z.max(0.0)
+    });
+    let specular = q.integrate(|w| {
+        let wi = to_local(w);
+        glossy.eval(wi, wo) * wi.z.max(0.0)
+    });
+    lj * (receiver.kd() * diffuse as f32 + receiver.ks() * specular as f32)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use shine_sh::basis::evaluate;
+    use shine_sh::zonal::rotate_zh;
+
+    #[test]
+    fn zonal_helpers_match_rotation_and_the_full_dot_product() {
+        let f = [0.7f32, -0.3, 0.25, 0.1, -0.05];
+        let g = [0.2f32, 0.4, -0.1, 0.3, 0.02];
+        let a = Vec3::new(0.3, -0.5, 0.8).normalize();
+        let b = Vec3::new(-0.6, 0.2, 0.4).normalize();
+        let fa = rotate_zh(&f, a).unwrap();
+        let gb = rotate_zh(&g, b).unwrap();
+        let full = shine_sh::dot(&fa, &gb).unwrap();
+        assert!((zh_dot(&f, &g, a.dot(b)) - full).abs() < 1e-5);
+        assert!((zh_eval(&f, a.dot(b)) - evaluate(&fa, b).unwrap()).abs() < 1e-5);
+    }
+
+    #[test]
+    fn lambert_sender_emission_is_the_hemisphere_cap_over_pi() {
+        let zh = sender_emission_zh(EMISSION_MAX_BANDS).unwrap();
+        let cap = cap_zh(std::f32::consts::FRAC_PI_2, EMISSION_MAX_BANDS).unwrap();
+        for (e, c) in zh.iter().zip(&cap) {
+            assert!((e - c / std::f32::consts::PI).abs() < 1e-6, "{e} vs {c}");
+        }
+    }
+}
