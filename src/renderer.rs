@@ -8,12 +8,17 @@ use crate::image_io::{HdrImage, ImageIoError, LdrImage};
 use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
 use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
+use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
+use crate::passes::receivers::{self, ReceiverError};
+use crate::passes::upsample::{self, UpsampleParams};
+use crate::settings::{GatherPath, GiTechnique, RadiusHeuristic};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
     ExecuteError, Executor, ExternalState, ImageDesc, ImageImport, PassTiming, RenderGraph,
 };
 use shine_scene::Scene;
+use shine_sh::brdf_table::{BrdfModel, HemisphereSampling};
 
 /// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
 const FRAMES_IN_FLIGHT: usize = 2;
@@ -21,6 +26,12 @@ const FRAMES_IN_FLIGHT: usize = 2;
 const SHADOW_DEPTH_BIAS: f32 = 1e-4;
 /// Receiver offset along its normal in shadow-map texels (removes acne at grazing angles).
 const SHADOW_NORMAL_OFFSET: f32 = 1.5;
+/// The one glossy lobe of the HVL gather's receiver BRDF (paper 003 §4.2 tabulates one per
+/// material; shine has one table for now): GGX of perceptual roughness 0.5 on a dielectric.
+const GATHER_GLOSSY: BrdfModel = BrdfModel::Ggx {
+    alpha: 0.25,
+    ior: 1.5,
+};
 
 /// What can go wrong while rendering.
 #[derive(Debug, thiserror::Error)]
@@ -40,6 +51,12 @@ pub enum RenderError {
     /// A read-back frame did not match its expected size.
     #[error(transparent)]
     Image(#[from] ImageIoError),
+    /// The HVL passes refused their inputs or parameters.
+    #[error(transparent)]
+    Hvl(#[from] HvlError),
+    /// The receiver or upsample pass refused its inputs.
+    #[error(transparent)]
+    Receivers(#[from] ReceiverError),
     /// `render` was called before `set_scene`.
     #[error("no scene: call set_scene first")]
     NoScene,
@@ -85,6 +102,8 @@ pub struct Renderer {
     linear: Sampler,
     nearest: Sampler,
     scene: Option<GpuScene>,
+    /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
+    brdf_tables: Vec<(u32, Buffer)>,
 }
 
 impl Renderer {
@@ -117,6 +136,7 @@ impl Renderer {
                     .max_lod(0.0),
             )?,
             scene: None,
+            brdf_tables: Vec::new(),
         })
     }
 
@@ -276,10 +296,27 @@ impl Renderer {
 
     /// Declares every pass of a frame; returns its HDR and LDR images.
     fn declare_frame(
-        &self,
+        &mut self,
         rg: &mut RenderGraph,
         settings: &Settings,
     ) -> Result<CompositeOutputs, RenderError> {
+        let hvl = settings.gi.contains(GiTechnique::Hvl);
+        let conv_bands = settings.hvl.convolution_bands;
+        if hvl && !self.brdf_tables.iter().any(|(b, _)| *b == conv_bands) {
+            let tables =
+                GatherBrdf::build(conv_bands, GATHER_GLOSSY, HemisphereSampling::default())?;
+            let buffer = Buffer::with_data(
+                &self.device,
+                &BufferDesc {
+                    name: "hvl brdf tables",
+                    size: 0,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::GpuOnly,
+                },
+                bytemuck::cast_slice(&tables.gpu_data()),
+            )?;
+            self.brdf_tables.push((conv_bands, buffer));
+        }
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
         let read_only = ExternalState::new(
             vk::PipelineStageFlags2::ALL_COMMANDS,
@@ -326,13 +363,69 @@ impl Renderer {
             shadow,
             self.nearest.raw(),
         );
+        let indirect = match primary {
+            Some((light, view)) if hvl => {
+                if view.orthographic {
+                    return Err(RenderError::Invalid(
+                        "HVL needs a spot or point primary light (a perspective RSM); this \
+                         scene's primary light is directional: use --gi none"
+                            .into(),
+                    ));
+                }
+                let params = hvl_params(settings);
+                let rsm = gbuffer::rsm(
+                    rg,
+                    &handles,
+                    view,
+                    light,
+                    settings.rsm.size,
+                    self.linear.raw(),
+                );
+                let hvls = hvl::hvl_cache(rg, &rsm, &params)?;
+                let recv = receivers::receivers(rg, &g, settings.receiver_scale)?;
+                let table = self
+                    .brdf_tables
+                    .iter()
+                    .find(|(b, _)| *b == conv_bands)
+                    .map(|(_, buffer)| buffer)
+                    .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
+                let brdf = rg.import_gpu_buffer(table, buffer_read, buffer_read);
+                let low = hvl::hvl_gather(rg, &recv, &hvls, &brdf, camera.eye, &params)?;
+                let upsample_params = UpsampleParams {
+                    depth_sigma: settings.upsample.depth_epsilon,
+                    normal_power: settings.upsample.normal_power,
+                    ..UpsampleParams::default()
+                };
+                Some(upsample::upsample(rg, &low, &recv, &g, &upsample_params)?)
+            }
+            _ => None,
+        };
         Ok(composite::composite(
             rg,
             &direct,
-            None,
+            indirect.as_ref(),
             extent,
             &CompositeParams::from_settings(&settings.output),
         ))
+    }
+}
+
+/// The HVL parameters of `settings.hvl` (paper 003).
+fn hvl_params(settings: &Settings) -> HvlParams {
+    let h = &settings.hvl;
+    HvlParams {
+        count: h.count,
+        radius: match h.radius {
+            RadiusHeuristic::R1 => hvl::RadiusHeuristic::R1,
+            RadiusHeuristic::R2 => hvl::RadiusHeuristic::R2,
+        },
+        radius_scale: h.radius_scale,
+        conv_bands: h.convolution_bands,
+        emission_bands: h.emission_bands,
+        path: match h.gather {
+            GatherPath::Full => hvl::Path::Full,
+            GatherPath::Zonal => hvl::Path::Zonal,
+        },
     }
 }
 

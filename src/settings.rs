@@ -420,7 +420,8 @@ pub struct ShadowSettings {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct UpsampleSettings {
-    /// ε of the depth weight 1 / (ε + |z_p − z_i|), in metres of linear view depth.
+    /// σ_z of the depth weight 1 / (1 + |z_p − z_i| / (σ_z z_p)): paper 002 eq. 11's ε made
+    /// relative to the pixel's linear depth z_p, so it does not depend on the scene's scale.
     /// Range 1e-6..=10.0, default 0.01.
     pub depth_epsilon: f32,
     /// Exponent p of the normal weight (N_p · N_i)^p. Range 1.0..=256.0, default 32.0

@@ -74,6 +74,72 @@ fn small_direct_only() -> Settings {
     s
 }
 
+/// 64×64 with HVL indirect light (64 HVLs, 3 bands, receivers at 1/2).
+fn small_hvl() -> Settings {
+    let mut s = Settings {
+        gi: GiTechniques::default(),
+        receiver_scale: 2,
+        ..small_direct_only()
+    };
+    s.rsm.size = 64;
+    s.hvl.count = 64;
+    s.hvl.convolution_bands = 3;
+    s.hvl.emission_bands = 3;
+    s
+}
+
+/// Sum of RGB over the frame.
+fn energy(frame: &shine::renderer::FrameImage) -> f64 {
+    frame
+        .hdr
+        .texels
+        .iter()
+        .map(|p| f64::from(p[0] + p[1] + p[2]))
+        .sum()
+}
+
+#[test]
+fn cornell_box_with_hvl_is_finite_brighter_bounded_and_repeatable() {
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let direct = render("cornell-box", &small_direct_only());
+    let a = render("cornell-box", &small_hvl());
+    let hdr: Vec<f32> = a.hdr.texels.iter().flatten().copied().collect();
+    assert!(
+        hdr.iter().all(|v| v.is_finite() && *v >= 0.0),
+        "non-finite or negative radiance"
+    );
+    let (with, without) = (energy(&a), energy(&direct));
+    // One bounce adds light, and in a closed box of albedo < 0.8 less than the direct light.
+    assert!(
+        with > without * 1.01,
+        "HVL added nothing: {with} vs {without}"
+    );
+    assert!(
+        with < without * 2.0,
+        "HVL more than doubled the light: {with} vs {without}"
+    );
+    let bound = radiance_bound(&scene);
+    let max = hdr.iter().copied().fold(0.0, f32::max);
+    assert!(
+        max <= bound,
+        "a pixel of radiance {max} exceeds the energy bound {bound}"
+    );
+    let b = render("cornell-box", &small_hvl());
+    assert_eq!(a.hdr.texels, b.hdr.texels, "two runs differ");
+    let names: Vec<_> = a.timings.iter().map(|t| t.name.as_str()).collect();
+    for pass in [
+        "rsm",
+        "hvl_cache",
+        "receivers",
+        "hvl_gather",
+        "upsample",
+        "composite",
+    ] {
+        assert!(names.contains(&pass), "no timing for {pass}: {names:?}");
+    }
+    eprintln!("frame energy: direct {without:.1}, direct + HVL {with:.1}");
+}
+
 #[test]
 fn cornell_box_direct_light_is_finite_lit_and_repeatable() {
     let settings = small_direct_only();

@@ -348,6 +348,7 @@ impl ReceiverImages {
             albedo: a,
             material: m,
             extent,
+            scale: 1,
         }
     }
 }

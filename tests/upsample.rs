@@ -183,11 +183,18 @@ impl GpuGBuffer {
             .images
             .each_ref()
             .map(|i| rg.import_gpu_image(i, uploaded_state(), ExternalState::UNDEFINED));
+        // Emission and hardware depth are not read by these passes: placeholders.
+        let [w, h] = self.extent;
+        let unused = |rg: &mut RenderGraph, name, format| {
+            rg.create_image(name, shine::graph::ImageDesc::new_2d(format, w, h))
+        };
         GBuffer {
             position,
             normal,
             albedo,
             material,
+            emissive: unused(rg, "unused emissive", vk::Format::R16G16B16A16_SFLOAT),
+            depth: unused(rg, "unused depth", vk::Format::D32_SFLOAT),
             extent: self.extent,
         }
     }
@@ -273,6 +280,8 @@ fn bad_scales_extents_and_parameters_are_errors() {
         normal: h,
         albedo: h,
         material: h,
+        emissive: h,
+        depth: h,
         extent: [8, 8],
     };
     for scale in [0, 3, 8] {

@@ -8,6 +8,8 @@ use shine_gpu::{Blend, DepthState, GraphicsPipelineDesc, VertexBufferLayout, vk}
 use shine_graph::{ColorLoad, DepthLoad, Handle, Image, ImageDesc, RenderGraph};
 use shine_scene::LightKind;
 
+pub use super::hvl::Rsm;
+
 /// Push constants of `view.glsl` (112 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -230,25 +232,6 @@ pub fn shadow_map(
     }
 }
 
-/// The reflective shadow map of the primary light (docs/frame.md).
-#[derive(Clone, Copy, Debug)]
-pub struct Rsm {
-    /// World position, w = 1 where something is seen.
-    pub position: Handle<Image>,
-    /// World normal.
-    pub normal: Handle<Image>,
-    /// Reflected flux per texel.
-    pub flux: Handle<Image>,
-    /// Light-space depth.
-    pub depth: Handle<Image>,
-    /// The light's view.
-    pub view: View,
-    /// Index of the light in the scene's lights.
-    pub light: u32,
-    /// Edge in texels.
-    pub size: u32,
-}
-
 /// Scene resources imported into a frame graph.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneHandles {
@@ -342,7 +325,8 @@ pub fn gbuffer(
     g
 }
 
-/// Rasterises the scene from the primary light into a new `size`² RSM.
+/// Rasterises the scene from the primary light (a perspective view) into a new `size`²
+/// reflective shadow map (docs/frame.md).
 pub fn rsm(
     rg: &mut RenderGraph,
     scene: &SceneHandles,
@@ -354,13 +338,13 @@ pub fn rsm(
     let image = |rg: &mut RenderGraph, name, format| {
         rg.create_image(name, ImageDesc::new_2d(format, size, size))
     };
+    let mut depth = image(rg, "rsm_depth", vk::Format::D32_SFLOAT);
     let mut r = Rsm {
         position: image(rg, "rsm_position", vk::Format::R32G32B32A32_SFLOAT),
         normal: image(rg, "rsm_normal", vk::Format::R16G16B16A16_SFLOAT),
         flux: image(rg, "rsm_flux", vk::Format::R32G32B32A32_SFLOAT),
-        depth: image(rg, "rsm_depth", vk::Format::D32_SFLOAT),
-        view,
-        light,
+        light_position: view.eye,
+        fov: view.extent,
         size,
     };
     let pipeline = scene_pipeline(
@@ -376,7 +360,7 @@ pub fn rsm(
         .color(&mut r.position, ColorLoad::Clear([0.0; 4]))
         .color(&mut r.normal, ColorLoad::Clear([0.0; 4]))
         .color(&mut r.flux, ColorLoad::Clear([0.0; 4]))
-        .depth(&mut r.depth, DepthLoad::Clear(1.0))
+        .depth(&mut depth, DepthLoad::Clear(1.0))
         .read("materials", &scene.materials)
         .read("srgb_textures", &scene.srgb_textures)
         .read("linear_textures", &scene.linear_textures)

@@ -47,6 +47,8 @@ use crate::gpu::ShaderDesc;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
 
+pub use super::receivers::Receivers;
+
 /// Most emission bands an [`Hvl`] stores (paper 003 §3 uses 0–5 bands for the emission).
 pub const EMISSION_MAX_BANDS: usize = 5;
 
@@ -119,21 +121,6 @@ pub struct Rsm {
     pub fov: f32,
     /// Side S of the RSM in texels.
     pub size: u32,
-}
-
-/// The receiver buffer (docs/frame.md, "Receiver buffer").
-#[derive(Debug, Clone, Copy)]
-pub struct Receivers {
-    /// `recv_position`, RGBA32F: xyz world position, w linear depth (0: background).
-    pub position: Handle<Image>,
-    /// `recv_normal`, RGBA16F: xyz unit world normal.
-    pub normal: Handle<Image>,
-    /// `recv_albedo`, RGBA8_UNORM: rgb linear base colour.
-    pub albedo: Handle<Image>,
-    /// `recv_material`, RGBA8_UNORM: r perceptual roughness, g metallic.
-    pub material: Handle<Image>,
-    /// Width and height of the receiver buffer.
-    pub extent: [u32; 2],
 }
 
 /// HVL radius heuristic (paper 003 §5.3).

@@ -7,6 +7,7 @@
 //! block's first sample when the whole block is background. A size not divisible by s gives
 //! `ceil(W/s)×ceil(H/s)` receivers whose right and bottom blocks are clipped to the image.
 
+pub use super::gbuffer::GBuffer;
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
 
@@ -43,21 +44,6 @@ pub enum ReceiverError {
     /// A tuning parameter is out of its range.
     #[error("upsample parameter {0}")]
     Parameter(&'static str),
-}
-
-/// The full-resolution G-buffer (docs/frame.md "G-buffer"), as the graph passes it along.
-#[derive(Debug, Clone, Copy)]
-pub struct GBuffer {
-    /// `gb_position`, RGBA32F: xyz world position, w linear view depth (0 on background).
-    pub position: Handle<Image>,
-    /// `gb_normal`, RGBA16F: xyz unit world shading normal.
-    pub normal: Handle<Image>,
-    /// `gb_albedo`, RGBA8_UNORM: linear base colour.
-    pub albedo: Handle<Image>,
-    /// `gb_material`, RGBA8_UNORM: r roughness, g metallic.
-    pub material: Handle<Image>,
-    /// Width and height W×H.
-    pub extent: [u32; 2],
 }
 
 /// The receiver buffer: the G-buffer's four images at `extent` = ceil(W/s)×ceil(H/s).
