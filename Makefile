@@ -1,5 +1,5 @@
 # The two commands of the README, and their parts.
-#   make render   the main job (today: the device report; a rendered frame once the frame lands)
+#   make render   the main job: the default scene (Cornell box) with HVL GI to out/cornell-box.png
 #   make test     formatting, lints and the whole test suite on the Vulkan device (lavapipe in CI)
 
 CARGO ?= cargo
@@ -9,7 +9,9 @@ CARGO ?= cargo
 deps:
 	./scripts/install-deps.sh
 
-render: info
+render: deps
+	mkdir -p out
+	$(CARGO) run --release -- render builtin:cornell-box --width 512 --height 512 -o out/cornell-box.png
 
 info: deps
 	$(CARGO) run --release -- info
