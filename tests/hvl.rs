@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_clean, device};
+use common::{assert_clean, device, f16_to_f32, f32_to_f16};
 use glam::{Vec3, Vec4};
 use shine::gpu::{Device, MemoryLocation};
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
@@ -27,43 +27,8 @@ const GLOSSY: BrdfModel = BrdfModel::Ggx {
 };
 
 // ---------------------------------------------------------------------------------------------
-// Half floats (the RGBA16F images), round to nearest even.
+// Half floats (the RGBA16F images): tests/common rounds to nearest even.
 // ---------------------------------------------------------------------------------------------
-
-fn f32_to_f16(v: f32) -> u16 {
-    let bits = v.to_bits();
-    let sign = ((bits >> 16) & 0x8000) as u16;
-    let exp = ((bits >> 23) & 0xff) as i32 - 127 + 15;
-    let mant = bits & 0x7f_ffff;
-    if exp >= 31 {
-        return sign | 0x7c00;
-    }
-    if exp <= 0 {
-        if exp < -10 {
-            return sign;
-        }
-        let m = (mant | 0x80_0000) >> (1 - exp);
-        let half = m >> 13;
-        let rest = m & 0x1fff;
-        let round = u32::from(rest > 0x1000 || (rest == 0x1000 && half & 1 == 1));
-        return sign | (half + round) as u16;
-    }
-    let half = ((exp as u32) << 10) | (mant >> 13);
-    let rest = mant & 0x1fff;
-    let round = u32::from(rest > 0x1000 || (rest == 0x1000 && half & 1 == 1));
-    sign | (half + round) as u16
-}
-
-fn f16_to_f32(h: u16) -> f32 {
-    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let exp = i32::from((h >> 10) & 0x1f);
-    let mant = f32::from(h & 0x3ff);
-    match exp {
-        0 => sign * mant * 2f32.powi(-24),
-        31 => sign * f32::INFINITY,
-        _ => sign * (1.0 + mant / 1024.0) * 2f32.powi(exp - 15),
-    }
-}
 
 /// A value as an RGBA16F texel stores it.
 fn q16(v: Vec4) -> Vec4 {

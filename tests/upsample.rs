@@ -9,7 +9,7 @@
 
 mod common;
 
-use common::{assert_clean, device};
+use common::{assert_clean, device, f16_to_f32 as f16_value, f32_to_f16 as f16_bits};
 use shine::gpu::{Device, MemoryLocation};
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
 use shine::graph::{Executor, ExternalState, Handle, Image, RenderGraph};
@@ -20,46 +20,6 @@ use shine::passes::upsample::{
     UpsampleInputs, UpsampleParams, UpsamplePush, upsample, upsample_cpu,
 };
 use shine::shaders;
-
-/// f32 → f16 bits, round to nearest even (normal and subnormal range; test data is finite).
-fn f16_bits(v: f32) -> u16 {
-    let bits = v.to_bits();
-    let sign = ((bits >> 16) & 0x8000) as u16;
-    let exp = ((bits >> 23) & 0xff) as i32 - 127 + 15;
-    let mant = bits & 0x7f_ffff;
-    if exp >= 31 {
-        return sign | 0x7c00;
-    }
-    let (mant, shift) = if exp <= 0 {
-        (mant | 0x80_0000, (14 - exp) as u32)
-    } else {
-        (mant, 13)
-    };
-    if shift > 24 {
-        return sign;
-    }
-    let half = mant >> shift;
-    let rest = mant & ((1 << shift) - 1);
-    let halfway = 1 << (shift - 1);
-    let mut out = half;
-    if rest > halfway || (rest == halfway && half & 1 == 1) {
-        out += 1;
-    }
-    let exp_bits = if exp <= 0 { 0 } else { (exp as u32) << 10 };
-    sign | (exp_bits + out) as u16
-}
-
-/// f16 bits → f32 (exact).
-fn f16_value(h: u16) -> f32 {
-    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let exp = i32::from((h >> 10) & 0x1f);
-    let mant = f32::from(h & 0x3ff);
-    sign * match exp {
-        0 => mant * 2f32.powi(-24),
-        31 => f32::INFINITY,
-        _ => (1.0 + mant / 1024.0) * 2f32.powi(exp - 15),
-    }
-}
 
 /// Rounds through f16 (what an RGBA16F image holds).
 fn f16_round(v: &[f32]) -> Vec<f32> {
