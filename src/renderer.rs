@@ -202,13 +202,13 @@ impl Renderer {
         count: u32,
     ) -> Result<Vec<PassTiming>, RenderError> {
         settings.validate()?;
+        // The frame's outputs must reach something outside the graph, or every pass is culled:
+        // the LDR image is handed to a throw-away import.
+        let sink = self.sink(settings)?;
         let mut timings = Vec::new();
         for _ in 0..count {
             let mut rg = self.executor.begin_frame();
             let frame = self.declare_frame(&mut rg, settings)?;
-            // The frame's outputs must reach something outside the graph, or every pass is
-            // culled: the LDR image is handed to a throw-away import.
-            let sink = self.sink(settings)?;
             let mut out = rg.import_gpu_image(
                 &sink,
                 ExternalState::UNDEFINED,

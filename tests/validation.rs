@@ -33,15 +33,7 @@ fn a_missing_barrier_is_reported_as_a_sync_hazard() {
             cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
             cmd.dispatch_threads(&pipeline, [count, 1, 1]);
             // Deliberately no barrier between the shader write and the copy's read.
-            let raw = cmd.device().raw().clone();
-            let cb = cmd.raw();
-            let region = [vk::BufferCopy {
-                src_offset: 0,
-                dst_offset: 0,
-                size: 64,
-            }];
-            // SAFETY: valid buffers and region; the hazard is the point of the test.
-            unsafe { raw.cmd_copy_buffer(cb, output.raw(), copy.raw(), &region) };
+            cmd.copy_buffer(output.raw(), copy.raw(), &[COPY_256]);
             Ok(())
         })
         .expect("submission");
@@ -108,6 +100,13 @@ fn timestamp_scopes_are_ordered_and_named() {
     common::assert_clean(&device);
 }
 
+/// The whole of a 256-byte buffer.
+const COPY_256: vk::BufferCopy = vk::BufferCopy {
+    src_offset: 0,
+    dst_offset: 0,
+    size: 256,
+};
+
 #[test]
 fn destruction_waits_for_the_submission_that_may_use_the_object() {
     let device = common::device();
@@ -119,16 +118,9 @@ fn destruction_waits_for_the_submission_that_may_use_the_object() {
 
     let (src, dst) = (make("src"), make("dst"));
     let mut cmd = device.begin_commands().expect("commands");
-    let raw = device.raw().clone();
-    let cb = cmd.raw();
-    let region = [vk::BufferCopy {
-        src_offset: 0,
-        dst_offset: 0,
-        size: 256,
-    }];
-    // SAFETY: both buffers are alive when recorded; `src` is dropped before submission on
+    // Both buffers are alive when recorded; `src` is dropped before submission on
     // purpose and must survive until the copy has run.
-    unsafe { raw.cmd_copy_buffer(cb, src.raw(), dst.raw(), &region) };
+    cmd.copy_buffer(src.raw(), dst.raw(), &[COPY_256]);
     drop(src);
     assert_eq!(
         device.pending_destructions(),
@@ -158,15 +150,8 @@ fn an_object_dropped_during_a_recording_outlives_other_submissions() {
     let make = |name| common::buffer(&device, name, 256, usage);
     let (src, dst) = (make("src"), make("dst"));
     let mut frame = device.begin_commands().expect("frame recording");
-    let raw = device.raw().clone();
-    let cb = frame.raw();
-    let region = [vk::BufferCopy {
-        src_offset: 0,
-        dst_offset: 0,
-        size: 256,
-    }];
-    // SAFETY: both buffers are alive when recorded; `src` must survive until the frame runs.
-    unsafe { raw.cmd_copy_buffer(cb, src.raw(), dst.raw(), &region) };
+    // Both buffers are alive when recorded; `src` must survive until the frame runs.
+    frame.copy_buffer(src.raw(), dst.raw(), &[COPY_256]);
     drop(src);
     // Another submission (an upload) goes first and completes.
     device.upload_buffer(&dst, 0, &[7u8; 16]).expect("upload");

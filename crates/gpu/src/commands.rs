@@ -290,6 +290,14 @@ impl Commands {
         unsafe { raw.cmd_dispatch(cb, x, y, z) };
     }
 
+    /// Copies buffer regions (the caller orders it against other work with barriers).
+    pub fn copy_buffer(&mut self, src: vk::Buffer, dst: vk::Buffer, regions: &[vk::BufferCopy]) {
+        let raw = self.device.raw().clone();
+        let cb = self.raw();
+        // SAFETY: `cb` is recording; the caller passes live buffers and in-bounds regions.
+        unsafe { raw.cmd_copy_buffer(cb, src, dst, regions) };
+    }
+
     /// Records a synchronization2 dependency.
     pub fn barrier(&mut self, dependency: &vk::DependencyInfo<'_>) {
         let raw = self.device.raw().clone();

@@ -80,10 +80,7 @@ impl Device {
         }];
         self.run_once(|cmd| {
             cmd.memory_barrier(ANY_ACCESS, COPY_WRITE);
-            let raw = cmd.device().raw().clone();
-            let cb = cmd.raw();
-            // SAFETY: both buffers are alive and the region lies inside both.
-            unsafe { raw.cmd_copy_buffer(cb, staging.raw(), buffer.raw(), &region) };
+            cmd.copy_buffer(staging.raw(), buffer.raw(), &region);
             cmd.memory_barrier(COPY_WRITE, ANY_ACCESS);
             Ok(())
         })?;
@@ -105,10 +102,7 @@ impl Device {
         }];
         self.run_once(|cmd| {
             cmd.memory_barrier(ANY_ACCESS, COPY_READ);
-            let raw = cmd.device().raw().clone();
-            let cb = cmd.raw();
-            // SAFETY: both buffers are alive and the region lies inside both.
-            unsafe { raw.cmd_copy_buffer(cb, buffer.raw(), staging.raw(), &region) };
+            cmd.copy_buffer(buffer.raw(), staging.raw(), &region);
             cmd.memory_barrier(COPY_WRITE, HOST_READ);
             Ok(())
         })?;
