@@ -278,14 +278,15 @@ fn texture_array(
     format: vk::Format,
     layers: &[Vec<u8>],
 ) -> Result<Image, shine_gpu::Error> {
-    // At least two layers: `Image` makes an array view only for several layers, and the
-    // shaders declare `texture2DArray`. Missing layers read as white.
-    let white = vec![255u8; (TEXTURE_SIZE * TEXTURE_SIZE * 4) as usize];
-    let mut layers: Vec<&[u8]> = layers.iter().map(Vec::as_slice).collect();
-    while layers.len() < 2 {
-        layers.push(&white);
-    }
-    let data = layers.concat();
+    // A scene without textures still binds a (white) layer: the shaders read it only through
+    // a texture index, which is NO_TEXTURE then.
+    let layer_bytes = (TEXTURE_SIZE * TEXTURE_SIZE * 4) as usize;
+    let data = if layers.is_empty() {
+        vec![255u8; layer_bytes]
+    } else {
+        layers.concat()
+    };
+    let layer_count = (data.len() / layer_bytes) as u32;
     let image = Image::new(
         device,
         &ImageDesc {
@@ -294,7 +295,9 @@ fn texture_array(
             format,
             usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
             mip_levels: 1,
-            array_layers: layers.len() as u32,
+            array_layers: layer_count,
+            // The shaders declare `texture2DArray`, also for a single layer.
+            array_view: true,
         },
     )?;
     device.upload_image(&image, &data, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)?;

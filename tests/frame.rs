@@ -163,3 +163,20 @@ fn cornell_box_direct_light_is_finite_lit_and_repeatable() {
         assert!(names.contains(&pass), "no timing for {pass}: {names:?}");
     }
 }
+
+#[test]
+fn textured_room_renders_finite_and_lit() {
+    // Texture arrays (sRGB and linear), normal maps, a point and a spot light.
+    let mut settings = small_direct_only();
+    settings.width = 32;
+    settings.height = 32;
+    let frame = render("room", &settings);
+    assert!(frame.hdr.texels.iter().flatten().all(|v| v.is_finite()));
+    let lit = frame
+        .hdr
+        .texels
+        .iter()
+        .filter(|p| p[0] + p[1] + p[2] > 1e-3)
+        .count();
+    assert!(lit > 32 * 32 / 2, "only {lit} of 1024 pixels are lit");
+}

@@ -150,6 +150,9 @@ pub struct ImageDesc<'a> {
     pub mip_levels: u32,
     /// Array layers (≥ 1).
     pub array_layers: u32,
+    /// View it as an array (`texture2DArray`) even with a single layer; images of several
+    /// layers always get an array view.
+    pub array_view: bool,
 }
 
 impl<'a> ImageDesc<'a> {
@@ -167,6 +170,7 @@ impl<'a> ImageDesc<'a> {
             usage,
             mip_levels: 1,
             array_layers: 1,
+            array_view: false,
         }
     }
 }
@@ -294,7 +298,7 @@ impl Image {
             }
             let view_info = vk::ImageViewCreateInfo::default()
                 .image(raw)
-                .view_type(if desc.array_layers > 1 {
+                .view_type(if desc.array_layers > 1 || desc.array_view {
                     vk::ImageViewType::TYPE_2D_ARRAY
                 } else {
                     vk::ImageViewType::TYPE_2D
