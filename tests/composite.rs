@@ -10,8 +10,8 @@
 
 mod common;
 
-use common::{assert_clean, device};
-use shine::gpu::{Device, MemoryLocation};
+use common::{assert_clean, buffer_with as buffer, device};
+use shine::gpu::Device;
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
 use shine::graph::*;
 use shine::passes::composite::{
@@ -95,21 +95,6 @@ fn indirect_bits() -> Vec<[u16; 4]> {
 
 fn values(bits: &[[u16; 4]]) -> Vec<[f32; 4]> {
     bits.iter().map(|t| t.map(half_value)).collect()
-}
-
-fn buffer(
-    device: &Device,
-    name: &str,
-    usage: vk::BufferUsageFlags,
-    data: &[u8],
-) -> shine::gpu::Buffer {
-    let desc = shine::gpu::BufferDesc {
-        name,
-        size: data.len() as u64,
-        usage,
-        location: MemoryLocation::GpuOnly,
-    };
-    shine::gpu::Buffer::with_data(device, &desc, data).unwrap()
 }
 
 /// Runs the composite on the device and returns the HDR and LDR frames read back.

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{assert_clean, device};
+use common::{assert_clean, buffer_with, device};
 use shine::gpu::{
     Blend, DepthState, Device, GraphicsPipelineDesc, MemoryLocation, VertexBufferLayout,
 };
@@ -307,22 +307,6 @@ fn aliased_images_through_clear_blits_and_copy() {
     assert_clean(&device);
 }
 
-/// A buffer with contents uploaded before the graph (a finished copy is its last write).
-fn uploaded(
-    device: &Device,
-    name: &str,
-    usage: vk::BufferUsageFlags,
-    data: &[u8],
-) -> shine::gpu::Buffer {
-    let desc = shine::gpu::BufferDesc {
-        name,
-        size: data.len() as u64,
-        usage,
-        location: MemoryLocation::GpuOnly,
-    };
-    shine::gpu::Buffer::with_data(device, &desc, data).unwrap()
-}
-
 #[test]
 fn indexed_depth_pass_then_sampled_in_compute() {
     let device = device();
@@ -335,13 +319,13 @@ fn indexed_depth_pass_then_sampled_in_compute() {
             positions.extend([x, y, z, 0.0]);
         }
     }
-    let vertices = uploaded(
+    let vertices = buffer_with(
         &device,
         "vertices",
         vk::BufferUsageFlags::VERTEX_BUFFER,
         bytemuck::cast_slice(&positions),
     );
-    let indices = uploaded(
+    let indices = buffer_with(
         &device,
         "indices",
         vk::BufferUsageFlags::INDEX_BUFFER,

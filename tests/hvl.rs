@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{assert_clean, device, f16_to_f32, f32_to_f16};
+use common::{assert_clean, device, f16_to_f32, f32_to_f16, storage_image_with};
 use glam::{Vec3, Vec4};
 use shine::gpu::{Device, MemoryLocation};
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
@@ -184,24 +184,6 @@ fn read_by_copy() -> ExternalState {
     ExternalState::new(S::COPY, A::TRANSFER_READ, L::UNDEFINED)
 }
 
-fn image(
-    device: &Device,
-    name: &str,
-    format: vk::Format,
-    extent: [u32; 2],
-    data: &[u8],
-) -> shine::gpu::Image {
-    let desc = shine::gpu::ImageDesc::new_2d(
-        name,
-        extent,
-        format,
-        vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST,
-    );
-    let image = shine::gpu::Image::new(device, &desc).unwrap();
-    device.upload_image(&image, data, L::GENERAL).unwrap();
-    image
-}
-
 fn buffer(device: &Device, name: &str, size: u64, data: Option<&[u8]>) -> shine::gpu::Buffer {
     let desc = shine::gpu::BufferDesc {
         name,
@@ -224,21 +206,21 @@ impl RsmImages {
     fn new(device: &Device, rsm: &RsmData) -> Self {
         let e = [rsm.size, rsm.size];
         Self([
-            image(
+            storage_image_with(
                 device,
                 "rsm_position",
                 vk::Format::R32G32B32A32_SFLOAT,
                 e,
                 &bytes_f32(&rsm.position),
             ),
-            image(
+            storage_image_with(
                 device,
                 "rsm_normal",
                 vk::Format::R16G16B16A16_SFLOAT,
                 e,
                 &bytes_f16(&rsm.normal),
             ),
-            image(
+            storage_image_with(
                 device,
                 "rsm_flux",
                 vk::Format::R32G32B32A32_SFLOAT,
@@ -271,28 +253,28 @@ impl ReceiverImages {
     fn new(device: &Device, r: &ReceiverData) -> Self {
         let e = r.extent;
         Self([
-            image(
+            storage_image_with(
                 device,
                 "recv_position",
                 vk::Format::R32G32B32A32_SFLOAT,
                 e,
                 &bytes_f32(&r.position),
             ),
-            image(
+            storage_image_with(
                 device,
                 "recv_normal",
                 vk::Format::R16G16B16A16_SFLOAT,
                 e,
                 &bytes_f16(&r.normal),
             ),
-            image(
+            storage_image_with(
                 device,
                 "recv_albedo",
                 vk::Format::R8G8B8A8_UNORM,
                 e,
                 &bytes_unorm8(&r.albedo),
             ),
-            image(
+            storage_image_with(
                 device,
                 "recv_material",
                 vk::Format::R8G8B8A8_UNORM,

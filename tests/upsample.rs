@@ -9,7 +9,9 @@
 
 mod common;
 
-use common::{assert_clean, device, f16_to_f32 as f16_value, f32_to_f16 as f16_bits};
+use common::{
+    assert_clean, device, f16_to_f32 as f16_value, f32_to_f16 as f16_bits, storage_image_with,
+};
 use shine::gpu::{Device, MemoryLocation};
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
 use shine::graph::{Executor, ExternalState, Handle, Image, RenderGraph};
@@ -70,28 +72,9 @@ impl CpuGBuffer {
     }
 }
 
-const USAGE: vk::ImageUsageFlags = vk::ImageUsageFlags::from_raw(
-    vk::ImageUsageFlags::STORAGE.as_raw()
-        | vk::ImageUsageFlags::TRANSFER_DST.as_raw()
-        | vk::ImageUsageFlags::TRANSFER_SRC.as_raw(),
-);
-
 /// The state `Device::upload_image` leaves an image in (GENERAL, the copy finished).
 fn uploaded_state() -> ExternalState {
     ExternalState::new(S::ALL_COMMANDS, A::MEMORY_WRITE, L::GENERAL)
-}
-
-fn image(
-    device: &Device,
-    name: &str,
-    extent: [u32; 2],
-    format: vk::Format,
-    data: &[u8],
-) -> shine::gpu::Image {
-    let desc = shine::gpu::ImageDesc::new_2d(name, extent, format, USAGE);
-    let image = shine::gpu::Image::new(device, &desc).unwrap();
-    device.upload_image(&image, data, L::GENERAL).unwrap();
-    image
 }
 
 /// The four G-buffer images on the device.
@@ -106,32 +89,32 @@ impl GpuGBuffer {
         Self {
             extent: e,
             images: [
-                image(
+                storage_image_with(
                     device,
                     "gb_position",
-                    e,
                     vk::Format::R32G32B32A32_SFLOAT,
+                    e,
                     bytemuck::cast_slice(&g.position),
                 ),
-                image(
+                storage_image_with(
                     device,
                     "gb_normal",
-                    e,
                     vk::Format::R16G16B16A16_SFLOAT,
+                    e,
                     &f16_bytes(&g.normal),
                 ),
-                image(
+                storage_image_with(
                     device,
                     "gb_albedo",
-                    e,
                     vk::Format::R8G8B8A8_UNORM,
+                    e,
                     &g.albedo,
                 ),
-                image(
+                storage_image_with(
                     device,
                     "gb_material",
-                    e,
                     vk::Format::R8G8B8A8_UNORM,
+                    e,
                     &g.material,
                 ),
             ],
@@ -341,11 +324,11 @@ fn upsample_both(
     let recv_cpu = recv.unwrap_or(&computed);
     let recv_gpu = recv.map(|r| GpuGBuffer::new(device, r));
     let radiance = f16_round(radiance);
-    let radiance_image = image(
+    let radiance_image = storage_image_with(
         device,
         "radiance",
-        recv_cpu.extent,
         vk::Format::R16G16B16A16_SFLOAT,
+        recv_cpu.extent,
         &f16_bytes(&radiance),
     );
     let mut executor = Executor::new(device, 1).unwrap();

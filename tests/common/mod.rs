@@ -146,3 +146,38 @@ pub fn f16_to_f32(h: u16) -> f32 {
         _ => sign * (1.0 + mant / 1024.0) * 2f32.powi(exp - 15),
     }
 }
+
+/// A device-local buffer of exactly `data.len()` bytes holding `data`.
+pub fn buffer_with(
+    device: &Device,
+    name: &str,
+    usage: vk::BufferUsageFlags,
+    data: &[u8],
+) -> Buffer {
+    let desc = BufferDesc {
+        name,
+        size: data.len() as u64,
+        usage,
+        location: MemoryLocation::GpuOnly,
+    };
+    Buffer::with_data(device, &desc, data).expect("buffer with data")
+}
+
+/// A storage image holding `data` (tightly packed texels), left in `GENERAL` layout.
+pub fn storage_image_with(
+    device: &Device,
+    name: &str,
+    format: vk::Format,
+    extent: [u32; 2],
+    data: &[u8],
+) -> shine::gpu::Image {
+    let usage = vk::ImageUsageFlags::STORAGE
+        | vk::ImageUsageFlags::TRANSFER_DST
+        | vk::ImageUsageFlags::TRANSFER_SRC;
+    let desc = shine::gpu::ImageDesc::new_2d(name, extent, format, usage);
+    let image = shine::gpu::Image::new(device, &desc).expect("image");
+    device
+        .upload_image(&image, data, vk::ImageLayout::GENERAL)
+        .expect("image upload");
+    image
+}

@@ -47,6 +47,21 @@ impl Device {
         )
     }
 
+    /// A host-visible transfer source holding `data`.
+    fn staging_with(&self, name: &str, data: &[u8]) -> Result<Buffer> {
+        let mut staging = self.staging(
+            name,
+            data.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        let mapped = staging
+            .mapped_mut()
+            .ok_or_else(|| Error::InvalidUsage("staging memory is not host-visible".into()))?;
+        mapped[..data.len()].copy_from_slice(data);
+        Ok(staging)
+    }
+
     /// Writes `data` at `offset` of `buffer` through a staging buffer and a copy (the buffer
     /// needs `TRANSFER_DST`); host-visible buffers can also be written through
     /// [`Buffer::mapped_mut`].
@@ -63,16 +78,7 @@ impl Device {
         if data.is_empty() {
             return Ok(());
         }
-        let mut staging = self.staging(
-            "staging upload",
-            data.len() as u64,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
-        )?;
-        let mapped = staging
-            .mapped_mut()
-            .ok_or_else(|| Error::InvalidUsage("staging memory is not host-visible".into()))?;
-        mapped[..data.len()].copy_from_slice(data);
+        let staging = self.staging_with("staging upload", data)?;
         let region = [vk::BufferCopy {
             src_offset: 0,
             dst_offset: offset,
@@ -128,16 +134,7 @@ impl Device {
                 data.len()
             )));
         }
-        let mut staging = self.staging(
-            "staging image upload",
-            expected,
-            vk::BufferUsageFlags::TRANSFER_SRC,
-            MemoryLocation::CpuToGpu,
-        )?;
-        let mapped = staging
-            .mapped_mut()
-            .ok_or_else(|| Error::InvalidUsage("staging memory is not host-visible".into()))?;
-        mapped[..data.len()].copy_from_slice(data);
+        let staging = self.staging_with("staging image upload", data)?;
         let range = image.full_range();
         self.run_once(|cmd| {
             cmd.image_barrier(
