@@ -1,15 +1,18 @@
-// HVL cache (paper 003 §5.2-5.3): distributes M = K*K Harmonics Virtual Lights over the RSM.
+// HVL cache (paper 003 §5.2-5.3): distributes M Harmonics Virtual Lights over the RSM.
 //
-// `build`: the S*S RSM is cut into a regular K*K grid of cells (cell c covers texels
-// [c*S/K, (c+1)*S/K) on each axis). Each cell gives one HVL: its position and normal are those
-// of the cell's valid texel nearest the cell centre (first in row-major order on a tie), its
-// flux is the sum of the flux of every valid texel of the cell (so the light's reflected power
-// is conserved for any M), its emission is the sender's F' (Lambert: cap ZH of the hemisphere
-// / pi, eq. 20). Radius r2 (eq. 24-26) here; with r1 the radius is left 0 for the `r1` stage.
-// A cell without a valid texel is an empty HVL (flux.a = 0, radius 0): the gather skips it.
+// `build`: the S*S RSM is cut into exactly M cells (shine::passes::hvl::HvlGrid: R rows of equal
+// height, row j holding cells floor(jM/R)..floor((j+1)M/R) of equal width; a K*K grid when
+// M = K*K). Each cell gives one HVL: its position and normal are those of the cell's valid texel
+// nearest the cell centre (first in row-major order on a tie), its flux is the sum of the flux
+// of every valid texel of the cell (so the light's reflected power is conserved for any M), its
+// emission is the sender's F' (Lambert: cap ZH of the hemisphere / pi, eq. 20). Radius r2
+// (eq. 24-26; for an orthographic RSM sqrt(2) W / sqrt(M)) here; with r1 the radius is left 0
+// for the `r1` stage. A cell without a valid texel is an empty HVL (flux.a = 0, radius 0): the
+// gather skips it. The distance d_j to the light is Euclidean (perspective) or along the
+// light's direction (orthographic).
 //
-// `r1`: radius heuristic r1 (eq. 23) over the 8-connected valid neighbours in the K*K grid;
-// an HVL without a usable neighbour falls back to r2. Both stages apply the user scale.
+// `r1`: radius heuristic r1 (eq. 23) over the cell's neighbours (HvlGrid::neighbours); an HVL
+// without a usable neighbour falls back to r2. Both stages apply the user scale.
 // CPU twin: shine::hvl_reference::build_cache.
 //! variant build HVL_STAGE_BUILD=1
 //! variant r1 HVL_STAGE_R1=1
@@ -19,7 +22,7 @@
 #include "sh.glsl"
 #include "hvl.glsl"
 
-layout(local_size_x = 8, local_size_y = 8) in;
+layout(local_size_x = 64) in;
 
 #ifdef HVL_STAGE_BUILD
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D rsm_position;
@@ -37,12 +40,17 @@ layout(set = 0, binding = 3, std430) buffer Hvls {
 
 // shine::passes::hvl::CachePush
 layout(push_constant) uniform Push {
-    // xyz: primary light position; w: RSM field of view lambda (radians)
-    vec4 light_position_fov;
+    // xyz: light position (perspective) or RSM eye (orthographic); w: fov lambda (radians) or
+    // width W (metres)
+    vec4 light_position_extent;
+    // xyz: unit axis of the RSM view; w: 1 orthographic, 0 perspective
+    vec4 light_direction_ortho;
     // RSM side S
     uint rsm_size;
-    // HVL grid side K (M = K*K)
-    uint grid;
+    // HVL count M
+    uint count;
+    // rows R of the cell grid
+    uint rows;
     // 1: r2 in the build stage; 0: the r1 stage sets the radius
     uint use_r2;
     // user radius scale k (1-2, paper 003 §5.3)
@@ -52,21 +60,47 @@ layout(push_constant) uniform Push {
 // eq. 23, paper 003: epsilon of the weights w_n = 1 / (|d - d_n| + epsilon), metres
 const float HVL_R1_EPSILON = 1e-3;
 
+bool orthographic() {
+    return push.light_direction_ortho.w > 0.5;
+}
+
 float r2_radius(float light_distance) {
-    return hvl_radius_r2(light_distance, push.light_position_fov.w, float(push.grid * push.grid));
+    if (orthographic()) {
+        return hvl_radius_r2_orthographic(push.light_position_extent.w, float(push.count));
+    }
+    return hvl_radius_r2(light_distance, push.light_position_extent.w, float(push.count));
+}
+
+// HvlGrid::row_start
+uint row_start(uint j) {
+    return j * push.count / push.rows;
+}
+
+// HvlGrid::row_of: ceil((m + 1) R / M) - 1
+uint row_of(uint m) {
+    return ((m + 1u) * push.rows + push.count - 1u) / push.count - 1u;
+}
+
+// HvlGrid::cell: texels [lo, hi) of cell m
+void cell_rect(uint m, out uvec2 lo, out uvec2 hi) {
+    uint j = row_of(m);
+    uint first = row_start(j);
+    uint n = row_start(j + 1u) - first;
+    uint i = m - first;
+    uint s = push.rsm_size;
+    lo = uvec2(i * s / n, j * s / push.rows);
+    hi = uvec2((i + 1u) * s / n, (j + 1u) * s / push.rows);
 }
 
 void main() {
-    uvec2 c = gl_GlobalInvocationID.xy;
-    uint k = push.grid;
-    if (c.x >= k || c.y >= k) {
+    uint index = gl_GlobalInvocationID.x;
+    if (index >= push.count) {
         return;
     }
-    uint index = c.y * k + c.x;
 #ifdef HVL_STAGE_BUILD
-    uint s = push.rsm_size;
-    uvec2 lo = c * s / k;
-    uvec2 hi = (c + 1u) * s / k;
+    uvec2 lo;
+    uvec2 hi;
+    cell_rect(index, lo, hi);
     vec2 centre = 0.5 * vec2(lo + hi);
     float best = 3.0e38;
     ivec2 rep = ivec2(-1);
@@ -94,7 +128,8 @@ void main() {
     if (rep.x >= 0) {
         vec3 p = imageLoad(rsm_position, rep).xyz;
         vec3 n = normalize(imageLoad(rsm_normal, rep).xyz);
-        float d = distance(p, push.light_position_fov.xyz);
+        vec3 from_light = p - push.light_position_extent.xyz;
+        float d = orthographic() ? dot(from_light, push.light_direction_ortho.xyz) : length(from_light);
         float r = push.use_r2 != 0u ? r2_radius(d) * push.radius_scale : 0.0;
         position_radius = vec4(p, r);
         normal_distance = vec4(n, d);
@@ -117,13 +152,25 @@ void main() {
         vec3 p = position_radius.xyz;
         float num = 0.0;
         float den = 0.0;
-        for (int dy = -1; dy <= 1; ++dy) {
-            for (int dx = -1; dx <= 1; ++dx) {
-                ivec2 q = ivec2(c) + ivec2(dx, dy);
-                if ((dx == 0 && dy == 0) || q.x < 0 || q.y < 0 || q.x >= int(k) || q.y >= int(k)) {
+        uint j = row_of(index);
+        uvec2 lo;
+        uvec2 hi;
+        cell_rect(index, lo, hi);
+        for (int dj = -1; dj <= 1; ++dj) {
+            int jj = int(j) + dj;
+            if (jj < 0 || jj >= int(push.rows)) {
+                continue;
+            }
+            uint first = row_start(uint(jj));
+            uint n = row_start(uint(jj) + 1u) - first;
+            // HvlGrid::neighbours: the cell of row jj under this cell's centre
+            uint c = dj == 0 ? index - first : min((lo.x + hi.x) * n / (2u * push.rsm_size), n - 1u);
+            for (int di = -1; di <= 1; ++di) {
+                int ii = int(c) + di;
+                if ((dj == 0 && di == 0) || ii < 0 || ii >= int(n)) {
                     continue;
                 }
-                uint m = uint(q.y) * k + uint(q.x);
+                uint m = first + uint(ii);
                 if (source.h[m].flux.a == 0.0) {
                     continue;
                 }

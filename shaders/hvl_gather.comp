@@ -6,19 +6,32 @@
 //   L_j = Phi_j * max(0, F'_j . Y(-omega_j)) * G_j(-omega_j)               eq. 20, 21, 22
 //   full path (O(n^2)):  L_j * (kd * L . F_lambert(theta_o) + ks * L . F_glossy(theta_o))  eq. 19
 //     with L = cap SH of the sphere (eq. 14-15) in the receiver frame (normal z, omega_o in
-//     the xz half-plane), F rows of the BRDF SH tables interpolated at theta_o (eq. 18);
+//     the xz half-plane), F rows of the BRDF SH tables interpolated at theta_o (eq. 18), the
+//     glossy row blended between the two GGX tables around the receiver's roughness;
 //   zonal path (O(n)): L_j * kd * sum_l cap_l (cc_l / pi) P_l(n . omega_j) (Lambert only).
 // kd = albedo (1 - metallic), ks = mix(1, albedo, metallic). Each HVL's contribution is clamped
 // at 0 per channel (band-limited ringing must not go negative in the RGBA16F output; the
 // paper's sinc window is not applied). CPU twin: shine::hvl_reference.
-//! variant full_c3_e3 HVL_FULL=1 SH_BANDS=3 EMISSION_BANDS=3
-//! variant full_c5_e3 HVL_FULL=1 SH_BANDS=5 EMISSION_BANDS=3
-//! variant full_c5_e5 HVL_FULL=1 SH_BANDS=5 EMISSION_BANDS=5
-//! variant full_c9_e3 HVL_FULL=1 SH_BANDS=9 EMISSION_BANDS=3
-//! variant full_c10_e5 HVL_FULL=1 SH_BANDS=10 EMISSION_BANDS=5
-//! variant zonal_c3_e3 HVL_ZONAL=1 SH_BANDS=3 EMISSION_BANDS=3
-//! variant zonal_c5_e3 HVL_ZONAL=1 SH_BANDS=5 EMISSION_BANDS=3
-//! variant zonal_c9_e3 HVL_ZONAL=1 SH_BANDS=9 EMISSION_BANDS=3
+//! variant full_c1 HVL_FULL=1 SH_BANDS=1
+//! variant full_c2 HVL_FULL=1 SH_BANDS=2
+//! variant full_c3 HVL_FULL=1 SH_BANDS=3
+//! variant full_c4 HVL_FULL=1 SH_BANDS=4
+//! variant full_c5 HVL_FULL=1 SH_BANDS=5
+//! variant full_c6 HVL_FULL=1 SH_BANDS=6
+//! variant full_c7 HVL_FULL=1 SH_BANDS=7
+//! variant full_c8 HVL_FULL=1 SH_BANDS=8
+//! variant full_c9 HVL_FULL=1 SH_BANDS=9
+//! variant full_c10 HVL_FULL=1 SH_BANDS=10
+//! variant zonal_c1 HVL_ZONAL=1 SH_BANDS=1
+//! variant zonal_c2 HVL_ZONAL=1 SH_BANDS=2
+//! variant zonal_c3 HVL_ZONAL=1 SH_BANDS=3
+//! variant zonal_c4 HVL_ZONAL=1 SH_BANDS=4
+//! variant zonal_c5 HVL_ZONAL=1 SH_BANDS=5
+//! variant zonal_c6 HVL_ZONAL=1 SH_BANDS=6
+//! variant zonal_c7 HVL_ZONAL=1 SH_BANDS=7
+//! variant zonal_c8 HVL_ZONAL=1 SH_BANDS=8
+//! variant zonal_c9 HVL_ZONAL=1 SH_BANDS=9
+//! variant zonal_c10 HVL_ZONAL=1 SH_BANDS=10
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "sh.glsl"
@@ -36,8 +49,8 @@ layout(set = 0, binding = 4, std430) readonly buffer Hvls {
 } hvls;
 
 #ifdef HVL_FULL
-// shine::passes::hvl::GatherBrdf::gpu_data: F of Lambert (albedo 1) then F of the glossy BRDF,
-// each 90 rows of SH_COEFFS floats (shine_sh::brdf_table layout)
+// shine::passes::hvl::GatherBrdf::gpu_data: F of Lambert (albedo 1) then F of GGX at each
+// roughness node, each 90 rows of SH_COEFFS floats (shine_sh::brdf_table layout)
 layout(set = 0, binding = 5, std430) readonly buffer Brdf {
     float f[];
 } brdf;
@@ -53,6 +66,12 @@ layout(push_constant) uniform Push {
     uvec2 extent;
     // HVLs in the cache
     uint hvl_count;
+    // bands of the HVL emission reconstructed (1-5)
+    uint emission_bands;
+    // roughness of the first glossy table, step between tables
+    vec2 roughness_nodes;
+    // number of glossy tables
+    uint glossy_tables;
     uint pad;
 } push;
 
@@ -73,6 +92,23 @@ void brdf_row(int table, float theta_o, out float f[SH_COEFFS]) {
         f[k] = brdf.f[base + i0 * SH_COEFFS + k] * (1.0 - t) + brdf.f[base + i1 * SH_COEFFS + k] * t;
     }
 }
+
+// shine::passes::hvl::GatherBrdf::glossy_f: the glossy row at `roughness`, blended linearly
+// between the two tables around it (clamped to the nodes)
+void glossy_row(float roughness, float theta_o, out float f[SH_COEFFS]) {
+    float last = float(push.glossy_tables - 1u);
+    float x = clamp((roughness - push.roughness_nodes.x) / push.roughness_nodes.y, 0.0, last);
+    int k0 = min(int(floor(x)), int(last));
+    int k1 = min(k0 + 1, int(last));
+    float t = x - float(k0);
+    float f0[SH_COEFFS];
+    float f1[SH_COEFFS];
+    brdf_row(1 + k0, theta_o, f0);
+    brdf_row(1 + k1, theta_o, f1);
+    for (int k = 0; k < SH_COEFFS; ++k) {
+        f[k] = f0[k] * (1.0 - t) + f1[k] * t;
+    }
+}
 #endif
 
 void main() {
@@ -88,7 +124,8 @@ void main() {
     vec3 x = position.xyz;
     vec3 n = normalize(imageLoad(recv_normal, px).xyz);
     vec3 albedo = imageLoad(recv_albedo, px).rgb;
-    float metallic = imageLoad(recv_material, px).g;
+    vec2 roughness_metallic = imageLoad(recv_material, px).rg;
+    float metallic = roughness_metallic.y;
     vec3 kd = albedo * (1.0 - metallic);
 #ifdef HVL_FULL
     vec3 ks = mix(vec3(1.0), albedo, metallic);
@@ -110,7 +147,7 @@ void main() {
     float f_lambert[SH_COEFFS];
     float f_glossy[SH_COEFFS];
     brdf_row(0, theta_o, f_lambert);
-    brdf_row(1, theta_o, f_glossy);
+    glossy_row(roughness_metallic.x, theta_o, f_glossy);
 #else
     float cc[SH_BANDS];
     sh_clamped_cosine_zh(cc);
@@ -139,7 +176,7 @@ void main() {
         for (int l = 0; l < 8; ++l) {
             emission[l] = hvls.h[j].emission[l];
         }
-        float e = max(0.0, hvl_zh_eval(emission, EMISSION_BANDS, dot(normalize(hvl_normal), -wj)));
+        float e = max(0.0, hvl_zh_eval(emission, int(push.emission_bands), dot(normalize(hvl_normal), -wj)));
         vec3 lj = hvls.h[j].flux.rgb * (e * g);
         float cos_a = cos(a);
 #ifdef HVL_FULL

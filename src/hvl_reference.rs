@@ -9,14 +9,14 @@
 
 use glam::{DVec3, Vec3, Vec4};
 use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
-use shine_sh::hvl::{HvlNeighbour, geometric_factor, radius_r1, radius_r2};
+use shine_sh::hvl::{HvlNeighbour, geometric_factor, radius_r1, radius_r2, radius_r2_orthographic};
 use shine_sh::kernels::clamped_cosine_zh;
 use shine_sh::legendre::legendre_all;
 use shine_sh::quadrature::SphereQuadrature;
 use shine_sh::zonal::{cap_sh, cap_zh, sphere_half_angle};
 
 use crate::passes::hvl::{
-    EMISSION_MAX_BANDS, GatherBrdf, Hvl, HvlError, HvlParams, Path, RadiusHeuristic,
+    EMISSION_MAX_BANDS, GatherBrdf, Hvl, HvlError, HvlParams, Path, RadiusHeuristic, RsmProjection,
 };
 
 /// ε of the r1 weights `w_n = 1 / (|d - d_n| + ε)`, metres (eq. 23, paper 003); the GLSL
@@ -38,10 +38,12 @@ pub struct RsmData {
     pub normal: Vec<Vec4>,
     /// `rsm_flux` texels.
     pub flux: Vec<Vec4>,
-    /// Primary light position.
+    /// Primary light position (perspective) or the RSM's eye (orthographic).
     pub light_position: Vec3,
-    /// RSM field of view λ, radians.
-    pub fov: f32,
+    /// Unit axis of the RSM's view.
+    pub light_direction: Vec3,
+    /// How the RSM was projected.
+    pub projection: RsmProjection,
 }
 
 /// The receiver buffer on the CPU: row-major texels, unorm channels already as floats.
@@ -55,7 +57,7 @@ pub struct ReceiverData {
     pub normal: Vec<Vec4>,
     /// `recv_albedo`.
     pub albedo: Vec<Vec4>,
-    /// `recv_material` (g = metallic).
+    /// `recv_material` (r = roughness, g = metallic).
     pub material: Vec<Vec4>,
 }
 
@@ -70,6 +72,8 @@ pub struct Receiver {
     pub albedo: Vec3,
     /// Metallic in [0, 1].
     pub metallic: f32,
+    /// Perceptual roughness in [0, 1] (selects the glossy tables).
+    pub roughness: f32,
 }
 
 impl Receiver {
@@ -124,7 +128,7 @@ pub fn zh_dot(f: &[f32], g: &[f32], cos_angle: f32) -> f32 {
 
 /// The HVL cache built from `rsm` as `hvl_cache` does (see [`crate::passes::hvl`]).
 pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlError> {
-    let k = params.validate_cache(rsm.size)?;
+    let grid = params.validate_cache(rsm.size)?;
     let s = rsm.size;
     let texels = (s * s) as usize;
     if rsm.position.len() != texels || rsm.normal.len() != texels || rsm.flux.len() != texels {
@@ -135,94 +139,87 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
         });
     }
     let count = params.count;
-    let r2 = |d: f32| radius_r2(d, rsm.fov, count);
+    let r2 = |d: f32| match rsm.projection {
+        RsmProjection::Perspective { fov } => radius_r2(d, fov, count),
+        RsmProjection::Orthographic { width } => radius_r2_orthographic(width, count),
+    };
+    let direction = rsm.light_direction.normalize_or(Vec3::NEG_Y);
+    let light_distance = |p: Vec3| match rsm.projection {
+        RsmProjection::Perspective { .. } => p.distance(rsm.light_position),
+        RsmProjection::Orthographic { .. } => (p - rsm.light_position).dot(direction),
+    };
     let mut emission = [0.0f32; 8];
     emission[..EMISSION_MAX_BANDS].copy_from_slice(&sender_emission_zh(EMISSION_MAX_BANDS)?);
     let mut hvls = Vec::with_capacity(count as usize);
-    for cy in 0..k {
-        for cx in 0..k {
-            let (lo, hi) = (
-                [cx * s / k, cy * s / k],
-                [(cx + 1) * s / k, (cy + 1) * s / k],
-            );
-            let centre = [0.5 * (lo[0] + hi[0]) as f32, 0.5 * (lo[1] + hi[1]) as f32];
-            let mut best = f32::MAX;
-            let mut rep = None;
-            let mut flux = Vec3::ZERO;
-            for y in lo[1]..hi[1] {
-                for x in lo[0]..hi[0] {
-                    let t = (y * s + x) as usize;
-                    if rsm.position[t].w == 0.0 {
-                        continue;
-                    }
-                    flux += rsm.flux[t].truncate();
-                    let off = [x as f32 + 0.5 - centre[0], y as f32 + 0.5 - centre[1]];
-                    let d2 = off[0] * off[0] + off[1] * off[1];
-                    if d2 < best {
-                        best = d2;
-                        rep = Some(t);
-                    }
+    for m in 0..count {
+        let (lo, hi) = grid.cell(m);
+        let centre = [0.5 * (lo[0] + hi[0]) as f32, 0.5 * (lo[1] + hi[1]) as f32];
+        let mut best = f32::MAX;
+        let mut rep = None;
+        let mut flux = Vec3::ZERO;
+        for y in lo[1]..hi[1] {
+            for x in lo[0]..hi[0] {
+                let t = (y * s + x) as usize;
+                if rsm.position[t].w == 0.0 {
+                    continue;
+                }
+                flux += rsm.flux[t].truncate();
+                let off = [x as f32 + 0.5 - centre[0], y as f32 + 0.5 - centre[1]];
+                let d2 = off[0] * off[0] + off[1] * off[1];
+                if d2 < best {
+                    best = d2;
+                    rep = Some(t);
                 }
             }
-            let hvl = match rep {
-                None => Hvl {
-                    position_radius: [0.0; 4],
-                    normal_distance: [0.0; 4],
-                    flux: [0.0; 4],
-                    emission: [0.0; 8],
-                },
-                Some(t) => {
-                    let p = rsm.position[t].truncate();
-                    let n = rsm.normal[t].truncate().normalize();
-                    let d = p.distance(rsm.light_position);
-                    let r = match params.radius {
-                        RadiusHeuristic::R2 => r2(d)? * params.radius_scale,
-                        RadiusHeuristic::R1 => 0.0,
-                    };
-                    Hvl {
-                        position_radius: p.extend(r).to_array(),
-                        normal_distance: n.extend(d).to_array(),
-                        flux: flux.extend(1.0).to_array(),
-                        emission,
-                    }
-                }
-            };
-            hvls.push(hvl);
         }
+        let hvl = match rep {
+            None => Hvl {
+                position_radius: [0.0; 4],
+                normal_distance: [0.0; 4],
+                flux: [0.0; 4],
+                emission: [0.0; 8],
+            },
+            Some(t) => {
+                let p = rsm.position[t].truncate();
+                let n = rsm.normal[t].truncate().normalize();
+                let d = light_distance(p);
+                let r = match params.radius {
+                    RadiusHeuristic::R2 => r2(d)? * params.radius_scale,
+                    RadiusHeuristic::R1 => 0.0,
+                };
+                Hvl {
+                    position_radius: p.extend(r).to_array(),
+                    normal_distance: n.extend(d).to_array(),
+                    flux: flux.extend(1.0).to_array(),
+                    emission,
+                }
+            }
+        };
+        hvls.push(hvl);
     }
     if params.radius == RadiusHeuristic::R1 {
         let source = hvls.clone();
-        for cy in 0..k as i32 {
-            for cx in 0..k as i32 {
-                let h = &mut hvls[(cy * k as i32 + cx) as usize];
-                if !h.is_valid() {
-                    continue;
-                }
-                let mut neighbours = Vec::with_capacity(8);
-                for dy in -1..=1 {
-                    for dx in -1..=1 {
-                        let (qx, qy) = (cx + dx, cy + dy);
-                        let inside = qx >= 0 && qy >= 0 && qx < k as i32 && qy < k as i32;
-                        if (dx == 0 && dy == 0) || !inside {
-                            continue;
-                        }
-                        let n = &source[(qy * k as i32 + qx) as usize];
-                        if n.is_valid() {
-                            neighbours.push(HvlNeighbour {
-                                position: Vec4::from(n.position_radius).truncate(),
-                                light_distance: n.normal_distance[3],
-                            });
-                        }
-                    }
-                }
-                let p = Vec4::from(h.position_radius).truncate();
-                let d = h.normal_distance[3];
-                let r = match radius_r1(p, d, &neighbours, R1_EPSILON) {
-                    Ok(r) if r > 0.0 => r,
-                    _ => r2(d)?,
-                };
-                h.position_radius[3] = r * params.radius_scale;
+        for (m, h) in hvls.iter_mut().enumerate() {
+            if !h.is_valid() {
+                continue;
             }
+            let neighbours: Vec<HvlNeighbour> = grid
+                .neighbours(m as u32)
+                .into_iter()
+                .map(|q| &source[q as usize])
+                .filter(|n| n.is_valid())
+                .map(|n| HvlNeighbour {
+                    position: Vec4::from(n.position_radius).truncate(),
+                    light_distance: n.normal_distance[3],
+                })
+                .collect();
+            let p = Vec4::from(h.position_radius).truncate();
+            let d = h.normal_distance[3];
+            let r = match radius_r1(p, d, &neighbours, R1_EPSILON) {
+                Ok(r) if r > 0.0 => r,
+                _ => r2(d)?,
+            };
+            h.position_radius[3] = r * params.radius_scale;
         }
     }
     Ok(hvls)
@@ -304,7 +301,7 @@ pub fn shade(
                 return Ok(Vec3::ZERO);
             };
             let f_lambert = brdf.lambert.lookup_f(theta_o);
-            let f_glossy = brdf.glossy.lookup_f(theta_o);
+            let f_glossy = brdf.glossy_f(receiver.roughness, theta_o);
             for hvl in hvls {
                 let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
                     continue;
@@ -355,6 +352,7 @@ pub fn gather(
             normal: receivers.normal[i].truncate(),
             albedo: receivers.albedo[i].truncate(),
             metallic: receivers.material[i].y,
+            roughness: receivers.material[i].x,
         };
         let count = (params.count as usize).min(hvls.len());
         out.push(shade(&receiver, &hvls[..count], brdf, camera, params)?.extend(0.0));

@@ -18,7 +18,7 @@ use shine_graph::{
     ExecuteError, Executor, ExternalState, ImageDesc, ImageImport, PassTiming, RenderGraph,
 };
 use shine_scene::Scene;
-use shine_sh::brdf_table::{BrdfModel, HemisphereSampling};
+use shine_sh::brdf_table::HemisphereSampling;
 
 /// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
 const FRAMES_IN_FLIGHT: usize = 2;
@@ -26,12 +26,6 @@ const FRAMES_IN_FLIGHT: usize = 2;
 const SHADOW_DEPTH_BIAS: f32 = 1e-4;
 /// Receiver offset along its normal in shadow-map texels (removes acne at grazing angles).
 const SHADOW_NORMAL_OFFSET: f32 = 1.5;
-/// The one glossy lobe of the HVL gather's receiver BRDF (paper 003 §4.2 tabulates one per
-/// material; shine has one table for now): GGX of perceptual roughness 0.5 on a dielectric.
-const GATHER_GLOSSY: BrdfModel = BrdfModel::Ggx {
-    alpha: 0.25,
-    ior: 1.5,
-};
 
 /// What can go wrong while rendering.
 #[derive(Debug, thiserror::Error)]
@@ -303,8 +297,7 @@ impl Renderer {
         let hvl = settings.gi.contains(GiTechnique::Hvl);
         let conv_bands = settings.hvl.convolution_bands;
         if hvl && !self.brdf_tables.iter().any(|(b, _)| *b == conv_bands) {
-            let tables =
-                GatherBrdf::build(conv_bands, GATHER_GLOSSY, HemisphereSampling::default())?;
+            let tables = GatherBrdf::build(conv_bands, HemisphereSampling::default())?;
             let buffer = Buffer::with_data(
                 &self.device,
                 &BufferDesc {
@@ -365,13 +358,6 @@ impl Renderer {
         );
         let indirect = match primary {
             Some((light, view)) if hvl => {
-                if view.orthographic {
-                    return Err(RenderError::Invalid(
-                        "HVL needs a spot or point primary light (a perspective RSM); this \
-                         scene's primary light is directional: use --gi none"
-                            .into(),
-                    ));
-                }
                 let params = hvl_params(settings);
                 let rsm = gbuffer::rsm(
                     rg,

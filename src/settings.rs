@@ -379,8 +379,8 @@ pub struct OutputSettings {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct HvlSettings {
-    /// Number M of HVLs distributed from the RSM. Range 64..=10000, default 400 (paper 003
-    /// fig. 10).
+    /// Number M of HVLs distributed from the RSM (any count: the RSM is cut into M cells).
+    /// Range 64..=10000 and at most `rsm.size²`, default 400 (paper 003 fig. 10).
     pub count: u32,
     /// Radius heuristic: `r1` (eq. 23) or `r2` (eq. 24–26). Default `r2`.
     pub radius: RadiusHeuristic,
@@ -390,7 +390,8 @@ pub struct HvlSettings {
     /// SH bands n of the convolution at shaded points (n² coefficients). Range 1..=10,
     /// default 5.
     pub convolution_bands: u32,
-    /// SH bands of each HVL's emission function. Range 1..=5, default 3.
+    /// SH bands of each HVL's emission function. Range 1..=5 and at most
+    /// `convolution_bands`, default 3.
     pub emission_bands: u32,
     /// Gather path: `full` (any BRDF, O(n²)) or `zonal` (symmetric lobes, O(n)).
     /// Default `full`.
@@ -610,6 +611,26 @@ impl Settings {
         check("hvl.convolution_bands", self.hvl.convolution_bands, 1..=10)?;
         check("hvl.emission_bands", self.hvl.emission_bands, 1..=5)?;
         check("rsm.size", self.rsm.size, 16..=4096)?;
+        let rsm_texels = u64::from(self.rsm.size).pow(2);
+        if u64::from(self.hvl.count) > rsm_texels {
+            return Err(SettingsError::OutOfRange {
+                field: "hvl.count",
+                value: self.hvl.count.to_string(),
+                allowed: format!(
+                    "at most rsm.size² = {rsm_texels} (one RSM texel per HVL at least): raise rsm.size"
+                ),
+            });
+        }
+        if self.hvl.emission_bands > self.hvl.convolution_bands {
+            return Err(SettingsError::OutOfRange {
+                field: "hvl.emission_bands",
+                value: self.hvl.emission_bands.to_string(),
+                allowed: format!(
+                    "1..={} (at most hvl.convolution_bands)",
+                    self.hvl.convolution_bands.min(5)
+                ),
+            });
+        }
         check("shadow.size", self.shadow.size, 64..=16384)?;
         check(
             "shadow.filter_radius",
@@ -644,7 +665,7 @@ mod tests {
     #[test]
     fn every_out_of_range_field_is_named() {
         type Edit = fn(&mut Settings);
-        let cases: [(&str, &str, Edit); 22] = [
+        let cases: [(&str, &str, Edit); 24] = [
             ("width", "0", |s| s.width = 0),
             ("width", "16385", |s| s.width = 16385),
             ("height", "0", |s| s.height = 0),
@@ -659,6 +680,14 @@ mod tests {
             }),
             ("hvl.count", "0", |s| s.hvl.count = 0),
             ("hvl.count", "10001", |s| s.hvl.count = 10001),
+            ("hvl.count", "257", |s| {
+                s.rsm.size = 16;
+                s.hvl.count = 257;
+            }),
+            ("hvl.emission_bands", "3", |s| {
+                s.hvl.convolution_bands = 2;
+                s.hvl.emission_bands = 3;
+            }),
             ("hvl.radius_scale", "0.5", |s| s.hvl.radius_scale = 0.5),
             ("hvl.radius_scale", "2.5", |s| s.hvl.radius_scale = 2.5),
             ("hvl.convolution_bands", "100", |s| {

@@ -13,16 +13,20 @@ use shine::hvl_reference::{
     self as reference, Emission, Receiver, ReceiverData, RsmData, integrate_hvl,
 };
 use shine::passes::hvl::{
-    CachePush, GatherBrdf, GatherPush, Hvl, HvlError, HvlParams, Path, RadiusHeuristic, Receivers,
-    Rsm, gather_variants, hvl_cache, hvl_gather,
+    CONV_BANDS, CachePush, GatherBrdf, GatherPush, Hvl, HvlError, HvlParams, Path, RadiusHeuristic,
+    Receivers, Rsm, RsmProjection, gather_variants, hvl_cache, hvl_gather,
 };
 use shine::shaders;
 use shine_sh::brdf_table::{BrdfModel, HemisphereSampling};
 
 const RSM_SIZE: u32 = 16;
 const RECV: [u32; 2] = [16, 16];
+/// Roughness of the single-HVL receivers: 0.6 is a node of the glossy tables and exact in
+/// unorm8 (153/255), so the gather's GGX is exactly [`GLOSSY`].
+const ROUGHNESS: f32 = 153.0 / 255.0;
+/// GGX at [`ROUGHNESS`] (α = roughness²).
 const GLOSSY: BrdfModel = BrdfModel::Ggx {
-    alpha: 0.5,
+    alpha: 0.36,
     ior: 1.5,
 };
 
@@ -58,8 +62,9 @@ fn bytes_unorm8(texels: &[Vec4]) -> Vec<u8> {
 // Synthetic inputs.
 // ---------------------------------------------------------------------------------------------
 
-/// A 16×16 RSM of a spot light at (0, 3, 0): a floor (y = 0) on most texels, a tilted patch,
-/// five empty texels (one whole 2×2 cell of the 64-HVL grid), and colourful fluxes; `flux_scale` multiplies every flux.
+/// A 16×16 RSM of a spot light at (0, 3, 0) looking down: a floor (y = 0) on most texels, a
+/// tilted patch, five empty texels (one whole 2×2 cell of the 64-HVL grid), and colourful
+/// fluxes; `flux_scale` multiplies every flux.
 fn synthetic_rsm(flux_scale: f32) -> RsmData {
     let s = RSM_SIZE;
     let mut rsm = RsmData {
@@ -68,7 +73,10 @@ fn synthetic_rsm(flux_scale: f32) -> RsmData {
         normal: Vec::new(),
         flux: Vec::new(),
         light_position: Vec3::new(0.0, 3.0, 0.0),
-        fov: std::f32::consts::FRAC_PI_2,
+        light_direction: Vec3::NEG_Y,
+        projection: RsmProjection::Perspective {
+            fov: std::f32::consts::FRAC_PI_2,
+        },
     };
     for j in 0..s {
         for i in 0..s {
@@ -142,7 +150,10 @@ fn synthetic_receivers() -> ReceiverData {
             } else {
                 0.0
             };
-            r.material.push(Vec4::new(0.5, metallic, 0.0, 0.0));
+            // Roughness over the whole range: below the first glossy node (clamped), on nodes
+            // and between them, in unorm8 steps.
+            let roughness = ((i * 37 + j * 11) % 256) as f32 / 255.0;
+            r.material.push(Vec4::new(roughness, metallic, 0.0, 0.0));
         }
     }
     r
@@ -166,7 +177,7 @@ fn tables(conv_bands: u32, sampling: [usize; 2]) -> GatherBrdf {
         n_theta: sampling[0],
         n_phi: sampling[1],
     };
-    GatherBrdf::build(conv_bands, GLOSSY, sampling).unwrap()
+    GatherBrdf::build(conv_bands, sampling).unwrap()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -240,7 +251,8 @@ impl RsmImages {
             normal: n,
             flux: f,
             light_position: rsm.light_position,
-            fov: rsm.fov,
+            light_direction: rsm.light_direction,
+            projection: rsm.projection,
             size: rsm.size,
         }
     }
@@ -387,7 +399,7 @@ fn close(a: f32, b: f32, rel: f32, abs: f32) -> bool {
 /// The Rust mirrors of the shader structs have the shaders' reflected sizes.
 #[test]
 fn records_and_push_constants_match_the_shaders() {
-    let spirv = shaders::HVL_GATHER_COMP_FULL_C3_E3.spirv;
+    let spirv = shaders::HVL_GATHER_COMP_FULL_C3.spirv;
     let module =
         naga::front::spv::parse_u8_slice(bytemuck::cast_slice(spirv), &Default::default()).unwrap();
     let hvl = module
@@ -404,7 +416,7 @@ fn records_and_push_constants_match_the_shaders() {
             std::mem::size_of::<CachePush>()
         );
     }
-    for (_, _, _, shader) in gather_variants() {
+    for (_, _, shader) in gather_variants() {
         assert_eq!(
             shader.push_constant_size as usize,
             std::mem::size_of::<GatherPush>()
@@ -416,14 +428,24 @@ fn records_and_push_constants_match_the_shaders() {
 fn bad_parameters_are_errors() {
     let ok = params(Path::Full, 5, 3);
     assert!(ok.validate_cache(16).is_ok());
-    let not_square = HvlParams { count: 65, ..ok };
+    // Any count in 64..=10000 that the RSM's texels can hold.
+    for count in [65, 70, 255, 256] {
+        let p = HvlParams { count, ..ok };
+        assert!(p.validate_cache(16).is_ok(), "{count} HVLs on a 16² RSM");
+    }
+    for count in [0, 63, 257, 400] {
+        let p = HvlParams { count, ..ok };
+        assert!(
+            matches!(p.validate_cache(16), Err(HvlError::Count { .. })),
+            "{count} HVLs on a 16² RSM"
+        );
+    }
     assert!(matches!(
-        not_square.validate_cache(16),
-        Err(HvlError::Count { .. })
-    ));
-    let too_many_for_rsm = HvlParams { count: 400, ..ok };
-    assert!(matches!(
-        too_many_for_rsm.validate_cache(16),
+        HvlParams {
+            count: 10_001,
+            ..ok
+        }
+        .validate_cache(4096),
         Err(HvlError::Count { .. })
     ));
     let emission_above_conv = params(Path::Full, 3, 5);
@@ -431,11 +453,21 @@ fn bad_parameters_are_errors() {
         emission_above_conv.validate_gather(),
         Err(HvlError::OutOfRange { .. })
     ));
-    let not_compiled = params(Path::Full, 7, 3);
-    assert!(matches!(
-        not_compiled.validate_gather(),
-        Err(HvlError::Variant { .. })
-    ));
+    for conv in [0, 11] {
+        assert!(matches!(
+            params(Path::Full, conv, 1).validate_gather(),
+            Err(HvlError::OutOfRange { .. })
+        ));
+    }
+    // Every convolution band count of both paths has a variant, with every emission count.
+    for path in [Path::Full, Path::Zonal] {
+        for conv in CONV_BANDS {
+            for emission in 1..=conv.min(5) {
+                assert!(params(path, conv, emission).validate_gather().is_ok());
+            }
+        }
+    }
+    assert_eq!(gather_variants().len(), 20);
     let zero = HvlParams { count: 0, ..ok };
     assert!(zero.validate_gather().is_err());
 }
@@ -444,20 +476,47 @@ fn bad_parameters_are_errors() {
 #[test]
 fn cache_matches_the_cpu_reference() {
     let device = device();
-    let rsm = synthetic_rsm(1.0);
-    for radius in [RadiusHeuristic::R2, RadiusHeuristic::R1] {
+    let perspective = synthetic_rsm(1.0);
+    // The same texels seen by a directional light along -y through a 4 m wide box.
+    let orthographic = RsmData {
+        light_position: Vec3::new(0.0, 5.0, 0.0),
+        projection: RsmProjection::Orthographic { width: 4.0 },
+        ..perspective.clone()
+    };
+    let cases = [
+        (&perspective, 64, RadiusHeuristic::R2),
+        (&perspective, 64, RadiusHeuristic::R1),
+        (&perspective, 70, RadiusHeuristic::R2),
+        (&perspective, 70, RadiusHeuristic::R1),
+        (&orthographic, 64, RadiusHeuristic::R2),
+        (&orthographic, 100, RadiusHeuristic::R1),
+    ];
+    for (rsm, count, radius) in cases {
         let p = HvlParams {
             radius,
+            count,
             ..params(Path::Full, 5, 3)
         };
-        let cpu = reference::build_cache(&rsm, &p).unwrap();
-        let gpu = gpu_cache(&device, &rsm, &p);
+        let cpu = reference::build_cache(rsm, &p).unwrap();
+        let gpu = gpu_cache(&device, rsm, &p);
         assert_eq!(gpu.len(), cpu.len());
-        // The empty texel (3, 3) leaves cell (1, 1) with 3 valid texels: still a light; cell
-        // (6, 1) is all empty: an invalid record the gather and r1 skip.
-        assert!(cpu[9].is_valid());
-        assert!(!cpu[8 + 6].is_valid());
-        assert_eq!(cpu.iter().filter(|h| h.is_valid()).count(), 63);
+        assert_eq!(cpu.len(), count as usize);
+        // Every cell but those wholly inside the empty texels holds a light, and the cells
+        // together carry all the RSM's flux.
+        let total: Vec3 = rsm.flux.iter().map(|f| f.truncate()).sum();
+        let cached: Vec3 = cpu.iter().map(|h| Vec4::from(h.flux).truncate()).sum();
+        assert!(
+            (total - cached).abs().max_element() < 1e-5 * total.max_element(),
+            "{count}: flux {cached} vs {total}"
+        );
+        assert!(cpu.iter().filter(|h| h.is_valid()).count() >= count as usize - 2);
+        if count == 64 {
+            // The empty texel (3, 3) leaves cell (1, 1) with 3 valid texels: still a light;
+            // cell (6, 1) is all empty: an invalid record the gather and r1 skip.
+            assert!(cpu[9].is_valid());
+            assert!(!cpu[8 + 6].is_valid());
+            assert_eq!(cpu.iter().filter(|h| h.is_valid()).count(), 63);
+        }
         for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
             let fields = [
                 (g.position_radius, c.position_radius),
@@ -468,14 +527,14 @@ fn cache_matches_the_cpu_reference() {
                 for k in 0..4 {
                     assert!(
                         close(gv[k], cv[k], 1e-5, 1e-6),
-                        "{radius:?} HVL {i}: {g:?} vs {c:?}"
+                        "{count} {radius:?} HVL {i}: {g:?} vs {c:?}"
                     );
                 }
             }
             for k in 0..8 {
                 assert!(
                     close(g.emission[k], c.emission[k], 1e-5, 1e-6),
-                    "{radius:?} HVL {i} emission"
+                    "{count} {radius:?} HVL {i} emission"
                 );
             }
         }
@@ -493,9 +552,17 @@ fn gather_matches_the_cpu_reference() {
     let rsm = synthetic_rsm(1.0);
     let receivers = synthetic_receivers();
     let hvls = reference::build_cache(&rsm, &params(Path::Full, 5, 3)).unwrap();
-    // Three of the compiled variants: a lavapipe compile of the 9- and 10-band variants costs
-    // seconds each (the 9-band ones are checked against the quadrature below).
-    for (path, conv, emission) in [(Path::Full, 3, 3), (Path::Full, 5, 5), (Path::Zonal, 5, 3)] {
+    // Some of the variants: a lavapipe compile of the 9- and 10-band variants costs seconds
+    // each (the 9-band ones are checked against the quadrature below).
+    let variants = [
+        (Path::Full, 2, 1),
+        (Path::Full, 3, 3),
+        (Path::Full, 5, 5),
+        (Path::Full, 6, 4),
+        (Path::Zonal, 1, 1),
+        (Path::Zonal, 5, 3),
+    ];
+    for (path, conv, emission) in variants {
         let p = params(path, conv, emission);
         let brdf = tables(conv, [12, 24]);
         let cpu = reference::gather(&receivers, &hvls, &brdf, CAMERA, &p).unwrap();
@@ -558,7 +625,7 @@ fn single_hvl_against_numerical_integration() {
         albedo: vec![Vec4::new(204.0, 153.0, 102.0, 255.0) / 255.0; 8],
         material: spots
             .iter()
-            .map(|s| Vec4::new(0.5, s.2, 0.0, 0.0))
+            .map(|s| Vec4::new(ROUGHNESS, s.2, 0.0, 0.0))
             .collect(),
     };
     // Worst relative error (of the largest channel) per variant: against the integral with the
@@ -596,6 +663,7 @@ fn single_hvl_against_numerical_integration() {
                 normal: receivers.normal[i].truncate(),
                 albedo: receivers.albedo[i].truncate(),
                 metallic: receivers.material[i].y,
+                roughness: receivers.material[i].x,
             };
             let sh = integrate_hvl(
                 &hvl,

@@ -244,6 +244,11 @@ float hvl_radius_r2(float light_distance, float fov, float hvl_count) {
     return light_distance * (g + g * g * g / 3.0);
 }
 
+// shine_sh::hvl::radius_r2_orthographic: sqrt(2) W / sqrt(M) for an orthographic RSM of width W
+float hvl_radius_r2_orthographic(float width, float hvl_count) {
+    return 1.41421356237309505 * width / sqrt(hvl_count);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Paper 002 (sphere proxies)
 // ---------------------------------------------------------------------------------------------

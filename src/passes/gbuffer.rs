@@ -9,6 +9,7 @@ use shine_graph::{ColorLoad, DepthLoad, Handle, Image, ImageDesc, RenderGraph};
 use shine_scene::LightKind;
 
 pub use super::hvl::Rsm;
+use super::hvl::RsmProjection;
 
 /// Push constants of `view.glsl` (112 bytes).
 #[repr(C)]
@@ -40,6 +41,14 @@ pub struct View {
 }
 
 impl View {
+    /// Unit world direction the view looks along.
+    pub fn forward(&self) -> Vec3 {
+        self.view
+            .inverse()
+            .transform_vector3(Vec3::NEG_Z)
+            .normalize_or(Vec3::NEG_Z)
+    }
+
     /// World to clip.
     pub fn view_proj(&self) -> Mat4 {
         self.proj * self.view
@@ -325,7 +334,7 @@ pub fn gbuffer(
     g
 }
 
-/// Rasterises the scene from the primary light (a perspective view) into a new `size`²
+/// Rasterises the scene from the primary light (perspective or orthographic) into a new `size`²
 /// reflective shadow map (docs/frame.md).
 pub fn rsm(
     rg: &mut RenderGraph,
@@ -344,7 +353,12 @@ pub fn rsm(
         normal: image(rg, "rsm_normal", vk::Format::R16G16B16A16_SFLOAT),
         flux: image(rg, "rsm_flux", vk::Format::R32G32B32A32_SFLOAT),
         light_position: view.eye,
-        fov: view.extent,
+        light_direction: view.forward(),
+        projection: if view.orthographic {
+            RsmProjection::Orthographic { width: view.extent }
+        } else {
+            RsmProjection::Perspective { fov: view.extent }
+        },
         size,
     };
     let pipeline = scene_pipeline(

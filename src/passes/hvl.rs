@@ -1,11 +1,12 @@
 //! Harmonics Virtual Lights (paper 003): the `hvl_cache` and `hvl_gather` passes.
 //!
-//! * [`hvl_cache`] turns the reflective shadow map of one primary light into `M = K²` HVLs
+//! * [`hvl_cache`] turns the reflective shadow map of one primary light into M HVLs
 //!   (spherical secondary lights, §5.2) stored as [`Hvl`] records, with radius heuristic r1
 //!   (eq. 23) or r2 (eq. 24–26) times a user scale, and the sender's SH emission (eq. 20).
 //! * [`hvl_gather`] sums, at every receiver, the outgoing radiance towards the camera due to
 //!   every HVL (eq. 1, 3, 19–22): the full O(n²) SH path with the receiver's BRDF SH tables
-//!   (Lambert + a glossy table, [`GatherBrdf`]) or the O(n) zonal path (Lambert only, §6.3).
+//!   (Lambert + glossy tables over roughness, [`GatherBrdf`]) or the O(n) zonal path (Lambert
+//!   only, §6.3).
 //!
 //! The CPU twin of both passes is [`crate::hvl_reference`]; docs/frame.md, section "Indirect
 //! light", fixes the formats and units.
@@ -13,10 +14,17 @@
 //! # Decisions and deviations from paper 003
 //!
 //! * **Construction.** The paper renders HVL data into the RSM (its "HVL cache", e.g. 1024²
-//!   texels for 400 HVLs) and takes M HVLs from it; we sample the RSM on a regular K×K grid (K = √M): each cell gives one HVL at its valid texel nearest the cell
-//!   centre, carrying the summed flux of all the cell's valid texels (so the reflected power
-//!   is the same for every M; the paper's Φ_j is "the light's power divided by the number of
-//!   HVLs"). r1's "8-connected neighbours in the cache" are the neighbours in this grid.
+//!   texels for 400 HVLs) and takes M HVLs from it; we cut the RSM into exactly M cells
+//!   ([`HvlGrid`]: R ≈ √M rows of ⌊M/R⌋ or ⌈M/R⌉ cells, a regular K×K grid when M = K²):
+//!   each cell gives one HVL at its valid texel nearest the cell centre, carrying the summed
+//!   flux of all the cell's valid texels (so the reflected power is the same for every M; the
+//!   paper's Φ_j is "the light's power divided by the number of HVLs"). r1's "8-connected
+//!   neighbours in the cache" are the cells beside it in its row and the three cells of each
+//!   adjacent row nearest its centre (the 8-neighbourhood when M = K²).
+//! * **Directional lights.** Eq. 24–26 assume a perspective RSM. An orthographic RSM (a
+//!   directional primary light) covers the same width W at every distance, so `d·λ` of eq. 24–25
+//!   becomes W: `r2 = √2 W / √M` ([`shine_sh::hvl::radius_r2_orthographic`]), and the distance
+//!   `d_j` of eq. 23 is measured along the light's direction.
 //! * **Emission.** RSM senders are Lambertian with the albedo already in the flux, so the
 //!   sender's `F'` (eq. 20) is `1/π` over the hemisphere: a ZH vector about `n_j`, identical to
 //!   the Lambert (albedo 1) row of [`shine_sh::brdf_table::BrdfTable::f_prime`] for every θ_l.
@@ -26,11 +34,15 @@
 //! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
 //!   never makes `indirect` negative; the paper's sinc window (§4.2) is not applied.
 //! * **Receiver BRDF.** `kd = albedo (1 - metallic)` times Lambert, `ks = mix(1, albedo,
-//!   metallic)` times ONE glossy table (GGX of a fixed α and η, built by [`GatherBrdf::build`]);
-//!   the receiver's roughness does not select a table yet (the paper indexes one table per
-//!   material). The zonal path has the Lambert term only.
-//! * `emission_bands ≤ conv_bands`, and only the band pairs compiled as variants of
-//!   `shaders/hvl_gather.comp` exist ([`gather_variants`]).
+//!   metallic)` times GGX (dielectric Fresnel, η = 1.5) at the receiver's roughness: the paper
+//!   tabulates one table per material; we tabulate [`GLOSSY_TABLES`] roughness nodes
+//!   ([`glossy_roughness`]) and interpolate the two tables around the receiver's roughness
+//!   linearly, which serves every material of every scene with one buffer. Rougher than the
+//!   first node is clamped to it (lobes sharper than roughness 0.2 are beyond what ≤ 10 bands
+//!   resolve). The zonal path has the Lambert term only.
+//! * `emission_bands ≤ conv_bands`; the emission band count is a push constant and each
+//!   convolution band count 1–10 of each path is a variant of `shaders/hvl_gather.comp`
+//!   ([`gather_variants`]).
 //!
 //! # Accuracy
 //!
@@ -76,23 +88,30 @@ impl Hvl {
     }
 }
 
-/// Push constants of `shaders/hvl_cache.comp` (both stages), 32 bytes.
+/// Push constants of `shaders/hvl_cache.comp` (both stages), 48 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CachePush {
-    /// xyz: primary light position; w: RSM field of view λ (radians).
-    pub light_position_fov: [f32; 4],
+    /// xyz: primary light position (perspective) or the RSM's eye (orthographic); w: the RSM's
+    /// field of view λ in radians (perspective) or its width W in metres (orthographic).
+    pub light_position_extent: [f32; 4],
+    /// xyz: unit axis of the RSM's view; w: 1 for an orthographic RSM, 0 for perspective.
+    pub light_direction_ortho: [f32; 4],
     /// RSM side S.
     pub rsm_size: u32,
-    /// HVL grid side K (M = K²).
-    pub grid: u32,
+    /// HVL count M.
+    pub count: u32,
+    /// Rows R of the [`HvlGrid`].
+    pub rows: u32,
     /// 1: the build stage sets r2; 0: the r1 stage sets the radius.
     pub use_r2: u32,
     /// User radius scale k.
     pub radius_scale: f32,
+    /// Padding.
+    pub pad: [f32; 3],
 }
 
-/// Push constants of `shaders/hvl_gather.comp`, 32 bytes.
+/// Push constants of `shaders/hvl_gather.comp`, 48 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GatherPush {
@@ -102,6 +121,12 @@ pub struct GatherPush {
     pub extent: [u32; 2],
     /// HVLs in the cache.
     pub hvl_count: u32,
+    /// Bands of the HVL emission reconstructed (1–5).
+    pub emission_bands: u32,
+    /// Roughness of the first glossy table and the step between tables ([`glossy_roughness`]).
+    pub roughness_nodes: [f32; 2],
+    /// Number of glossy tables ([`GLOSSY_TABLES`]).
+    pub glossy_tables: u32,
     /// Padding.
     pub pad: u32,
 }
@@ -115,12 +140,144 @@ pub struct Rsm {
     pub normal: Handle<Image>,
     /// `rsm_flux`, RGBA32F: rgb reflected flux Φ of the texel (W).
     pub flux: Handle<Image>,
-    /// Position of the primary light (point or spot: r2 needs a perspective RSM).
+    /// Position of the primary light (perspective) or the RSM's eye (orthographic).
     pub light_position: Vec3,
-    /// Full field of view λ of the square RSM, radians (eq. 24).
-    pub fov: f32,
+    /// Unit axis of the RSM's view (the light's direction for a directional light).
+    pub light_direction: Vec3,
+    /// How the RSM was projected.
+    pub projection: RsmProjection,
     /// Side S of the RSM in texels.
     pub size: u32,
+}
+
+/// The projection of an RSM: it decides the r2 heuristic and the distance `d_j` to the light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RsmProjection {
+    /// A point or spot light's square frustum of full field of view λ (radians, eq. 24).
+    Perspective {
+        /// λ.
+        fov: f32,
+    },
+    /// A directional light's box of width W (metres) across.
+    Orthographic {
+        /// W.
+        width: f32,
+    },
+}
+
+impl RsmProjection {
+    /// `(λ or W, 1 for orthographic)`, the shader's encoding.
+    fn encode(self) -> (f32, f32) {
+        match self {
+            Self::Perspective { fov } => (fov, 0.0),
+            Self::Orthographic { width } => (width, 1.0),
+        }
+    }
+
+    /// Checks λ in (0, π) or W > 0.
+    fn validate(self) -> Result<(), HvlError> {
+        match self {
+            Self::Perspective { fov } if !(fov > 0.0 && fov < std::f32::consts::PI) => {
+                Err(HvlError::OutOfRange {
+                    name: "RSM fov",
+                    value: f64::from(fov),
+                    expected: "0 < λ < π radians",
+                })
+            }
+            Self::Orthographic { width } if !(width > 0.0 && width.is_finite()) => {
+                Err(HvlError::OutOfRange {
+                    name: "RSM width",
+                    value: f64::from(width),
+                    expected: "a finite width > 0 metres",
+                })
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+/// How the S×S RSM is cut into exactly M cells, one HVL each: R rows of equal height, row j
+/// holding the cells `row_start(j)..row_start(j + 1)` (`row_start(j) = ⌊j M / R⌋`) of equal
+/// width. The GLSL twin is in `shaders/hvl_cache.comp`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct HvlGrid {
+    /// Number of cells M.
+    pub count: u32,
+    /// Number of rows R.
+    pub rows: u32,
+    /// RSM side S.
+    pub size: u32,
+}
+
+impl HvlGrid {
+    /// The grid of `count` cells over an RSM of side `size`: R = round(√M), raised so that no
+    /// row holds more than S cells and lowered to at most S rows; `None` when M > S².
+    pub fn new(count: u32, size: u32) -> Option<Self> {
+        if count == 0 || size == 0 || u64::from(count) > u64::from(size) * u64::from(size) {
+            return None;
+        }
+        let rows = ((f64::from(count).sqrt().round()) as u32)
+            .max(count.div_ceil(size))
+            .min(size);
+        Some(Self { count, rows, size })
+    }
+
+    /// First cell of row `j` (`j ≤ R`; `row_start(R) = M`).
+    pub fn row_start(&self, j: u32) -> u32 {
+        (u64::from(j) * u64::from(self.count) / u64::from(self.rows)) as u32
+    }
+
+    /// The row of cell `m`: `⌈(m + 1) R / M⌉ - 1`.
+    pub fn row_of(&self, m: u32) -> u32 {
+        ((u64::from(m + 1) * u64::from(self.rows)).div_ceil(u64::from(self.count)) - 1) as u32
+    }
+
+    /// Cells in row `j`.
+    pub fn row_len(&self, j: u32) -> u32 {
+        self.row_start(j + 1) - self.row_start(j)
+    }
+
+    /// The texel rectangle `[x0, y0]..[x1, y1]` (exclusive) of cell `m`.
+    pub fn cell(&self, m: u32) -> ([u32; 2], [u32; 2]) {
+        let j = self.row_of(m);
+        let (i, n) = (m - self.row_start(j), self.row_len(j));
+        let s = self.size;
+        (
+            [i * s / n, j * s / self.rows],
+            [(i + 1) * s / n, (j + 1) * s / self.rows],
+        )
+    }
+
+    /// The r1 neighbours of cell `m` (eq. 23's "8-connected neighbours"): the cells beside it in
+    /// its row and, in each adjacent row, the cell under its centre and that cell's two
+    /// neighbours.
+    pub fn neighbours(&self, m: u32) -> Vec<u32> {
+        let j = self.row_of(m);
+        let ([x0, _], [x1, _]) = self.cell(m);
+        let mut out = Vec::with_capacity(8);
+        for dj in [-1i64, 0, 1] {
+            let jj = i64::from(j) + dj;
+            if jj < 0 || jj >= i64::from(self.rows) {
+                continue;
+            }
+            let jj = jj as u32;
+            let n = self.row_len(jj);
+            // The cell of row jj under the centre (x0 + x1) / 2 of cell m.
+            let c = if dj == 0 {
+                m - self.row_start(j)
+            } else {
+                ((x0 + x1) * n / (2 * self.size)).min(n - 1)
+            };
+            for di in [-1i64, 0, 1] {
+                let ii = i64::from(c) + di;
+                if (dj == 0 && di == 0) || ii < 0 || ii >= i64::from(n) {
+                    continue;
+                }
+                out.push(self.row_start(jj) + ii as u32);
+            }
+        }
+        out
+    }
 }
 
 /// HVL radius heuristic (paper 003 §5.3).
@@ -144,8 +301,8 @@ pub enum Path {
 /// Parameters of the HVL passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct HvlParams {
-    /// Number of HVLs M. The cache needs a square K² with 64 ≤ M ≤ 10 000 and K ≤ the RSM
-    /// side; the gather takes any 1 ≤ M ≤ 10 000 records.
+    /// Number of HVLs M. The cache needs 64 ≤ M ≤ 10 000 and M ≤ S² (S the RSM side); the
+    /// gather takes any 1 ≤ M ≤ 10 000 records.
     pub count: u32,
     /// Radius heuristic.
     pub radius: RadiusHeuristic,
@@ -162,9 +319,9 @@ pub struct HvlParams {
 /// Errors of the HVL passes: parameters out of range or inconsistent inputs.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum HvlError {
-    /// The HVL count is not a square K² in 64..=10 000, or K exceeds the RSM side.
+    /// The HVL count is outside 64..=10 000 or exceeds the RSM's texel count.
     #[error(
-        "HVL count {count} is not usable with a {rsm_size}×{rsm_size} RSM: it must be a square K² with 64 ≤ K² ≤ 10000 and K ≤ {rsm_size}"
+        "HVL count {count} is not usable with a {rsm_size}×{rsm_size} RSM: it must lie in 64..=10000 and not exceed the RSM's texel count (raise rsm.size)"
     )]
     Count {
         /// The count asked for.
@@ -174,16 +331,14 @@ pub enum HvlError {
     },
     /// No compiled `hvl_gather.comp` variant has these bands and path.
     #[error(
-        "no hvl_gather variant for {path:?} with {conv_bands} convolution and {emission_bands} emission bands; available: {available}"
+        "no hvl_gather variant for {path:?} with {conv_bands} convolution bands; available: {available}"
     )]
     Variant {
         /// Convolution bands asked for.
         conv_bands: u32,
-        /// Emission bands asked for.
-        emission_bands: u32,
         /// Path asked for.
         path: Path,
-        /// The compiled variants, as `path cC eE`.
+        /// The compiled variants, as `path cC`.
         available: String,
     },
     /// A scalar parameter out of its range.
@@ -211,34 +366,36 @@ pub enum HvlError {
     Sh(#[from] shine_sh::ShError),
 }
 
-/// The `hvl_gather.comp` variants compiled: `(path, conv_bands, emission_bands, shader)`.
-pub fn gather_variants() -> [(Path, u32, u32, &'static ShaderDesc); 8] {
-    [
-        (Path::Full, 3, 3, &shaders::HVL_GATHER_COMP_FULL_C3_E3),
-        (Path::Full, 5, 3, &shaders::HVL_GATHER_COMP_FULL_C5_E3),
-        (Path::Full, 5, 5, &shaders::HVL_GATHER_COMP_FULL_C5_E5),
-        (Path::Full, 9, 3, &shaders::HVL_GATHER_COMP_FULL_C9_E3),
-        (Path::Full, 10, 5, &shaders::HVL_GATHER_COMP_FULL_C10_E5),
-        (Path::Zonal, 3, 3, &shaders::HVL_GATHER_COMP_ZONAL_C3_E3),
-        (Path::Zonal, 5, 3, &shaders::HVL_GATHER_COMP_ZONAL_C5_E3),
-        (Path::Zonal, 9, 3, &shaders::HVL_GATHER_COMP_ZONAL_C9_E3),
-    ]
+/// Convolution band counts of the gather (paper 003: 1–10).
+pub const CONV_BANDS: std::ops::RangeInclusive<u32> = 1..=10;
+
+/// The `hvl_gather.comp` variants: `(path, conv_bands, shader)` for every path and every band
+/// count of [`CONV_BANDS`] (variants `full_cN` and `zonal_cN`).
+pub fn gather_variants() -> Vec<(Path, u32, &'static ShaderDesc)> {
+    [(Path::Full, "full"), (Path::Zonal, "zonal")]
+        .into_iter()
+        .flat_map(|(path, name)| {
+            CONV_BANDS.filter_map(move |bands| {
+                shaders::get(&format!("hvl_gather.comp:{name}_c{bands}"))
+                    .map(|shader| (path, bands, shader))
+            })
+        })
+        .collect()
 }
 
-/// The gather shader for `params` (its path and band counts), or [`HvlError::Variant`].
+/// The gather shader for `params` (its path and convolution bands), or [`HvlError::Variant`].
 pub fn gather_shader(params: &HvlParams) -> Result<&'static ShaderDesc, HvlError> {
     let variants = gather_variants();
     variants
         .iter()
-        .find(|v| v.0 == params.path && v.1 == params.conv_bands && v.2 == params.emission_bands)
-        .map(|v| v.3)
+        .find(|v| v.0 == params.path && v.1 == params.conv_bands)
+        .map(|v| v.2)
         .ok_or_else(|| HvlError::Variant {
             conv_bands: params.conv_bands,
-            emission_bands: params.emission_bands,
             path: params.path,
             available: variants
                 .iter()
-                .map(|v| format!("{:?} c{} e{}", v.0, v.1, v.2))
+                .map(|v| format!("{:?} c{}", v.0, v.1))
                 .collect::<Vec<_>>()
                 .join(", "),
         })
@@ -246,15 +403,14 @@ pub fn gather_shader(params: &HvlParams) -> Result<&'static ShaderDesc, HvlError
 
 impl HvlParams {
     /// Checks the parameters for the cache built from an RSM of side `rsm_size`; returns the
-    /// grid side K (`count = K²`).
-    pub fn validate_cache(&self, rsm_size: u32) -> Result<u32, HvlError> {
-        let k = (f64::from(self.count).sqrt().round()) as u32;
-        if k * k != self.count || !(64..=10_000).contains(&self.count) || k > rsm_size {
-            return Err(HvlError::Count {
+    /// cells of the RSM, one per HVL.
+    pub fn validate_cache(&self, rsm_size: u32) -> Result<HvlGrid, HvlError> {
+        let grid = HvlGrid::new(self.count, rsm_size)
+            .filter(|_| (64..=10_000).contains(&self.count))
+            .ok_or(HvlError::Count {
                 count: self.count,
                 rsm_size,
-            });
-        }
+            })?;
         if !(0.1..=4.0).contains(&self.radius_scale) {
             return Err(HvlError::OutOfRange {
                 name: "radius_scale",
@@ -262,7 +418,7 @@ impl HvlParams {
                 expected: "0.1..=4 (the paper uses 1–2)",
             });
         }
-        Ok(k)
+        Ok(grid)
     }
 
     /// Checks the band counts and the HVL count of the gather (`1..=10 000` records, bands as
@@ -295,34 +451,93 @@ impl HvlParams {
     }
 }
 
+/// Number of glossy BRDF tables of the gather, at the roughness nodes of [`glossy_roughness`].
+pub const GLOSSY_TABLES: u32 = 5;
+
+/// Perceptual roughness of the first glossy table; the nodes are spaced evenly up to 1.
+pub const GLOSSY_ROUGHNESS_MIN: f32 = 0.2;
+
+/// The Fresnel index of refraction of the glossy tables (dielectrics; metals take their colour
+/// from `ks`).
+pub const GLOSSY_IOR: f32 = 1.5;
+
+/// Perceptual roughness of glossy table `k` (GGX α = roughness², as the direct light).
+pub fn glossy_roughness(k: u32) -> f32 {
+    GLOSSY_ROUGHNESS_MIN + k as f32 * glossy_roughness_step()
+}
+
+/// Roughness between two glossy tables.
+pub fn glossy_roughness_step() -> f32 {
+    (1.0 - GLOSSY_ROUGHNESS_MIN) / (GLOSSY_TABLES - 1) as f32
+}
+
+/// The two glossy tables around `roughness` and the weight of the second: `(k, k + 1, t)`,
+/// clamped to the nodes (the GLSL twin is `glossy_rows` in `shaders/hvl_gather.comp`).
+pub fn glossy_blend(roughness: f32) -> (u32, u32, f32) {
+    let x = ((roughness - GLOSSY_ROUGHNESS_MIN) / glossy_roughness_step())
+        .clamp(0.0, (GLOSSY_TABLES - 1) as f32);
+    let k0 = (x.floor() as u32).min(GLOSSY_TABLES - 1);
+    let k1 = (k0 + 1).min(GLOSSY_TABLES - 1);
+    (k0, k1, x - k0 as f32)
+}
+
 /// The receiver BRDF SH tables of the full gather path (paper 003 §4.2, eq. 18): `F` of
-/// Lambert (albedo 1, scaled by `kd` per receiver) and `F` of one glossy BRDF (scaled by `ks`).
+/// Lambert (albedo 1, scaled by `kd` per receiver) and `F` of GGX at each roughness node
+/// (scaled by `ks`).
 #[derive(Debug, Clone, PartialEq)]
 pub struct GatherBrdf {
     /// `F` of Lambert with albedo 1.
     pub lambert: BrdfTable,
-    /// `F` of the glossy lobe (GGX in the frame; any isotropic model works).
-    pub glossy: BrdfTable,
+    /// `F` of GGX at [`glossy_roughness`]`(k)`, k = 0..[`GLOSSY_TABLES`].
+    pub glossy: Vec<BrdfTable>,
 }
 
 impl GatherBrdf {
-    /// Tabulates both BRDFs to `conv_bands` bands with the hemisphere quadrature `sampling`.
-    pub fn build(
-        conv_bands: u32,
-        glossy: BrdfModel,
-        sampling: HemisphereSampling,
-    ) -> Result<Self, HvlError> {
+    /// Tabulates every BRDF to `conv_bands` bands with the hemisphere quadrature `sampling`.
+    pub fn build(conv_bands: u32, sampling: HemisphereSampling) -> Result<Self, HvlError> {
         let bands = conv_bands as usize;
+        let glossy = (0..GLOSSY_TABLES)
+            .map(|k| {
+                let r = glossy_roughness(k);
+                let model = BrdfModel::Ggx {
+                    alpha: r * r,
+                    ior: GLOSSY_IOR,
+                };
+                BrdfTable::build_with(model, bands, sampling)
+            })
+            .collect::<Result<_, _>>()?;
         Ok(Self {
             lambert: BrdfTable::build_with(BrdfModel::Lambert { albedo: 1.0 }, bands, sampling)?,
-            glossy: BrdfTable::build_with(glossy, bands, sampling)?,
+            glossy,
         })
     }
 
-    /// The GPU buffer `brdf` of the gather: Lambert `F` rows then glossy `F` rows
-    /// (`2 × 90 × bands²` floats, the shine-sh table layout).
+    /// The glossy row `F(θ_o)` at `roughness`: the two nodes' rows blended linearly.
+    pub fn glossy_f(&self, roughness: f32, theta_o: f32) -> Vec<f32> {
+        let (k0, k1, t) = glossy_blend(roughness);
+        let a = self.glossy[k0 as usize].lookup_f(theta_o);
+        let b = self.glossy[k1 as usize].lookup_f(theta_o);
+        a.iter()
+            .zip(&b)
+            .map(|(a, b)| a * (1.0 - t) + b * t)
+            .collect()
+    }
+
+    /// The GPU buffer `brdf` of the gather: Lambert `F` rows then each glossy table's `F` rows
+    /// (`(1 + GLOSSY_TABLES) × 90 × bands²` floats, the shine-sh table layout).
     pub fn gpu_data(&self) -> Vec<f32> {
-        [self.lambert.f(), self.glossy.f()].concat()
+        std::iter::once(&self.lambert)
+            .chain(&self.glossy)
+            .flat_map(|t| t.f().iter().copied())
+            .collect()
+    }
+
+    /// Bytes of [`GatherBrdf::gpu_data`] at `conv_bands` bands.
+    pub fn gpu_bytes(conv_bands: u32) -> u64 {
+        u64::from(1 + GLOSSY_TABLES)
+            * shine_sh::brdf_table::THETA_SAMPLES as u64
+            * u64::from(conv_bands * conv_bands)
+            * 4
     }
 }
 
@@ -348,15 +563,15 @@ pub fn cache_bytes(count: u32) -> u64 {
     u64::from(count) * std::mem::size_of::<Hvl>() as u64
 }
 
-/// Adds the `hvl_cache` pass(es): the RSM → `params.count` [`Hvl`] records (row-major over the
-/// K×K grid) in a new transient buffer, returned. With [`RadiusHeuristic::R1`] a second
+/// Adds the `hvl_cache` pass(es): the RSM → `params.count` [`Hvl`] records (in the cell order
+/// of [`HvlGrid`]) in a new transient buffer, returned. With [`RadiusHeuristic::R1`] a second
 /// dispatch computes the radii from the first one's records.
 pub fn hvl_cache(
     rg: &mut RenderGraph,
     rsm: &Rsm,
     params: &HvlParams,
 ) -> Result<Handle<Buffer>, HvlError> {
-    let k = params.validate_cache(rsm.size)?;
+    let grid = params.validate_cache(rsm.size)?;
     for (name, image) in [
         ("rsm_position", &rsm.position),
         ("rsm_normal", &rsm.normal),
@@ -364,20 +579,14 @@ pub fn hvl_cache(
     ] {
         check_extent(name, image, [rsm.size, rsm.size])?;
     }
-    if !(rsm.fov > 0.0 && rsm.fov < std::f32::consts::PI) {
-        return Err(HvlError::OutOfRange {
-            name: "RSM fov",
-            value: f64::from(rsm.fov),
-            expected: "0 < λ < π radians",
-        });
-    }
-    let push = CachePush {
-        light_position_fov: rsm.light_position.extend(rsm.fov).to_array(),
-        rsm_size: rsm.size,
-        grid: k,
-        use_r2: u32::from(params.radius == RadiusHeuristic::R2),
-        radius_scale: params.radius_scale,
-    };
+    rsm.projection.validate()?;
+    let push = cache_push(
+        rsm.light_position,
+        rsm.light_direction,
+        rsm.projection,
+        grid,
+        params,
+    );
     let desc = BufferDesc::new(cache_bytes(params.count));
     let mut built = rg.create_buffer("hvl_cache", desc);
     rg.compute("hvl_cache", &shaders::HVL_CACHE_COMP_BUILD)
@@ -386,7 +595,7 @@ pub fn hvl_cache(
         .read("rsm_flux", &rsm.flux)
         .write("hvls", &mut built)
         .push(&push)
-        .dispatch([k, k, 1]);
+        .dispatch([params.count, 1, 1]);
     if params.radius == RadiusHeuristic::R2 {
         return Ok(built);
     }
@@ -395,8 +604,32 @@ pub fn hvl_cache(
         .read("source", &built)
         .write("hvls", &mut sized)
         .push(&push)
-        .dispatch([k, k, 1]);
+        .dispatch([params.count, 1, 1]);
     Ok(sized)
+}
+
+/// The cache's push constants.
+fn cache_push(
+    light_position: Vec3,
+    light_direction: Vec3,
+    projection: RsmProjection,
+    grid: HvlGrid,
+    params: &HvlParams,
+) -> CachePush {
+    let (extent, ortho) = projection.encode();
+    CachePush {
+        light_position_extent: light_position.extend(extent).to_array(),
+        light_direction_ortho: light_direction
+            .normalize_or(Vec3::NEG_Y)
+            .extend(ortho)
+            .to_array(),
+        rsm_size: grid.size,
+        count: grid.count,
+        rows: grid.rows,
+        use_r2: u32::from(params.radius == RadiusHeuristic::R2),
+        radius_scale: params.radius_scale,
+        pad: [0.0; 3],
+    }
 }
 
 /// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
@@ -428,10 +661,7 @@ pub fn hvl_gather(
             expected: format!("at least {need} bytes for {} HVLs", params.count),
         });
     }
-    let table = 2
-        * shine_sh::brdf_table::THETA_SAMPLES as u64
-        * u64::from(params.conv_bands * params.conv_bands)
-        * 4;
+    let table = GatherBrdf::gpu_bytes(params.conv_bands);
     if params.path == Path::Full && brdf.desc().size != table {
         return Err(HvlError::Size {
             name: "brdf",
@@ -451,6 +681,9 @@ pub fn hvl_gather(
         camera: camera.extend(0.0).to_array(),
         extent: receivers.extent,
         hvl_count: params.count,
+        emission_bands: params.emission_bands,
+        roughness_nodes: [GLOSSY_ROUGHNESS_MIN, glossy_roughness_step()],
+        glossy_tables: GLOSSY_TABLES,
         pad: 0,
     };
     let mut pass = rg.compute("hvl_gather", shader);
@@ -466,4 +699,71 @@ pub fn hvl_gather(
         .push(&push)
         .dispatch([w, h, 1]);
     Ok(indirect)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every texel lies in exactly one cell, every cell holds a texel, rows are found back
+    /// from cell indices, and a square count is the regular K×K grid with 8-neighbourhoods.
+    #[test]
+    fn grid_cells_partition_the_rsm() {
+        for (count, size) in [
+            (64, 8),
+            (64, 16),
+            (70, 16),
+            (255, 16),
+            (256, 16),
+            (1000, 40),
+        ] {
+            let grid = HvlGrid::new(count, size).unwrap();
+            let mut owner = vec![u32::MAX; (size * size) as usize];
+            for m in 0..count {
+                let j = grid.row_of(m);
+                assert!(
+                    grid.row_start(j) <= m && m < grid.row_start(j + 1),
+                    "{count} {m}"
+                );
+                let (lo, hi) = grid.cell(m);
+                assert!(lo[0] < hi[0] && lo[1] < hi[1], "{count}: cell {m} is empty");
+                for y in lo[1]..hi[1] {
+                    for x in lo[0]..hi[0] {
+                        let t = &mut owner[(y * size + x) as usize];
+                        assert_eq!(*t, u32::MAX, "{count}: texel ({x}, {y}) in two cells");
+                        *t = m;
+                    }
+                }
+                let n = grid.neighbours(m);
+                assert!(!n.contains(&m) && n.iter().all(|&q| q < count));
+            }
+            assert!(
+                owner.iter().all(|&m| m != u32::MAX),
+                "{count}: texel in no cell"
+            );
+        }
+        let square = HvlGrid::new(64, 16).unwrap();
+        assert_eq!(square.rows, 8);
+        assert_eq!(square.cell(9), ([2, 2], [4, 4]));
+        let mut n = square.neighbours(9);
+        n.sort_unstable();
+        assert_eq!(n, [0, 1, 2, 8, 10, 16, 17, 18]);
+        assert_eq!(square.neighbours(0).len(), 3);
+        assert!(HvlGrid::new(257, 16).is_none());
+        assert!(HvlGrid::new(0, 16).is_none());
+    }
+
+    #[test]
+    fn glossy_blend_clamps_and_hits_nodes() {
+        assert_eq!(glossy_blend(0.0), (0, 1, 0.0));
+        assert_eq!(
+            glossy_blend(1.0),
+            (GLOSSY_TABLES - 1, GLOSSY_TABLES - 1, 0.0)
+        );
+        let (k0, k1, t) = glossy_blend(glossy_roughness(2));
+        assert!((k0 == 2 && t.abs() < 1e-5) || (k0 == 1 && k1 == 2 && (t - 1.0).abs() < 1e-5));
+        let (k0, k1, t) = glossy_blend(0.5 * (glossy_roughness(1) + glossy_roughness(2)));
+        assert_eq!((k0, k1), (1, 2));
+        assert!((t - 0.5).abs() < 1e-5);
+    }
 }

@@ -124,6 +124,27 @@ pub fn radius_r2(light_distance: f32, fov: f32, hvl_count: u32) -> Result<f32> {
     Ok((f64::from(light_distance) * (g + g * g * g / 3.0)) as f32)
 }
 
+/// Eq. 24–25 for an orthographic RSM (a directional light) of width `width` across: its
+/// footprint is the same at every distance, so `d λ` becomes `W` and the small-angle form of
+/// `tan` gives `r2 = √2 W / √M`. Not in paper 003 (its RSMs are perspective); shine's extension.
+pub fn radius_r2_orthographic(width: f32, hvl_count: u32) -> Result<f32> {
+    if !(width.is_finite() && width > 0.0) {
+        return Err(ShError::OutOfRange {
+            name: "RSM width",
+            value: f64::from(width),
+            expected: "finite, > 0",
+        });
+    }
+    if hvl_count == 0 {
+        return Err(ShError::OutOfRange {
+            name: "HVL count",
+            value: 0.0,
+            expected: "≥ 1",
+        });
+    }
+    Ok((std::f64::consts::SQRT_2 * f64::from(width) / f64::from(hvl_count).sqrt()) as f32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
