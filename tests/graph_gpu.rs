@@ -307,41 +307,9 @@ fn aliased_images_through_clear_blits_and_copy() {
     assert_clean(&device);
 }
 
-#[test]
-fn indexed_depth_pass_then_sampled_in_compute() {
-    let device = device();
-    let (w, h) = (8u32, 8u32);
-    // A far triangle, then a near one over it: the depth test keeps the near depth.
-    let (far, near) = (0.75f32, 0.25f32);
-    let mut positions: Vec<f32> = Vec::new();
-    for z in [far, near] {
-        for (x, y) in [(-1.0, -1.0), (3.0, -1.0), (-1.0, 3.0)] {
-            positions.extend([x, y, z, 0.0]);
-        }
-    }
-    let vertices = buffer_with(
-        &device,
-        "vertices",
-        vk::BufferUsageFlags::VERTEX_BUFFER,
-        bytemuck::cast_slice(&positions),
-    );
-    let indices = buffer_with(
-        &device,
-        "indices",
-        vk::BufferUsageFlags::INDEX_BUFFER,
-        bytemuck::cast_slice(&[0u32, 1, 2, 3, 4, 5]),
-    );
-    let readback = readback_buffer(&device, "readback", u64::from(w * h) * 4);
-    let sampler = shine::gpu::Sampler::new(&device, &vk::SamplerCreateInfo::default()).unwrap();
-    let uploaded_state = ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::UNDEFINED);
-
-    let mut executor = Executor::new(&device, 1).unwrap();
-    let mut rg = executor.begin_frame();
-    let vb = rg.import_gpu_buffer(&vertices, uploaded_state, ExternalState::UNDEFINED);
-    let ib = rg.import_gpu_buffer(&indices, uploaded_state, ExternalState::UNDEFINED);
-    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
-    let mut depth = rg.create_image("depth", ImageDesc::new_2d(vk::Format::D32_SFLOAT, w, h));
-    let pipeline = GraphicsPipelineDesc {
+/// Depth-only pipeline of `graph_depth.vert` over vec4 positions.
+fn depth_pipeline() -> GraphicsPipelineDesc {
+    GraphicsPipelineDesc {
         vertex: &shaders::TESTS_GRAPH_DEPTH_VERT,
         fragment: None,
         vertex_buffers: vec![VertexBufferLayout {
@@ -358,7 +326,119 @@ fn indexed_depth_pass_then_sampled_in_compute() {
             write: true,
         }),
         depth_bias: None,
+    }
+}
+
+/// A far full-screen triangle, then a near one (clip space, vec4 positions), and their indices.
+fn far_then_near(far: f32, near: f32) -> (Vec<f32>, Vec<u32>) {
+    let mut positions: Vec<f32> = Vec::new();
+    for z in [far, near] {
+        for (x, y) in [(-1.0, -1.0), (3.0, -1.0), (-1.0, 3.0)] {
+            positions.extend([x, y, z, 0.0]);
+        }
+    }
+    (positions, vec![0, 1, 2, 3, 4, 5])
+}
+
+/// Two raster passes into the two halves of one depth image (an atlas of two tiles): each
+/// clears and draws only inside its area, so the first tile survives the second pass's clear;
+/// an area outside the attachment is an error, not a Vulkan fault.
+#[test]
+fn raster_areas_render_tiles_of_one_attachment() {
+    let device = device();
+    let (w, h) = (8u32, 8u32);
+    let (far, near) = (0.75f32, 0.25f32);
+    let (positions, index_data) = far_then_near(far, near);
+    let vertices = buffer_with(
+        &device,
+        "vertices",
+        vk::BufferUsageFlags::VERTEX_BUFFER,
+        bytemuck::cast_slice(&positions),
+    );
+    let indices = buffer_with(
+        &device,
+        "indices",
+        vk::BufferUsageFlags::INDEX_BUFFER,
+        bytemuck::cast_slice(&index_data),
+    );
+    let readback = readback_buffer(&device, "readback", u64::from(w * h) * 4);
+    let sampler = shine::gpu::Sampler::new(&device, &vk::SamplerCreateInfo::default()).unwrap();
+    let uploaded_state = ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::UNDEFINED);
+    let mut executor = Executor::new(&device, 1).unwrap();
+    let graph = |executor: &Executor, right_offset: u32| {
+        let mut rg = executor.begin_frame();
+        let vb = rg.import_gpu_buffer(&vertices, uploaded_state, ExternalState::UNDEFINED);
+        let ib = rg.import_gpu_buffer(&indices, uploaded_state, ExternalState::UNDEFINED);
+        let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+        let mut depth = rg.create_image("atlas", ImageDesc::new_2d(vk::Format::D32_SFLOAT, w, h));
+        rg.raster("left tile", depth_pipeline())
+            .depth(&mut depth, DepthLoad::Clear(1.0))
+            .area([0, 0], [w / 2, h])
+            .vertex_buffer(&vb)
+            .index_buffer(&ib, vk::IndexType::UINT32)
+            .draw_indexed(3, 1);
+        rg.raster("right tile", depth_pipeline())
+            .depth(&mut depth, DepthLoad::Clear(1.0))
+            .area([right_offset, 0], [w / 2, h])
+            .vertex_buffer(&vb)
+            .index_buffer(&ib, vk::IndexType::UINT32)
+            .draw_indexed(6, 1);
+        rg.compute("read_depth", &shaders::TESTS_GRAPH_DEPTH_READ_COMP)
+            .read("depth", &depth)
+            .sampler("nearest", sampler.raw())
+            .write("result", &mut out)
+            .push(&[w, h])
+            .dispatch([w, h, 1]);
+        rg
     };
+    let tiles = graph(&executor, w / 2);
+    run(&device, &mut executor, tiles);
+    let depths = floats(&device, &readback);
+    for (i, d) in depths.iter().enumerate() {
+        let expected = if (i as u32 % w) < w / 2 { far } else { near };
+        assert_eq!(*d, expected, "texel {i}");
+    }
+    let mut commands = device.begin_commands().unwrap();
+    let outside = graph(&executor, w / 2 + 1);
+    let err = executor.execute(commands.raw(), outside).unwrap_err();
+    drop(commands);
+    assert!(
+        err.to_string().contains("outside its 8×8 attachments"),
+        "{err}"
+    );
+    assert_clean(&device);
+}
+
+#[test]
+fn indexed_depth_pass_then_sampled_in_compute() {
+    let device = device();
+    let (w, h) = (8u32, 8u32);
+    // A far triangle, then a near one over it: the depth test keeps the near depth.
+    let (far, near) = (0.75f32, 0.25f32);
+    let (positions, index_data) = far_then_near(far, near);
+    let vertices = buffer_with(
+        &device,
+        "vertices",
+        vk::BufferUsageFlags::VERTEX_BUFFER,
+        bytemuck::cast_slice(&positions),
+    );
+    let indices = buffer_with(
+        &device,
+        "indices",
+        vk::BufferUsageFlags::INDEX_BUFFER,
+        bytemuck::cast_slice(&index_data),
+    );
+    let readback = readback_buffer(&device, "readback", u64::from(w * h) * 4);
+    let sampler = shine::gpu::Sampler::new(&device, &vk::SamplerCreateInfo::default()).unwrap();
+    let uploaded_state = ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::UNDEFINED);
+
+    let mut executor = Executor::new(&device, 1).unwrap();
+    let mut rg = executor.begin_frame();
+    let vb = rg.import_gpu_buffer(&vertices, uploaded_state, ExternalState::UNDEFINED);
+    let ib = rg.import_gpu_buffer(&indices, uploaded_state, ExternalState::UNDEFINED);
+    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+    let mut depth = rg.create_image("depth", ImageDesc::new_2d(vk::Format::D32_SFLOAT, w, h));
+    let pipeline = depth_pipeline();
     rg.raster("depth_only", pipeline)
         .depth(&mut depth, DepthLoad::Clear(1.0))
         .vertex_buffer(&vb)

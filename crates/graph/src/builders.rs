@@ -41,6 +41,7 @@ impl RenderGraph {
             index_buffer: None,
             push: Vec::new(),
             draws: Vec::new(),
+            area: None,
         })));
         RasterPass { pass }
     }
@@ -389,6 +390,25 @@ impl RasterPass<'_> {
             clear: [0.0; 4],
         };
         self.with(|r| r.depth = Some(attachment));
+        self
+    }
+
+    /// Restricts rendering to the rectangle at `offset` of size `extent` inside the
+    /// attachments: render area, viewport and scissor (a tile of an atlas). Loads, clears and
+    /// stores touch only this rectangle; the rest of the attachments keeps its contents. The
+    /// rectangle must lie inside the attachments (checked when the pass is recorded).
+    pub fn area(&mut self, offset: [u32; 2], extent: [u32; 2]) -> &mut Self {
+        let rect = vk::Rect2D {
+            offset: vk::Offset2D {
+                x: offset[0] as i32,
+                y: offset[1] as i32,
+            },
+            extent: vk::Extent2D {
+                width: extent[0],
+                height: extent[1],
+            },
+        };
+        self.with(|r| r.area = Some(rect));
         self
     }
 

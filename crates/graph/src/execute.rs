@@ -55,6 +55,26 @@ pub enum ExecuteError {
         "imported resource `{0}` has no Vulkan object: import it with import_vk_* or import_gpu_*"
     )]
     MissingObject(String),
+    /// A raster pass's area does not lie inside its attachments.
+    #[error(
+        "raster pass `{pass}`: area {width}×{height} at ({x}, {y}) is outside its {attachment_width}×{attachment_height} attachments"
+    )]
+    RenderArea {
+        /// The pass.
+        pass: String,
+        /// Area origin x.
+        x: u32,
+        /// Area origin y.
+        y: u32,
+        /// Area width.
+        width: u32,
+        /// Area height.
+        height: u32,
+        /// Attachment width.
+        attachment_width: u32,
+        /// Attachment height.
+        attachment_height: u32,
+    },
 }
 
 /// What a raw pass gets: the device, the command buffer and the graph's resources.
@@ -361,13 +381,30 @@ impl Recorder<'_> {
         let extent = first.map_or_else(vk::Extent3D::default, |a| {
             image_extent(self.plan, a.resource)
         });
-        let area = vk::Rect2D {
+        let whole = vk::Rect2D {
             offset: vk::Offset2D::default(),
             extent: vk::Extent2D {
                 width: extent.width,
                 height: extent.height,
             },
         };
+        let area = work.area.unwrap_or(whole);
+        let (x, y) = (area.offset.x.max(0) as u32, area.offset.y.max(0) as u32);
+        let inside = area.offset.x >= 0
+            && area.offset.y >= 0
+            && u64::from(x) + u64::from(area.extent.width) <= u64::from(extent.width)
+            && u64::from(y) + u64::from(area.extent.height) <= u64::from(extent.height);
+        if !inside {
+            return Err(ExecuteError::RenderArea {
+                pass: pass.name.clone(),
+                x,
+                y,
+                width: area.extent.width,
+                height: area.extent.height,
+                attachment_width: extent.width,
+                attachment_height: extent.height,
+            });
+        }
         let colors: Vec<vk::RenderingAttachmentInfo<'_>> = work
             .colors
             .iter()
@@ -405,10 +442,10 @@ impl Recorder<'_> {
             rendering = rendering.depth_attachment(d);
         }
         let viewport = vk::Viewport {
-            x: 0.0,
-            y: 0.0,
-            width: extent.width as f32,
-            height: extent.height as f32,
+            x: area.offset.x as f32,
+            y: area.offset.y as f32,
+            width: area.extent.width as f32,
+            height: area.extent.height as f32,
             min_depth: 0.0,
             max_depth: 1.0,
         };

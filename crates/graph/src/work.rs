@@ -73,6 +73,8 @@ pub(crate) struct RasterWork {
     pub index_buffer: Option<(ResourceId, vk::IndexType)>,
     pub push: Vec<u8>,
     pub draws: Vec<Draw>,
+    /// Render area, viewport and scissor: `None` covers the whole attachments.
+    pub area: Option<vk::Rect2D>,
 }
 
 /// A transfer command on whole resources.
