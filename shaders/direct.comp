@@ -1,6 +1,6 @@
 // Direct light (docs/frame.md): every punctual light on the G-buffer with the metallic-
-// roughness BRDF, the primary light shadowed through its RSM depth with a PCF kernel (soft
-// edges), plus emission.
+// roughness BRDF, each shadowed through its tiles of the shadow atlas with a PCF kernel (soft
+// edges), plus emission. CPU side: src/passes/direct.rs, src/passes/shadows.rs.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "scene.glsl"
@@ -17,28 +17,67 @@ layout(set = 0, binding = 5, std430) readonly buffer Lights {
     Light l[];
 } lights;
 DEFINE_LOAD_LIGHT(lights)
-layout(set = 0, binding = 6) uniform texture2D shadow_depth;
+layout(set = 0, binding = 6) uniform texture2D shadow_atlas;
 layout(set = 0, binding = 7) uniform sampler shadow_sampler;
 layout(set = 0, binding = 8, rgba16f) uniform image2D direct;
 
+// shine::passes::shadows::ShadowViewRecord
+struct ShadowView {
+    mat4 view_proj;
+    // xy: tile origin in atlas uv; zw: tile size in atlas uv
+    vec4 tile;
+    // x: texel size in metres at 1 m (perspective) or absolute (orthographic); y: 1 orthographic
+    vec4 params;
+};
+
+// shine::passes::shadows::LightShadowRecord
+struct LightShadow {
+    uint first_view;
+    uint view_count;
+    uint pad0;
+    uint pad1;
+};
+
+layout(set = 0, binding = 9, std430) readonly buffer ShadowViews {
+    ShadowView v[];
+} shadow_views;
+
+layout(set = 0, binding = 10, std430) readonly buffer ShadowLights {
+    LightShadow l[];
+} shadow_lights;
+
 layout(push_constant) uniform Push {
-    mat4 shadow_view_proj;
     vec4 eye;
-    // x: light count, y: primary (shadowed) light or 0xffffffff, z: PCF radius in texels,
-    // w: 1 when the frame has a shadow map.
+    // x: light count, y: PCF radius in texels, z: 1 when the frame has a shadow atlas
     uvec4 counts;
-    // x: depth bias in NDC depth units; y: shadow-map texel size in metres at 1 m from the
-    // light (perspective) or in metres (orthographic, z = 1); w: normal offset in texels.
+    // x: depth bias in NDC depth units; y: normal offset in texels; zw: one atlas texel in uv
     vec4 shadow;
 } push;
 
-// Normal-offset shadow lookup: the receiver point moves along its normal by a few shadow-map
-// texels (their world size grows with distance under a perspective light), which removes acne
-// on surfaces at grazing angles to the light without a large depth bias.
-float shadow_visibility(vec3 p, vec3 n, vec3 light_position) {
-    float texel = push.shadow.z > 0.5 ? push.shadow.y : push.shadow.y * distance(p, light_position);
-    p += n * texel * push.shadow.w;
-    vec4 clip = push.shadow_view_proj * vec4(p, 1.0);
+// The cube face of a point light that sees direction d (shine::passes::shadows::CUBE_FACES
+// order: +x, -x, +y, -y, +z, -z), by d's major axis.
+uint cube_face(vec3 d) {
+    vec3 a = abs(d);
+    if (a.x >= a.y && a.x >= a.z) {
+        return d.x >= 0.0 ? 0u : 1u;
+    }
+    if (a.y >= a.z) {
+        return d.y >= 0.0 ? 2u : 3u;
+    }
+    return d.z >= 0.0 ? 4u : 5u;
+}
+
+// Normal-offset PCF lookup in shadow view k: the receiver point moves along its normal by a
+// few shadow-map texels (their world size grows with distance under a perspective light),
+// which removes acne at grazing angles without a large depth bias; the taps stay inside the
+// view's tile. 0 outside the view's frustum.
+float shadow_view_visibility(uint k, vec3 p, vec3 n, vec3 light_position) {
+    mat4 view_proj = shadow_views.v[k].view_proj;
+    vec4 tile = shadow_views.v[k].tile;
+    vec4 params = shadow_views.v[k].params;
+    float texel = params.y > 0.5 ? params.x : params.x * distance(p, light_position);
+    p += n * texel * push.shadow.y;
+    vec4 clip = view_proj * vec4(p, 1.0);
     if (clip.w <= 0.0) {
         return 0.0;
     }
@@ -47,18 +86,36 @@ float shadow_visibility(vec3 p, vec3 n, vec3 light_position) {
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) {
         return 0.0;
     }
-    vec2 texel_uv = 1.0 / vec2(textureSize(sampler2D(shadow_depth, shadow_sampler), 0));
-    int r = int(push.counts.z);
+    vec2 texel_uv = push.shadow.zw;
+    vec2 lo = tile.xy + 0.5 * texel_uv;
+    vec2 hi = tile.xy + tile.zw - 0.5 * texel_uv;
+    vec2 centre = tile.xy + uv * tile.zw;
+    int r = int(push.counts.y);
     float lit = 0.0;
     float taps = 0.0;
     for (int y = -r; y <= r; ++y) {
         for (int x = -r; x <= r; ++x) {
-            float stored = textureLod(sampler2D(shadow_depth, shadow_sampler), uv + vec2(x, y) * texel_uv, 0.0).r;
+            vec2 at = clamp(centre + vec2(x, y) * texel_uv, lo, hi);
+            float stored = textureLod(sampler2D(shadow_atlas, shadow_sampler), at, 0.0).r;
             lit += (ndc.z - push.shadow.x <= stored) ? 1.0 : 0.0;
             taps += 1.0;
         }
     }
     return lit / taps;
+}
+
+// Visibility of light i from p: 1 for an unshadowed light, else through its view (the cube
+// face facing p for a point light).
+float shadow_visibility(uint i, Light light, vec3 p, vec3 n) {
+    uint count = shadow_lights.l[i].view_count;
+    if (push.counts.z == 0u || count == 0u) {
+        return 1.0;
+    }
+    uint k = shadow_lights.l[i].first_view;
+    if (count == 6u) {
+        k += cube_face(p - light.position);
+    }
+    return shadow_view_visibility(k, p, n, light.position);
 }
 
 void main() {
@@ -94,10 +151,7 @@ void main() {
         if (nl <= 0.0) {
             continue;
         }
-        float visibility = 1.0;
-        if (i == push.counts.y && push.counts.w == 1u) {
-            visibility = shadow_visibility(p, n, light.position);
-        }
+        float visibility = shadow_visibility(i, light, p, n);
         radiance += brdf_metallic_roughness(n, l, v, albedo, rm.y, rm.x) * irradiance * nl * visibility;
     }
     imageStore(direct, pixel, vec4(radiance, 1.0));

@@ -10,6 +10,7 @@ use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
 use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
 use crate::passes::receivers::{self, ReceiverError};
+use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::settings::{GatherPath, GiTechnique, RadiusHeuristic};
 use crate::settings::{Settings, SettingsError};
@@ -51,6 +52,9 @@ pub enum RenderError {
     /// The receiver or upsample pass refused its inputs.
     #[error(transparent)]
     Receivers(#[from] ReceiverError),
+    /// The scene's lights do not fit one shadow atlas.
+    #[error(transparent)]
+    Shadows(#[from] ShadowLayoutError),
     /// `render` was called before `set_scene`.
     #[error("no scene: call set_scene first")]
     NoScene,
@@ -98,6 +102,17 @@ pub struct Renderer {
     scene: Option<GpuScene>,
     /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
     brdf_tables: Vec<(u32, Buffer)>,
+    /// The shadow atlas layout of the current scene and its GPU records, for one
+    /// `(shadow.size, PCF radius)`.
+    shadow_layout: Option<ShadowCache>,
+}
+
+/// A [`ShadowLayout`] and its records on the GPU.
+struct ShadowCache {
+    key: (u32, u32),
+    layout: ShadowLayout,
+    views: Buffer,
+    lights: Buffer,
 }
 
 impl Renderer {
@@ -131,6 +146,7 @@ impl Renderer {
             )?,
             scene: None,
             brdf_tables: Vec::new(),
+            shadow_layout: None,
         })
     }
 
@@ -143,6 +159,7 @@ impl Renderer {
             self.device.wait_idle()?;
         }
         self.scene = Some(uploaded);
+        self.shadow_layout = None;
         Ok(())
     }
 
@@ -283,9 +300,55 @@ impl Renderer {
         Ok(())
     }
 
+    /// What the last frame had to compromise on (e.g. shadow tiles shrunk to fit the device),
+    /// for the caller to report.
+    pub fn warnings(&self) -> Vec<String> {
+        self.shadow_layout
+            .iter()
+            .filter_map(|c| c.layout.warning.clone())
+            .collect()
+    }
+
     /// GPU times of the passes of frames whose timestamps are available.
     pub fn timings(&mut self) -> Result<Vec<PassTiming>, RenderError> {
         Ok(self.executor.timings()?)
+    }
+
+    /// Lays out the shadow atlas of the current scene for `settings` and uploads its records,
+    /// unless the cached layout already matches.
+    fn prepare_shadows(&mut self, settings: &Settings) -> Result<(), RenderError> {
+        let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
+        let pcf_radius = settings.shadow.filter_radius.round() as u32;
+        let key = (settings.shadow.size, pcf_radius);
+        if self.shadow_layout.as_ref().is_some_and(|c| c.key == key) {
+            return Ok(());
+        }
+        let max_dimension = self.device.limits().max_image_dimension2_d;
+        let layout = ShadowLayout::new(scene, settings.shadow.size, pcf_radius, max_dimension)?;
+        let upload = |name, bytes: &[u8]| {
+            Buffer::with_data(
+                &self.device,
+                &BufferDesc {
+                    name,
+                    size: 0,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                    location: MemoryLocation::GpuOnly,
+                },
+                bytes,
+            )
+        };
+        let views = upload("shadow views", bytemuck::cast_slice(&layout.view_records()))?;
+        let lights = upload(
+            "shadow lights",
+            bytemuck::cast_slice(&layout.light_records()),
+        )?;
+        self.shadow_layout = Some(ShadowCache {
+            key,
+            layout,
+            views,
+            lights,
+        });
+        Ok(())
     }
 
     /// Declares every pass of a frame; returns its HDR and LDR images.
@@ -310,6 +373,7 @@ impl Renderer {
             )?;
             self.brdf_tables.push((conv_bands, buffer));
         }
+        self.prepare_shadows(settings)?;
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
         let read_only = ExternalState::new(
             vk::PipelineStageFlags2::ALL_COMMANDS,
@@ -336,8 +400,6 @@ impl Renderer {
         let primary = scene
             .primary_light()
             .and_then(|i| Some((i as u32, gbuffer::light_view(scene, i)?)));
-        let shadow_map = primary
-            .map(|(i, view)| gbuffer::shadow_map(rg, &handles, view, i, settings.shadow.size));
         let light_count = u32::try_from(scene.light_list.len())
             .map_err(|_| RenderError::Invalid("too many lights".into()))?;
         let shadow = ShadowParams {
@@ -346,12 +408,16 @@ impl Renderer {
             bias: SHADOW_DEPTH_BIAS,
             normal_offset: SHADOW_NORMAL_OFFSET,
         };
+        let cache = self.shadow_layout.as_ref().ok_or(RenderError::NoScene)?;
+        let shadow_views = rg.import_gpu_buffer(&cache.views, buffer_read, buffer_read);
+        let shadow_lights = rg.import_gpu_buffer(&cache.lights, buffer_read, buffer_read);
+        let atlas = shadows::shadow_atlas(rg, &handles, &cache.layout, shadow_views, shadow_lights);
         let direct = direct::direct(
             rg,
             &g,
             &handles,
             light_count,
-            shadow_map.as_ref(),
+            &atlas,
             camera.eye,
             shadow,
             self.nearest.raw(),

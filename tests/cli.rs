@@ -185,7 +185,7 @@ fn profile_reports_every_pass_as_json() {
         .iter()
         .filter_map(|p| p["name"].as_str())
         .collect();
-    for pass in ["gbuffer", "shadow", "direct", "composite"] {
+    for pass in ["gbuffer", "shadow light 0", "direct", "composite"] {
         assert!(passes.contains(&pass), "{pass} missing from {passes:?}");
     }
 }

@@ -41,6 +41,9 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
     let mut renderer = Renderer::new(&device)?;
     renderer.set_scene(&scene, settings.time)?;
     let timings = renderer.render_timed(&settings, args.warmup + args.frames)?;
+    for warning in renderer.warnings() {
+        eprintln!("warning: {warning}");
+    }
     let first_frame = timings.iter().map(|t| t.frame).min().unwrap_or(0);
     let measured: Vec<_> = timings
         .into_iter()

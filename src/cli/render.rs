@@ -60,6 +60,9 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         bar.finish_and_clear();
     }
     let frame = last.ok_or("no frame was rendered")?;
+    for warning in renderer.warnings() {
+        eprintln!("warning: {warning}");
+    }
     write_frame(&args.output, &frame.ldr, &frame.hdr)?;
     let total: f64 = frame.timings.iter().map(|t| t.end_ns - t.begin_ns).sum();
     println!(

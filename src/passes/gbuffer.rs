@@ -1,5 +1,5 @@
 //! `gbuffer` and `rsm`: the scene rasterised from the camera into the G-buffer, and from the
-//! primary light into the reflective shadow map whose depth is also the shadow map.
+//! primary light into the reflective shadow map.
 
 use crate::gpu_scene::{GpuScene, Vertex};
 use crate::shaders;
@@ -85,7 +85,7 @@ impl View {
 }
 
 /// Vulkan clip space from a right-handed GL-style projection: y points down.
-fn flip_y(mut proj: Mat4) -> Mat4 {
+pub(crate) fn flip_y(mut proj: Mat4) -> Mat4 {
     proj.y_axis.y = -proj.y_axis.y;
     proj
 }
@@ -198,49 +198,6 @@ pub struct GBuffer {
     pub extent: [u32; 2],
 }
 
-/// The primary light's shadow map: depth only, from the same view as the RSM but at its own
-/// (usually higher) resolution.
-#[derive(Clone, Copy, Debug)]
-pub struct ShadowMap {
-    /// Light-space depth.
-    pub depth: Handle<Image>,
-    /// The light's view.
-    pub view: View,
-    /// Index of the light in the scene's lights.
-    pub light: u32,
-    /// Edge in texels.
-    pub size: u32,
-}
-
-/// Rasterises the scene's depth from the primary light into a new `size`² shadow map.
-pub fn shadow_map(
-    rg: &mut RenderGraph,
-    scene: &SceneHandles,
-    view: View,
-    light: u32,
-    size: u32,
-) -> ShadowMap {
-    let mut depth = rg.create_image(
-        "shadow_depth",
-        ImageDesc::new_2d(vk::Format::D32_SFLOAT, size, size),
-    );
-    // Slope-scaled bias against acne (constant in depth units, slope factor); the direct pass
-    // adds a normal offset on top.
-    let pipeline = scene_pipeline(None, &[], Some((1.0, 1.5)));
-    rg.raster("shadow", pipeline)
-        .depth(&mut depth, DepthLoad::Clear(1.0))
-        .vertex_buffer(&scene.vertices)
-        .index_buffer(&scene.indices, vk::IndexType::UINT32)
-        .push(&view.constants(None))
-        .draw_indexed(scene.index_count, 1);
-    ShadowMap {
-        depth,
-        view,
-        light,
-        size,
-    }
-}
-
 /// Scene resources imported into a frame graph.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneHandles {
@@ -260,7 +217,9 @@ pub struct SceneHandles {
     pub index_count: u32,
 }
 
-fn scene_pipeline(
+/// The pipeline of every scene raster pass: the flattened scene's vertices through
+/// `gbuffer.vert`, an optional fragment shader and colour targets, depth tested and written.
+pub(crate) fn scene_pipeline(
     fragment: Option<&'static shine_gpu::ShaderDesc>,
     colors: &[vk::Format],
     depth_bias: Option<(f32, f32)>,

@@ -7,4 +7,5 @@ pub mod direct;
 pub mod gbuffer;
 pub mod hvl;
 pub mod receivers;
+pub mod shadows;
 pub mod upsample;

@@ -1,0 +1,289 @@
+//! `shadow`: a depth map for every light of the scene, each rendered into one tile of a single
+//! shadow atlas that the direct pass samples (docs/frame.md, "Shadow atlas").
+//!
+//! Decisions:
+//! * **One atlas.** lavapipe indexes arrays of textures only with constants, so every map is a
+//!   square tile of one D32 image: a spot light has one tile (its outer cone), a directional
+//!   light one (an orthographic box around the scene), a point light six (cube faces +x, -x,
+//!   +y, -y, +z, -z). Each tile is one raster pass restricted to its rectangle
+//!   ([`shine_graph::RasterPass::area`]), so clears and draws never touch the other tiles.
+//! * **Tile size** is the `shadow.size` setting for every tile; when the atlas would exceed the
+//!   device's largest 2D image the tiles are halved until it fits (with a warning).
+//! * **Cube faces overlap.** A point-light face covers slightly more than 90° (its central 90°
+//!   leaves a margin of PCF radius + 2 texels on each side), so the PCF kernel of a receiver
+//!   whose major axis picked the face never leaves the face's valid depth.
+
+use super::gbuffer::{SceneHandles, View, flip_y, light_view, scene_pipeline};
+use crate::gpu_scene::GpuScene;
+use glam::{Mat4, Vec3};
+use shine_gpu::{GraphicsPipelineDesc, vk};
+use shine_graph::{DepthLoad, Handle, Image, ImageDesc, RenderGraph};
+use shine_scene::LightKind;
+
+/// Smallest tile the atlas shrinks to before refusing (texels).
+pub const MIN_TILE: u32 = 16;
+
+/// Cube faces of a point light, in the order of its tiles: the axis each looks along and its
+/// up vector (the direct pass picks the face by the receiver's major axis, in this order).
+pub const CUBE_FACES: [(Vec3, Vec3, &str); 6] = [
+    (Vec3::X, Vec3::Y, "+x"),
+    (Vec3::NEG_X, Vec3::Y, "-x"),
+    (Vec3::Y, Vec3::Z, "+y"),
+    (Vec3::NEG_Y, Vec3::Z, "-y"),
+    (Vec3::Z, Vec3::Y, "+z"),
+    (Vec3::NEG_Z, Vec3::Y, "-z"),
+];
+
+/// One shadow view as the direct pass reads it (std430, 96 bytes; `ShadowView` of
+/// `shaders/direct.comp`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ShadowViewRecord {
+    /// World to the view's clip space.
+    pub view_proj: [[f32; 4]; 4],
+    /// xy: the tile's origin in atlas uv; zw: its size in atlas uv.
+    pub tile: [f32; 4],
+    /// x: texel size in metres at 1 m from the light (perspective) or absolute (orthographic);
+    /// y: 1 for orthographic; zw: 0.
+    pub params: [f32; 4],
+}
+
+/// Which views shadow one light (std430, 16 bytes; `LightShadow` of `shaders/direct.comp`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LightShadowRecord {
+    /// Index of the light's first view.
+    pub first_view: u32,
+    /// Number of views: 0 (unshadowed), 1 (spot, directional) or 6 (point).
+    pub view_count: u32,
+    /// Padding.
+    pub pad: [u32; 2],
+}
+
+/// Where every light's shadow views lie in the atlas.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShadowLayout {
+    /// Side of every tile in texels.
+    pub tile: u32,
+    /// Tiles per atlas row.
+    pub columns: u32,
+    /// Tile rows.
+    pub rows: u32,
+    /// Every view: the light it belongs to, its pass name and its view.
+    pub views: Vec<(u32, String, View)>,
+    /// Per light of the scene, in light order.
+    pub lights: Vec<LightShadowRecord>,
+    /// Set when the tiles had to shrink below the asked size.
+    pub warning: Option<String>,
+}
+
+/// Why the shadow atlas cannot be laid out.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error(
+    "{views} shadow views do not fit a {max_dimension}² atlas even with {MIN_TILE}² tiles: the scene has too many lights"
+)]
+pub struct ShadowLayoutError {
+    /// Views asked for.
+    pub views: usize,
+    /// The device's largest 2D image side.
+    pub max_dimension: u32,
+}
+
+impl ShadowLayout {
+    /// The views of every light of `scene` in tiles of `tile` texels (smaller if the atlas
+    /// would exceed `max_dimension`), with a margin of `pcf_radius` + 2 texels around each
+    /// cube face.
+    pub fn new(
+        scene: &GpuScene,
+        tile: u32,
+        pcf_radius: u32,
+        max_dimension: u32,
+    ) -> Result<Self, ShadowLayoutError> {
+        let mut views = Vec::new();
+        let mut lights = Vec::with_capacity(scene.light_list.len());
+        for (i, light) in scene.light_list.iter().enumerate() {
+            let first_view = views.len() as u32;
+            let index = i as u32;
+            match light.light_kind() {
+                Some(LightKind::Point) => {
+                    let margin = (pcf_radius + 2) as f32;
+                    for (axis, up, face) in CUBE_FACES {
+                        let view = cube_face(scene, Vec3::from(light.position), axis, up, {
+                            tile as f32 / (tile as f32 - 2.0 * margin).max(1.0)
+                        });
+                        views.push((index, format!("shadow light {i} {face}"), view));
+                    }
+                }
+                Some(_) => {
+                    if let Some(view) = light_view(scene, i) {
+                        views.push((index, format!("shadow light {i}"), view));
+                    }
+                }
+                None => {}
+            }
+            lights.push(LightShadowRecord {
+                first_view,
+                view_count: views.len() as u32 - first_view,
+                pad: [0; 2],
+            });
+        }
+        let n = views.len().max(1) as u32;
+        let columns = (f64::from(n).sqrt().ceil()) as u32;
+        let rows = n.div_ceil(columns);
+        let mut side = tile;
+        while u64::from(columns.max(rows)) * u64::from(side) > u64::from(max_dimension) {
+            side /= 2;
+            if side < MIN_TILE {
+                return Err(ShadowLayoutError {
+                    views: views.len(),
+                    max_dimension,
+                });
+            }
+        }
+        let warning = (side != tile).then(|| {
+            format!(
+                "{} shadow views at {tile}² do not fit a {max_dimension}² image: shadow tiles shrunk to {side}²",
+                views.len()
+            )
+        });
+        Ok(Self {
+            warning,
+            tile: side,
+            columns,
+            rows,
+            views,
+            lights,
+        })
+    }
+
+    /// Width and height of the atlas in texels.
+    pub fn atlas_extent(&self) -> [u32; 2] {
+        [self.columns * self.tile, self.rows * self.tile]
+    }
+
+    /// Texel origin of tile `k`.
+    pub fn tile_origin(&self, k: u32) -> [u32; 2] {
+        [
+            (k % self.columns) * self.tile,
+            (k / self.columns) * self.tile,
+        ]
+    }
+
+    /// The views as the direct pass reads them (at least one record, so the buffer exists).
+    pub fn view_records(&self) -> Vec<ShadowViewRecord> {
+        let [w, h] = self.atlas_extent();
+        let mut records: Vec<ShadowViewRecord> = self
+            .views
+            .iter()
+            .enumerate()
+            .map(|(k, (_, _, view))| {
+                let [x, y] = self.tile_origin(k as u32);
+                let texel = if view.orthographic {
+                    view.extent / self.tile as f32
+                } else {
+                    2.0 * (0.5 * view.extent).tan() / self.tile as f32
+                };
+                ShadowViewRecord {
+                    view_proj: view.view_proj().to_cols_array_2d(),
+                    tile: [
+                        x as f32 / w as f32,
+                        y as f32 / h as f32,
+                        self.tile as f32 / w as f32,
+                        self.tile as f32 / h as f32,
+                    ],
+                    params: [texel, f32::from(u8::from(view.orthographic)), 0.0, 0.0],
+                }
+            })
+            .collect();
+        if records.is_empty() {
+            records.push(ShadowViewRecord::default());
+        }
+        records
+    }
+
+    /// The per-light records (at least one, so the buffer exists).
+    pub fn light_records(&self) -> Vec<LightShadowRecord> {
+        let mut records = self.lights.clone();
+        if records.is_empty() {
+            records.push(LightShadowRecord::default());
+        }
+        records
+    }
+}
+
+/// One cube face of a point light at `eye` looking along `axis`: a square frustum whose
+/// half-angle tangent is `tan_half` (1 = exactly 90°), reaching past the scene's far side.
+fn cube_face(scene: &GpuScene, eye: Vec3, axis: Vec3, up: Vec3, tan_half: f32) -> View {
+    let (lo, hi) = scene.bounds;
+    let center = (lo + hi) * 0.5;
+    let radius = ((hi - lo).length() * 0.5).max(1e-3);
+    let far = (eye - center).length() + radius * 2.0;
+    let near = (far * 1e-3).max(1e-3);
+    let fov = 2.0 * tan_half.atan();
+    View {
+        view: Mat4::look_to_rh(eye, axis, up),
+        proj: flip_y(Mat4::perspective_rh(fov, 1.0, near, far)),
+        eye,
+        orthographic: false,
+        extent: fov,
+    }
+}
+
+/// The shadow atlas of a frame and the buffers describing it.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowAtlas {
+    /// D32 depth, the tiles of [`ShadowLayout`].
+    pub depth: Handle<Image>,
+    /// [`ShadowViewRecord`]s.
+    pub views: Handle<shine_graph::Buffer>,
+    /// [`LightShadowRecord`]s, one per light.
+    pub lights: Handle<shine_graph::Buffer>,
+    /// Atlas width and height.
+    pub extent: [u32; 2],
+    /// Number of views rendered (0: nothing is shadowed).
+    pub view_count: u32,
+}
+
+/// Rasterises the scene's depth from every view of `layout` into its tile of a new atlas.
+/// `views` and `lights` hold [`ShadowLayout::view_records`] and
+/// [`ShadowLayout::light_records`].
+pub fn shadow_atlas(
+    rg: &mut RenderGraph,
+    scene: &SceneHandles,
+    layout: &ShadowLayout,
+    views: Handle<shine_graph::Buffer>,
+    lights: Handle<shine_graph::Buffer>,
+) -> ShadowAtlas {
+    let extent = layout.atlas_extent();
+    let mut depth = rg.create_image(
+        "shadow_atlas",
+        ImageDesc::new_2d(vk::Format::D32_SFLOAT, extent[0], extent[1]),
+    );
+    if layout.views.is_empty() {
+        // Nothing casts a shadow: the atlas is one cleared tile the direct pass never reads.
+        rg.raster("shadow clear", shadow_pipeline())
+            .depth(&mut depth, DepthLoad::Clear(1.0));
+    }
+    for (k, (_, name, view)) in layout.views.iter().enumerate() {
+        rg.raster(name, shadow_pipeline())
+            .depth(&mut depth, DepthLoad::Clear(1.0))
+            .area(layout.tile_origin(k as u32), [layout.tile, layout.tile])
+            .vertex_buffer(&scene.vertices)
+            .index_buffer(&scene.indices, vk::IndexType::UINT32)
+            .push(&view.constants(None))
+            .draw_indexed(scene.index_count, 1);
+    }
+    ShadowAtlas {
+        depth,
+        views,
+        lights,
+        extent,
+        view_count: layout.views.len() as u32,
+    }
+}
+
+/// Depth-only scene pipeline with a slope-scaled bias against acne (constant in depth units,
+/// slope factor); the direct pass adds a normal offset on top.
+fn shadow_pipeline() -> GraphicsPipelineDesc {
+    scene_pipeline(None, &[], Some((1.0, 1.5)))
+}
