@@ -1,6 +1,8 @@
-//! `shine profile` reports: per-pass GPU time statistics and a Chrome trace.
+//! `shine profile` reports: per-pass time statistics and a Chrome trace.
 //!
-//! Input is the [`PassTiming`]s of the measured frames (the caller drops the warm-up frames).
+//! Input is the [`PassTiming`]s of the measured frames (the caller drops the warm-up frames),
+//! from GPU timestamps or from the host clock around passes submitted one by one
+//! ([`PassClock`]).
 //! Per pass: median, 95th percentile and mean of its GPU time per frame, in milliseconds, and
 //! its share of the frame. Definitions:
 //!
@@ -130,9 +132,44 @@ pub struct PassStats {
     pub share: f64,
 }
 
-/// Per-pass GPU time statistics over the measured frames.
+/// Which clock timed the passes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PassClock {
+    /// GPU timestamps around each pass of a whole-frame submission.
+    Gpu,
+    /// Host time from submit to completion of each pass submitted alone
+    /// ([`crate::graph::Executor::execute_serialized`]): for devices whose timestamps do not
+    /// bracket compute work (lavapipe).
+    Host,
+}
+
+impl PassClock {
+    /// The clock `shine profile` uses by default on a device of `device_type`: host timing on
+    /// CPU implementations (lavapipe writes timestamps when it flushes rasterisation, so a
+    /// compute pass's time lands outside its own scope), GPU timestamps elsewhere.
+    pub fn for_device(device_type: crate::gpu::vk::PhysicalDeviceType) -> Self {
+        if device_type == crate::gpu::vk::PhysicalDeviceType::CPU {
+            Self::Host
+        } else {
+            Self::Gpu
+        }
+    }
+
+    /// `gpu` or `host`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Gpu => "gpu",
+            Self::Host => "host",
+        }
+    }
+}
+
+/// Per-pass time statistics over the measured frames.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ProfileReport {
+    /// The clock that timed the passes.
+    pub clock: PassClock,
     /// Number of frames measured.
     pub frames: usize,
     /// Passes in order of first execution.
@@ -189,8 +226,8 @@ fn frames(timings: &[PassTiming]) -> Result<Vec<FrameTimes>, ProfileError> {
 }
 
 impl ProfileReport {
-    /// Computes the report from the timings of the measured frames.
-    pub fn from_timings(timings: &[PassTiming]) -> Result<Self, ProfileError> {
+    /// Computes the report from the timings of the measured frames, taken with `clock`.
+    pub fn from_timings(timings: &[PassTiming], clock: PassClock) -> Result<Self, ProfileError> {
         let frames = frames(timings)?;
         let mut names: Vec<&str> = Vec::new();
         for frame in &frames {
@@ -226,6 +263,7 @@ impl ProfileReport {
             })
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self {
+            clock,
             frames: frames.len(),
             passes,
             frame: Stats::from_ns(&totals).ok_or(ProfileError::NoTimings)?,
@@ -251,8 +289,12 @@ impl ProfileReport {
             .chain([5])
             .max()
             .unwrap_or(5);
+        let heading = match self.clock {
+            PassClock::Gpu => "GPU time (timestamps)",
+            PassClock::Host => "Time per pass submitted alone (host clock)",
+        };
         let mut out = format!(
-            "GPU time over {} frame(s), ms\n{:<width$}  {:>10}  {:>10}  {:>10}  {:>7}\n",
+            "{heading} over {} frame(s), ms\n{:<width$}  {:>10}  {:>10}  {:>10}  {:>7}\n",
             self.frames, "pass", "median", "p95", "mean", "share"
         );
         let mut line = |name: &str, s: &Stats, share: f64| {
@@ -433,7 +475,7 @@ mod tests {
 
     #[test]
     fn statistics_by_hand() {
-        let report = ProfileReport::from_timings(&five_frames()).unwrap();
+        let report = ProfileReport::from_timings(&five_frames(), PassClock::Gpu).unwrap();
         assert_eq!(report.frames, 5);
         let a = &report.passes[0];
         assert_eq!(a.name, "a");
@@ -481,7 +523,7 @@ mod tests {
             timing("gi", 0, 4.0, 8.0),
             timing("a", 1, 0.0, 3.0),
         ];
-        let report = ProfileReport::from_timings(&timings).unwrap();
+        let report = ProfileReport::from_timings(&timings, PassClock::Gpu).unwrap();
         let a = &report.passes[0];
         // Frame 0: 1 + 2 ms; frame 1: 3 ms.
         assert_eq!(a.time.samples, 2);
@@ -495,10 +537,10 @@ mod tests {
     #[test]
     fn bad_input_is_an_error() {
         assert!(matches!(
-            ProfileReport::from_timings(&[]),
+            ProfileReport::from_timings(&[], PassClock::Gpu),
             Err(ProfileError::NoTimings)
         ));
-        let message = ProfileReport::from_timings(&[timing("x", 3, 2.0, 1.0)])
+        let message = ProfileReport::from_timings(&[timing("x", 3, 2.0, 1.0)], PassClock::Gpu)
             .unwrap_err()
             .to_string();
         assert!(message.contains("`x` of frame 3"), "{message}");
@@ -509,7 +551,7 @@ mod tests {
     #[test]
     fn formats() {
         let timings = [timing("a", 0, 0.0, 3.0), timing("b, c", 0, 3.0, 4.0)];
-        let report = ProfileReport::from_timings(&timings).unwrap();
+        let report = ProfileReport::from_timings(&timings, PassClock::Gpu).unwrap();
         assert_eq!(
             report.to_csv(),
             "pass,samples,median_ms,p95_ms,mean_ms,share\n\

@@ -12,6 +12,7 @@ use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
 use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
+use crate::profile_report::PassClock;
 use crate::settings::{GatherPath, GiTechnique, RadiusHeuristic};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
@@ -206,11 +207,13 @@ impl Renderer {
     }
 
     /// Renders `count` frames without reading them back (profiling); returns the pass timings
-    /// of every frame.
+    /// of every frame, from GPU timestamps or, with [`PassClock::Host`], from the host clock
+    /// around each pass submitted alone.
     pub fn render_timed(
         &mut self,
         settings: &Settings,
         count: u32,
+        clock: PassClock,
     ) -> Result<Vec<PassTiming>, RenderError> {
         settings.validate()?;
         // The frame's outputs must reach something outside the graph, or every pass is culled:
@@ -230,8 +233,13 @@ impl Renderer {
                 ),
             );
             rg.blit_image("present", &frame.ldr, &mut out, vk::Filter::NEAREST);
-            self.run(rg)?;
-            timings.extend(self.executor.timings()?);
+            match clock {
+                PassClock::Gpu => {
+                    self.run(rg)?;
+                    timings.extend(self.executor.timings()?);
+                }
+                PassClock::Host => timings.extend(self.executor.execute_serialized(rg)?.1),
+            }
         }
         Ok(timings)
     }

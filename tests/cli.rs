@@ -179,6 +179,8 @@ fn profile_reports_every_pass_as_json() {
     );
     let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON report");
     assert_eq!(report["frames"], 3, "{stdout}");
+    // lavapipe is a CPU device: `auto` times each pass alone on the host clock.
+    assert_eq!(report["clock"], "host", "{stdout}");
     let passes: Vec<_> = report["passes"]
         .as_array()
         .expect("passes")
@@ -188,4 +190,19 @@ fn profile_reports_every_pass_as_json() {
     for pass in ["gbuffer", "shadow light 0", "direct", "composite"] {
         assert!(passes.contains(&pass), "{pass} missing from {passes:?}");
     }
+}
+
+#[test]
+fn profile_refuses_an_unknown_clock() {
+    let run = shine()
+        .args(["profile", "builtin:cornell-box", "--clock", "sundial"])
+        .args(["--width", "16", "--height", "16", "--gi", "none"])
+        .output()
+        .expect("run shine profile");
+    assert_eq!(run.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("unknown --clock `sundial`: expected auto, gpu or host"),
+        "{stderr}"
+    );
 }

@@ -159,6 +159,26 @@ fn compute_raster_compute_matches_the_cpu_and_reruns_bit_identically() {
     assert_clean(&device);
 }
 
+/// The same graph run one pass per submission: the same result, host times in pass order that
+/// do not overlap, and no GPU timestamps left to read for that frame.
+#[test]
+fn serialized_execution_computes_the_same_and_times_each_pass() {
+    let device = device();
+    let result = readback_buffer(&device, "result", u64::from(W * H) * 16);
+    let mut executor = Executor::new(&device, 2).unwrap();
+    let graph = splat_graph(&executor, &result);
+    let (plan, timings) = executor.execute_serialized(graph).unwrap();
+    assert_eq!(plan.order(), ["emit", "splat", "gather"]);
+    assert_eq!(floats(&device, &result), splat_expected());
+    let names: Vec<&str> = timings.iter().map(|t| t.name.as_str()).collect();
+    assert_eq!(names, ["emit", "splat", "gather"]);
+    for pair in timings.windows(2) {
+        assert!(pair[0].begin_ns <= pair[0].end_ns && pair[0].end_ns <= pair[1].begin_ns);
+    }
+    assert!(executor.timings().unwrap().is_empty());
+    assert_clean(&device);
+}
+
 const N: u32 = 64;
 
 #[test]

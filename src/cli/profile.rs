@@ -1,10 +1,11 @@
-//! `shine profile`: per-pass GPU time over N frames after a warm-up, as a table, JSON or CSV,
-//! and optionally a Chrome trace (Perfetto opens it).
+//! `shine profile`: per-pass time over N frames after a warm-up, as a table, JSON or CSV, and
+//! optionally a Chrome trace (Perfetto opens it). Passes are timed by GPU timestamps, or on
+//! CPU devices (lavapipe) by the host clock around each pass submitted alone.
 
 use super::CliError;
 use super::frame_args::{SettingsArgs, load_scene};
 use shine::gpu::{Device, DeviceDesc};
-use shine::profile_report::{ProfileReport, ReportFormat, write_chrome_trace};
+use shine::profile_report::{PassClock, ProfileReport, ReportFormat, write_chrome_trace};
 use shine::renderer::Renderer;
 use std::path::PathBuf;
 
@@ -25,6 +26,10 @@ pub struct ProfileArgs {
     /// Also write a Chrome trace (JSON) of the measured frames.
     #[arg(long)]
     trace: Option<PathBuf>,
+    /// Pass clock: `gpu` (timestamps), `host` (each pass submitted alone, timed on the host)
+    /// or `auto` (host on CPU devices such as lavapipe, whose timestamps miss compute work).
+    #[arg(long, default_value = "auto")]
+    clock: String,
     #[command(flatten)]
     settings: SettingsArgs,
 }
@@ -38,9 +43,17 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
     let settings = args.settings.resolve()?;
     let scene = load_scene(&args.scene)?;
     let device = Device::new(&DeviceDesc::from_env())?;
+    let clock = match args.clock.as_str() {
+        "auto" => PassClock::for_device(device.info().device_type),
+        "gpu" => PassClock::Gpu,
+        "host" => PassClock::Host,
+        other => {
+            return Err(format!("unknown --clock `{other}`: expected auto, gpu or host").into());
+        }
+    };
     let mut renderer = Renderer::new(&device)?;
     renderer.set_scene(&scene, settings.time)?;
-    let timings = renderer.render_timed(&settings, args.warmup + args.frames)?;
+    let timings = renderer.render_timed(&settings, args.warmup + args.frames, clock)?;
     for warning in renderer.warnings() {
         eprintln!("warning: {warning}");
     }
@@ -49,7 +62,7 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
         .into_iter()
         .filter(|t| t.frame >= first_frame + u64::from(args.warmup))
         .collect();
-    let report = ProfileReport::from_timings(&measured)?;
+    let report = ProfileReport::from_timings(&measured, clock)?;
     println!("{}", report.format(format)?);
     if let Some(path) = &args.trace {
         write_chrome_trace(path, &measured)?;

@@ -767,8 +767,32 @@ impl Executor {
     pub fn execute(
         &mut self,
         cb: vk::CommandBuffer,
-        mut graph: RenderGraph,
+        graph: RenderGraph,
     ) -> Result<Arc<Plan>, ExecuteError> {
+        self.run(graph, Some(cb)).map(|(plan, _)| plan)
+    }
+
+    /// Compiles and runs `graph` one pass at a time: each pass (with its barriers) is recorded
+    /// into its own command buffer, submitted and waited for, and timed on the host from submit
+    /// to completion. Returns the plan and the host times of its passes (origin: the first
+    /// submit).
+    ///
+    /// For devices whose timestamps do not bracket the work of a pass (lavapipe writes them when
+    /// it flushes rasterisation, not when a compute dispatch runs): the times are exact up to a
+    /// submission's overhead (tens of µs), at the cost of serialising the frame.
+    pub fn execute_serialized(
+        &mut self,
+        graph: RenderGraph,
+    ) -> Result<(Arc<Plan>, Vec<PassTiming>), ExecuteError> {
+        self.run(graph, None)
+    }
+
+    /// [`Executor::execute`] into `cb`, or [`Executor::execute_serialized`] when `cb` is `None`.
+    fn run(
+        &mut self,
+        mut graph: RenderGraph,
+        cb: Option<vk::CommandBuffer>,
+    ) -> Result<(Arc<Plan>, Vec<PassTiming>), ExecuteError> {
         let plan = self.compiler.compile(&graph, &DeviceMemory(&self.device))?;
         let slot_index = (self.frame % self.slots.len() as u64) as usize;
         let set = self.transients_for(&plan, slot_index)?;
@@ -817,18 +841,29 @@ impl Executor {
             self.timings.extend(read_timings(&slot.timestamps, frame)?);
         }
         slot.descriptors.reset()?;
-        slot.timestamps.reset(cb);
-
-        let recorder = Recorder {
-            device: &self.device,
-            cb,
-            plan: &plan,
-            objects: &objects,
-        };
+        if let Some(cb) = cb {
+            slot.timestamps.reset(cb);
+        }
+        let mut host_timings = Vec::new();
+        let start = std::time::Instant::now();
         for (position, pass) in plan.passes.iter().enumerate() {
+            // Serialized: a command buffer of its own for this pass.
+            let mut own = match cb {
+                Some(_) => None,
+                None => Some(self.device.begin_commands()?),
+            };
+            let pass_cb = cb.or(own.as_mut().map(|c| c.raw())).unwrap_or_default();
+            let recorder = Recorder {
+                device: &self.device,
+                cb: pass_cb,
+                plan: &plan,
+                objects: &objects,
+            };
             recorder.barriers(&pass.barriers);
-            slot.timestamps.begin(cb, &pass.name)?;
-            self.device.begin_label(cb, &pass.name);
+            if cb.is_some() {
+                slot.timestamps.begin(pass_cb, &pass.name)?;
+            }
+            self.device.begin_label(pass_cb, &pass.name);
             let work = std::mem::replace(&mut graph.works[pass.id.0 as usize], Work::Declared);
             let recorded = match work {
                 Work::Declared => Ok(()),
@@ -871,21 +906,54 @@ impl Executor {
                 Work::Raw(f) => {
                     let mut ctx = RawContext {
                         device: &self.device,
-                        cb,
+                        cb: pass_cb,
                         resources: &objects,
                     };
                     f(&mut ctx).map_err(ExecuteError::from)
                 }
             };
-            self.device.end_label(cb);
-            slot.timestamps.end(cb)?;
+            self.device.end_label(pass_cb);
+            if cb.is_some() {
+                slot.timestamps.end(pass_cb)?;
+            }
             recorded?;
+            if let Some(commands) = own {
+                let begin_ns = start.elapsed().as_secs_f64() * 1e9;
+                self.device.submit(commands)?.wait()?;
+                host_timings.push(PassTiming {
+                    name: pass.name.clone(),
+                    begin_ns,
+                    end_ns: start.elapsed().as_secs_f64() * 1e9,
+                    frame: self.frame,
+                });
+            }
         }
-        recorder.barriers(&plan.final_barriers);
-        slot.unread = Some(self.frame);
+        match cb {
+            Some(cb) => {
+                Recorder {
+                    device: &self.device,
+                    cb,
+                    plan: &plan,
+                    objects: &objects,
+                }
+                .barriers(&plan.final_barriers);
+                slot.unread = Some(self.frame);
+            }
+            None => {
+                let mut commands = self.device.begin_commands()?;
+                Recorder {
+                    device: &self.device,
+                    cb: commands.raw(),
+                    plan: &plan,
+                    objects: &objects,
+                }
+                .barriers(&plan.final_barriers);
+                self.device.submit(commands)?.wait()?;
+            }
+        }
         self.compiler.finish_frame(&plan);
         self.frame += 1;
-        Ok(plan)
+        Ok((plan, host_timings))
     }
 
     /// Per-pass GPU times of every executed frame not reported yet, oldest first. Call only
