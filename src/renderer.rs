@@ -11,7 +11,7 @@ use crate::passes::gbuffer::{self, SceneHandles};
 use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
 use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::upsample::{self, UpsampleParams};
-use crate::settings::{GatherPath, GiTechnique, RadiusHeuristic};
+use crate::settings::{Component, GatherPath, GiTechnique, RadiusHeuristic};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
@@ -400,10 +400,21 @@ impl Renderer {
             }
             _ => None,
         };
+        // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
+        let (first, second) = match (settings.output.component, indirect.as_ref()) {
+            (Component::Full, indirect) => (&direct, indirect),
+            (Component::Direct, _) => (&direct, None),
+            (Component::Indirect, Some(indirect)) => (indirect, None),
+            (Component::Indirect, None) => {
+                return Err(RenderError::Invalid(
+                    "output.component = indirect needs a GI technique (this frame has none)".into(),
+                ));
+            }
+        };
         Ok(composite::composite(
             rg,
-            &direct,
-            indirect.as_ref(),
+            first,
+            second,
             extent,
             &CompositeParams::from_settings(&settings.output),
         ))
