@@ -6,11 +6,15 @@
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
+pub mod gpu_bvh;
+pub mod gpu_environment;
 pub mod gpu_scene;
 pub mod hvl_reference;
+pub mod image_compare;
 pub mod image_io;
 pub mod passes;
 pub mod profile_report;
+pub mod reference;
 pub mod renderer;
 pub mod settings;
 pub mod tonemap;

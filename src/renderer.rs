@@ -13,7 +13,7 @@ use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::profile_report::PassClock;
-use crate::settings::{GatherPath, GiTechnique, RadiusHeuristic};
+use crate::settings::{Component, GatherPath, GiTechnique, RadiusHeuristic};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
@@ -460,10 +460,21 @@ impl Renderer {
             }
             _ => None,
         };
+        // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
+        let (first, second) = match (settings.output.component, indirect.as_ref()) {
+            (Component::Full, indirect) => (&direct, indirect),
+            (Component::Direct, _) => (&direct, None),
+            (Component::Indirect, Some(indirect)) => (indirect, None),
+            (Component::Indirect, None) => {
+                return Err(RenderError::Invalid(
+                    "output.component = indirect needs a GI technique (this frame has none)".into(),
+                ));
+            }
+        };
         Ok(composite::composite(
             rg,
-            &direct,
-            indirect.as_ref(),
+            first,
+            second,
             extent,
             &CompositeParams::from_settings(&settings.output),
         ))

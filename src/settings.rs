@@ -182,6 +182,19 @@ named_choice! {
 }
 
 named_choice! {
+    /// Which part of the radiance the frame shows (image tests compare each against the
+    /// path-traced reference, src/reference.rs).
+    pub enum Component ("output component") {
+        /// Direct + indirect light.
+        Full = "full",
+        /// The direct pass only (emission and punctual lights).
+        Direct = "direct",
+        /// The GI technique's indirect light only (needs a GI technique).
+        Indirect = "indirect",
+    }
+}
+
+named_choice! {
     /// How an HVL's radius is estimated from the HVL cache (paper 003 §5.3).
     pub enum RadiusHeuristic ("HVL radius heuristic") {
         /// Eq. 23: weighted mean distance to the 8-connected neighbours in the HVL cache.
@@ -373,6 +386,8 @@ pub struct OutputSettings {
     /// Linear factor applied to radiance before tonemapping (and in the EXR).
     /// Range 1e-6..=1e6, default 1.0.
     pub exposure: f32,
+    /// Radiance shown: `full`, `direct` or `indirect` (GI only). Default `full`.
+    pub component: Component,
 }
 
 /// `[hvl]`: Harmonics Virtual Lights (paper 003).
@@ -453,6 +468,7 @@ impl Default for OutputSettings {
         Self {
             tonemap: Tonemap::PbrNeutral,
             exposure: 1.0,
+            component: Component::Full,
         }
     }
 }
@@ -742,6 +758,7 @@ mod tests {
             output: OutputSettings {
                 tonemap: Tonemap::Aces,
                 exposure: 0.1,
+                component: Component::Indirect,
             },
             hvl: HvlSettings {
                 radius: RadiusHeuristic::R1,

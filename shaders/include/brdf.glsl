@@ -5,6 +5,18 @@
 
 const float BRDF_PI = 3.14159265358979323846;
 
+// GGX alpha of a perceptual roughness (clamped away from a delta lobe).
+float brdf_alpha(float roughness) {
+    return max(roughness * roughness, 1e-3);
+}
+
+// Trowbridge-Reitz (GGX) normal distribution D at cos(n, h) = nh.
+float ggx_distribution(float nh, float a) {
+    float a2 = a * a;
+    float d_denom = nh * nh * (a2 - 1.0) + 1.0;
+    return a2 / (BRDF_PI * d_denom * d_denom);
+}
+
 // f(l, v) for unit n, l, v; `roughness` is perceptual (alpha = roughness^2).
 vec3 brdf_metallic_roughness(vec3 n, vec3 l, vec3 v, vec3 base_color, float metallic, float roughness) {
     vec3 h = normalize(l + v);
@@ -12,15 +24,85 @@ vec3 brdf_metallic_roughness(vec3 n, vec3 l, vec3 v, vec3 base_color, float meta
     float nv = max(dot(n, v), 1e-4);
     float nh = max(dot(n, h), 0.0);
     float vh = max(dot(v, h), 0.0);
-    float a = max(roughness * roughness, 1e-3);
+    float a = brdf_alpha(roughness);
     float a2 = a * a;
-    float d_denom = nh * nh * (a2 - 1.0) + 1.0;
-    float d = a2 / (BRDF_PI * d_denom * d_denom);
+    float d = ggx_distribution(nh, a);
     float vis = 0.5 / max(nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2), 1e-6);
     vec3 f0 = mix(vec3(0.04), base_color, metallic);
     vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
     vec3 diffuse = (1.0 - f) * (1.0 - metallic) * base_color / BRDF_PI;
     return diffuse + f * d * vis;
+}
+
+// --- Importance sampling of the BRDF above (path tracer) ---
+// One-sample mixture: the specular lobe (GGX D sampling of the half vector) with probability
+// brdf_specular_probability, else the cosine-weighted hemisphere; brdf_pdf is the mixture's
+// solid-angle density, so f·cos/pdf is unbiased for every direction either lobe can produce.
+
+// Orthonormal tangent and bitangent of unit n (Duff et al. 2017, branchless).
+void brdf_basis(vec3 n, out vec3 t, out vec3 b) {
+    float s = n.z >= 0.0 ? 1.0 : -1.0;
+    float a = -1.0 / (s + n.z);
+    float c = n.x * n.y * a;
+    t = vec3(1.0 + s * n.x * n.x * a, s * c, -s * n.x);
+    b = vec3(c, s + n.y * n.y * a, -n.y);
+}
+
+// Cosine-weighted direction about n (density cos / π).
+vec3 sample_cosine(vec3 n, vec2 xi) {
+    vec3 t;
+    vec3 b;
+    brdf_basis(n, t, b);
+    float r = sqrt(xi.x);
+    float phi = 2.0 * BRDF_PI * xi.y;
+    return normalize(r * cos(phi) * t + r * sin(phi) * b + sqrt(max(0.0, 1.0 - xi.x)) * n);
+}
+
+// GGX half vector about n (density D(h)·(n·h) over half vectors).
+vec3 sample_ggx_half(vec3 n, float a, vec2 xi) {
+    vec3 t;
+    vec3 b;
+    brdf_basis(n, t, b);
+    float a2 = a * a;
+    float cos_theta = sqrt(max(0.0, (1.0 - xi.x) / (1.0 + (a2 - 1.0) * xi.x)));
+    float sin_theta = sqrt(max(0.0, 1.0 - cos_theta * cos_theta));
+    float phi = 2.0 * BRDF_PI * xi.y;
+    return normalize(sin_theta * cos(phi) * t + sin_theta * sin(phi) * b + cos_theta * n);
+}
+
+// Probability of sampling the specular lobe: its normal-incidence weight (F0 luminance)
+// against the diffuse weight, kept within [0.1, 0.9] while both lobes exist.
+float brdf_specular_probability(vec3 base_color, float metallic) {
+    const vec3 Y = vec3(0.2126, 0.7152, 0.0722);
+    float ws = dot(mix(vec3(0.04), base_color, metallic), Y);
+    float wd = dot(base_color, Y) * (1.0 - metallic);
+    if (wd <= 0.0) {
+        return 1.0;
+    }
+    return clamp(ws / max(ws + wd, 1e-6), 0.1, 0.9);
+}
+
+// Solid-angle density of brdf_sample's mixture for direction l.
+float brdf_pdf(vec3 n, vec3 l, vec3 v, float p_specular, float roughness) {
+    float nl = dot(n, l);
+    if (nl <= 0.0) {
+        return 0.0;
+    }
+    vec3 h = normalize(l + v);
+    float nh = max(dot(n, h), 0.0);
+    float vh = max(dot(v, h), 1e-6);
+    float a = brdf_alpha(roughness);
+    float spec = ggx_distribution(nh, a) * nh / (4.0 * vh);
+    return (1.0 - p_specular) * nl / BRDF_PI + p_specular * spec;
+}
+
+// Samples a direction for brdf_metallic_roughness at (n, v) from three uniform numbers.
+vec3 brdf_sample(vec3 n, vec3 v, float p_specular, float roughness, vec3 xi) {
+    if (xi.z < p_specular) {
+        vec3 h = sample_ggx_half(n, brdf_alpha(roughness), xi.xy);
+        return reflect(-v, h);
+    }
+    return sample_cosine(n, xi.xy);
 }
 
 #endif

@@ -11,6 +11,12 @@ layout(set = 0, binding = 1) uniform texture2DArray srgb_textures;
 layout(set = 0, binding = 2) uniform texture2DArray linear_textures;
 layout(set = 0, binding = 3) uniform sampler texture_sampler;
 
+// Texture lookups of `surface`: implicit-LOD sampling in fragment shaders; a compute shader
+// (no derivatives) defines SURFACE_SAMPLE before the #include, e.g. with textureLod at mip 0.
+#ifndef SURFACE_SAMPLE
+#define SURFACE_SAMPLE(tex, uvw) texture(sampler2DArray(tex, texture_sampler), uvw)
+#endif
+
 struct Surface {
     vec3 base_color;
     vec3 normal;
@@ -27,20 +33,20 @@ Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 u
     s.base_color = materials.m[i].base_color.rgb;
     uint base_tex = materials.m[i].base_color_texture;
     if (base_tex != NO_TEXTURE) {
-        s.base_color *= texture(sampler2DArray(srgb_textures, texture_sampler), vec3(uv, float(base_tex))).rgb;
+        s.base_color *= SURFACE_SAMPLE(srgb_textures, vec3(uv, float(base_tex))).rgb;
     }
     s.roughness = materials.m[i].roughness;
     s.metallic = materials.m[i].metallic;
     uint mr_tex = materials.m[i].metallic_roughness_texture;
     if (mr_tex != NO_TEXTURE) {
-        vec4 mr = texture(sampler2DArray(linear_textures, texture_sampler), vec3(uv, float(mr_tex)));
+        vec4 mr = SURFACE_SAMPLE(linear_textures, vec3(uv, float(mr_tex)));
         s.roughness *= mr.g;
         s.metallic *= mr.b;
     }
     s.emissive = materials.m[i].emissive;
     uint emissive_tex = materials.m[i].emissive_texture;
     if (emissive_tex != NO_TEXTURE) {
-        s.emissive *= texture(sampler2DArray(srgb_textures, texture_sampler), vec3(uv, float(emissive_tex))).rgb;
+        s.emissive *= SURFACE_SAMPLE(srgb_textures, vec3(uv, float(emissive_tex))).rgb;
     }
     uint normal_tex = materials.m[i].normal_texture;
     float normal_scale = materials.m[i].normal_scale;
@@ -51,7 +57,7 @@ Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 u
     if (normal_tex != NO_TEXTURE) {
         vec3 t = normalize(tangent.xyz - n * dot(n, tangent.xyz));
         vec3 b = cross(n, t) * tangent.w;
-        vec3 tn = texture(sampler2DArray(linear_textures, texture_sampler), vec3(uv, float(normal_tex))).xyz * 2.0 - 1.0;
+        vec3 tn = SURFACE_SAMPLE(linear_textures, vec3(uv, float(normal_tex))).xyz * 2.0 - 1.0;
         tn.xy *= normal_scale;
         n = normalize(tn.x * t + tn.y * b + tn.z * n);
     }

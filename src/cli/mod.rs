@@ -1,8 +1,10 @@
 //! Command-line interface: one module per subcommand.
 
+mod compare;
 mod frame_args;
 mod info;
 mod profile;
+mod reference;
 mod render;
 mod scene;
 
@@ -27,6 +29,10 @@ enum Command {
     Render(render::RenderArgs),
     /// Per-pass GPU times of a scene over many frames.
     Profile(profile::ProfileArgs),
+    /// Path-traced reference of a scene (linear EXR): direct, indirect or full radiance.
+    Reference(reference::ReferenceArgs),
+    /// RMSE, PSNR and SSIM of an EXR image against a reference EXR.
+    Compare(compare::CompareArgs),
     /// Built-in scenes: list them or export one as .glb.
     Scene(scene::SceneArgs),
 }
@@ -37,6 +43,8 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Info(args) => info::run(&args),
         Command::Render(args) => render::run(&args),
         Command::Profile(args) => profile::run(&args),
+        Command::Reference(args) => reference::run(&args),
+        Command::Compare(args) => compare::run(&args),
         Command::Scene(args) => scene::run(&args),
     }
 }

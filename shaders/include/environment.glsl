@@ -1,0 +1,26 @@
+// The environment light (src/gpu_environment.rs): an equirectangular RGBA32F texture baked
+// from shine_scene::Environment::radiance, black without an environment. Define
+// ENVIRONMENT_BINDING and ENVIRONMENT_SAMPLER_BINDING before the #include; the sampler must be
+// linear, repeating in u and clamped in v.
+//
+// Mapping: u = atan(d.x, -d.z) / 2π + 1/2, v = acos(d.y) / π (+Y up, v = 0 at the zenith).
+#ifndef ENVIRONMENT_GLSL
+#define ENVIRONMENT_GLSL
+
+#if !defined(ENVIRONMENT_BINDING) || !defined(ENVIRONMENT_SAMPLER_BINDING)
+#error "define ENVIRONMENT_BINDING and ENVIRONMENT_SAMPLER_BINDING before including environment.glsl"
+#endif
+
+layout(set = 0, binding = ENVIRONMENT_BINDING) uniform texture2D environment;
+layout(set = 0, binding = ENVIRONMENT_SAMPLER_BINDING) uniform sampler environment_sampler;
+
+// Radiance arriving from direction `dir` (need not be unit).
+vec3 environment_radiance(vec3 dir) {
+    vec3 d = normalize(dir);
+    const float PI = 3.14159265358979323846;
+    float u = atan(d.x, -d.z) / (2.0 * PI) + 0.5;
+    float v = acos(clamp(d.y, -1.0, 1.0)) / PI;
+    return textureLod(sampler2D(environment, environment_sampler), vec2(u, v), 0.0).rgb;
+}
+
+#endif

@@ -1,0 +1,111 @@
+//! `path_trace`: the reference path tracer (docs/frame.md, "Path-traced reference").
+//!
+//! Progressive: every dispatch adds [`PathTraceParams::samples`] samples per pixel to running
+//! sums in an accumulation buffer (three planes of RGBA32F texels — direct, indirect, full —
+//! alpha counting the samples), so the caller keeps the buffer across frames and divides on
+//! readback ([`crate::reference`]). Each sample's random numbers are seeded from (pixel,
+//! sample index, seed): runs are deterministic and disjoint sample ranges independent.
+
+use crate::graph::{Buffer, Handle, Image, RenderGraph, vk};
+use crate::passes::gbuffer::SceneHandles;
+use crate::shaders;
+use glam::Mat4;
+
+/// Bytes of one pixel of one plane of the accumulation buffer (RGBA32F).
+pub const ACCUMULATION_TEXEL: u64 = 16;
+/// Planes of the accumulation buffer: direct, indirect, full.
+pub const ACCUMULATION_PLANES: u64 = 3;
+
+/// Push constants of path_trace.comp (112 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct PathTraceConstants {
+    /// Clip space (with the raster passes' Y flip) to world.
+    pub inv_view_proj: [[f32; 4]; 4],
+    /// Width, height, index of the first sample of this dispatch, samples per pixel.
+    pub frame: [u32; 4],
+    /// Bounces, light count, flags (`FLAG_*`), seed.
+    pub config: [u32; 4],
+    /// Padding.
+    pub pad: [f32; 4],
+}
+
+/// Jitter the camera ray within the pixel (anti-aliasing); off: through the pixel centre, as
+/// the raster passes sample.
+pub const FLAG_JITTER: u32 = 1;
+/// Emissive surfaces light other surfaces (always seen by the camera).
+pub const FLAG_EMISSIVE_LIGHTING: u32 = 2;
+/// Diagnostic: every surface is Lambertian with albedo = base colour (white-furnace tests).
+pub const FLAG_LAMBERT_ONLY: u32 = 4;
+
+/// What one `path_trace` dispatch computes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PathTraceParams {
+    /// Image size in pixels.
+    pub extent: [u32; 2],
+    /// Camera view-projection of the raster passes (`gbuffer::camera_view(..).view_proj()`).
+    pub view_proj: Mat4,
+    /// Scattering vertices after the first one (0: direct only, 1: one-bounce indirect).
+    pub bounces: u32,
+    /// Number of lights in the scene's light buffer.
+    pub light_count: u32,
+    /// `FLAG_*` bits.
+    pub flags: u32,
+    /// Seed mixed into every pixel's random numbers.
+    pub seed: u32,
+    /// Index of this dispatch's first sample (progressive accumulation).
+    pub first_sample: u32,
+    /// Samples per pixel added by this dispatch.
+    pub samples: u32,
+}
+
+/// The BVH and environment bindings of the tracer (src/gpu_bvh.rs, src/gpu_environment.rs).
+#[derive(Debug)]
+pub struct TraceHandles {
+    /// `bvh_nodes`.
+    pub nodes: Handle<Buffer>,
+    /// `bvh_triangles`.
+    pub triangles: Handle<Buffer>,
+    /// `environment` (RGBA32F equirectangular).
+    pub environment: Handle<Image>,
+}
+
+/// Adds one progressive `path_trace` dispatch accumulating into `accumulation` (at least
+/// `ACCUMULATION_PLANES × width × height × 16` bytes).
+pub fn path_trace(
+    rg: &mut RenderGraph,
+    scene: &SceneHandles,
+    trace: &TraceHandles,
+    accumulation: &mut Handle<Buffer>,
+    params: &PathTraceParams,
+    texture_sampler: vk::Sampler,
+    environment_sampler: vk::Sampler,
+) {
+    let [w, h] = params.extent;
+    let constants = PathTraceConstants {
+        inv_view_proj: params.view_proj.inverse().to_cols_array_2d(),
+        frame: [w, h, params.first_sample, params.samples],
+        config: [
+            params.bounces,
+            params.light_count,
+            params.flags,
+            params.seed,
+        ],
+        pad: [0.0; 4],
+    };
+    rg.compute("path_trace", &shaders::PATH_TRACE_COMP)
+        .read("materials", &scene.materials)
+        .read("srgb_textures", &scene.srgb_textures)
+        .read("linear_textures", &scene.linear_textures)
+        .sampler("texture_sampler", texture_sampler)
+        .read("vertices", &scene.vertices)
+        .read("indices", &scene.indices)
+        .read("lights", &scene.lights)
+        .read("bvh_nodes", &trace.nodes)
+        .read("bvh_triangles", &trace.triangles)
+        .read("environment", &trace.environment)
+        .sampler("environment_sampler", environment_sampler)
+        .write("accumulation", accumulation)
+        .push(&constants)
+        .dispatch([w, h, 1]);
+}

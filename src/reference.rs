@@ -1,0 +1,323 @@
+//! The path-traced reference: renders the loaded scene with `path_trace` (docs/frame.md) into
+//! direct-only, indirect-only and full radiance images — the yardstick every GI technique is
+//! compared against ([`crate::image_compare`]).
+//!
+//! ```no_run
+//! # fn main() -> Result<(), Box<dyn std::error::Error>> {
+//! use shine::reference::{PathTracer, ReferenceParams};
+//! let device = shine::gpu::Device::new(&shine::gpu::DeviceDesc::from_env())?;
+//! let scene = shine_scene::Scene::builtin("cornell-box")?;
+//! let mut tracer = PathTracer::new(&device, &scene, 0.0, &ReferenceParams::default())?;
+//! tracer.accumulate(64)?;
+//! let images = tracer.read()?;
+//! # Ok(()) }
+//! ```
+
+use crate::gpu_bvh::GpuBvh;
+use crate::gpu_scene::GpuScene;
+use crate::image_io::HdrImage;
+use crate::passes::gbuffer::{self, SceneHandles};
+use crate::passes::path_trace::{self, PathTraceParams, TraceHandles};
+use crate::renderer::RenderError;
+use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, Sampler, vk};
+use shine_graph::{Executor, ExternalState};
+use shine_scene::Scene;
+
+/// Largest image side of a reference (the accumulation buffer stays far below 128 MiB).
+pub const MAX_EXTENT: u32 = 2048;
+/// Largest number of bounces.
+pub const MAX_BOUNCES: u32 = 64;
+/// Samples per pixel of one dispatch at most (keeps each submission short on a CPU device).
+const MAX_SAMPLES_PER_DISPATCH: u32 = 16;
+/// Pixel-samples of one dispatch at most.
+const MAX_PIXEL_SAMPLES_PER_DISPATCH: u64 = 1 << 20;
+
+/// What the reference computes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReferenceParams {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Scattering vertices after the first (0: direct only; 1: one-bounce indirect, what the
+    /// GI techniques compute). Default 1.
+    pub bounces: u32,
+    /// Jitter camera rays within their pixel (anti-aliased). Off: through pixel centres, as
+    /// the raster passes sample (for pixel-exact comparisons with them). Default on.
+    pub jitter: bool,
+    /// Emissive surfaces light the scene (they are always seen by the camera). Off: only the
+    /// punctual lights and the environment light the scene, as the raster GI techniques do.
+    /// Default on.
+    pub emissive_lighting: bool,
+    /// Diagnostic: every surface Lambertian with albedo = base colour (white furnace).
+    pub lambert_only: bool,
+    /// Seed of the random numbers (different seeds give independent estimates).
+    pub seed: u32,
+}
+
+impl Default for ReferenceParams {
+    fn default() -> Self {
+        Self {
+            width: 256,
+            height: 256,
+            bounces: 1,
+            jitter: true,
+            emissive_lighting: true,
+            lambert_only: false,
+            seed: 0,
+        }
+    }
+}
+
+impl ReferenceParams {
+    fn validate(&self) -> Result<(), RenderError> {
+        if self.width == 0
+            || self.height == 0
+            || self.width > MAX_EXTENT
+            || self.height > MAX_EXTENT
+        {
+            return Err(RenderError::Invalid(format!(
+                "reference size {}×{} is out of range (1..={MAX_EXTENT} per side)",
+                self.width, self.height
+            )));
+        }
+        if self.bounces > MAX_BOUNCES {
+            return Err(RenderError::Invalid(format!(
+                "{} bounces is out of range (0..={MAX_BOUNCES})",
+                self.bounces
+            )));
+        }
+        Ok(())
+    }
+
+    fn flags(&self) -> u32 {
+        let bit = |on: bool, flag: u32| if on { flag } else { 0 };
+        bit(self.jitter, path_trace::FLAG_JITTER)
+            | bit(self.emissive_lighting, path_trace::FLAG_EMISSIVE_LIGHTING)
+            | bit(self.lambert_only, path_trace::FLAG_LAMBERT_ONLY)
+    }
+}
+
+/// A reference read back: mean radiance per pixel over `samples` samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceImages {
+    /// Light that scattered once (plus emission and background seen by the camera).
+    pub direct: HdrImage,
+    /// Light that scattered more than once (up to `bounces + 1` times).
+    pub indirect: HdrImage,
+    /// `direct + indirect`.
+    pub full: HdrImage,
+    /// Samples per pixel averaged.
+    pub samples: u32,
+}
+
+/// A progressive path tracer of one scene at one instant.
+pub struct PathTracer {
+    device: Device,
+    executor: Executor,
+    scene: GpuScene,
+    bvh: GpuBvh,
+    environment: Image,
+    texture_sampler: Sampler,
+    environment_sampler: Sampler,
+    accumulation: Buffer,
+    params: ReferenceParams,
+    samples: u32,
+}
+
+impl PathTracer {
+    /// Uploads `scene` at time `t` (its geometry, BVH and environment) for references of
+    /// `params`.
+    pub fn new(
+        device: &Device,
+        scene: &Scene,
+        t: f32,
+        params: &ReferenceParams,
+    ) -> Result<Self, RenderError> {
+        params.validate()?;
+        let gpu_scene = GpuScene::upload(device, scene, t)?;
+        let bvh = GpuBvh::upload(device, scene, t)?;
+        let environment = crate::gpu_environment::upload(device, scene.environment.as_ref())?;
+        let sampler = |u, v| {
+            Sampler::new(
+                device,
+                &vk::SamplerCreateInfo::default()
+                    .mag_filter(vk::Filter::LINEAR)
+                    .min_filter(vk::Filter::LINEAR)
+                    .address_mode_u(u)
+                    .address_mode_v(v)
+                    .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .max_lod(0.0),
+            )
+        };
+        let pixels = u64::from(params.width) * u64::from(params.height);
+        let size = pixels * path_trace::ACCUMULATION_PLANES * path_trace::ACCUMULATION_TEXEL;
+        let accumulation = Buffer::with_data(
+            device,
+            &BufferDesc {
+                name: "path trace accumulation",
+                size,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC
+                    | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+            &vec![0u8; size as usize],
+        )?;
+        Ok(Self {
+            device: device.clone(),
+            executor: Executor::new(device, 1)?,
+            scene: gpu_scene,
+            bvh,
+            environment,
+            texture_sampler: sampler(
+                vk::SamplerAddressMode::REPEAT,
+                vk::SamplerAddressMode::REPEAT,
+            )?,
+            environment_sampler: sampler(
+                vk::SamplerAddressMode::REPEAT,
+                vk::SamplerAddressMode::CLAMP_TO_EDGE,
+            )?,
+            accumulation,
+            params: *params,
+            samples: 0,
+        })
+    }
+
+    /// Samples per pixel accumulated so far.
+    pub fn samples(&self) -> u32 {
+        self.samples
+    }
+
+    /// Samples per pixel [`PathTracer::accumulate`] adds per submission at most (a progress
+    /// bar's step).
+    pub fn samples_per_dispatch(&self) -> u32 {
+        let pixels = u64::from(self.params.width) * u64::from(self.params.height);
+        let by_pixels = (MAX_PIXEL_SAMPLES_PER_DISPATCH / pixels.max(1)).max(1);
+        u32::try_from(by_pixels)
+            .unwrap_or(u32::MAX)
+            .min(MAX_SAMPLES_PER_DISPATCH)
+    }
+
+    /// Adds `samples` samples per pixel (in submissions of at most
+    /// [`PathTracer::samples_per_dispatch`]), waiting for the GPU.
+    pub fn accumulate(&mut self, samples: u32) -> Result<(), RenderError> {
+        let mut left = samples;
+        while left > 0 {
+            let now = left.min(self.samples_per_dispatch());
+            self.dispatch(now)?;
+            left -= now;
+        }
+        Ok(())
+    }
+
+    fn dispatch(&mut self, samples: u32) -> Result<(), RenderError> {
+        let scene = &self.scene;
+        let read = ExternalState::new(
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::AccessFlags2::MEMORY_READ,
+            vk::ImageLayout::UNDEFINED,
+        );
+        let sampled = ExternalState::new(
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::AccessFlags2::SHADER_READ,
+            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        );
+        let accumulated = ExternalState::new(
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
+            vk::ImageLayout::UNDEFINED,
+        );
+        let mut rg = self.executor.begin_frame();
+        let handles = SceneHandles {
+            vertices: rg.import_gpu_buffer(&scene.vertices, read, read),
+            indices: rg.import_gpu_buffer(&scene.indices, read, read),
+            materials: rg.import_gpu_buffer(&scene.materials, read, read),
+            lights: rg.import_gpu_buffer(&scene.lights, read, read),
+            srgb_textures: rg.import_gpu_image(&scene.srgb_textures, sampled, sampled),
+            linear_textures: rg.import_gpu_image(&scene.linear_textures, sampled, sampled),
+            index_count: scene.index_count,
+        };
+        let trace = TraceHandles {
+            nodes: rg.import_gpu_buffer(&self.bvh.nodes, read, read),
+            triangles: rg.import_gpu_buffer(&self.bvh.triangles, read, read),
+            environment: rg.import_gpu_image(&self.environment, sampled, sampled),
+        };
+        let mut accumulation = rg.import_gpu_buffer(&self.accumulation, accumulated, accumulated);
+        let light_count = u32::try_from(scene.light_list.len())
+            .map_err(|_| RenderError::Invalid("too many lights".into()))?;
+        let camera = gbuffer::camera_view(scene, self.params.width, self.params.height);
+        let params = PathTraceParams {
+            extent: [self.params.width, self.params.height],
+            view_proj: camera.view_proj(),
+            bounces: self.params.bounces,
+            light_count,
+            flags: self.params.flags(),
+            seed: self.params.seed,
+            first_sample: self.samples,
+            samples,
+        };
+        path_trace::path_trace(
+            &mut rg,
+            &handles,
+            &trace,
+            &mut accumulation,
+            &params,
+            self.texture_sampler.raw(),
+            self.environment_sampler.raw(),
+        );
+        let mut commands = self.device.begin_commands()?;
+        self.executor.execute(commands.raw(), rg)?;
+        self.device.submit(commands)?.wait()?;
+        self.samples = self.samples.saturating_add(samples);
+        Ok(())
+    }
+
+    /// Reads the running means back (black before the first sample).
+    pub fn read(&self) -> Result<ReferenceImages, RenderError> {
+        let bytes = self.device.read_buffer(&self.accumulation)?;
+        let sums: &[[f32; 4]] = bytemuck::try_cast_slice(&bytes)
+            .map_err(|e| RenderError::Invalid(format!("accumulation readback: {e}")))?;
+        let pixels = self.params.width as usize * self.params.height as usize;
+        let plane = |k: usize| -> HdrImage {
+            let texels = sums
+                .iter()
+                .skip(k * pixels)
+                .take(pixels)
+                .map(|s| {
+                    let n = s[3].max(1.0);
+                    [s[0] / n, s[1] / n, s[2] / n, 1.0]
+                })
+                .collect();
+            HdrImage {
+                width: self.params.width,
+                height: self.params.height,
+                texels,
+            }
+        };
+        Ok(ReferenceImages {
+            direct: plane(0),
+            indirect: plane(1),
+            full: plane(2),
+            samples: self.samples,
+        })
+    }
+
+    /// The BVH the tracer uses (tests compare its GPU traversal with the CPU one).
+    pub fn bvh(&self) -> &GpuBvh {
+        &self.bvh
+    }
+}
+
+/// Renders a reference of `scene` at time `t` with `samples` samples per pixel.
+pub fn render_reference(
+    device: &Device,
+    scene: &Scene,
+    t: f32,
+    params: &ReferenceParams,
+    samples: u32,
+) -> Result<ReferenceImages, RenderError> {
+    let mut tracer = PathTracer::new(device, scene, t, params)?;
+    tracer.accumulate(samples)?;
+    tracer.read()
+}

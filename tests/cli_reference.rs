@@ -1,0 +1,165 @@
+//! `shine reference` and `shine compare` as a user runs them, including bad input (exit
+//! status 1, a message, no panic).
+
+use std::path::PathBuf;
+use std::process::{Command, Output};
+
+fn shine(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_shine"))
+        .args(args)
+        .output()
+        .expect("run shine")
+}
+
+fn scratch(test: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(test);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("scratch dir");
+    dir
+}
+
+fn text(out: &Output) -> String {
+    format!(
+        "{}\n{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    )
+}
+
+fn fails_cleanly(out: &Output, needle: &str) {
+    let all = text(out);
+    assert_eq!(out.status.code(), Some(1), "{all}");
+    assert!(all.contains(needle), "expected `{needle}` in:\n{all}");
+    assert!(!all.contains("panicked"), "{all}");
+}
+
+#[test]
+fn reference_then_compare_reports_metrics() {
+    let dir = scratch("cli_reference_compare");
+    let a = dir.join("a.exr");
+    let b = dir.join("b.exr");
+    for (path, seed) in [(&a, "1"), (&b, "2")] {
+        let out = shine(&[
+            "reference",
+            "builtin:cornell-box",
+            "--spp",
+            "2",
+            "--width",
+            "32",
+            "--height",
+            "32",
+            "--indirect-only",
+            "--seed",
+            seed,
+            "-o",
+            path.to_str().expect("utf-8 path"),
+        ]);
+        assert!(out.status.success(), "{}", text(&out));
+        assert!(
+            text(&out).contains("ns per sample per pixel"),
+            "{}",
+            text(&out)
+        );
+    }
+    let out = shine(&[
+        "compare",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--format",
+        "json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("compare prints JSON");
+    let rmse = report["rmse"].as_f64().expect("rmse");
+    let ssim = report["ssim"].as_f64().expect("ssim");
+    assert!(
+        rmse > 0.0 && rmse < 1.0 && ssim > -1.0 && ssim < 1.0,
+        "{report}"
+    );
+    // An image against itself: RMSE 0, PSNR infinite (null in JSON), SSIM 1.
+    let out = shine(&["compare", a.to_str().unwrap(), a.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(text(&out).contains("RMSE    0.000000"), "{}", text(&out));
+    assert!(text(&out).contains("SSIM    1.000000"), "{}", text(&out));
+    // A time budget stops early and still writes the image.
+    let c = dir.join("c.exr");
+    let out = shine(&[
+        "reference",
+        "builtin:cornell-box",
+        "--spp",
+        "100000",
+        "--seconds",
+        "0.01",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "-o",
+        c.to_str().unwrap(),
+    ]);
+    assert!(out.status.success() && c.exists(), "{}", text(&out));
+}
+
+#[test]
+fn bad_input_fails_cleanly() {
+    let dir = scratch("cli_reference_bad_input");
+    let missing = dir.join("missing.exr");
+    let out = shine(&[
+        "compare",
+        missing.to_str().unwrap(),
+        missing.to_str().unwrap(),
+    ]);
+    fails_cleanly(&out, "missing.exr");
+    // Size mismatch.
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    for (path, size) in [(&a, "16"), (&b, "24")] {
+        let out = shine(&[
+            "reference",
+            "builtin:cornell-box",
+            "--spp",
+            "1",
+            "--width",
+            size,
+            "--height",
+            size,
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", text(&out));
+    }
+    let out = shine(&["compare", a.to_str().unwrap(), b.to_str().unwrap()]);
+    fails_cleanly(&out, "sizes differ");
+    let out = shine(&[
+        "compare",
+        a.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--format",
+        "xml",
+    ]);
+    fails_cleanly(&out, "unknown format");
+    // Bad reference arguments: output format, zero spp, zero size, unknown scene.
+    let bad = dir.join("x.txt");
+    let out = shine(&[
+        "reference",
+        "builtin:cornell-box",
+        "-o",
+        bad.to_str().unwrap(),
+    ]);
+    fails_cleanly(&out, "x.txt");
+    let out_path = dir.join("z.exr");
+    let z = out_path.to_str().unwrap();
+    fails_cleanly(
+        &shine(&["reference", "builtin:cornell-box", "--spp", "0", "-o", z]),
+        "--spp",
+    );
+    fails_cleanly(
+        &shine(&["reference", "builtin:cornell-box", "--width", "0", "-o", z]),
+        "out of range",
+    );
+    fails_cleanly(
+        &shine(&["reference", "builtin:no-such-scene", "-o", z]),
+        "no-such-scene",
+    );
+    assert!(!out_path.exists());
+}

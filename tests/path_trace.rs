@@ -1,0 +1,418 @@
+//! The reference path tracer (src/reference.rs, shaders/path_trace.comp) against closed-form
+//! answers, and its BVH traversal (shaders/include/trace.glsl) against the CPU BVH.
+
+mod common;
+
+use glam::{Mat4, Quat, Vec3};
+use shine::gpu::{ComputePipeline, Descriptor, vk};
+use shine::gpu_bvh::GpuBvh;
+use shine::image_compare::rmse;
+use shine::reference::{PathTracer, ReferenceImages, ReferenceParams, render_reference};
+use shine_scene::bvh::Ray;
+use shine_scene::environment::Environment;
+use shine_scene::{Camera, Light, Material, Mesh, Node, Primitive, Projection, Scene, Transform};
+
+/// A scene of one mesh (flat-shaded triangles) with one material, a camera and `lights`.
+fn one_mesh_scene(
+    triangles: &[[Vec3; 3]],
+    material: Material,
+    camera: Mat4,
+    lights: Vec<Light>,
+    environment: Option<Environment>,
+) -> Scene {
+    let mut primitive = Primitive::default();
+    for (i, t) in triangles.iter().enumerate() {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+        for v in t {
+            primitive.positions.push(*v);
+            primitive.normals.push(n);
+            primitive.bounds.grow(*v);
+        }
+        primitive
+            .indices
+            .extend([3 * i as u32, 3 * i as u32 + 1, 3 * i as u32 + 2]);
+    }
+    Scene {
+        source: "test".into(),
+        nodes: vec![Node {
+            name: "mesh".into(),
+            parent: None,
+            children: vec![],
+            transform: Transform::default(),
+            mesh: Some(0),
+            camera: None,
+            lights: vec![],
+        }],
+        roots: vec![0],
+        meshes: vec![Mesh {
+            name: "mesh".into(),
+            primitives: vec![primitive],
+        }],
+        materials: vec![material],
+        material_names: vec!["material".into()],
+        lights,
+        cameras: vec![Camera {
+            name: "camera".into(),
+            projection: Projection::Perspective {
+                yfov: 1.0,
+                aspect_ratio: None,
+                znear: 0.01,
+                zfar: None,
+            },
+            world: camera,
+            node: None,
+        }],
+        environment,
+        ..Scene::default()
+    }
+}
+
+/// A UV sphere of radius `r` at the origin: outward-facing (counter-clockwise seen from
+/// outside) or inward-facing.
+fn sphere(r: f32, outward: bool) -> Vec<[Vec3; 3]> {
+    let (rings, segments) = (24, 48);
+    let point = |i: u32, j: u32| {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+        r * Vec3::new(
+            theta.sin() * phi.cos(),
+            theta.cos(),
+            theta.sin() * phi.sin(),
+        )
+    };
+    let mut out = Vec::new();
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            // (a, d, c) and (a, c, b) wind counter-clockwise seen from outside.
+            let mut tris = vec![];
+            if i > 0 {
+                tris.push([a, d, c]);
+            }
+            if i + 1 < rings {
+                tris.push([a, c, b]);
+            }
+            for t in tris {
+                out.push(if outward { t } else { [t[0], t[2], t[1]] });
+            }
+        }
+    }
+    out
+}
+
+fn lambert(albedo: f32, emissive: f32) -> Material {
+    Material {
+        base_color: [albedo, albedo, albedo, 1.0],
+        emissive: [emissive; 3],
+        metallic: 0.0,
+        double_sided: 1,
+        ..Material::default()
+    }
+}
+
+fn params(size: u32, bounces: u32) -> ReferenceParams {
+    ReferenceParams {
+        width: size,
+        height: size,
+        bounces,
+        jitter: false,
+        emissive_lighting: true,
+        lambert_only: true,
+        seed: 0,
+    }
+}
+
+fn assert_all(image: &shine::image_io::HdrImage, expected: f32, tolerance: f32, what: &str) {
+    for (i, t) in image.texels.iter().enumerate() {
+        for c in &t[..3] {
+            assert!(
+                (c - expected).abs() <= tolerance * expected.max(1e-3),
+                "{what}: pixel {i} = {t:?}, expected {expected}"
+            );
+        }
+    }
+}
+
+/// White furnace: inside a closed sphere of Lambertian albedo a emitting L_e, a path that
+/// scatters k times carries a^k L_e, so with B bounces the camera sees L_e Σ_{k=0}^{B+1} a^k:
+/// direct L_e (1 + a), indirect L_e Σ_{k=2}^{B+1} a^k. Every sample of every pixel gives that
+/// exactly (cosine sampling of a Lambertian: weight a; every ray hits the emitter), so the
+/// Monte-Carlo standard error is 0 and the tolerance only covers float rounding.
+#[test]
+fn white_furnace_inside_a_closed_sphere() {
+    let device = common::device();
+    let (a, le) = (0.6f32, 0.5f32);
+    let scene = one_mesh_scene(
+        &sphere(1.0, false),
+        lambert(a, le),
+        Mat4::IDENTITY,
+        vec![],
+        None,
+    );
+    for bounces in [0u32, 1, 3] {
+        let images =
+            render_reference(&device, &scene, 0.0, &params(16, bounces), 4).expect("reference");
+        let series = |from: u32| (from..=bounces + 1).map(|k| a.powi(k as i32)).sum::<f32>();
+        assert_all(&images.direct, le * (1.0 + a), 1e-3, "direct");
+        if bounces > 0 {
+            assert_all(&images.indirect, le * series(2), 1e-3, "indirect");
+        }
+        assert_all(
+            &images.full,
+            le * series(0),
+            1e-3,
+            &format!("full, {bounces} bounces"),
+        );
+    }
+    common::assert_clean(&device);
+}
+
+/// An outward sphere of albedo a under a uniform environment L: the camera sees L around it
+/// and a·L on it (every reflected ray escapes a convex object), all direct light.
+#[test]
+fn uniform_environment_on_a_convex_sphere() {
+    let device = common::device();
+    let (a, l) = (0.5f32, 0.8f32);
+    let env = Environment {
+        zenith: Vec3::splat(l),
+        horizon: Vec3::splat(l),
+        ground: Vec3::splat(l),
+        intensity: 1.0,
+    };
+    let camera = Mat4::from_translation(Vec3::new(0.0, 0.0, 3.0));
+    let scene = one_mesh_scene(
+        &sphere(1.0, true),
+        lambert(a, 0.0),
+        camera,
+        vec![],
+        Some(env),
+    );
+    let images = render_reference(&device, &scene, 0.0, &params(32, 2), 2).expect("reference");
+    let (mut on, mut off) = (0, 0);
+    for t in &images.full.texels {
+        if (t[0] - l).abs() < 1e-3 * l {
+            off += 1;
+        } else {
+            assert!(
+                (t[0] - a * l).abs() < 1e-3,
+                "sphere pixel {t:?}, expected {}",
+                a * l
+            );
+            on += 1;
+        }
+    }
+    assert!(on > 100 && off > 100, "{on} sphere and {off} sky pixels");
+    assert_all(&images.indirect, 0.0, 1e-6, "indirect");
+    common::assert_clean(&device);
+}
+
+/// A Lambertian plane (albedo a) under a point light of intensity I at height h: radiance
+/// a/π · E with E = I cos θ / d² (inverse square law, no range window).
+#[test]
+fn diffuse_plane_under_a_point_light_matches_analytic_irradiance() {
+    let device = common::device();
+    let (a, intensity, h) = (0.5f32, 10.0f32, 2.0f32);
+    let s = 20.0;
+    let corners = [
+        Vec3::new(-s, 0.0, -s),
+        Vec3::new(-s, 0.0, s),
+        Vec3::new(s, 0.0, s),
+        Vec3::new(s, 0.0, -s),
+    ];
+    let plane = [
+        [corners[0], corners[1], corners[2]],
+        [corners[0], corners[2], corners[3]],
+    ];
+    let light_position = Vec3::new(0.3, h, -0.2);
+    let light = Light {
+        position: light_position.to_array(),
+        kind: 1,
+        direction: [0.0, -1.0, 0.0],
+        range: 0.0,
+        color: [1.0; 3],
+        intensity,
+        inner_cone_angle: 0.0,
+        outer_cone_angle: 0.0,
+        node: u32::MAX,
+        _pad: 0,
+    };
+    // Looking straight down from 5 m.
+    let eye = Vec3::new(0.0, 5.0, 0.0);
+    let camera =
+        Mat4::from_rotation_translation(Quat::from_rotation_x(-std::f32::consts::FRAC_PI_2), eye);
+    let scene = one_mesh_scene(&plane, lambert(a, 0.0), camera, vec![light], None);
+    let size = 24;
+    let images = render_reference(&device, &scene, 0.0, &params(size, 0), 1).expect("reference");
+    // The camera ray of every pixel centre, as the tracer builds it.
+    let view_proj = {
+        let gpu = shine::gpu_scene::GpuScene::upload(&device, &scene, 0.0).expect("upload");
+        shine::passes::gbuffer::camera_view(&gpu, size, size).view_proj()
+    };
+    let inverse = view_proj.inverse();
+    for y in 0..size {
+        for x in 0..size {
+            let ndc = |z: f32| {
+                let p = inverse
+                    * glam::Vec4::new(
+                        (x as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+                        (y as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+                        z,
+                        1.0,
+                    );
+                p.truncate() / p.w
+            };
+            let (o, d) = (ndc(0.0), (ndc(0.5) - ndc(0.0)).normalize());
+            let p = o + d * (-o.y / d.y);
+            let to_light = light_position - p;
+            let d2 = to_light.length_squared();
+            let cos = to_light.y / d2.sqrt();
+            let expected = a / std::f32::consts::PI * intensity * cos / d2;
+            let got = images.direct.texels[(y * size + x) as usize][0];
+            assert!(
+                (got - expected).abs() < 1e-3 * expected,
+                "pixel ({x}, {y}): {got}, expected {expected}"
+            );
+        }
+    }
+    common::assert_clean(&device);
+}
+
+/// trace.glsl's closest hit and occlusion equal shine-scene's `Bvh::intersect` on the Cornell
+/// box for rays from inside and outside it.
+#[test]
+fn gpu_traversal_hits_equal_cpu_bvh_hits() {
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let bvh = GpuBvh::upload(&device, &scene, 0.0).expect("bvh");
+    let (lo, hi) = {
+        let b = scene.bounds(&scene.rest_world_transforms());
+        (b.min, b.max)
+    };
+    // Deterministic pseudo-random rays: origins in the box grown by 20 %, directions anywhere.
+    let mut state = 12345u32;
+    let mut rand = move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    let count = 4096usize;
+    let mut rays: Vec<[f32; 4]> = Vec::new();
+    let mut cpu = Vec::new();
+    for i in 0..count {
+        let grow = (hi - lo) * 0.2;
+        let o = lo - grow + (hi - lo + 2.0 * grow) * Vec3::new(rand(), rand(), rand());
+        let d = (Vec3::new(rand(), rand(), rand()) * 2.0 - 1.0).normalize_or(Vec3::X);
+        // Every fourth ray is a short segment (occlusion with a finite t_max).
+        let t_max = if i % 4 == 0 { 0.3 } else { 1e30 };
+        rays.push([o.x, o.y, o.z, 0.0]);
+        rays.push([d.x, d.y, d.z, t_max]);
+        cpu.push(bvh.bvh.intersect(&Ray {
+            origin: o,
+            dir: d,
+            t_min: 0.0,
+            t_max,
+        }));
+    }
+    let pipeline =
+        ComputePipeline::new(&device, &shine::shaders::TESTS_TRACE_RAYS_COMP).expect("pipeline");
+    let ray_buffer = common::storage_with(&device, "rays", bytemuck::cast_slice(&rays));
+    let hits = common::buffer(
+        &device,
+        "hits",
+        (count * 32) as u64,
+        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+    );
+    let push = [count as u32, 0, 0, 0];
+    device
+        .run_once(|cmd| {
+            cmd.begin_scope("trace_rays")?;
+            cmd.bind_compute(
+                &pipeline,
+                &[
+                    ("bvh_nodes", Descriptor::from(&bvh.nodes)),
+                    ("bvh_triangles", Descriptor::from(&bvh.triangles)),
+                    ("rays", Descriptor::from(&ray_buffer)),
+                    ("hits", Descriptor::from(&hits)),
+                ],
+            )?;
+            cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&push))?;
+            cmd.dispatch_threads(&pipeline, [count as u32, 1, 1]);
+            cmd.end_scope()
+        })
+        .expect("dispatch");
+    let gpu: Vec<[f32; 4]> =
+        bytemuck::cast_slice(&device.read_buffer(&hits).expect("readback")).to_vec();
+    let (mut hit_count, mut ties) = (0, 0);
+    for (i, expected) in cpu.iter().enumerate() {
+        let (h, occluded) = (gpu[2 * i], gpu[2 * i + 1][0] > 0.5);
+        match expected {
+            None => {
+                assert!(h[0] < 0.0, "ray {i}: GPU hit {h:?}, CPU none");
+                assert!(!occluded, "ray {i}: GPU occluded, CPU none");
+            }
+            Some(hit) => {
+                hit_count += 1;
+                assert!(occluded, "ray {i}: CPU hit, GPU not occluded");
+                assert!(
+                    (h[0] - hit.t).abs() <= 1e-4 * hit.t.max(1.0),
+                    "ray {i}: t {} vs {}",
+                    h[0],
+                    hit.t
+                );
+                let flat = bvh.flat_index[hit.triangle];
+                if h[3].to_bits() != flat {
+                    // Two triangles at the same t (a shared edge): either is the closest hit.
+                    ties += 1;
+                } else {
+                    assert!(
+                        (h[1] - hit.u).abs() < 1e-3 && (h[2] - hit.v).abs() < 1e-3,
+                        "ray {i}: uv"
+                    );
+                }
+            }
+        }
+    }
+    assert!(hit_count > count / 3, "only {hit_count} hits");
+    assert!(ties <= count / 100, "{ties} hits on a different triangle");
+    common::assert_clean(&device);
+}
+
+/// The Monte-Carlo error falls as 1/√spp: two independent estimates (different seeds) of the
+/// Cornell box differ by √2·σ/√N, so 16× the samples divide their RMSE by about 4.
+#[test]
+fn error_falls_as_inverse_square_root_of_samples() {
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let base = ReferenceParams {
+        width: 32,
+        height: 32,
+        bounces: 1,
+        jitter: false,
+        emissive_lighting: false,
+        lambert_only: false,
+        seed: 1,
+    };
+    let run = |seed: u32, spp: u32| -> ReferenceImages {
+        let mut tracer = PathTracer::new(&device, &scene, 0.0, &ReferenceParams { seed, ..base })
+            .expect("tracer");
+        tracer.accumulate(spp).expect("accumulate");
+        tracer.read().expect("read")
+    };
+    let error = |spp| {
+        let (a, b) = (run(1, spp), run(2, spp));
+        rmse(&a.indirect, &b.indirect).expect("rmse")
+    };
+    let (few, many) = (error(4), error(64));
+    let ratio = few / many;
+    assert!(
+        (3.2..=4.8).contains(&ratio),
+        "RMSE {few} at 4 spp, {many} at 64 spp: ratio {ratio}, expected ≈ 4"
+    );
+    common::assert_clean(&device);
+}

@@ -1,0 +1,101 @@
+//! Image tests: frames of the Cornell box against the path-traced reference (src/reference.rs)
+//! with PSNR/SSIM thresholds (src/image_compare.rs: metrics on linear radiance clamped to
+//! [0, 1]). Same lights on both sides: the spot lamp only (emissive surfaces are seen but light
+//! nothing, `emissive_lighting: false`), camera rays through pixel centres as the raster samples.
+
+mod common;
+
+use shine::image_compare::{Comparison, compare};
+use shine::reference::{ReferenceParams, render_reference};
+use shine::renderer::Renderer;
+use shine::settings::{Component, GiTechniques, Settings};
+use shine_scene::Scene;
+
+const SIZE: u32 = 128;
+
+fn raster(component: Component) -> shine::image_io::HdrImage {
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let mut renderer = Renderer::new(&device).expect("renderer");
+    renderer.set_scene(&scene, 0.0).expect("upload");
+    let mut settings = Settings {
+        width: SIZE,
+        height: SIZE,
+        ..Settings::default()
+    };
+    if component == Component::Direct {
+        settings.gi = GiTechniques::none();
+    }
+    settings.output.component = component;
+    let frame = renderer.render(&settings).expect("frame");
+    drop(renderer);
+    common::assert_clean(&device);
+    frame.hdr
+}
+
+fn reference(bounces: u32, spp: u32) -> shine::reference::ReferenceImages {
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let params = ReferenceParams {
+        width: SIZE,
+        height: SIZE,
+        bounces,
+        jitter: false,
+        emissive_lighting: false,
+        lambert_only: false,
+        seed: 0,
+    };
+    let images = render_reference(&device, &scene, 0.0, &params, spp).expect("reference");
+    common::assert_clean(&device);
+    images
+}
+
+fn report(what: &str, c: &Comparison) {
+    println!(
+        "{what}: RMSE {:.4}, PSNR {:.2} dB, SSIM {:.4}",
+        c.rmse, c.psnr, c.ssim
+    );
+}
+
+/// The raster direct pass (shadow-mapped spot lamp, Lambert + GGX) against the path-traced
+/// direct light: both evaluate the same BRDF and light falloff at the same points, so they
+/// differ only at shadow edges (PCF against hard ray-traced shadows) and by the G-buffer's
+/// 8-bit albedo and material quantisation. No bounce: the estimate is exact (1 spp suffices).
+#[test]
+fn raster_direct_light_matches_the_path_traced_direct_light() {
+    let direct = raster(Component::Direct);
+    let reference = reference(0, 1);
+    let c = compare(&direct, &reference.direct).expect("compare");
+    report("direct", &c);
+    // Measured (lavapipe): RMSE 0.0027, PSNR 51.3 dB, SSIM 0.996.
+    assert!(c.psnr > 45.0 && c.ssim > 0.99, "{c:?}");
+}
+
+/// HVL one-bounce indirect light (default settings: 400 HVLs, receivers at 1/2) against the
+/// path-traced one-bounce indirect light of the same lamp.
+#[test]
+fn hvl_indirect_light_against_the_path_traced_reference() {
+    let hvl = raster(Component::Indirect);
+    let reference = reference(1, 64);
+    let c = compare(&hvl, &reference.indirect).expect("compare");
+    report("indirect", &c);
+    // Measured (lavapipe, reference at 64 spp whose noise lowers SSIM): RMSE 0.0104,
+    // PSNR 39.7 dB, SSIM 0.88.
+    assert!(c.psnr > 36.0 && c.ssim > 0.82, "{c:?}");
+    // Energy: measured HVL / reference mean indirect radiance 1.19 (HVL is brighter; not yet
+    // explained). Kept within 0.8..=1.3 so a regression either way shows.
+    let mean = |image: &shine::image_io::HdrImage| {
+        image
+            .texels
+            .iter()
+            .map(|t| f64::from(t[0] + t[1] + t[2]))
+            .sum::<f64>()
+            / image.texels.len() as f64
+    };
+    let ratio = mean(&hvl) / mean(&reference.indirect);
+    println!("indirect mean ratio HVL / reference: {ratio:.3}");
+    assert!(
+        (0.8..=1.3).contains(&ratio),
+        "HVL / reference mean indirect radiance {ratio}"
+    );
+}
