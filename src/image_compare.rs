@@ -13,7 +13,10 @@
 //!   `K1 = 0.01`, `K2 = 0.03`, averaged over every window position that lies fully inside the
 //!   image (no padding); images smaller than the window are refused.
 //!
-//! FLIP is not offered: no maintained Rust crate of it exists.
+//! - **FLIP** (LDR-FLIP, Andersson et al. 2020, through the `nv-flip` binding of NVIDIA's
+//!   reference implementation): the mean of its per-pixel error map (0 identical … 1), on the
+//!   clamped values sRGB-encoded to 8 bits (what a display shows at exposure 1), at the
+//!   binding's default 67 pixels per degree (a 0.7 m viewing distance from a 24" monitor).
 
 use crate::image_io::HdrImage;
 
@@ -51,6 +54,8 @@ pub struct Comparison {
     pub psnr: f64,
     /// Mean structural similarity on luminance.
     pub ssim: f64,
+    /// Mean LDR-FLIP error (0 identical, 1 worst).
+    pub flip: f64,
 }
 
 fn check(a: &HdrImage, b: &HdrImage) -> Result<(), CompareError> {
@@ -173,13 +178,39 @@ pub fn ssim(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError>
     Ok(sum / mu_x.len() as f64)
 }
 
-/// RMSE, PSNR and SSIM of `image` against `reference`.
+/// The clamped RGB of `image`, sRGB-encoded to 8 bits.
+fn srgb8(image: &HdrImage) -> Vec<u8> {
+    let n = image.width as usize * image.height as usize;
+    image
+        .texels
+        .iter()
+        .take(n)
+        .flat_map(|t| [t[0], t[1], t[2]])
+        .map(|c| (crate::tonemap::srgb_oetf(c.clamp(0.0, 1.0)) * 255.0).round() as u8)
+        .collect()
+}
+
+/// Mean LDR-FLIP error of `image` against `reference` (see the module documentation).
+pub fn flip(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError> {
+    check(image, reference)?;
+    let (w, h) = (image.width, image.height);
+    if w == 0 || h == 0 {
+        return Err(CompareError::TooSmall(w, h));
+    }
+    let test = nv_flip::FlipImageRgb8::with_data(w, h, &srgb8(image));
+    let reference = nv_flip::FlipImageRgb8::with_data(w, h, &srgb8(reference));
+    let map = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    Ok(f64::from(nv_flip::FlipPool::from_image(&map).mean()))
+}
+
+/// RMSE, PSNR, SSIM and FLIP of `image` against `reference`.
 pub fn compare(image: &HdrImage, reference: &HdrImage) -> Result<Comparison, CompareError> {
     let rmse = rmse(image, reference)?;
     Ok(Comparison {
         rmse,
         psnr: psnr_of_rmse(rmse),
         ssim: ssim(image, reference)?,
+        flip: flip(image, reference)?,
     })
 }
 
@@ -248,6 +279,21 @@ mod tests {
         );
         assert!(ssim(&blurred, &reference).unwrap() < 0.2);
         assert!(ssim(&brighter, &reference).unwrap() > 0.95);
+    }
+
+    #[test]
+    fn flip_is_zero_for_identical_images_and_grows_with_the_difference() {
+        let reference = image(32, 32, |x, y| ((x * 7 + y * 3) % 16) as f32 / 16.0);
+        assert_eq!(flip(&reference, &reference).unwrap(), 0.0);
+        let near = image(32, 32, |x, y| ((x * 7 + y * 3) % 16) as f32 / 16.0 + 0.02);
+        let far = image(32, 32, |x, y| ((x * 7 + y * 3) % 16) as f32 / 16.0 + 0.2);
+        let (a, b) = (
+            flip(&near, &reference).unwrap(),
+            flip(&far, &reference).unwrap(),
+        );
+        assert!(0.0 < a && a < b && b <= 1.0, "{a} {b}");
+        let empty = image(0, 0, |_, _| 0.0);
+        assert_eq!(flip(&empty, &empty), Err(CompareError::TooSmall(0, 0)));
     }
 
     #[test]

@@ -35,6 +35,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             "rmse": c.rmse,
             "psnr": c.psnr.is_finite().then_some(c.psnr),
             "ssim": c.ssim,
+            "flip": c.flip,
             "width": image.width,
             "height": image.height,
         });
@@ -44,6 +45,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         println!("RMSE    {:.6}", c.rmse);
         println!("PSNR    {:.3} dB", c.psnr);
         println!("SSIM    {:.6}", c.ssim);
+        println!("FLIP    {:.6}", c.flip);
     }
     Ok(())
 }
