@@ -13,7 +13,7 @@ use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::profile_report::PassClock;
-use crate::settings::{Component, GatherPath, GiTechnique, RadiusHeuristic};
+use crate::settings::{Component, GiTechnique};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
@@ -486,17 +486,11 @@ fn hvl_params(settings: &Settings) -> HvlParams {
     let h = &settings.hvl;
     HvlParams {
         count: h.count,
-        radius: match h.radius {
-            RadiusHeuristic::R1 => hvl::RadiusHeuristic::R1,
-            RadiusHeuristic::R2 => hvl::RadiusHeuristic::R2,
-        },
+        radius: h.radius,
         radius_scale: h.radius_scale,
         conv_bands: h.convolution_bands,
         emission_bands: h.emission_bands,
-        path: match h.gather {
-            GatherPath::Full => hvl::Path::Full,
-            GatherPath::Zonal => hvl::Path::Zonal,
-        },
+        path: h.gather,
     }
 }
 

@@ -280,23 +280,7 @@ impl HvlGrid {
     }
 }
 
-/// HVL radius heuristic (paper 003 §5.3).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum RadiusHeuristic {
-    /// Eq. 23: weighted mean distance to the 8-connected neighbours (a second dispatch).
-    R1,
-    /// Eq. 24–26: from the RSM field of view, the HVL count and the distance to the light.
-    R2,
-}
-
-/// How the gather convolves the incoming light with the receiver's BRDF.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Path {
-    /// Full SH dot product with the BRDF SH tables rotated to the receiver frame, O(n²).
-    Full,
-    /// Zonal harmonics only, O(n): circularly symmetric lobes (Lambert).
-    Zonal,
-}
+pub use crate::settings::{GatherPath as Path, RadiusHeuristic};
 
 /// Parameters of the HVL passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
