@@ -106,6 +106,37 @@ pub struct Renderer {
     /// The shadow atlas layout of the current scene and its GPU records, for one
     /// `(shadow.size, PCF radius)`.
     shadow_layout: Option<ShadowCache>,
+    /// Readback buffers of [`Renderer::render`].
+    readback: Option<Readback>,
+}
+
+/// The buffers a rendered frame is copied into, kept while the frame size is unchanged.
+struct Readback {
+    extent: [u32; 2],
+    hdr: Buffer,
+    ldr: Buffer,
+}
+
+impl Readback {
+    fn new(device: &Device, extent: [u32; 2]) -> Result<Self, RenderError> {
+        let pixels = u64::from(extent[0]) * u64::from(extent[1]);
+        let buffer = |name, bytes_per_texel: u64| {
+            Buffer::new(
+                device,
+                &BufferDesc {
+                    name,
+                    size: pixels * bytes_per_texel,
+                    usage: vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
+        };
+        Ok(Self {
+            extent,
+            hdr: buffer("hdr readback", 16)?,
+            ldr: buffer("ldr readback", 4)?,
+        })
+    }
 }
 
 /// A [`ShadowLayout`] and its records on the GPU.
@@ -148,6 +179,7 @@ impl Renderer {
             scene: None,
             brdf_tables: Vec::new(),
             shadow_layout: None,
+            readback: None,
         })
     }
 
@@ -168,20 +200,10 @@ impl Renderer {
     pub fn render(&mut self, settings: &Settings) -> Result<FrameImage, RenderError> {
         settings.validate()?;
         let (width, height) = (settings.width, settings.height);
-        let pixels = u64::from(width) * u64::from(height);
-        let readback = |name, bytes_per_texel: u64| {
-            Buffer::new(
-                &self.device,
-                &BufferDesc {
-                    name,
-                    size: pixels * bytes_per_texel,
-                    usage: vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
+        let readback = match self.readback.take() {
+            Some(r) if r.extent == [width, height] => r,
+            _ => Readback::new(&self.device, [width, height])?,
         };
-        let (hdr_buffer, ldr_buffer) =
-            (readback("hdr readback", 16)?, readback("ldr readback", 4)?);
         let mut rg = self.executor.begin_frame();
         let frame = self.declare_frame(&mut rg, settings)?;
         let read_by_copy = ExternalState::new(
@@ -189,21 +211,29 @@ impl Renderer {
             vk::AccessFlags2::TRANSFER_READ,
             vk::ImageLayout::UNDEFINED,
         );
-        let mut hdr_out = rg.import_gpu_buffer(&hdr_buffer, ExternalState::UNDEFINED, read_by_copy);
-        let mut ldr_out = rg.import_gpu_buffer(&ldr_buffer, ExternalState::UNDEFINED, read_by_copy);
+        let mut hdr_out =
+            rg.import_gpu_buffer(&readback.hdr, ExternalState::UNDEFINED, read_by_copy);
+        let mut ldr_out =
+            rg.import_gpu_buffer(&readback.ldr, ExternalState::UNDEFINED, read_by_copy);
         rg.copy_image_to_buffer("readback hdr", &frame.hdr, &mut hdr_out);
         rg.copy_image_to_buffer("readback ldr", &frame.ldr, &mut ldr_out);
         self.run(rg)?;
         let timings = self.executor.timings()?;
-        Ok(FrameImage {
+        let image = FrameImage {
             hdr: HdrImage::from_rgba32f_bytes(
                 width,
                 height,
-                &self.device.read_buffer(&hdr_buffer)?,
+                &self.device.read_buffer(&readback.hdr)?,
             )?,
-            ldr: LdrImage::from_rgba8_bytes(width, height, &self.device.read_buffer(&ldr_buffer)?)?,
+            ldr: LdrImage::from_rgba8_bytes(
+                width,
+                height,
+                &self.device.read_buffer(&readback.ldr)?,
+            )?,
             timings,
-        })
+        };
+        self.readback = Some(readback);
+        Ok(image)
     }
 
     /// Renders `count` frames without reading them back (profiling); returns the pass timings
