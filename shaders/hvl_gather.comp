@@ -1,6 +1,7 @@
 // HVL gather (paper 003 §5.1, eq. 1, 3, 19-22): outgoing radiance towards the camera at each
-// receiver from every HVL of the cache (brute force, as the paper's prototype). Visibility is
-// not computed: HVLs are unshadowed (the paper's renderings do the same, §6).
+// receiver from every HVL of the cache (brute force, as the paper's prototype). As published,
+// HVLs are unshadowed (§6); the `_vis` variants (shine's extension) drop an HVL whose centre,
+// lifted off its surface by 1% of its radius, is hidden from the receiver by a BVH shadow ray.
 //
 // Per HVL j at receiver x (omega_j: unit direction x -> y_j, a: half-angle of the sphere):
 //   L_j = Phi_j * max(0, F'_j . Y(-omega_j)) * G_j(-omega_j)               eq. 20, 21, 22
@@ -32,6 +33,26 @@
 //! variant zonal_c8 HVL_ZONAL=1 SH_BANDS=8
 //! variant zonal_c9 HVL_ZONAL=1 SH_BANDS=9
 //! variant zonal_c10 HVL_ZONAL=1 SH_BANDS=10
+//! variant full_c1_vis HVL_FULL=1 SH_BANDS=1 HVL_VISIBILITY=1
+//! variant full_c2_vis HVL_FULL=1 SH_BANDS=2 HVL_VISIBILITY=1
+//! variant full_c3_vis HVL_FULL=1 SH_BANDS=3 HVL_VISIBILITY=1
+//! variant full_c4_vis HVL_FULL=1 SH_BANDS=4 HVL_VISIBILITY=1
+//! variant full_c5_vis HVL_FULL=1 SH_BANDS=5 HVL_VISIBILITY=1
+//! variant full_c6_vis HVL_FULL=1 SH_BANDS=6 HVL_VISIBILITY=1
+//! variant full_c7_vis HVL_FULL=1 SH_BANDS=7 HVL_VISIBILITY=1
+//! variant full_c8_vis HVL_FULL=1 SH_BANDS=8 HVL_VISIBILITY=1
+//! variant full_c9_vis HVL_FULL=1 SH_BANDS=9 HVL_VISIBILITY=1
+//! variant full_c10_vis HVL_FULL=1 SH_BANDS=10 HVL_VISIBILITY=1
+//! variant zonal_c1_vis HVL_ZONAL=1 SH_BANDS=1 HVL_VISIBILITY=1
+//! variant zonal_c2_vis HVL_ZONAL=1 SH_BANDS=2 HVL_VISIBILITY=1
+//! variant zonal_c3_vis HVL_ZONAL=1 SH_BANDS=3 HVL_VISIBILITY=1
+//! variant zonal_c4_vis HVL_ZONAL=1 SH_BANDS=4 HVL_VISIBILITY=1
+//! variant zonal_c5_vis HVL_ZONAL=1 SH_BANDS=5 HVL_VISIBILITY=1
+//! variant zonal_c6_vis HVL_ZONAL=1 SH_BANDS=6 HVL_VISIBILITY=1
+//! variant zonal_c7_vis HVL_ZONAL=1 SH_BANDS=7 HVL_VISIBILITY=1
+//! variant zonal_c8_vis HVL_ZONAL=1 SH_BANDS=8 HVL_VISIBILITY=1
+//! variant zonal_c9_vis HVL_ZONAL=1 SH_BANDS=9 HVL_VISIBILITY=1
+//! variant zonal_c10_vis HVL_ZONAL=1 SH_BANDS=10 HVL_VISIBILITY=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "sh.glsl"
@@ -57,6 +78,17 @@ layout(set = 0, binding = 5, std430) readonly buffer Brdf {
 #endif
 
 layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
+
+#ifdef HVL_VISIBILITY
+#define TRACE_NODES_BINDING 7
+#define TRACE_TRIANGLES_BINDING 8
+#include "trace.glsl"
+
+// The HVL centre lies on its sender's surface: the shadow ray aims at it lifted along the
+// sender's normal by this fraction of the HVL radius (plus 0.1 mm), so the sender itself never
+// hides it.
+const float HVL_VISIBILITY_LIFT = 0.01;
+#endif
 
 // shine::passes::hvl::GatherPush
 layout(push_constant) uniform Push {
@@ -172,6 +204,17 @@ void main() {
         if (!(g > 0.0)) {
             continue;
         }
+#ifdef HVL_VISIBILITY
+        if (dist > r) {
+            vec3 origin = trace_offset(x, n);
+            vec3 target = position_radius.xyz + normalize(hvl_normal) * (HVL_VISIBILITY_LIFT * r + 1e-4);
+            vec3 to_target = target - origin;
+            float reach = length(to_target);
+            if (trace_occluded(origin, to_target / reach, 0.0, reach)) {
+                continue;
+            }
+        }
+#endif
         float emission[8];
         for (int l = 0; l < 8; ++l) {
             emission[l] = hvls.h[j].emission[l];

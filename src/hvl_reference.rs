@@ -27,6 +27,25 @@ pub const R1_EPSILON: f32 = 1e-3;
 /// constant `HVL_MIN_DISTANCE`.
 pub const MIN_DISTANCE: f32 = 1e-6;
 
+/// The shadow ray of the `_vis` gather aims at the HVL centre lifted along its normal by this
+/// fraction of its radius plus 0.1 mm (GLSL `HVL_VISIBILITY_LIFT`).
+pub const VISIBILITY_LIFT: f32 = 0.01;
+
+/// Whether the segment from a receiver (`origin`, already offset off its surface) to an HVL's
+/// lifted centre (`target`) is unoccluded: the shadow ray of [`HvlParams::visibility`].
+pub type Visibility<'a> = &'a dyn Fn(Vec3, Vec3) -> bool;
+
+/// The shadow ray's end points for receiver `x` (normal `n`) and `hvl`, as `hvl_gather.comp`
+/// computes them (`trace_offset` of `shaders/include/trace.glsl`, then the lifted centre).
+pub fn visibility_ray(x: Vec3, n: Vec3, hvl: &Hvl) -> (Vec3, Vec3) {
+    let scale = 1.0 + x.abs().max_element();
+    let origin = x + n * (1e-4 * scale);
+    let r = hvl.position_radius[3];
+    let hvl_n = Vec4::from(hvl.normal_distance).truncate().normalize();
+    let target = Vec4::from(hvl.position_radius).truncate() + hvl_n * (VISIBILITY_LIFT * r + 1e-4);
+    (origin, target)
+}
+
 /// An RSM on the CPU: `size²` texels, row-major, in the units of docs/frame.md.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RsmData {
@@ -289,8 +308,19 @@ pub fn shade(
     brdf: &GatherBrdf,
     camera: Vec3,
     params: &HvlParams,
+    visible: Option<Visibility<'_>>,
 ) -> Result<Vec3, HvlError> {
     let bands = params.conv_bands as usize;
+    // With visibility, an HVL whose lifted centre is hidden from the receiver (outside its
+    // sphere) sends nothing.
+    let hidden = |hvl: &Hvl, x: Vec3, n: Vec3| match visible {
+        Some(visible) if params.visibility => {
+            let centre = Vec4::from(hvl.position_radius).truncate();
+            let (origin, target) = visibility_ray(x, n, hvl);
+            centre.distance(x) > hvl.position_radius[3] && !visible(origin, target)
+        }
+        _ => false,
+    };
     let emission = Emission::Sh(params.emission_bands as usize);
     let (x, n) = (receiver.position, receiver.normal.normalize());
     let (kd, ks) = (receiver.kd(), receiver.ks());
@@ -306,6 +336,9 @@ pub fn shade(
                 let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
                     continue;
                 };
+                if hidden(hvl, x, n) {
+                    continue;
+                }
                 let local = Vec3::new(wj.dot(t), wj.dot(b), wj.dot(n)).normalize();
                 let cap = cap_sh(local, a, bands)?;
                 let diffuse = shine_sh::dot(&cap, &f_lambert)?;
@@ -322,6 +355,9 @@ pub fn shade(
                 let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
                     continue;
                 };
+                if hidden(hvl, x, n) {
+                    continue;
+                }
                 let cap = cap_zh(a, bands)?;
                 sum += (lj * kd * zh_dot(&cap, &cc, n.dot(wj))).max(Vec3::ZERO);
             }
@@ -330,13 +366,15 @@ pub fn shade(
     Ok(sum)
 }
 
-/// The gather over a whole receiver buffer (row-major RGBA, a = 0; background black).
+/// The gather over a whole receiver buffer (row-major RGBA, a = 0; background black); `visible`
+/// answers the shadow rays when `params.visibility` is set.
 pub fn gather(
     receivers: &ReceiverData,
     hvls: &[Hvl],
     brdf: &GatherBrdf,
     camera: Vec3,
     params: &HvlParams,
+    visible: Option<Visibility<'_>>,
 ) -> Result<Vec<Vec4>, HvlError> {
     params.validate_gather()?;
     let texels = (receivers.extent[0] * receivers.extent[1]) as usize;
@@ -355,7 +393,7 @@ pub fn gather(
             roughness: receivers.material[i].x,
         };
         let count = (params.count as usize).min(hvls.len());
-        out.push(shade(&receiver, &hvls[..count], brdf, camera, params)?.extend(0.0));
+        out.push(shade(&receiver, &hvls[..count], brdf, camera, params, visible)?.extend(0.0));
     }
     Ok(out)
 }

@@ -3,6 +3,7 @@
 //! Each frame declares its passes (docs/frame.md) into a fresh graph; the executor compiles it
 //! (cached while the shape is unchanged), records it and times every pass.
 
+use crate::gpu_bvh::GpuBvh;
 use crate::gpu_scene::{GpuScene, SceneUploadError};
 use crate::image_io::{HdrImage, ImageIoError, LdrImage};
 use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
@@ -101,6 +102,8 @@ pub struct Renderer {
     linear: Sampler,
     nearest: Sampler,
     scene: Option<GpuScene>,
+    /// The scene's BVH for shadow rays, uploaded with the scene.
+    bvh: Option<GpuBvh>,
     /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
     brdf_tables: Vec<(u32, Buffer)>,
     /// The shadow atlas layout of the current scene and its GPU records, for one
@@ -177,6 +180,7 @@ impl Renderer {
                     .max_lod(0.0),
             )?,
             scene: None,
+            bvh: None,
             brdf_tables: Vec::new(),
             shadow_layout: None,
             readback: None,
@@ -188,10 +192,12 @@ impl Renderer {
     /// old one, and shine cannot see host submissions.
     pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
         let uploaded = GpuScene::upload(&self.device, scene, t)?;
+        let bvh = GpuBvh::upload(&self.device, scene, t)?;
         if self.scene.is_some() {
             self.device.wait_idle()?;
         }
         self.scene = Some(uploaded);
+        self.bvh = Some(bvh);
         self.shadow_layout = None;
         Ok(())
     }
@@ -480,7 +486,15 @@ impl Renderer {
                     .map(|(_, buffer)| buffer)
                     .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
                 let brdf = rg.import_gpu_buffer(table, buffer_read, buffer_read);
-                let low = hvl::hvl_gather(rg, &recv, &hvls, &brdf, camera.eye, &params)?;
+                let bvh = match (params.visibility, self.bvh.as_ref()) {
+                    (true, Some(b)) => Some(hvl::BvhHandles {
+                        nodes: rg.import_gpu_buffer(&b.nodes, buffer_read, buffer_read),
+                        triangles: rg.import_gpu_buffer(&b.triangles, buffer_read, buffer_read),
+                    }),
+                    _ => None,
+                };
+                let low =
+                    hvl::hvl_gather(rg, &recv, &hvls, &brdf, bvh.as_ref(), camera.eye, &params)?;
                 let upsample_params = UpsampleParams {
                     depth_sigma: settings.upsample.depth_epsilon,
                     normal_power: settings.upsample.normal_power,
@@ -521,6 +535,7 @@ fn hvl_params(settings: &Settings) -> HvlParams {
         conv_bands: h.convolution_bands,
         emission_bands: h.emission_bands,
         path: h.gather,
+        visibility: h.visibility,
     }
 }
 

@@ -408,6 +408,9 @@ pub struct HvlSettings {
     /// SH bands of each HVL's emission function. Range 1..=5 and at most
     /// `convolution_bands`, default 3.
     pub emission_bands: u32,
+    /// Shadow rays through the scene's BVH from every receiver to every HVL (shine's
+    /// extension: paper 003's HVLs are unshadowed). Default false.
+    pub visibility: bool,
     /// Gather path: `full` (any BRDF, O(n²)) or `zonal` (symmetric lobes, O(n)).
     /// Default `full`.
     pub gather: GatherPath,
@@ -481,6 +484,7 @@ impl Default for HvlSettings {
             radius_scale: 1.5,
             convolution_bands: 5,
             emission_bands: 3,
+            visibility: false,
             gather: GatherPath::Full,
         }
     }

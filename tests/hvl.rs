@@ -7,14 +7,15 @@ mod common;
 use common::{assert_clean, device, f16_to_f32, f32_to_f16, storage_image_with};
 use glam::{Vec3, Vec4};
 use shine::gpu::{Device, MemoryLocation};
+use shine::gpu_bvh::GpuBvh;
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
 use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::hvl_reference::{
     self as reference, Emission, Receiver, ReceiverData, RsmData, integrate_hvl,
 };
 use shine::passes::hvl::{
-    CONV_BANDS, CachePush, GatherBrdf, GatherPush, Hvl, HvlError, HvlParams, Path, RadiusHeuristic,
-    Receivers, Rsm, RsmProjection, gather_variants, hvl_cache, hvl_gather,
+    BvhHandles, CONV_BANDS, CachePush, GatherBrdf, GatherPush, Hvl, HvlError, HvlParams, Path,
+    RadiusHeuristic, Receivers, Rsm, RsmProjection, gather_variants, hvl_cache, hvl_gather,
 };
 use shine::shaders;
 use shine_sh::brdf_table::{BrdfModel, HemisphereSampling};
@@ -169,6 +170,7 @@ fn params(path: Path, conv_bands: u32, emission_bands: u32) -> HvlParams {
         conv_bands,
         emission_bands,
         path,
+        visibility: false,
     }
 }
 
@@ -332,7 +334,8 @@ fn decode_rgba16f(bytes: &[u8]) -> Vec<Vec4> {
     halves.chunks_exact(4).map(Vec4::from_slice).collect()
 }
 
-/// Runs the gather alone on `hvls` (uploaded) and returns `indirect`.
+/// Runs the gather alone on `hvls` (uploaded) and returns `indirect`; `bvh` answers the
+/// shadow rays of `params.visibility`.
 fn gpu_gather(
     device: &Device,
     receivers: &ReceiverData,
@@ -340,6 +343,7 @@ fn gpu_gather(
     brdf: &GatherBrdf,
     camera: Vec3,
     params: &HvlParams,
+    bvh: Option<&GpuBvh>,
 ) -> Vec<Vec4> {
     let images = ReceiverImages::new(device, receivers);
     let hvl_buffer = buffer(
@@ -363,7 +367,20 @@ fn gpu_gather(
     let hvl_handle: Handle<Buffer> =
         rg.import_gpu_buffer(&hvl_buffer, uploaded_state(), UNUSED_AFTER);
     let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
-    let indirect = hvl_gather(&mut rg, &recv, &hvl_handle, &brdf_handle, camera, params).unwrap();
+    let bvh_handles = bvh.map(|b| BvhHandles {
+        nodes: rg.import_gpu_buffer(&b.nodes, uploaded_state(), UNUSED_AFTER),
+        triangles: rg.import_gpu_buffer(&b.triangles, uploaded_state(), UNUSED_AFTER),
+    });
+    let indirect = hvl_gather(
+        &mut rg,
+        &recv,
+        &hvl_handle,
+        &brdf_handle,
+        bvh_handles.as_ref(),
+        camera,
+        params,
+    )
+    .unwrap();
     read_indirect(&mut rg, &indirect, &readback);
     run(device, &mut executor, rg);
     decode_rgba16f(&device.read_buffer(&readback).unwrap())
@@ -416,7 +433,7 @@ fn records_and_push_constants_match_the_shaders() {
             std::mem::size_of::<CachePush>()
         );
     }
-    for (_, _, shader) in gather_variants() {
+    for (_, _, _, shader) in gather_variants() {
         assert_eq!(
             shader.push_constant_size as usize,
             std::mem::size_of::<GatherPush>()
@@ -467,7 +484,7 @@ fn bad_parameters_are_errors() {
             }
         }
     }
-    assert_eq!(gather_variants().len(), 20);
+    assert_eq!(gather_variants().len(), 40);
     let zero = HvlParams { count: 0, ..ok };
     assert!(zero.validate_gather().is_err());
 }
@@ -565,8 +582,8 @@ fn gather_matches_the_cpu_reference() {
     for (path, conv, emission) in variants {
         let p = params(path, conv, emission);
         let brdf = tables(conv, [12, 24]);
-        let cpu = reference::gather(&receivers, &hvls, &brdf, CAMERA, &p).unwrap();
-        let gpu = gpu_gather(&device, &receivers, &hvls, &brdf, CAMERA, &p);
+        let cpu = reference::gather(&receivers, &hvls, &brdf, CAMERA, &p, None).unwrap();
+        let gpu = gpu_gather(&device, &receivers, &hvls, &brdf, CAMERA, &p, None);
         let peak = cpu.iter().fold(0.0f32, |m, v| m.max(v.max_element()));
         assert!(peak > 0.0, "{path:?} c{conv} e{emission}: no light at all");
         let lit = cpu.iter().filter(|v| v.max_element() > 0.01 * peak).count();
@@ -581,6 +598,104 @@ fn gather_matches_the_cpu_reference() {
                     "{path:?} c{conv} e{emission} pixel {i}: GPU {g} vs CPU {c}"
                 );
             }
+        }
+    }
+    assert_clean(&device);
+}
+
+/// A scene holding only `quads` (corner lists, counter-clockwise), for the shadow rays.
+fn occluder_scene(quads: &[[Vec3; 4]]) -> shine_scene::Scene {
+    let mut w = shine_scene::glb_writer::GlbWriter::new();
+    let material = w.push("materials", serde_json::json!({"name": "occluder"}));
+    let mut geometry = shine_scene::builtin::shapes::MeshData::default();
+    for q in quads {
+        geometry.quad(*q, glam::Vec2::ONE);
+    }
+    let mesh = w.mesh("occluders", &[(&geometry, material)]);
+    let root = w.push(
+        "nodes",
+        serde_json::json!({"name": "occluders", "mesh": mesh}),
+    );
+    w.scene("occluders", &[root]);
+    shine_scene::load_slice(&w.to_glb(), None, "occluders.glb").unwrap()
+}
+
+/// The `_vis` gather against the CPU gather whose shadow rays go through the CPU BVH: with
+/// nothing in the way the result is exactly the unshadowed gather; behind a slab just above
+/// the floor HVLs most light is gone, pixel by pixel as the CPU traces it.
+#[test]
+fn gather_visibility_matches_the_cpu_shadow_rays() {
+    let device = device();
+    let rsm = synthetic_rsm(1.0);
+    let receivers = synthetic_receivers();
+    let hvls = reference::build_cache(&rsm, &params(Path::Full, 3, 3)).unwrap();
+    let brdf = tables(3, [12, 24]);
+    let unshadowed = params(Path::Full, 3, 3);
+    let shadowed = HvlParams {
+        visibility: true,
+        ..unshadowed
+    };
+    let plain = gpu_gather(&device, &receivers, &hvls, &brdf, CAMERA, &unshadowed, None);
+    let far = occluder_scene(&[[
+        Vec3::new(50.0, 50.0, 50.0),
+        Vec3::new(51.0, 50.0, 50.0),
+        Vec3::new(51.0, 51.0, 50.0),
+        Vec3::new(50.0, 51.0, 50.0),
+    ]]);
+    let far_bvh = GpuBvh::upload(&device, &far, 0.0).unwrap();
+    let clear = gpu_gather(
+        &device,
+        &receivers,
+        &hvls,
+        &brdf,
+        CAMERA,
+        &shadowed,
+        Some(&far_bvh),
+    );
+    assert_eq!(clear, plain, "an empty scene hid something");
+
+    let slab = occluder_scene(&[[
+        Vec3::new(-3.0, 0.1, 3.0),
+        Vec3::new(3.0, 0.1, 3.0),
+        Vec3::new(3.0, 0.1, -3.0),
+        Vec3::new(-3.0, 0.1, -3.0),
+    ]]);
+    let slab_bvh = GpuBvh::upload(&device, &slab, 0.0).unwrap();
+    let gpu = gpu_gather(
+        &device,
+        &receivers,
+        &hvls,
+        &brdf,
+        CAMERA,
+        &shadowed,
+        Some(&slab_bvh),
+    );
+    let visible = |origin: Vec3, target: Vec3| {
+        let d = target - origin;
+        let ray = shine_scene::bvh::Ray {
+            origin,
+            dir: d / d.length(),
+            t_min: 0.0,
+            t_max: d.length(),
+        };
+        slab_bvh.bvh.intersect(&ray).is_none()
+    };
+    let cpu =
+        reference::gather(&receivers, &hvls, &brdf, CAMERA, &shadowed, Some(&visible)).unwrap();
+    let peak = plain.iter().fold(0.0f32, |m, v| m.max(v.max_element()));
+    let energy = |img: &[Vec4]| img.iter().map(|v| v.truncate().element_sum()).sum::<f32>();
+    assert!(
+        energy(&gpu) < 0.5 * energy(&plain),
+        "the slab hid little: {} of {}",
+        energy(&gpu),
+        energy(&plain)
+    );
+    for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+        for k in 0..4 {
+            assert!(
+                close(g[k], c[k], 2e-3, 1e-3 * peak),
+                "pixel {i}: GPU {g} vs CPU {c}"
+            );
         }
     }
     assert_clean(&device);
@@ -651,7 +766,7 @@ fn single_hvl_against_numerical_integration() {
             ..params(path, conv, emission)
         };
         let brdf = tables(conv, [48, 96]);
-        let gpu = gpu_gather(&device, &receivers, &[hvl], &brdf, camera, &p);
+        let gpu = gpu_gather(&device, &receivers, &[hvl], &brdf, camera, &p, None);
         let glossy = match path {
             Path::Full => GLOSSY,
             Path::Zonal => BrdfModel::Lambert { albedo: 0.0 },
@@ -722,7 +837,7 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
         let recv = recv_images.import(&mut rg, RECV);
         let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
         let hvls = hvl_cache(&mut rg, &rsm_handles, &p).unwrap();
-        let indirect = hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, CAMERA, &p).unwrap();
+        let indirect = hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, None, CAMERA, &p).unwrap();
         read_indirect(&mut rg, &indirect, &readback);
         run(&device, &mut executor, rg);
         let out = decode_rgba16f(&device.read_buffer(&readback).unwrap());

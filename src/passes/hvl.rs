@@ -30,7 +30,9 @@
 //!   the Lambert (albedo 1) row of [`shine_sh::brdf_table::BrdfTable::f_prime`] for every θ_l.
 //!   Each record stores it (5 bands), the gather reconstructs `F'·Y(-ω_j)` to the emission band
 //!   count of its variant and clamps it at 0 (band-limited ringing).
-//! * **Visibility** is not computed: HVLs are unshadowed, as in the paper's results (§6).
+//! * **Visibility.** As published, HVLs are unshadowed (§6). [`HvlParams::visibility`] adds
+//!   one BVH shadow ray per receiver and HVL, to the HVL's centre lifted off its surface
+//!   (shine's extension; measured against the path tracer in the issue notes).
 //! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
 //!   never makes `indirect` negative; the paper's sinc window (§4.2) is not applied.
 //! * **Receiver BRDF.** `kd = albedo (1 - metallic)` times Lambert, `ks = mix(1, albedo,
@@ -298,6 +300,9 @@ pub struct HvlParams {
     pub emission_bands: u32,
     /// Full or zonal convolution.
     pub path: Path,
+    /// Shadow rays from each receiver to each HVL through the scene's BVH (not in paper 003,
+    /// whose HVLs are unshadowed).
+    pub visibility: bool,
 }
 
 /// Errors of the HVL passes: parameters out of range or inconsistent inputs.
@@ -345,6 +350,9 @@ pub enum HvlError {
         /// What it should be.
         expected: String,
     },
+    /// HVL visibility was asked for without the scene's BVH.
+    #[error("HVL visibility needs the scene's BVH buffers")]
+    NoBvh,
     /// Building the BRDF SH tables failed.
     #[error("BRDF SH table: {0}")]
     Sh(#[from] shine_sh::ShError),
@@ -353,33 +361,40 @@ pub enum HvlError {
 /// Convolution band counts of the gather (paper 003: 1–10).
 pub const CONV_BANDS: std::ops::RangeInclusive<u32> = 1..=10;
 
-/// The `hvl_gather.comp` variants: `(path, conv_bands, shader)` for every path and every band
-/// count of [`CONV_BANDS`] (variants `full_cN` and `zonal_cN`).
-pub fn gather_variants() -> Vec<(Path, u32, &'static ShaderDesc)> {
-    [(Path::Full, "full"), (Path::Zonal, "zonal")]
-        .into_iter()
-        .flat_map(|(path, name)| {
-            CONV_BANDS.filter_map(move |bands| {
-                shaders::get(&format!("hvl_gather.comp:{name}_c{bands}"))
-                    .map(|shader| (path, bands, shader))
-            })
-        })
-        .collect()
+/// The `hvl_gather.comp` variants: `(path, conv_bands, visibility, shader)` for every path,
+/// every band count of [`CONV_BANDS`] and with or without shadow rays (variants `full_cN`,
+/// `zonal_cN`, `full_cN_vis`, `zonal_cN_vis`).
+pub fn gather_variants() -> Vec<(Path, u32, bool, &'static ShaderDesc)> {
+    let mut variants = Vec::new();
+    for (path, name) in [(Path::Full, "full"), (Path::Zonal, "zonal")] {
+        for visibility in [false, true] {
+            for bands in CONV_BANDS {
+                let suffix = if visibility { "_vis" } else { "" };
+                if let Some(shader) =
+                    shaders::get(&format!("hvl_gather.comp:{name}_c{bands}{suffix}"))
+                {
+                    variants.push((path, bands, visibility, shader));
+                }
+            }
+        }
+    }
+    variants
 }
 
-/// The gather shader for `params` (its path and convolution bands), or [`HvlError::Variant`].
+/// The gather shader for `params` (its path, convolution bands and visibility), or
+/// [`HvlError::Variant`].
 pub fn gather_shader(params: &HvlParams) -> Result<&'static ShaderDesc, HvlError> {
     let variants = gather_variants();
     variants
         .iter()
-        .find(|v| v.0 == params.path && v.1 == params.conv_bands)
-        .map(|v| v.2)
+        .find(|v| v.0 == params.path && v.1 == params.conv_bands && v.2 == params.visibility)
+        .map(|v| v.3)
         .ok_or_else(|| HvlError::Variant {
             conv_bands: params.conv_bands,
             path: params.path,
             available: variants
                 .iter()
-                .map(|v| format!("{:?} c{}", v.0, v.1))
+                .map(|v| format!("{:?} c{}{}", v.0, v.1, if v.2 { " vis" } else { "" }))
                 .collect::<Vec<_>>()
                 .join(", "),
         })
@@ -616,19 +631,35 @@ fn cache_push(
     }
 }
 
+/// The scene's BVH buffers (`crate::gpu_bvh::GpuBvh`) imported into a graph, for the shadow
+/// rays of [`HvlParams::visibility`].
+#[derive(Debug, Clone, Copy)]
+pub struct BvhHandles {
+    /// `bvh_nodes`.
+    pub nodes: Handle<Buffer>,
+    /// `bvh_triangles`.
+    pub triangles: Handle<Buffer>,
+}
+
 /// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
 /// radiance towards `camera` from all `params.count` HVLs of `hvls`, 0 on background), returned.
 /// `brdf` holds [`GatherBrdf::gpu_data`] at `params.conv_bands` bands (unused by the zonal
-/// path).
+/// path); `bvh` is needed when `params.visibility` is set.
 pub fn hvl_gather(
     rg: &mut RenderGraph,
     receivers: &Receivers,
     hvls: &Handle<Buffer>,
     brdf: &Handle<Buffer>,
+    bvh: Option<&BvhHandles>,
     camera: Vec3,
     params: &HvlParams,
 ) -> Result<Handle<Image>, HvlError> {
     let shader = params.validate_gather()?;
+    let bvh = match (params.visibility, bvh) {
+        (true, None) => return Err(HvlError::NoBvh),
+        (true, Some(b)) => Some(b),
+        (false, _) => None,
+    };
     for (name, image) in [
         ("recv_position", &receivers.position),
         ("recv_normal", &receivers.normal),
@@ -678,6 +709,10 @@ pub fn hvl_gather(
         .read("hvls", hvls);
     if params.path == Path::Full {
         pass.read("brdf", brdf);
+    }
+    if let Some(b) = bvh {
+        pass.read("bvh_nodes", &b.nodes)
+            .read("bvh_triangles", &b.triangles);
     }
     pass.write("indirect", &mut indirect)
         .push(&push)
