@@ -3,17 +3,19 @@
 //! Each frame declares its passes (docs/frame.md) into a fresh graph; the executor compiles it
 //! (cached while the shape is unchanged), records it and times every pass.
 
+use crate::gpu_bvh::GpuBvh;
 use crate::gpu_scene::{GpuScene, SceneUploadError};
 use crate::image_io::{HdrImage, ImageIoError, LdrImage};
 use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
 use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
 use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
+use crate::passes::igi::{self, IgiError, IgiParams, TraceBuffers};
 use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::profile_report::PassClock;
-use crate::settings::{Component, GatherPath, GiTechnique, RadiusHeuristic};
+use crate::settings::{Component, GatherPath, GiTechnique, IgiFilter, RadiusHeuristic};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
@@ -50,6 +52,9 @@ pub enum RenderError {
     /// The HVL passes refused their inputs or parameters.
     #[error(transparent)]
     Hvl(#[from] HvlError),
+    /// The IGI passes refused their inputs or parameters.
+    #[error(transparent)]
+    Igi(#[from] IgiError),
     /// The receiver or upsample pass refused its inputs.
     #[error(transparent)]
     Receivers(#[from] ReceiverError),
@@ -101,6 +106,8 @@ pub struct Renderer {
     linear: Sampler,
     nearest: Sampler,
     scene: Option<GpuScene>,
+    /// The scene's BVH for shadow rays (IGI's VPL visibility), uploaded with the scene.
+    bvh: Option<GpuBvh>,
     /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
     brdf_tables: Vec<(u32, Buffer)>,
     /// The shadow atlas layout of the current scene and its GPU records, for one
@@ -146,6 +153,7 @@ impl Renderer {
                     .max_lod(0.0),
             )?,
             scene: None,
+            bvh: None,
             brdf_tables: Vec::new(),
             shadow_layout: None,
         })
@@ -156,10 +164,12 @@ impl Renderer {
     /// old one, and shine cannot see host submissions.
     pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
         let uploaded = GpuScene::upload(&self.device, scene, t)?;
+        let bvh = GpuBvh::upload(&self.device, scene, t)?;
         if self.scene.is_some() {
             self.device.wait_idle()?;
         }
         self.scene = Some(uploaded);
+        self.bvh = Some(bvh);
         self.shadow_layout = None;
         Ok(())
     }
@@ -458,6 +468,18 @@ impl Renderer {
                 };
                 Some(upsample::upsample(rg, &low, &recv, &g, &upsample_params)?)
             }
+            Some((light, view)) if settings.gi.contains(GiTechnique::Igi) => {
+                let rsm = gbuffer::rsm(
+                    rg,
+                    &handles,
+                    view,
+                    light,
+                    settings.rsm.size,
+                    self.linear.raw(),
+                );
+                let bvh = self.bvh.as_ref().ok_or(RenderError::NoScene)?;
+                Some(igi_indirect(rg, settings, &g, &rsm, bvh, camera.eye)?)
+            }
             _ => None,
         };
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
@@ -478,6 +500,47 @@ impl Renderer {
             extent,
             &CompositeParams::from_settings(&settings.output),
         ))
+    }
+}
+
+/// Paper 000's branch of the frame: VPLs from the primary light's RSM, per-pixel incident
+/// radiance SH with shadow rays through `bvh`, the discontinuity filter and the BRDF; returns the
+/// full-resolution indirect image (no receiver buffer: the interleaving needs the pixel grid).
+fn igi_indirect(
+    rg: &mut RenderGraph,
+    settings: &Settings,
+    g: &gbuffer::GBuffer,
+    rsm: &hvl::Rsm,
+    bvh: &GpuBvh,
+    camera: glam::Vec3,
+) -> Result<shine_graph::Handle<shine_graph::Image>, RenderError> {
+    let buffer_read = ExternalState::new(
+        vk::PipelineStageFlags2::ALL_COMMANDS,
+        vk::AccessFlags2::MEMORY_READ,
+        vk::ImageLayout::UNDEFINED,
+    );
+    let trace = TraceBuffers {
+        nodes: rg.import_gpu_buffer(&bvh.nodes, buffer_read, buffer_read),
+        triangles: rg.import_gpu_buffer(&bvh.triangles, buffer_read, buffer_read),
+    };
+    Ok(igi::igi(rg, g, rsm, &trace, camera, &igi_params(settings))?)
+}
+
+/// The IGI parameters of `settings.igi` (paper 000).
+pub fn igi_params(settings: &Settings) -> IgiParams {
+    let i = &settings.igi;
+    IgiParams {
+        pattern: [i.n, i.m],
+        vpl_count: i.vpl_count,
+        sh_order: i.sh_order,
+        filter_radius: i.filter_radius,
+        mode: match i.filter {
+            IgiFilter::Sh => igi::FilterMode::Sh,
+            IgiFilter::Irradiance => igi::FilterMode::Irradiance,
+        },
+        clamp_distance: i.clamp_distance,
+        depth_tolerance: i.depth_tolerance,
+        normal_threshold: i.normal_threshold,
     }
 }
 
