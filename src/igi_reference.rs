@@ -213,7 +213,8 @@ pub fn sh_filter(
                 kd / std::f32::consts::PI * (sum[0] / count) + ks * (sum[1] / count)
             }
             FilterMode::Sh => {
-                let [lambert, phong] = brdf_sh(n, (-wo).reflect(n), phong_exponent(roughness), bands)?;
+                let [lambert, phong] =
+                    brdf_sh(n, (-wo).reflect(n), phong_exponent(roughness), bands)?;
                 let mut diffuse = Vec3::ZERO;
                 let mut glossy = Vec3::ZERO;
                 for ((s, bl), bp) in sum.iter().zip(&lambert).zip(&phong) {
@@ -262,8 +263,8 @@ pub fn brute_force(
                 if occluded(origin, dir, (target - origin).length() * SHADOW_END) {
                     continue;
                 }
-                let glossy = (exponent + 1.0) / std::f32::consts::TAU
-                    * r.dot(dir).max(0.0).powf(exponent);
+                let glossy =
+                    (exponent + 1.0) / std::f32::consts::TAU * r.dot(dir).max(0.0).powf(exponent);
                 sum += e * (kd / std::f32::consts::PI * n.dot(dir).max(0.0) + ks * glossy);
             }
             sum.max(Vec3::ZERO)

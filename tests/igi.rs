@@ -18,7 +18,7 @@ use shine::image_io::HdrImage;
 use shine::passes::gbuffer::GBuffer;
 use shine::passes::hvl::Hvl;
 use shine::passes::igi::{self, FilterMode, IgiParams, TraceBuffers};
-use shine::reference::{ReferenceParams, ReferenceImages, render_reference};
+use shine::reference::{ReferenceImages, ReferenceParams, render_reference};
 use shine::renderer::Renderer;
 use shine::settings::{Component, GiTechniques, IgiFilter, Settings};
 use shine_scene::bvh::{Bvh, BvhTriangle, Ray};
@@ -60,10 +60,7 @@ fn synthetic_gbuffer() -> GBufferData {
             let (p, ng) = if i < w / 2 {
                 (Vec3::new(-1.5 + 0.2 * fi, 0.0, -1.5 + 0.2 * fj), Vec3::Y)
             } else {
-                (
-                    Vec3::new(0.2 * (fi - 8.0), 0.2 + 0.15 * fj, -2.0),
-                    Vec3::Z,
-                )
+                (Vec3::new(0.2 * (fi - 8.0), 0.2 + 0.15 * fj, -2.0), Vec3::Z)
             };
             let (t, b) = if i < w / 2 {
                 (Vec3::X, Vec3::Z)
@@ -73,7 +70,11 @@ fn synthetic_gbuffer() -> GBufferData {
             let bump = 0.4 * (3.0 * fi).sin() * t + 0.4 * (2.0 * fj).cos() * b;
             let n = (ng + bump).normalize();
             let background = (i + 2 * j) % 13 == 0;
-            let depth = if background { 0.0 } else { (p - CAMERA).length() };
+            let depth = if background {
+                0.0
+            } else {
+                (p - CAMERA).length()
+            };
             g.position.push(p.extend(depth));
             g.normal.push(q16(n.extend(0.0)));
             g.geometric_normal.push(q16(ng.extend(0.0)));
@@ -304,10 +305,7 @@ fn run_gpu(
         .each_ref()
         .map(|i| rg.import_gpu_image(i, uploaded_state(), ExternalState::UNDEFINED));
     let unused = |rg: &mut RenderGraph, name, format| {
-        rg.create_image(
-            name,
-            shine::graph::ImageDesc::new_2d(format, e[0], e[1]),
-        )
+        rg.create_image(name, shine::graph::ImageDesc::new_2d(format, e[0], e[1]))
     };
     let gb = GBuffer {
         position,
@@ -322,29 +320,40 @@ fn run_gpu(
     let sh: Handle<Buffer> = match &field_buffer {
         Some(f) => rg.import_gpu_buffer(f, uploaded_state(), ExternalState::UNDEFINED),
         None => {
-            let lights = rg.import_gpu_buffer(&vpl_buffer, uploaded_state(), ExternalState::UNDEFINED);
+            let lights =
+                rg.import_gpu_buffer(&vpl_buffer, uploaded_state(), ExternalState::UNDEFINED);
             let trace = TraceBuffers {
                 nodes: rg.import_gpu_buffer(&nodes, uploaded_state(), ExternalState::UNDEFINED),
                 triangles: rg.import_gpu_buffer(&tris, uploaded_state(), ExternalState::UNDEFINED),
             };
             let sh = igi::vpl_sh(&mut rg, &gb, &lights, &trace, CAMERA, params).expect("vpl_sh");
-            let mut out = rg.import_gpu_buffer(&sh_readback, ExternalState::UNDEFINED, read_by_copy());
+            let mut out =
+                rg.import_gpu_buffer(&sh_readback, ExternalState::UNDEFINED, read_by_copy());
             rg.copy_buffer("read sh", &sh, &mut out);
             sh
         }
     };
     let indirect = igi::sh_filter(&mut rg, &gb, &sh, CAMERA, params).expect("sh_filter");
-    let mut out = rg.import_gpu_buffer(&indirect_readback, ExternalState::UNDEFINED, read_by_copy());
+    let mut out =
+        rg.import_gpu_buffer(&indirect_readback, ExternalState::UNDEFINED, read_by_copy());
     rg.copy_image_to_buffer("read indirect", &indirect, &mut out);
     let mut commands = device.begin_commands().expect("commands");
     executor.execute(commands.raw(), rg).expect("execute");
-    device.submit(commands).expect("submit").wait().expect("wait");
+    device
+        .submit(commands)
+        .expect("submit")
+        .wait()
+        .expect("wait");
     let coefficients = if field.is_some() {
         Vec::new()
     } else {
-        let words: Vec<u32> = bytemuck::cast_slice(&device.read_buffer(&sh_readback).expect("read")).to_vec();
+        let words: Vec<u32> =
+            bytemuck::cast_slice(&device.read_buffer(&sh_readback).expect("read")).to_vec();
         let c = params.coefficients() as usize;
-        unpack(&words).chunks_exact(c).map(<[Vec3]>::to_vec).collect()
+        unpack(&words)
+            .chunks_exact(c)
+            .map(<[Vec3]>::to_vec)
+            .collect()
     };
     let halves: Vec<f32> = device
         .read_buffer(&indirect_readback)
@@ -364,7 +373,11 @@ fn run_gpu(
 
 /// Largest |a − b| over `|b|`-scaled tolerance: `|a − b| ≤ rel·max|b| + abs` per pixel.
 fn worst(a: &[Vec3], b: &[Vec3]) -> f32 {
-    let scale = b.iter().map(|v| v.abs().max_element()).fold(0.0f32, f32::max).max(1e-6);
+    let scale = b
+        .iter()
+        .map(|v| v.abs().max_element())
+        .fold(0.0f32, f32::max)
+        .max(1e-6);
     a.iter()
         .zip(b)
         .map(|(x, y)| (*x - *y).abs().max_element() / scale)
@@ -404,7 +417,9 @@ fn vpl_sh_projection_matches_shine_sh() {
         let cpu = reference::vpl_sh(&g, &vpls, CAMERA, &p, occluded(&bvh)).expect("cpu");
         let flat = |c: &[Vec<Vec3>]| c.concat();
         let err = worst(&flat(&gpu.coefficients), &flat(&cpu));
-        println!("{pattern:?} order {order} {mode:?}: worst coefficient error {err:.2e} of the largest");
+        println!(
+            "{pattern:?} order {order} {mode:?}: worst coefficient error {err:.2e} of the largest"
+        );
         // Halves hold 11 significant bits (4.9e-4 relative).
         assert!(err < 2e-3, "{pattern:?} {order} {mode:?}: {err}");
         let nonzero = cpu.iter().filter(|c| c[0] != Vec3::ZERO).count();
@@ -446,7 +461,11 @@ fn one_set_without_filter_is_brute_force_vpl_shading() {
 fn filtering_a_constant_field_leaves_it_unchanged() {
     let device = device();
     let (g, vpls, bvh) = (synthetic_gbuffer(), synthetic_vpls(), occluder());
-    for (order, mode) in [(3, FilterMode::Sh), (4, FilterMode::Sh), (3, FilterMode::Irradiance)] {
+    for (order, mode) in [
+        (3, FilterMode::Sh),
+        (4, FilterMode::Sh),
+        (3, FilterMode::Irradiance),
+    ] {
         let p0 = params([4, 4], order, 0, mode);
         let c = p0.coefficients() as usize;
         let constant: Vec<Vec3> = (0..c)
@@ -471,7 +490,11 @@ fn filtering_a_constant_field_leaves_it_unchanged() {
 fn filter_matches_the_cpu_reference() {
     let device = device();
     let (g, vpls, bvh) = (synthetic_gbuffer(), synthetic_vpls(), occluder());
-    for (radius, mode) in [(1, FilterMode::Sh), (2, FilterMode::Sh), (1, FilterMode::Irradiance)] {
+    for (radius, mode) in [
+        (1, FilterMode::Sh),
+        (2, FilterMode::Sh),
+        (1, FilterMode::Irradiance),
+    ] {
         let p = params([4, 4], 3, radius, mode);
         let gpu = run_gpu(&device, &g, &vpls, &bvh, &p, None);
         let cpu = reference::sh_filter(&g, &gpu.coefficients, CAMERA, &p).expect("cpu");
@@ -511,7 +534,10 @@ fn bad_parameters_are_errors() {
             ..IgiParams::default()
         },
     ] {
-        assert!(igi::sh_filter(&mut rg, &g, &sh, CAMERA, &bad).is_err(), "{bad:?}");
+        assert!(
+            igi::sh_filter(&mut rg, &g, &sh, CAMERA, &bad).is_err(),
+            "{bad:?}"
+        );
     }
     let big = GBuffer {
         extent: [4096, 4096],
@@ -609,12 +635,16 @@ fn room_igi_against_the_path_traced_reference() {
         u.psnr,
         100.0 * (1.0 - mean(&igi) / mean(&unclamped))
     );
-    // Measured (lavapipe): see the threshold comment in the report; margin ~2 dB.
-    assert!(c.psnr > PSNR_THRESHOLD, "{c:?}");
+    // Measured (lavapipe, reference at 64 spp whose noise lowers PSNR and SSIM): RMSE 0.046,
+    // PSNR 26.7 dB, SSIM 0.78, mean ratio 0.96; without the clamp PSNR 26.3 dB and the clamp
+    // removes 5.3% of the mean indirect radiance. The chrome torus (roughness 0.05) dominates
+    // the error: its mirror lobe sees the order-3 SH radiance blurred (paper 000 §4.4).
+    assert!(c.psnr > 25.0 && c.ssim > 0.72, "{c:?}");
+    assert!(
+        (0.85..=1.15).contains(&ratio),
+        "IGI / reference mean {ratio}"
+    );
 }
-
-/// Measured PSNR of the default IGI frame minus a margin (filled in from the measurement).
-const PSNR_THRESHOLD: f64 = 0.0;
 
 /// Paper 000's point: on the normal-mapped, glossy room, filtering the incident radiance SH
 /// beats filtering irradiance (classic IGI) against the same reference.
@@ -631,5 +661,49 @@ fn sh_filtering_beats_irradiance_filtering_on_the_room() {
         "PSNR against the reference: SH {:.2} dB, irradiance {:.2} dB (SSIM {:.4} vs {:.4})",
         sh.psnr, irradiance.psnr, sh.ssim, irradiance.ssim
     );
-    assert!(sh.psnr > irradiance.psnr, "SH {sh:?} irradiance {irradiance:?}");
+    // Measured (lavapipe): SH 26.73 dB, irradiance 24.60 dB (SSIM 0.779 vs 0.745).
+    assert!(
+        sh.psnr > irradiance.psnr,
+        "SH {sh:?} irradiance {irradiance:?}"
+    );
+}
+
+/// Writes the reference and IGI variants of the room as PNGs to /tmp/igi_dump for a look
+/// (`cargo test --test igi -- --ignored`).
+#[test]
+#[ignore]
+fn dump_room_images() {
+    let reference = room_reference();
+    let dir = std::path::Path::new("/tmp/igi_dump");
+    std::fs::create_dir_all(dir).unwrap();
+    let save = |name: &str, image: &HdrImage| {
+        let ldr = shine::image_io::LdrImage {
+            width: image.width,
+            height: image.height,
+            texels: image
+                .texels
+                .iter()
+                .map(|t| {
+                    let e = |c: f32| ((c * 2.0).clamp(0.0, 1.0).powf(1.0 / 2.2) * 255.0) as u8;
+                    [e(t[0]), e(t[1]), e(t[2]), 255]
+                })
+                .collect(),
+        };
+        shine::image_io::write_png(&dir.join(name), &ldr).unwrap();
+    };
+    save("reference.png", &reference.indirect);
+    save("sh.png", &room_igi(|_| {}));
+    save(
+        "irr.png",
+        &room_igi(|s| s.igi.filter = IgiFilter::Irradiance),
+    );
+    save("sh_nofilter.png", &room_igi(|s| s.igi.filter_radius = 0));
+    save(
+        "sh_1x1.png",
+        &room_igi(|s| {
+            s.igi.n = 1;
+            s.igi.m = 1;
+            s.igi.filter_radius = 0;
+        }),
+    );
 }
