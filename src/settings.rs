@@ -1003,6 +1003,7 @@ mod tests {
             }),
             ("igi.vpl_count", "300", |s| {
                 s.rsm.size = 16;
+                s.hvl.count = 64;
                 s.igi.vpl_count = 300;
             }),
         ];

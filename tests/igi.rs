@@ -707,3 +707,75 @@ fn dump_room_images() {
         }),
     );
 }
+
+/// `sh_rotation` + `sh_rotation_apply` of sh.glsl (the rotation the GGX path of sh_filter uses)
+/// against shine-sh's Ivanic–Ruedenberg rotation, bands 2–4, random rotations and vectors.
+#[test]
+fn glsl_sh_rotation_matches_shine_sh() {
+    use shine::gpu::{ComputePipeline, Descriptor};
+    use shine_sh::rotation::ShRotation;
+    let device = device();
+    let mut seed = 7u32;
+    let mut next = move || {
+        seed = seed.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (seed >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+    };
+    for bands in [2usize, 3, 4] {
+        let shader =
+            shine::shaders::get(&format!("tests/sh_rotate.comp:b{bands}")).expect("variant");
+        let cases = 32;
+        let mut rotations = Vec::new();
+        let mut inputs = Vec::new();
+        let mut expected = Vec::new();
+        for _ in 0..cases {
+            let axis = Vec3::new(next(), next(), next()).normalize_or(Vec3::Y);
+            let q = glam::Quat::from_axis_angle(axis, 6.0 * next());
+            let m = glam::Mat3::from_quat(q);
+            for c in [m.x_axis, m.y_axis, m.z_axis] {
+                rotations.extend_from_slice(&c.extend(0.0).to_array());
+            }
+            let f: Vec<f32> = (0..bands * bands).map(|_| next()).collect();
+            expected.extend(
+                ShRotation::from_mat3(m, bands)
+                    .expect("rotation")
+                    .apply(&f)
+                    .expect("apply"),
+            );
+            inputs.extend(f);
+        }
+        let pipeline = ComputePipeline::new(&device, shader).expect("pipeline");
+        let r = common::storage_with(&device, "rotations", bytemuck::cast_slice(&rotations));
+        let i = common::storage_with(&device, "inputs", bytemuck::cast_slice(&inputs));
+        let o = common::buffer(
+            &device,
+            "outputs",
+            (inputs.len() * 4) as u64,
+            vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+        );
+        let count = cases as u32;
+        device
+            .run_once(|cmd| {
+                cmd.bind_compute(
+                    &pipeline,
+                    &[
+                        ("rotations", Descriptor::from(&r)),
+                        ("inputs", Descriptor::from(&i)),
+                        ("outputs", Descriptor::from(&o)),
+                    ],
+                )?;
+                cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
+                cmd.dispatch_threads(&pipeline, [count, 1, 1]);
+                Ok(())
+            })
+            .expect("dispatch");
+        let got: Vec<f32> = bytemuck::cast_slice(&device.read_buffer(&o).expect("read")).to_vec();
+        let err = got
+            .iter()
+            .zip(&expected)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max);
+        println!("bands {bands}: worst |GLSL − shine-sh| {err:.2e}");
+        assert!(err < 1e-5, "bands {bands}: {err}");
+    }
+    assert_clean(&device);
+}
