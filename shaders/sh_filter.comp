@@ -10,13 +10,20 @@
 // interleaved set exactly k^2 times (paper 000 §2.3: a filter exactly as wide as the pattern).
 // k = 0 is no filter.
 // Resolve (paper 000 §3.1, §3.3) about the SHADING normal n and reflected direction r:
-//   SH:  L_o = kd . (L . B_lambert(n)) + ks . (L . B_phong(r, e)),   per rgb channel
-//   irr: L_o = kd / pi . E + ks . G
-// kd, ks: igi_material_weights; e = igi_phong_exponent(roughness). Output clamped at 0 per
-// channel (band-limited ringing must not go negative in the RGBA16F image).
+//   SH, Phong (o2-o4): L_o = kd . (L . B_lambert(n)) + ks . (L . B_phong(r, e)), per channel,
+//     kd, ks: igi_material_weights; e = igi_phong_exponent(roughness);
+//   SH, GGX (g2-g4): L rotated into the receiver frame of the BRDF SH tables (z = n, omega_o
+//     in the xz half-plane) by sh_rotation, then kd (L . F_lambert(theta_o)) +
+//     igi_ggx_table_weight(ks) (L . F_ggx(roughness, theta_o)) with the HVL gather's tables
+//     (brdf_table.glsl) and the weights of igi_material_weights;
+//   irr: L_o = kd / pi . E + ks . G.
+// Output clamped at 0 per channel (band-limited ringing must not go negative in RGBA16F).
 //! variant o2 SH_BANDS=2
 //! variant o3 SH_BANDS=3
 //! variant o4 SH_BANDS=4
+//! variant g2 SH_BANDS=2 IGI_GGX=1
+//! variant g3 SH_BANDS=3 IGI_GGX=1
+//! variant g4 SH_BANDS=4 IGI_GGX=1
 //! variant irr SH_BANDS=1 IGI_IRRADIANCE=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -35,6 +42,14 @@ layout(set = 0, binding = 5, std430) readonly buffer VplSh {
 } vpl_sh;
 
 layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
+
+#ifdef IGI_GGX
+// shine::passes::hvl::GatherBrdf::gpu_data at SH_BANDS bands
+layout(set = 0, binding = 7, std430) readonly buffer Brdf {
+    float f[];
+} brdf;
+#include "brdf_table.glsl"
+#endif
 
 #ifdef IGI_IRRADIANCE
 #define SH_OUT 2
@@ -56,7 +71,11 @@ layout(push_constant) uniform Push {
     float depth_tolerance;
     // cosine threshold of the geometric normals
     float normal_threshold;
-    uint pad0;
+    // number of glossy tables (GGX path)
+    uint glossy_tables;
+    // roughness of the first glossy table, step between tables (GGX path)
+    vec2 roughness_nodes;
+    vec2 pad;
 } push;
 
 vec3 load(uint base, int k) {
@@ -116,13 +135,46 @@ void main() {
     vec3 albedo = imageLoad(gb_albedo, px).rgb;
     vec2 roughness_metallic = imageLoad(gb_material, px).rg;
     vec3 wo = normalize(push.camera.xyz - x);
+    vec3 result;
+#if defined(IGI_GGX)
     vec3 kd;
     vec3 ks;
     igi_material_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
-    vec3 result;
-#ifdef IGI_IRRADIANCE
+    ks = igi_ggx_table_weight(ks, dot(n, wo));
+    // A shading normal facing away from the viewer is evaluated at grazing view.
+    float cos_o = clamp(dot(n, wo), 1e-4, 1.0);
+    vec3 t = wo - n * dot(n, wo);
+    if (dot(t, t) < 1e-12) {
+        t = abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+        t -= n * dot(n, t);
+    }
+    t = normalize(t);
+    vec3 b = cross(n, t);
+    float rot[SH_ROT_SIZE];
+    sh_rotation(transpose(mat3(t, b, n)), rot);
+    float theta_o = acos(cos_o);
+    float f_lambert[SH_COEFFS];
+    float f_glossy[SH_COEFFS];
+    brdf_table_row(0, theta_o, f_lambert);
+    brdf_table_glossy_row(roughness_metallic.x, push.roughness_nodes, push.glossy_tables, theta_o, f_glossy);
+    for (int c = 0; c < 3; ++c) {
+        float world[SH_COEFFS];
+        for (int k = 0; k < SH_COEFFS; ++k) {
+            world[k] = sum[k][c] / count;
+        }
+        float local[SH_COEFFS];
+        sh_rotation_apply(rot, world, local);
+        result[c] = kd[c] * sh_dot(local, f_lambert) + ks[c] * sh_dot(local, f_glossy);
+    }
+#elif defined(IGI_IRRADIANCE)
+    vec3 kd;
+    vec3 ks;
+    igi_material_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
     result = kd / IGI_PI * (sum[0] / count) + ks * (sum[1] / count);
 #else
+    vec3 kd;
+    vec3 ks;
+    igi_material_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
     float exponent = igi_phong_exponent(roughness_metallic.x);
     float b_lambert[SH_COEFFS];
     float b_phong[SH_COEFFS];

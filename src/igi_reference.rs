@@ -3,11 +3,12 @@
 //! math of shine-sh (basis, Lambert and Phong `r_l`, ZH rotation), and the brute-force VPL
 //! shading that IGI with one set and no filter must reproduce. Used by `tests/igi.rs`.
 
-use glam::{Vec3, Vec4};
+use glam::{Mat3, Vec3, Vec4};
+use shine_sh::rotation::ShRotation;
 use shine_sh::{ShError, basis, kernels, zonal};
 
-use crate::passes::hvl::Hvl;
-use crate::passes::igi::{FilterMode, IgiParams, permutation_stride, pixel_set, vpl_cell};
+use crate::passes::hvl::{GatherBrdf, Hvl};
+use crate::passes::igi::{FilterMode, Glossy, IgiParams, permutation_stride, pixel_set, vpl_cell};
 
 /// `IGI_MIN_DISTANCE` of igi.glsl (metres).
 pub const MIN_DISTANCE: f32 = 1e-4;
@@ -61,6 +62,54 @@ pub fn brdf_sh(n: Vec3, r: Vec3, exponent: f32, bands: usize) -> Result<[Vec<f32
     let lambert = zonal::rotate_zh(&kernels::lambert_r(1.0, bands)?, n)?;
     let phong = zonal::rotate_zh(&kernels::phong_r(1.0, exponent, bands)?, r)?;
     Ok([lambert, phong])
+}
+
+/// `igi_ggx_table_weight`: `ks` over Schlick's F with F0 = 0.04 at `n_dot_v` (the tables hold the
+/// dielectric Fresnel).
+pub fn ggx_table_weight(ks: Vec3, n_dot_v: f32) -> Vec3 {
+    ks / (0.04 + 0.96 * (1.0 - n_dot_v.clamp(0.0, 1.0)).powi(5))
+}
+
+/// The GGX path of `sh_filter` for one pixel: `sh` (world-frame rgb SH, already filtered)
+/// rotated into the receiver frame of the BRDF SH tables (z = `n`, `wo` in the xz half-plane)
+/// with shine-sh's rotation, dotted with the Lambert and the roughness-blended GGX rows, weighted
+/// by [`material_weights`] (the glossy one through [`ggx_table_weight`]).
+pub fn ggx_resolve(
+    sh: &[Vec3],
+    n: Vec3,
+    wo: Vec3,
+    albedo: Vec3,
+    roughness: f32,
+    metallic: f32,
+    tables: &GatherBrdf,
+) -> Result<Vec3, ShError> {
+    let bands = basis_bands(sh.len());
+    let (kd, ks) = material_weights(albedo, metallic, n.dot(wo));
+    let ks = ggx_table_weight(ks, n.dot(wo));
+    let cos_o = n.dot(wo).clamp(1e-4, 1.0);
+    let mut t = wo - n * n.dot(wo);
+    if t.length_squared() < 1e-12 {
+        t = if n.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+        t -= n * n.dot(t);
+    }
+    let t = t.normalize();
+    let b = n.cross(t);
+    let rotation = ShRotation::from_mat3(Mat3::from_cols(t, b, n).transpose(), bands)?;
+    let theta_o = cos_o.acos();
+    let lambert = tables.lambert.lookup_f(theta_o);
+    let glossy = tables.glossy_f(roughness, theta_o);
+    let mut out = Vec3::ZERO;
+    for c in 0..3 {
+        let world: Vec<f32> = sh.iter().map(|v| v[c]).collect();
+        let local = rotation.apply(&world)?;
+        out[c] = kd[c] * shine_sh::dot(&local, &lambert)? + ks[c] * shine_sh::dot(&local, &glossy)?;
+    }
+    Ok(out)
+}
+
+/// Bands of an SH vector of `len` coefficients.
+fn basis_bands(len: usize) -> usize {
+    (len as f64).sqrt().round() as usize
 }
 
 /// `trace_offset` of trace.glsl.
@@ -153,10 +202,12 @@ pub fn vpl_sh(
 }
 
 /// `sh_filter`: the discontinuity filter over `coefficients` (from [`vpl_sh`]) and the BRDF;
-/// returns the outgoing radiance per pixel (clamped at 0), 0 on background.
+/// returns the outgoing radiance per pixel (clamped at 0), 0 on background. `tables`: the BRDF
+/// SH tables at `sh_order` bands, needed by the GGX path only.
 pub fn sh_filter(
     g: &GBufferData,
     coefficients: &[Vec<Vec3>],
+    tables: Option<&GatherBrdf>,
     camera: Vec3,
     params: &IgiParams,
 ) -> Result<Vec<Vec3>, ShError> {
@@ -211,6 +262,15 @@ pub fn sh_filter(
         let result = match params.mode {
             FilterMode::Irradiance => {
                 kd / std::f32::consts::PI * (sum[0] / count) + ks * (sum[1] / count)
+            }
+            FilterMode::Sh if params.glossy == Glossy::Ggx => {
+                let tables = tables.ok_or(ShError::OutOfRange {
+                    name: "BRDF tables",
+                    value: 0.0,
+                    expected: "GatherBrdf tables for the GGX path",
+                })?;
+                let filtered: Vec<Vec3> = sum.iter().map(|s| *s / count).collect();
+                ggx_resolve(&filtered, n, wo, albedo, roughness, metallic, tables)?
             }
             FilterMode::Sh => {
                 let [lambert, phong] =

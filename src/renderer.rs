@@ -15,7 +15,7 @@ use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::profile_report::PassClock;
-use crate::settings::{Component, GatherPath, GiTechnique, IgiFilter, RadiusHeuristic};
+use crate::settings::{Component, GatherPath, GiTechnique, IgiFilter, IgiGlossy, RadiusHeuristic};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
@@ -369,6 +369,46 @@ impl Renderer {
         Ok(())
     }
 
+    /// Builds and uploads the BRDF SH tables ([`GatherBrdf`]) at `bands` bands unless cached.
+    fn prepare_brdf_tables(&mut self, bands: u32) -> Result<(), RenderError> {
+        if self.brdf_tables.iter().any(|(b, _)| *b == bands) {
+            return Ok(());
+        }
+        let tables = GatherBrdf::build(bands, HemisphereSampling::default())?;
+        let buffer = Buffer::with_data(
+            &self.device,
+            &BufferDesc {
+                name: "brdf tables",
+                size: 0,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+            bytemuck::cast_slice(&tables.gpu_data()),
+        )?;
+        self.brdf_tables.push((bands, buffer));
+        Ok(())
+    }
+
+    /// The cached BRDF SH tables at `bands` bands, imported into `rg`.
+    fn import_brdf_tables(
+        &self,
+        rg: &mut RenderGraph,
+        bands: u32,
+    ) -> Result<shine_graph::Handle<shine_graph::Buffer>, RenderError> {
+        let buffer_read = ExternalState::new(
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::AccessFlags2::MEMORY_READ,
+            vk::ImageLayout::UNDEFINED,
+        );
+        let table = self
+            .brdf_tables
+            .iter()
+            .find(|(b, _)| *b == bands)
+            .map(|(_, buffer)| buffer)
+            .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
+        Ok(rg.import_gpu_buffer(table, buffer_read, buffer_read))
+    }
+
     /// Declares every pass of a frame; returns its HDR and LDR images.
     fn declare_frame(
         &mut self,
@@ -377,19 +417,12 @@ impl Renderer {
     ) -> Result<CompositeOutputs, RenderError> {
         let hvl = settings.gi.contains(GiTechnique::Hvl);
         let conv_bands = settings.hvl.convolution_bands;
-        if hvl && !self.brdf_tables.iter().any(|(b, _)| *b == conv_bands) {
-            let tables = GatherBrdf::build(conv_bands, HemisphereSampling::default())?;
-            let buffer = Buffer::with_data(
-                &self.device,
-                &BufferDesc {
-                    name: "hvl brdf tables",
-                    size: 0,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::GpuOnly,
-                },
-                bytemuck::cast_slice(&tables.gpu_data()),
-            )?;
-            self.brdf_tables.push((conv_bands, buffer));
+        if hvl {
+            self.prepare_brdf_tables(conv_bands)?;
+        }
+        let igi_params = igi_params(settings);
+        if settings.gi.contains(GiTechnique::Igi) && igi_params.needs_brdf_tables() {
+            self.prepare_brdf_tables(igi_params.sh_order)?;
         }
         self.prepare_shadows(settings)?;
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
@@ -477,8 +510,21 @@ impl Renderer {
                     settings.rsm.size,
                     self.linear.raw(),
                 );
+                let brdf = if igi_params.needs_brdf_tables() {
+                    Some(self.import_brdf_tables(rg, igi_params.sh_order)?)
+                } else {
+                    None
+                };
                 let bvh = self.bvh.as_ref().ok_or(RenderError::NoScene)?;
-                Some(igi_indirect(rg, settings, &g, &rsm, bvh, camera.eye)?)
+                Some(igi_indirect(
+                    rg,
+                    &igi_params,
+                    &g,
+                    &rsm,
+                    bvh,
+                    brdf.as_ref(),
+                    camera.eye,
+                )?)
             }
             _ => None,
         };
@@ -508,10 +554,11 @@ impl Renderer {
 /// full-resolution indirect image (no receiver buffer: the interleaving needs the pixel grid).
 fn igi_indirect(
     rg: &mut RenderGraph,
-    settings: &Settings,
+    params: &IgiParams,
     g: &gbuffer::GBuffer,
     rsm: &hvl::Rsm,
     bvh: &GpuBvh,
+    brdf: Option<&shine_graph::Handle<shine_graph::Buffer>>,
     camera: glam::Vec3,
 ) -> Result<shine_graph::Handle<shine_graph::Image>, RenderError> {
     let buffer_read = ExternalState::new(
@@ -523,7 +570,7 @@ fn igi_indirect(
         nodes: rg.import_gpu_buffer(&bvh.nodes, buffer_read, buffer_read),
         triangles: rg.import_gpu_buffer(&bvh.triangles, buffer_read, buffer_read),
     };
-    Ok(igi::igi(rg, g, rsm, &trace, camera, &igi_params(settings))?)
+    Ok(igi::igi(rg, g, rsm, &trace, brdf, camera, params)?)
 }
 
 /// The IGI parameters of `settings.igi` (paper 000).
@@ -537,6 +584,10 @@ pub fn igi_params(settings: &Settings) -> IgiParams {
         mode: match i.filter {
             IgiFilter::Sh => igi::FilterMode::Sh,
             IgiFilter::Irradiance => igi::FilterMode::Irradiance,
+        },
+        glossy: match i.glossy {
+            IgiGlossy::Ggx => igi::Glossy::Ggx,
+            IgiGlossy::Phong => igi::Glossy::Phong,
         },
         clamp_distance: i.clamp_distance,
         depth_tolerance: i.depth_tolerance,

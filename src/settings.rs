@@ -225,6 +225,16 @@ named_choice! {
 }
 
 named_choice! {
+    /// The glossy lobe of IGI's SH resolve (`src/passes/igi.rs`).
+    pub enum IgiGlossy ("IGI glossy lobe") {
+        /// GGX through the BRDF SH tables of the HVL gather, radiance rotated per pixel.
+        Ggx = "ggx",
+        /// Paper 000 §3.3: Lambert and Phong r_l, the Phong lobe standing for the GGX.
+        Phong = "phong",
+    }
+}
+
+named_choice! {
     /// One indirect-light technique of DESIGN §4 that shine implements today.
     pub enum GiTechnique ("GI technique") {
         /// Harmonics Virtual Lights (paper 003).
@@ -480,6 +490,9 @@ pub struct IgiSettings {
     pub filter_radius: u32,
     /// What is filtered: `sh` (paper 000) or `irradiance` (classic IGI). Default `sh`.
     pub filter: IgiFilter,
+    /// Glossy lobe of the SH mode: `ggx` (BRDF SH tables) or `phong` (paper 000 §3.3.2).
+    /// Default `ggx`.
+    pub glossy: IgiGlossy,
     /// Minimum VPL distance d_min in metres: 1/d² is evaluated as 1/max(d², d_min²) (the VPL
     /// singularity clamp). Range 0.0..=10.0, default 0.1.
     pub clamp_distance: f32,
@@ -500,6 +513,7 @@ impl Default for IgiSettings {
             sh_order: 3,
             filter_radius: 1,
             filter: IgiFilter::Sh,
+            glossy: IgiGlossy::Ggx,
             clamp_distance: 0.1,
             depth_tolerance: 0.05,
             normal_threshold: 0.9,

@@ -27,12 +27,19 @@
 //! * **Clamp.** The VPL singularity 1/d² is evaluated as `1/max(d, d_min)²` (`clamp_distance`,
 //!   default 0.1 m; the classic bounded-geometry-term clamp of IGI). The energy it removes is
 //!   measured by `tests/igi.rs` against the path-traced reference.
-//! * **Glossy BRDF.** Paper 000 §3.3 uses radially symmetric lobes; we do the same: the GGX of
-//!   the metallic-roughness material becomes a Phong lobe about the reflected direction with
-//!   exponent `0.5/α² − 0.5` (`igi_phong_exponent`, α = roughness²), `kd = (1 − F)(1 − metallic)
-//!   albedo`, `ks = F` (Schlick at the mirror direction). The GGX SH tables of the HVL gather
-//!   (`GatherBrdf`) live in the receiver's tangent frame and would need an SH rotation of the
-//!   filtered radiance per pixel in GLSL, which sh.glsl does not have yet (see the report).
+//! * **Glossy BRDF** ([`Glossy`], `igi.glossy`). `ggx` (default): the HVL gather's BRDF SH
+//!   tables (Lambert + GGX at 5 roughness nodes blended linearly, [`hvl::GatherBrdf`], built at
+//!   `sh_order` bands, the renderer's cached buffer) in the receiver frame (z = shading normal,
+//!   ω_o in the xz half-plane); the filtered radiance is rotated into that frame per pixel
+//!   (`sh_rotation`, Ivanic–Ruedenberg, twin of `shine_sh::rotation`). Weights as the Phong path
+//!   (below), the glossy one divided by the dielectric Schlick F (F0 = 0.04) at n·v because the
+//!   tables already hold the exact η = 1.5 Fresnel (`igi_ggx_table_weight`): 1 for dielectrics,
+//!   ≈ albedo/0.04 for metals. (The HVL gather's `ks = mix(1, albedo, metallic)` keeps the
+//!   dielectric Fresnel for metals: ~20× too dark a metallic lobe; measured here: the IGI mean
+//!   indirect fell to 0.82 of the reference with those weights.) `phong`: paper 000 §3.3 literally — Lambert `r_l` about the normal and
+//!   a Phong lobe about the reflected direction with exponent `0.5/α² − 0.5`
+//!   (`igi_phong_exponent`, α = roughness²), `kd = (1 − F)(1 − metallic) albedo`, `ks = F`
+//!   (Schlick at the mirror direction). Irradiance mode always uses the Phong weights.
 //! * **Resolution.** Everything runs at full resolution (the interleaving needs the pixel grid):
 //!   no receiver buffer, no upsample.
 //! * **Storage.** `vpl_sh` holds C rgb coefficients per pixel as two u32 of packed halves
@@ -66,6 +73,17 @@ pub enum FilterMode {
     Irradiance,
 }
 
+/// The glossy lobe of the SH resolve.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Glossy {
+    /// GGX through the BRDF SH tables of the HVL gather ([`hvl::GatherBrdf`]), the filtered
+    /// radiance rotated into the receiver frame (sh.glsl `sh_rotation`).
+    Ggx,
+    /// Paper 000 §3.3.2: a Phong lobe about the reflected direction standing for the GGX
+    /// (`igi_phong_exponent`), Lambert r_l about the normal (§3.3.1).
+    Phong,
+}
+
 /// Parameters of the IGI passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct IgiParams {
@@ -80,6 +98,8 @@ pub struct IgiParams {
     pub filter_radius: u32,
     /// SH (paper 000) or irradiance (classic IGI).
     pub mode: FilterMode,
+    /// Glossy lobe of the SH mode.
+    pub glossy: Glossy,
     /// d_min of the 1/d² clamp in metres (0..=10).
     pub clamp_distance: f32,
     /// Relative depth tolerance of the filter (> 0).
@@ -96,6 +116,7 @@ impl Default for IgiParams {
             sh_order: 3,
             filter_radius: 1,
             mode: FilterMode::Sh,
+            glossy: Glossy::Ggx,
             clamp_distance: 0.1,
             depth_tolerance: 0.05,
             normal_threshold: 0.9,
@@ -121,7 +142,7 @@ pub struct VplShPush {
     pub pad: [u32; 2],
 }
 
-/// Push constants of `shaders/sh_filter.comp` (48 bytes).
+/// Push constants of `shaders/sh_filter.comp` (64 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FilterPush {
@@ -137,8 +158,12 @@ pub struct FilterPush {
     pub depth_tolerance: f32,
     /// Cosine threshold of the geometric normals.
     pub normal_threshold: f32,
+    /// Number of glossy tables ([`hvl::GLOSSY_TABLES`], GGX path).
+    pub glossy_tables: u32,
+    /// Roughness of the first glossy table and the step between tables (GGX path).
+    pub roughness_nodes: [f32; 2],
     /// Padding.
-    pub pad: u32,
+    pub pad: [f32; 2],
 }
 
 /// Errors of the IGI passes.
@@ -236,12 +261,18 @@ impl IgiParams {
         }
     }
 
-    /// The shader variant name of both passes (`o2`, `o3`, `o4` or `irr`).
-    fn variant(&self) -> String {
-        match self.mode {
-            FilterMode::Sh => format!("o{}", self.sh_order),
-            FilterMode::Irradiance => "irr".to_owned(),
+    /// The shader variant name (`o2`–`o4`, `g2`–`g4` for the filter's GGX path, or `irr`).
+    fn variant(&self, filter: bool) -> String {
+        match (self.mode, self.glossy) {
+            (FilterMode::Sh, Glossy::Ggx) if filter => format!("g{}", self.sh_order),
+            (FilterMode::Sh, _) => format!("o{}", self.sh_order),
+            (FilterMode::Irradiance, _) => "irr".to_owned(),
         }
+    }
+
+    /// Whether the filter reads the BRDF SH tables (SH mode with GGX).
+    pub fn needs_brdf_tables(&self) -> bool {
+        self.mode == FilterMode::Sh && self.glossy == Glossy::Ggx
     }
 
     /// Bytes of the `vpl_sh` buffer for an image of `extent`, or [`IgiError::TooLarge`].
@@ -336,7 +367,7 @@ pub fn vpl_sh(
             expected: "at least vpl_count × 80 bytes",
         });
     }
-    let shader = shader("vpl_sh.comp", params)?;
+    let shader = shader("vpl_sh.comp", params, false)?;
     let mut sh = rg.create_buffer("vpl_sh", BufferDesc::new(bytes));
     let push = VplShPush {
         camera_clamp: camera.extend(params.clamp_distance).to_array(),
@@ -363,11 +394,13 @@ pub fn vpl_sh(
 }
 
 /// Adds `sh_filter`: the discontinuity filter over `sh` and the BRDF at every pixel; returns
-/// the full-resolution `indirect` image (RGBA16F outgoing radiance towards `camera`).
+/// the full-resolution `indirect` image (RGBA16F outgoing radiance towards `camera`). `brdf`
+/// holds [`hvl::GatherBrdf::gpu_data`] at `params.sh_order` bands; only the GGX path reads it.
 pub fn sh_filter(
     rg: &mut RenderGraph,
     g: &GBuffer,
     sh: &Handle<Buffer>,
+    brdf: Option<&Handle<Buffer>>,
     camera: Vec3,
     params: &IgiParams,
 ) -> Result<Handle<Image>, IgiError> {
@@ -380,7 +413,18 @@ pub fn sh_filter(
             expected: "W × H × coefficients × 8 bytes",
         });
     }
-    let shader = shader("sh_filter.comp", params)?;
+    let shader = shader("sh_filter.comp", params, true)?;
+    let brdf = match (params.needs_brdf_tables(), brdf) {
+        (false, _) => None,
+        (true, Some(b)) if b.desc().size == hvl::GatherBrdf::gpu_bytes(params.sh_order) => Some(b),
+        (true, _) => {
+            return Err(IgiError::OutOfRange {
+                name: "brdf tables bytes",
+                value: brdf.map_or(0.0, |b| b.desc().size as f64),
+                expected: "GatherBrdf::gpu_data at sh_order bands (the GGX path needs them)",
+            });
+        }
+    };
     let [w, h] = g.extent;
     let mut indirect = rg.create_image(
         "indirect",
@@ -393,38 +437,49 @@ pub fn sh_filter(
         radius: params.filter_radius,
         depth_tolerance: params.depth_tolerance,
         normal_threshold: params.normal_threshold,
-        pad: 0,
+        glossy_tables: hvl::GLOSSY_TABLES,
+        roughness_nodes: [hvl::GLOSSY_ROUGHNESS_MIN, hvl::glossy_roughness_step()],
+        pad: [0.0; 2],
     };
-    rg.compute("sh_filter", shader)
-        .read("gb_position", &g.position)
+    let mut pass = rg.compute("sh_filter", shader);
+    pass.read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
         .read("gb_geometric_normal", &g.geometric_normal)
         .read("gb_albedo", &g.albedo)
         .read("gb_material", &g.material)
-        .read("vpl_sh", sh)
-        .write("indirect", &mut indirect)
+        .read("vpl_sh", sh);
+    if let Some(brdf) = brdf {
+        pass.read("brdf", brdf);
+    }
+    pass.write("indirect", &mut indirect)
         .push(&push)
         .dispatch([w, h, 1]);
     Ok(indirect)
 }
 
 /// The three IGI passes in a row: VPLs from `rsm`, `vpl_sh`, `sh_filter`; returns `indirect`.
+/// `brdf`: as for [`sh_filter`].
 pub fn igi(
     rg: &mut RenderGraph,
     g: &GBuffer,
     rsm: &Rsm,
     bvh: &TraceBuffers,
+    brdf: Option<&Handle<Buffer>>,
     camera: Vec3,
     params: &IgiParams,
 ) -> Result<Handle<Image>, IgiError> {
     let lights = vpls(rg, rsm, params)?;
     let sh = vpl_sh(rg, g, &lights, bvh, camera, params)?;
-    sh_filter(rg, g, &sh, camera, params)
+    sh_filter(rg, g, &sh, brdf, camera, params)
 }
 
-/// The compiled variant of `file` for `params`.
-fn shader(file: &str, params: &IgiParams) -> Result<&'static crate::gpu::ShaderDesc, IgiError> {
-    shaders::get(&format!("{file}:{}", params.variant())).ok_or(IgiError::OutOfRange {
+/// The compiled variant of `file` for `params` (`filter`: the sh_filter variants).
+fn shader(
+    file: &str,
+    params: &IgiParams,
+    filter: bool,
+) -> Result<&'static crate::gpu::ShaderDesc, IgiError> {
+    shaders::get(&format!("{file}:{}", params.variant(filter))).ok_or(IgiError::OutOfRange {
         name: "sh_order",
         value: f64::from(params.sh_order),
         expected: "a compiled variant: SH order 2..=4",
