@@ -50,6 +50,16 @@
 //!   geometric-normal test as the SH mode, so the comparison isolates what is filtered.
 //! * **hvl + igi**: refused by the settings (both are the one-bounce light of the primary
 //!   light).
+//!
+//! # Measured (lavapipe, `tests/igi.rs`, `shine profile`)
+//!
+//! * `room` (spot light only, 128², one-bounce indirect against the path tracer at 64 spp):
+//!   SH filtering 26.61 dB PSNR / SSIM 0.781 (GGX tables; Phong lobe 26.73 dB / 0.779), classic
+//!   irradiance filtering 24.60 dB / 0.745; mean indirect 0.95 of the reference; the 0.1 m clamp
+//!   removes 5.5% of the mean indirect radiance and raises PSNR from 26.15 dB.
+//! * `shine profile builtin:room --gi igi` at 256², release, host clock per pass: vpl_sh
+//!   5785 / 1682 / 555 ms and sh_filter 90 / 93 / 127 ms for n×m = 1×1 / 2×2 / 4×4 (256 VPLs,
+//!   order 3); the shadow rays dominate and scale as 1/(nm).
 
 use glam::Vec3;
 
