@@ -75,6 +75,7 @@ layout(set = 0, binding = 4, std430) readonly buffer Hvls {
 layout(set = 0, binding = 5, std430) readonly buffer Brdf {
     float f[];
 } brdf;
+#include "brdf_table.glsl"
 #endif
 
 layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
@@ -109,37 +110,15 @@ layout(push_constant) uniform Push {
 
 // Receivers closer than this to an HVL centre get nothing from it (metres).
 const float HVL_MIN_DISTANCE = 1e-6;
-// shine_sh::brdf_table::THETA_SAMPLES
-const int HVL_THETA_SAMPLES = 90;
 
 #ifdef HVL_FULL
-// shine_sh::brdf_table::BrdfTable::lookup_f: linear interpolation between 1-degree rows
+// brdf_row / glossy_row: shaders/include/brdf_table.glsl (shared with sh_filter.comp)
 void brdf_row(int table, float theta_o, out float f[SH_COEFFS]) {
-    float x = clamp(degrees(theta_o) - 0.5, 0.0, float(HVL_THETA_SAMPLES - 1));
-    int i0 = int(floor(x));
-    int i1 = min(i0 + 1, HVL_THETA_SAMPLES - 1);
-    float t = x - float(i0);
-    int base = table * HVL_THETA_SAMPLES * SH_COEFFS;
-    for (int k = 0; k < SH_COEFFS; ++k) {
-        f[k] = brdf.f[base + i0 * SH_COEFFS + k] * (1.0 - t) + brdf.f[base + i1 * SH_COEFFS + k] * t;
-    }
+    brdf_table_row(table, theta_o, f);
 }
 
-// shine::passes::hvl::GatherBrdf::glossy_f: the glossy row at `roughness`, blended linearly
-// between the two tables around it (clamped to the nodes)
 void glossy_row(float roughness, float theta_o, out float f[SH_COEFFS]) {
-    float last = float(push.glossy_tables - 1u);
-    float x = clamp((roughness - push.roughness_nodes.x) / push.roughness_nodes.y, 0.0, last);
-    int k0 = min(int(floor(x)), int(last));
-    int k1 = min(k0 + 1, int(last));
-    float t = x - float(k0);
-    float f0[SH_COEFFS];
-    float f1[SH_COEFFS];
-    brdf_row(1 + k0, theta_o, f0);
-    brdf_row(1 + k1, theta_o, f1);
-    for (int k = 0; k < SH_COEFFS; ++k) {
-        f[k] = f0[k] * (1.0 - t) + f1[k] * t;
-    }
+    brdf_table_glossy_row(roughness, push.roughness_nodes, push.glossy_tables, theta_o, f);
 }
 #endif
 

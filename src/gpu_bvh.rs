@@ -13,6 +13,17 @@ use shine_scene::Scene;
 use shine_scene::bvh::{Bvh, BvhNode};
 
 use crate::gpu_scene::SceneUploadError;
+use crate::graph::{ExternalState, Handle, RenderGraph};
+
+/// A [`GpuBvh`]'s buffers imported into a frame graph, bound by the names `trace.glsl`
+/// declares (`bvh_nodes`, `bvh_triangles`).
+#[derive(Debug, Clone, Copy)]
+pub struct TraceBuffers {
+    /// `bvh_nodes`.
+    pub nodes: Handle<crate::graph::Buffer>,
+    /// `bvh_triangles`.
+    pub triangles: Handle<crate::graph::Buffer>,
+}
 
 /// A BVH triangle as `trace.glsl` reads it (48 bytes): world-space vertices and the
 /// triangle's index in the flattened scene index buffer.
@@ -50,6 +61,14 @@ pub struct GpuBvh {
 }
 
 impl GpuBvh {
+    /// Imports both buffers into `rg`, read-only, in `state` before and after the frame.
+    pub fn import(&self, rg: &mut RenderGraph, state: ExternalState) -> TraceBuffers {
+        TraceBuffers {
+            nodes: rg.import_gpu_buffer(&self.nodes, state, state),
+            triangles: rg.import_gpu_buffer(&self.triangles, state, state),
+        }
+    }
+
     /// Builds the BVH of `scene` at time `t` (seconds, animations applied) and uploads it.
     pub fn upload(device: &Device, scene: &Scene, t: f32) -> Result<Self, SceneUploadError> {
         let world = scene.world_transforms_at(t);

@@ -10,6 +10,7 @@ pub mod gpu_bvh;
 pub mod gpu_environment;
 pub mod gpu_scene;
 pub mod hvl_reference;
+pub mod igi_reference;
 pub mod image_compare;
 pub mod image_io;
 pub mod passes;

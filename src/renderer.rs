@@ -10,11 +10,12 @@ use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
 use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
 use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
+use crate::passes::igi::{self, IgiError, IgiParams};
 use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::profile_report::PassClock;
-use crate::settings::{Component, GiTechnique};
+use crate::settings::{Component, GiTechnique, IgiFilter, IgiGlossy};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{
@@ -51,6 +52,9 @@ pub enum RenderError {
     /// The HVL passes refused their inputs or parameters.
     #[error(transparent)]
     Hvl(#[from] HvlError),
+    /// The IGI passes refused their inputs or parameters.
+    #[error(transparent)]
+    Igi(#[from] IgiError),
     /// The receiver or upsample pass refused its inputs.
     #[error(transparent)]
     Receivers(#[from] ReceiverError),
@@ -102,7 +106,8 @@ pub struct Renderer {
     linear: Sampler,
     nearest: Sampler,
     scene: Option<GpuScene>,
-    /// The scene's BVH for shadow rays, uploaded with the scene.
+    /// The scene's BVH for shadow rays (HVL visibility, IGI's VPL visibility), uploaded with
+    /// the scene.
     bvh: Option<GpuBvh>,
     /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
     brdf_tables: Vec<(u32, Buffer)>,
@@ -395,6 +400,46 @@ impl Renderer {
         Ok(())
     }
 
+    /// Builds and uploads the BRDF SH tables ([`GatherBrdf`]) at `bands` bands unless cached.
+    fn prepare_brdf_tables(&mut self, bands: u32) -> Result<(), RenderError> {
+        if self.brdf_tables.iter().any(|(b, _)| *b == bands) {
+            return Ok(());
+        }
+        let tables = GatherBrdf::build(bands, HemisphereSampling::default())?;
+        let buffer = Buffer::with_data(
+            &self.device,
+            &BufferDesc {
+                name: "brdf tables",
+                size: 0,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+            bytemuck::cast_slice(&tables.gpu_data()),
+        )?;
+        self.brdf_tables.push((bands, buffer));
+        Ok(())
+    }
+
+    /// The cached BRDF SH tables at `bands` bands, imported into `rg`.
+    fn import_brdf_tables(
+        &self,
+        rg: &mut RenderGraph,
+        bands: u32,
+    ) -> Result<shine_graph::Handle<shine_graph::Buffer>, RenderError> {
+        let buffer_read = ExternalState::new(
+            vk::PipelineStageFlags2::ALL_COMMANDS,
+            vk::AccessFlags2::MEMORY_READ,
+            vk::ImageLayout::UNDEFINED,
+        );
+        let table = self
+            .brdf_tables
+            .iter()
+            .find(|(b, _)| *b == bands)
+            .map(|(_, buffer)| buffer)
+            .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
+        Ok(rg.import_gpu_buffer(table, buffer_read, buffer_read))
+    }
+
     /// Declares every pass of a frame; returns its HDR and LDR images.
     fn declare_frame(
         &mut self,
@@ -403,19 +448,12 @@ impl Renderer {
     ) -> Result<CompositeOutputs, RenderError> {
         let hvl = settings.gi.contains(GiTechnique::Hvl);
         let conv_bands = settings.hvl.convolution_bands;
-        if hvl && !self.brdf_tables.iter().any(|(b, _)| *b == conv_bands) {
-            let tables = GatherBrdf::build(conv_bands, HemisphereSampling::default())?;
-            let buffer = Buffer::with_data(
-                &self.device,
-                &BufferDesc {
-                    name: "hvl brdf tables",
-                    size: 0,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::GpuOnly,
-                },
-                bytemuck::cast_slice(&tables.gpu_data()),
-            )?;
-            self.brdf_tables.push((conv_bands, buffer));
+        if hvl {
+            self.prepare_brdf_tables(conv_bands)?;
+        }
+        let igi_params = igi_params(settings);
+        if settings.gi.contains(GiTechnique::Igi) && igi_params.needs_brdf_tables() {
+            self.prepare_brdf_tables(igi_params.sh_order)?;
         }
         self.prepare_shadows(settings)?;
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
@@ -487,10 +525,7 @@ impl Renderer {
                     .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
                 let brdf = rg.import_gpu_buffer(table, buffer_read, buffer_read);
                 let bvh = match (params.visibility, self.bvh.as_ref()) {
-                    (true, Some(b)) => Some(hvl::BvhHandles {
-                        nodes: rg.import_gpu_buffer(&b.nodes, buffer_read, buffer_read),
-                        triangles: rg.import_gpu_buffer(&b.triangles, buffer_read, buffer_read),
-                    }),
+                    (true, Some(b)) => Some(b.import(rg, buffer_read)),
                     _ => None,
                 };
                 let low =
@@ -501,6 +536,31 @@ impl Renderer {
                     ..UpsampleParams::default()
                 };
                 Some(upsample::upsample(rg, &low, &recv, &g, &upsample_params)?)
+            }
+            Some((light, view)) if settings.gi.contains(GiTechnique::Igi) => {
+                let rsm = gbuffer::rsm(
+                    rg,
+                    &handles,
+                    view,
+                    light,
+                    settings.rsm.size,
+                    self.linear.raw(),
+                );
+                let brdf = if igi_params.needs_brdf_tables() {
+                    Some(self.import_brdf_tables(rg, igi_params.sh_order)?)
+                } else {
+                    None
+                };
+                let bvh = self.bvh.as_ref().ok_or(RenderError::NoScene)?;
+                Some(igi_indirect(
+                    rg,
+                    &igi_params,
+                    &g,
+                    &rsm,
+                    bvh,
+                    brdf.as_ref(),
+                    camera.eye,
+                )?)
             }
             _ => None,
         };
@@ -522,6 +582,49 @@ impl Renderer {
             extent,
             &CompositeParams::from_settings(&settings.output),
         ))
+    }
+}
+
+/// Paper 000's branch of the frame: VPLs from the primary light's RSM, per-pixel incident
+/// radiance SH with shadow rays through `bvh`, the discontinuity filter and the BRDF; returns the
+/// full-resolution indirect image (no receiver buffer: the interleaving needs the pixel grid).
+fn igi_indirect(
+    rg: &mut RenderGraph,
+    params: &IgiParams,
+    g: &gbuffer::GBuffer,
+    rsm: &hvl::Rsm,
+    bvh: &GpuBvh,
+    brdf: Option<&shine_graph::Handle<shine_graph::Buffer>>,
+    camera: glam::Vec3,
+) -> Result<shine_graph::Handle<shine_graph::Image>, RenderError> {
+    let buffer_read = ExternalState::new(
+        vk::PipelineStageFlags2::ALL_COMMANDS,
+        vk::AccessFlags2::MEMORY_READ,
+        vk::ImageLayout::UNDEFINED,
+    );
+    let trace = bvh.import(rg, buffer_read);
+    Ok(igi::igi(rg, g, rsm, &trace, brdf, camera, params)?)
+}
+
+/// The IGI parameters of `settings.igi` (paper 000).
+pub fn igi_params(settings: &Settings) -> IgiParams {
+    let i = &settings.igi;
+    IgiParams {
+        pattern: [i.n, i.m],
+        vpl_count: i.vpl_count,
+        sh_order: i.sh_order,
+        filter_radius: i.filter_radius,
+        mode: match i.filter {
+            IgiFilter::Sh => igi::FilterMode::Sh,
+            IgiFilter::Irradiance => igi::FilterMode::Irradiance,
+        },
+        glossy: match i.glossy {
+            IgiGlossy::Ggx => igi::Glossy::Ggx,
+            IgiGlossy::Phong => igi::Glossy::Phong,
+        },
+        clamp_distance: i.clamp_distance,
+        depth_tolerance: i.depth_tolerance,
+        normal_threshold: i.normal_threshold,
     }
 }
 

@@ -215,16 +215,38 @@ named_choice! {
 }
 
 named_choice! {
+    /// What the IGI discontinuity filter averages (paper 000 §2.3 against §3).
+    pub enum IgiFilter ("IGI filter mode") {
+        /// The per-pixel incident radiance as SH (paper 000): the BRDF is applied after filtering.
+        Sh = "sh",
+        /// Classic IGI: the per-pixel irradiance (and glossy radiance) about the shading normal.
+        Irradiance = "irradiance",
+    }
+}
+
+named_choice! {
+    /// The glossy lobe of IGI's SH resolve (`src/passes/igi.rs`).
+    pub enum IgiGlossy ("IGI glossy lobe") {
+        /// GGX through the BRDF SH tables of the HVL gather, radiance rotated per pixel.
+        Ggx = "ggx",
+        /// Paper 000 §3.3: Lambert and Phong r_l, the Phong lobe standing for the GGX.
+        Phong = "phong",
+    }
+}
+
+named_choice! {
     /// One indirect-light technique of DESIGN §4 that shine implements today.
     pub enum GiTechnique ("GI technique") {
         /// Harmonics Virtual Lights (paper 003).
         Hvl = "hvl",
+        /// Instant GI with interleaved sampling and SH-filtered incoming radiance (paper 000).
+        Igi = "igi",
     }
 }
 
 /// Techniques that later issues add: named so that asking for one says "not implemented yet"
 /// rather than "unknown".
-const PLANNED_GI: [&str; 3] = ["proxy", "igi", "aaf"];
+const PLANNED_GI: [&str; 2] = ["proxy", "aaf"];
 
 /// The name of the empty technique list: direct light only.
 const NO_GI: &str = "none";
@@ -374,6 +396,8 @@ pub struct Settings {
     pub shadow: ShadowSettings,
     /// Joint bilateral upsampling of the receiver-resolution GI (paper 002 eq. 11).
     pub upsample: UpsampleSettings,
+    /// Instant GI with SH-filtered incoming radiance (paper 000).
+    pub igi: IgiSettings,
 }
 
 /// `[output]`: how the HDR frame becomes the written image.
@@ -448,6 +472,58 @@ pub struct UpsampleSettings {
     pub normal_power: f32,
 }
 
+/// `[igi]`: instant global illumination with interleaved sampling and SH-filtered incident
+/// radiance (paper 000, `src/passes/igi.rs`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct IgiSettings {
+    /// Interleaving pattern width n (VPL sets per row of a tile). Range 1..=8, default 4.
+    pub n: u32,
+    /// Interleaving pattern height m. Range 1..=8, default 4.
+    pub m: u32,
+    /// Number of VPLs taken from the RSM (cut into exactly this many cells), shared out over
+    /// the n·m sets. Range 64..=10000 and at most `rsm.size²`, default 256.
+    pub vpl_count: u32,
+    /// SH order (bands) of the per-pixel incident radiance: 2, 3 or 4 (4, 9 or 16
+    /// coefficients). Default 3 (paper 000 §3.1).
+    pub sh_order: u32,
+    /// Size k of the discontinuity filter's window in interleaving tiles: k·n × k·m pixels
+    /// around the pixel, every set counted k² times (0: no filter; 1: exactly one tile, as
+    /// paper 000 §2.3). Range 0..=4, default 1.
+    pub filter_radius: u32,
+    /// What is filtered: `sh` (paper 000) or `irradiance` (classic IGI). Default `sh`.
+    pub filter: IgiFilter,
+    /// Glossy lobe of the SH mode: `ggx` (BRDF SH tables) or `phong` (paper 000 §3.3.2).
+    /// Default `ggx`.
+    pub glossy: IgiGlossy,
+    /// Minimum VPL distance d_min in metres: 1/d² is evaluated as 1/max(d², d_min²) (the VPL
+    /// singularity clamp). Range 0.0..=10.0, default 0.1.
+    pub clamp_distance: f32,
+    /// Relative depth tolerance of the filter: a neighbour q is used when
+    /// |z_q − z_p| ≤ depth_tolerance · z_p. Range 1e-4..=1.0, default 0.05.
+    pub depth_tolerance: f32,
+    /// Cosine threshold of the filter's geometric-normal test (n_p · n_q ≥ this).
+    /// Range -1.0..=1.0, default 0.9.
+    pub normal_threshold: f32,
+}
+
+impl Default for IgiSettings {
+    fn default() -> Self {
+        Self {
+            n: 4,
+            m: 4,
+            vpl_count: 256,
+            sh_order: 3,
+            filter_radius: 1,
+            filter: IgiFilter::Sh,
+            glossy: IgiGlossy::Ggx,
+            clamp_distance: 0.1,
+            depth_tolerance: 0.05,
+            normal_threshold: 0.9,
+        }
+    }
+}
+
 impl Default for Settings {
     fn default() -> Self {
         Self {
@@ -462,6 +538,7 @@ impl Default for Settings {
             rsm: RsmSettings::default(),
             shadow: ShadowSettings::default(),
             upsample: UpsampleSettings::default(),
+            igi: IgiSettings::default(),
         }
     }
 }
@@ -667,6 +744,39 @@ impl Settings {
             self.upsample.normal_power,
             1.0..=256.0,
         )?;
+        self.validate_igi()?;
+        Ok(())
+    }
+
+    /// The `[igi]` checks of [`Settings::validate`], and the combination rule: `igi` and `hvl`
+    /// both compute the one-bounce indirect light of the primary light, so a frame takes one.
+    fn validate_igi(&self) -> Result<(), SettingsError> {
+        let i = &self.igi;
+        check("igi.n", i.n, 1..=8)?;
+        check("igi.m", i.m, 1..=8)?;
+        check("igi.vpl_count", i.vpl_count, 64..=10_000)?;
+        check("igi.sh_order", i.sh_order, 2..=4)?;
+        check("igi.filter_radius", i.filter_radius, 0..=4)?;
+        check("igi.clamp_distance", i.clamp_distance, 0.0..=10.0)?;
+        check("igi.depth_tolerance", i.depth_tolerance, 1e-4..=1.0)?;
+        check("igi.normal_threshold", i.normal_threshold, -1.0..=1.0)?;
+        let rsm_texels = u64::from(self.rsm.size).pow(2);
+        if u64::from(i.vpl_count) > rsm_texels {
+            return Err(SettingsError::OutOfRange {
+                field: "igi.vpl_count",
+                value: i.vpl_count.to_string(),
+                allowed: format!(
+                    "at most rsm.size² = {rsm_texels} (one RSM texel per VPL at least): raise rsm.size"
+                ),
+            });
+        }
+        if self.gi.contains(GiTechnique::Igi) && self.gi.contains(GiTechnique::Hvl) {
+            return Err(SettingsError::GiList {
+                list: self.gi.to_string(),
+                reason: "`igi` and `hvl` both compute the one-bounce indirect light of the \
+                         primary light: choose one",
+            });
+        }
         Ok(())
     }
 }
@@ -870,7 +980,7 @@ mod tests {
     fn gi_errors_are_clear() {
         let unknown = "hvl,foo".parse::<GiTechniques>().unwrap_err().to_string();
         assert!(unknown.contains("`foo`"), "{unknown}");
-        assert!(unknown.contains("hvl, none, proxy, igi, aaf"), "{unknown}");
+        assert!(unknown.contains("hvl, igi, none, proxy, aaf"), "{unknown}");
         let planned = "hvl,proxy".parse::<GiTechniques>().unwrap_err().to_string();
         assert!(
             planned.contains("`proxy` is not implemented yet"),
@@ -883,13 +993,51 @@ mod tests {
                 "{bad}: {message}"
             );
         }
-        let in_file = Settings::from_toml_str("gi = \"igi\"")
+        let in_file = Settings::from_toml_str("gi = \"aaf\"")
             .unwrap_err()
             .to_string();
         assert!(
-            in_file.contains("`igi` is not implemented yet"),
+            in_file.contains("`aaf` is not implemented yet"),
             "{in_file}"
         );
+    }
+
+    #[test]
+    fn igi_settings_are_checked() {
+        let igi =
+            Settings::from_toml_str("gi = \"igi\"\n[igi]\nn = 2\nfilter = \"irradiance\"").unwrap();
+        assert!(igi.gi.contains(GiTechnique::Igi));
+        assert_eq!((igi.igi.n, igi.igi.filter), (2, IgiFilter::Irradiance));
+        type Edit = fn(&mut Settings);
+        let cases: [(&str, &str, Edit); 8] = [
+            ("igi.n", "0", |s| s.igi.n = 0),
+            ("igi.m", "9", |s| s.igi.m = 9),
+            ("igi.sh_order", "5", |s| s.igi.sh_order = 5),
+            ("igi.sh_order", "1", |s| s.igi.sh_order = 1),
+            ("igi.vpl_count", "10", |s| s.igi.vpl_count = 10),
+            ("igi.filter_radius", "5", |s| s.igi.filter_radius = 5),
+            ("igi.clamp_distance", "NaN", |s| {
+                s.igi.clamp_distance = f32::NAN
+            }),
+            ("igi.vpl_count", "300", |s| {
+                s.rsm.size = 16;
+                s.hvl.count = 64;
+                s.igi.vpl_count = 300;
+            }),
+        ];
+        for (field, value, edit) in cases {
+            let mut settings = Settings::default();
+            edit(&mut settings);
+            let message = settings.validate().unwrap_err().to_string();
+            assert!(
+                message.contains(&format!("`{field}` = {value}")),
+                "{field}: {message}"
+            );
+        }
+        let both = Settings::from_toml_str("gi = \"hvl,igi\"")
+            .unwrap_err()
+            .to_string();
+        assert!(both.contains("choose one"), "{both}");
     }
 
     #[test]

@@ -14,8 +14,8 @@ use shine::hvl_reference::{
     self as reference, Emission, Receiver, ReceiverData, RsmData, integrate_hvl,
 };
 use shine::passes::hvl::{
-    BvhHandles, CONV_BANDS, CachePush, GatherBrdf, GatherPush, Hvl, HvlError, HvlParams, Path,
-    RadiusHeuristic, Receivers, Rsm, RsmProjection, gather_variants, hvl_cache, hvl_gather,
+    CONV_BANDS, CachePush, GatherBrdf, GatherPush, Hvl, HvlError, HvlParams, Path, RadiusHeuristic,
+    Receivers, Rsm, RsmProjection, gather_variants, hvl_cache, hvl_gather,
 };
 use shine::shaders;
 use shine_sh::brdf_table::{BrdfModel, HemisphereSampling};
@@ -367,10 +367,7 @@ fn gpu_gather(
     let hvl_handle: Handle<Buffer> =
         rg.import_gpu_buffer(&hvl_buffer, uploaded_state(), UNUSED_AFTER);
     let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
-    let bvh_handles = bvh.map(|b| BvhHandles {
-        nodes: rg.import_gpu_buffer(&b.nodes, uploaded_state(), UNUSED_AFTER),
-        triangles: rg.import_gpu_buffer(&b.triangles, uploaded_state(), UNUSED_AFTER),
-    });
+    let bvh_handles = bvh.map(|b| b.import(&mut rg, uploaded_state()));
     let indirect = hvl_gather(
         &mut rg,
         &recv,

@@ -137,6 +137,11 @@ impl GpuGBuffer {
             albedo,
             material,
             emissive: unused(rg, "unused emissive", vk::Format::R16G16B16A16_SFLOAT),
+            geometric_normal: unused(
+                rg,
+                "unused geometric normal",
+                vk::Format::R16G16B16A16_SFLOAT,
+            ),
             depth: unused(rg, "unused depth", vk::Format::D32_SFLOAT),
             extent: self.extent,
         }
@@ -224,6 +229,7 @@ fn bad_scales_extents_and_parameters_are_errors() {
         albedo: h,
         material: h,
         emissive: h,
+        geometric_normal: h,
         depth: h,
         extent: [8, 8],
     };

@@ -139,6 +139,132 @@ void sh_cap(vec3 d, float cos_a, out float c[SH_COEFFS]) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// General rotation (Ivanic-Ruedenberg), compiled for SH_BANDS <= 4 only (per-pixel use)
+// ---------------------------------------------------------------------------------------------
+#if SH_BANDS <= 4
+
+// Floats of the block-diagonal rotation of SH_BANDS bands: sum over l of (2l+1)^2.
+#define SH_ROT_SIZE (SH_BANDS * (4 * SH_BANDS * SH_BANDS - 1) / 3)
+
+// First float of band l's (2l+1)^2 row-major block (row/column index m + l).
+int sh_rot_offset(int l) {
+    return l * (4 * l * l - 1) / 3;
+}
+
+// Work array of sh_rotation (private to the invocation): the recurrence reads it in place, so
+// no array is copied per call of sh_rot_p.
+float sh_rot_work[SH_ROT_SIZE];
+
+// Ivanic-Ruedenberg P of shine_sh::rotation::band_from_previous, in the basis without the
+// Condon-Shortley phase: band 1 at sh_rot_work[1..10], band l-1 at sh_rot_offset(l - 1).
+float sh_rot_p(int l, int i, int a, int b) {
+    int po = sh_rot_offset(l - 1);
+    int wp = 2 * l - 1;
+    float r_i1 = sh_rot_work[1 + (i + 1) * 3 + 2];
+    float r_im1 = sh_rot_work[1 + (i + 1) * 3];
+    if (b == l) {
+        return r_i1 * sh_rot_work[po + (a + l - 1) * wp + (2 * l - 2)] - r_im1 * sh_rot_work[po + (a + l - 1) * wp];
+    }
+    if (b == -l) {
+        return r_i1 * sh_rot_work[po + (a + l - 1) * wp] + r_im1 * sh_rot_work[po + (a + l - 1) * wp + (2 * l - 2)];
+    }
+    return sh_rot_work[1 + (i + 1) * 3 + 1] * sh_rot_work[po + (a + l - 1) * wp + (b + l - 1)];
+}
+
+// shine_sh::rotation::ShRotation::from_mat3(r) (its blocks, same layout): g = D(R) f rotates a
+// function with R, g(s) = f(R^-1 s). r: orthonormal, det 1 (GLSL column-major mat3).
+void sh_rotation(mat3 r, out float d[SH_ROT_SIZE]) {
+    sh_rot_work[0] = 1.0;
+#if SH_BANDS > 1
+    // Band 1, m = -1, 0, 1 <-> y, z, x.
+    int axis[3] = int[](1, 2, 0);
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j) {
+            sh_rot_work[1 + i * 3 + j] = r[axis[j]][axis[i]];
+        }
+    }
+    for (int l = 2; l < SH_BANDS; ++l) {
+        int w = 2 * l + 1;
+        int o = sh_rot_offset(l);
+        float lf = float(l);
+        for (int m = -l; m <= l; ++m) {
+            float am = float(abs(m));
+            float k0 = m == 0 ? 1.0 : 0.0;
+            for (int n = -l; n <= l; ++n) {
+                float den = abs(n) < l ? float((l + n) * (l - n)) : float(2 * l * (2 * l - 1));
+                float u = sqrt(float((l + m) * (l - m)) / den);
+                float v = 0.5 * sqrt((1.0 + k0) * (lf + am - 1.0) * (lf + am) / den) * (1.0 - 2.0 * k0);
+                float wc = -0.5 * sqrt(max((lf - am - 1.0) * (lf - am) / den, 0.0)) * (1.0 - k0);
+                float val = 0.0;
+                if (u != 0.0) {
+                    val += u * sh_rot_p(l, 0, m, n);
+                }
+                if (v != 0.0) {
+                    float vv;
+                    if (m == 0) {
+                        vv = sh_rot_p(l, 1, 1, n) + sh_rot_p(l, -1, -1, n);
+                    } else if (m > 0) {
+                        float k1 = m == 1 ? 1.0 : 0.0;
+                        vv = sh_rot_p(l, 1, m - 1, n) * sqrt(1.0 + k1);
+                        if (m != 1) {
+                            vv -= sh_rot_p(l, -1, -m + 1, n);
+                        }
+                    } else {
+                        float km1 = m == -1 ? 1.0 : 0.0;
+                        vv = sh_rot_p(l, -1, -m - 1, n) * sqrt(1.0 + km1);
+                        if (m != -1) {
+                            vv += sh_rot_p(l, 1, m + 1, n);
+                        }
+                    }
+                    val += v * vv;
+                }
+                if (wc != 0.0) {
+                    float ww;
+                    if (m > 0) {
+                        ww = sh_rot_p(l, 1, m + 1, n) + sh_rot_p(l, -1, -m - 1, n);
+                    } else {
+                        ww = sh_rot_p(l, 1, m - 1, n) - sh_rot_p(l, -1, -m + 1, n);
+                    }
+                    val += wc * ww;
+                }
+                sh_rot_work[o + (m + l) * w + (n + l)] = val;
+            }
+        }
+    }
+    // To the Condon-Shortley basis: D_cs[m][n] = (-1)^(m+n) D[m][n].
+    for (int l = 1; l < SH_BANDS; ++l) {
+        int w = 2 * l + 1;
+        int o = sh_rot_offset(l);
+        for (int i = 0; i < w; ++i) {
+            for (int j = 0; j < w; ++j) {
+                if (((i + j) & 1) == 1) {
+                    sh_rot_work[o + i * w + j] = -sh_rot_work[o + i * w + j];
+                }
+            }
+        }
+    }
+#endif
+    d = sh_rot_work;
+}
+
+// shine_sh::rotation::ShRotation::apply
+void sh_rotation_apply(float d[SH_ROT_SIZE], float c[SH_COEFFS], out float o[SH_COEFFS]) {
+    for (int l = 0; l < SH_BANDS; ++l) {
+        int w = 2 * l + 1;
+        int base = l * l;
+        int off = sh_rot_offset(l);
+        for (int i = 0; i < w; ++i) {
+            float s = 0.0;
+            for (int j = 0; j < w; ++j) {
+                s += d[off + i * w + j] * c[base + j];
+            }
+            o[base + i] = s;
+        }
+    }
+}
+#endif
+
+// ---------------------------------------------------------------------------------------------
 // Kernels, convolution, windowing
 // ---------------------------------------------------------------------------------------------
 

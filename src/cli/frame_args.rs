@@ -20,7 +20,7 @@ pub struct SettingsArgs {
     /// Scene time in seconds (animations).
     #[arg(long)]
     time: Option<f32>,
-    /// GI techniques: `hvl` (default), `none`; later `proxy`, `igi`, `aaf`, combined with commas.
+    /// GI techniques: `hvl` (default), `igi`, `none`; later `proxy`, `aaf`, combined with commas.
     #[arg(long)]
     gi: Option<String>,
     /// Tonemapping: none, aces, pbr-neutral.

@@ -192,6 +192,9 @@ pub struct GBuffer {
     pub material: Handle<Image>,
     /// Emitted radiance.
     pub emissive: Handle<Image>,
+    /// World geometric normal: the interpolated vertex normal before normal mapping, facing
+    /// the camera (`gb_geometric_normal`, RGBA16F; paper 000's filter tests it).
+    pub geometric_normal: Handle<Image>,
     /// Hardware depth.
     pub depth: Handle<Image>,
     /// Width and height.
@@ -261,6 +264,7 @@ pub fn gbuffer(
         albedo: image(rg, "gb_albedo", vk::Format::R8G8B8A8_UNORM),
         material: image(rg, "gb_material", vk::Format::R8G8B8A8_UNORM),
         emissive: image(rg, "gb_emissive", vk::Format::R16G16B16A16_SFLOAT),
+        geometric_normal: image(rg, "gb_geometric_normal", vk::Format::R16G16B16A16_SFLOAT),
         depth: image(rg, "depth", vk::Format::D32_SFLOAT),
         extent,
     };
@@ -272,6 +276,7 @@ pub fn gbuffer(
             vk::Format::R8G8B8A8_UNORM,
             vk::Format::R8G8B8A8_UNORM,
             vk::Format::R16G16B16A16_SFLOAT,
+            vk::Format::R16G16B16A16_SFLOAT,
         ],
         None,
     );
@@ -281,6 +286,7 @@ pub fn gbuffer(
         .color(&mut g.albedo, ColorLoad::Clear([0.0; 4]))
         .color(&mut g.material, ColorLoad::Clear([0.0; 4]))
         .color(&mut g.emissive, ColorLoad::Clear([0.0; 4]))
+        .color(&mut g.geometric_normal, ColorLoad::Clear([0.0; 4]))
         .depth(&mut g.depth, DepthLoad::Clear(1.0))
         .read("materials", &scene.materials)
         .read("srgb_textures", &scene.srgb_textures)

@@ -58,6 +58,7 @@ use glam::Vec3;
 use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
 
 use crate::gpu::ShaderDesc;
+use crate::gpu_bvh::TraceBuffers;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
 
@@ -631,16 +632,6 @@ fn cache_push(
     }
 }
 
-/// The scene's BVH buffers (`crate::gpu_bvh::GpuBvh`) imported into a graph, for the shadow
-/// rays of [`HvlParams::visibility`].
-#[derive(Debug, Clone, Copy)]
-pub struct BvhHandles {
-    /// `bvh_nodes`.
-    pub nodes: Handle<Buffer>,
-    /// `bvh_triangles`.
-    pub triangles: Handle<Buffer>,
-}
-
 /// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
 /// radiance towards `camera` from all `params.count` HVLs of `hvls`, 0 on background), returned.
 /// `brdf` holds [`GatherBrdf::gpu_data`] at `params.conv_bands` bands (unused by the zonal
@@ -650,7 +641,7 @@ pub fn hvl_gather(
     receivers: &Receivers,
     hvls: &Handle<Buffer>,
     brdf: &Handle<Buffer>,
-    bvh: Option<&BvhHandles>,
+    bvh: Option<&TraceBuffers>,
     camera: Vec3,
     params: &HvlParams,
 ) -> Result<Handle<Image>, HvlError> {

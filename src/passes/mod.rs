@@ -6,6 +6,7 @@ pub mod composite;
 pub mod direct;
 pub mod gbuffer;
 pub mod hvl;
+pub mod igi;
 pub mod path_trace;
 pub mod receivers;
 pub mod shadows;

@@ -1,0 +1,140 @@
+// vpl_sh (paper 000 §3, steps 1-2): each pixel's incident radiance from the VPLs of its
+// interleaved set, with shadow rays through the BVH, projected to SH (variants o2, o3, o4: SH
+// order = bands) or, for classic IGI (variant irr), reduced to the irradiance about the shading
+// normal and the glossy radiance about the reflected direction. Output: `vpl_sh`, per pixel
+// SH_OUT coefficients of rgb as two uints (packHalf2x16(r, g), packHalf2x16(b, 0)), row-major
+// pixels, coefficient-minor. CPU twin: shine::igi_reference::vpl_sh.
+//
+// Pixel px uses set s = igi_set(px): the VPLs of global index i = s + k n m < M, k = 0, 1, ...,
+// VPL record igi_vpl_cell(i) of the HVL cache layout (shaders/include/hvl.glsl). The set holds
+// |S_s| = ceil((M - s) / nm) of the M VPLs, so each contribution is scaled by M / |S_s| (an
+// unbiased estimate of the sum over all VPLs).
+//! variant o2 SH_BANDS=2
+//! variant o3 SH_BANDS=3
+//! variant o4 SH_BANDS=4
+//! variant irr SH_BANDS=1 IGI_IRRADIANCE=1
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "igi.glsl"
+#include "hvl.glsl"
+#define TRACE_NODES_BINDING 6
+#define TRACE_TRIANGLES_BINDING 7
+#include "trace.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 1, rgba16f) readonly uniform image2D gb_geometric_normal;
+#ifdef IGI_IRRADIANCE
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D gb_normal;
+layout(set = 0, binding = 3, rgba8) readonly uniform image2D gb_material;
+#endif
+
+layout(set = 0, binding = 4, std430) readonly buffer Vpls {
+    Hvl h[];
+} vpls;
+
+layout(set = 0, binding = 5, std430) buffer VplSh {
+    uint c[];
+} vpl_sh;
+
+#ifdef IGI_IRRADIANCE
+#define SH_OUT 2
+#else
+#define SH_OUT SH_COEFFS
+#endif
+
+// shine::passes::igi::VplShPush
+layout(push_constant) uniform Push {
+    // xyz: camera position; w: clamp distance d_min (metres)
+    vec4 camera_clamp;
+    // image size
+    uvec2 extent;
+    // interleaving pattern n, m
+    uvec2 pattern;
+    // VPL count M
+    uint vpl_count;
+    // permutation stride (coprime with M)
+    uint stride;
+    uint pad0;
+    uint pad1;
+} push;
+
+// A ray to a VPL stops this fraction short of it (the VPL lies on a surface).
+const float IGI_SHADOW_END = 0.999;
+
+void store(uint base, int k, vec3 v) {
+    v = clamp(v, vec3(-65504.0), vec3(65504.0));
+    vpl_sh.c[base + 2u * uint(k)] = packHalf2x16(v.rg);
+    vpl_sh.c[base + 2u * uint(k) + 1u] = packHalf2x16(vec2(v.b, 0.0));
+}
+
+void main() {
+    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
+        return;
+    }
+    uint base = (uint(px.y) * push.extent.x + uint(px.x)) * uint(SH_OUT) * 2u;
+    vec3 acc[SH_OUT];
+    for (int k = 0; k < SH_OUT; ++k) {
+        acc[k] = vec3(0.0);
+    }
+    vec4 position = imageLoad(gb_position, px);
+    if (position.w != 0.0) {
+        vec3 x = position.xyz;
+        vec3 ng = normalize(imageLoad(gb_geometric_normal, px).xyz);
+        vec3 origin = trace_offset(x, ng);
+#ifdef IGI_IRRADIANCE
+        vec3 n = normalize(imageLoad(gb_normal, px).xyz);
+        vec3 wo = normalize(push.camera_clamp.xyz - x);
+        vec3 r = reflect(-wo, n);
+        float exponent = igi_phong_exponent(imageLoad(gb_material, px).r);
+        float lobe_norm = (exponent + 1.0) / (2.0 * IGI_PI);
+#endif
+        uint sets = push.pattern.x * push.pattern.y;
+        uint s = igi_set(px, push.pattern);
+        if (s < push.vpl_count) {
+            uint members = (push.vpl_count - s + sets - 1u) / sets;
+            float scale = float(push.vpl_count) / float(members);
+            for (uint i = s; i < push.vpl_count; i += sets) {
+                uint j = igi_vpl_cell(i, push.stride, push.vpl_count);
+                // Field by field: naga cannot read a whole-struct copy out of a buffer.
+                vec4 position_radius = vpls.h[j].position_radius;
+                vec4 flux = vpls.h[j].flux;
+                if (flux.a == 0.0) {
+                    continue;
+                }
+                vec3 v = position_radius.xyz - x;
+                float dist = length(v);
+                if (!(dist > 0.0)) {
+                    continue;
+                }
+                vec3 w = v / dist;
+                // Light from below the geometric surface cannot reach x.
+                if (dot(w, ng) <= 0.0) {
+                    continue;
+                }
+                vec3 e = igi_vpl_irradiance(flux.rgb, vpls.h[j].normal_distance.xyz, w, dist, push.camera_clamp.w) * scale;
+                if (all(equal(e, vec3(0.0)))) {
+                    continue;
+                }
+                if (trace_occluded(origin, w, 0.0, length(position_radius.xyz - origin) * IGI_SHADOW_END)) {
+                    continue;
+                }
+#ifdef IGI_IRRADIANCE
+                acc[0] += e * max(0.0, dot(n, w));
+                acc[1] += e * (lobe_norm * pow(max(0.0, dot(r, w)), exponent));
+#else
+                float y[SH_COEFFS];
+                sh_basis(w, y);
+                for (int k = 0; k < SH_COEFFS; ++k) {
+                    acc[k] += e * y[k];
+                }
+#endif
+            }
+        }
+    }
+    for (int k = 0; k < SH_OUT; ++k) {
+        store(base, k, acc[k]);
+    }
+}
