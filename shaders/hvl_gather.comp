@@ -10,7 +10,8 @@
 //     the xz half-plane), F rows of the BRDF SH tables interpolated at theta_o (eq. 18), the
 //     glossy row blended between the two GGX tables around the receiver's roughness;
 //   zonal path (O(n)): L_j * kd * sum_l cap_l (cc_l / pi) P_l(n . omega_j) (Lambert only).
-// kd = albedo (1 - metallic), ks = mix(1, albedo, metallic). Each HVL's contribution is clamped
+// kd, ks: brdf_indirect_weights (Schlick F at n.v; ks over the tables' own dielectric F). Each
+// HVL's contribution is clamped
 // at 0 per channel (band-limited ringing must not go negative in the RGBA16F output; the
 // paper's sinc window is not applied). CPU twin: shine::hvl_reference.
 //! variant full_c1 HVL_FULL=1 SH_BANDS=1
@@ -56,6 +57,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "sh.glsl"
+#include "brdf.glsl"
 #include "hvl.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -137,11 +139,13 @@ void main() {
     vec3 albedo = imageLoad(recv_albedo, px).rgb;
     vec2 roughness_metallic = imageLoad(recv_material, px).rg;
     float metallic = roughness_metallic.y;
-    vec3 kd = albedo * (1.0 - metallic);
-#ifdef HVL_FULL
-    vec3 ks = mix(vec3(1.0), albedo, metallic);
     vec3 wo = normalize(push.camera.xyz - x);
     float cos_o = dot(n, wo);
+    vec3 kd;
+    vec3 ks;
+    brdf_indirect_weights(albedo, metallic, cos_o, kd, ks);
+#ifdef HVL_FULL
+    ks = brdf_table_fresnel_weight(ks, cos_o);
     if (cos_o <= 0.0) {
         imageStore(indirect, px, vec4(0.0));
         return;

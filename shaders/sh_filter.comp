@@ -11,11 +11,11 @@
 // k = 0 is no filter.
 // Resolve (paper 000 §3.1, §3.3) about the SHADING normal n and reflected direction r:
 //   SH, Phong (o2-o4): L_o = kd . (L . B_lambert(n)) + ks . (L . B_phong(r, e)), per channel,
-//     kd, ks: igi_material_weights; e = igi_phong_exponent(roughness);
+//     kd, ks: brdf_indirect_weights; e = igi_phong_exponent(roughness);
 //   SH, GGX (g2-g4): L rotated into the receiver frame of the BRDF SH tables (z = n, omega_o
 //     in the xz half-plane) by sh_rotation, then kd (L . F_lambert(theta_o)) +
-//     igi_ggx_table_weight(ks) (L . F_ggx(roughness, theta_o)) with the HVL gather's tables
-//     (brdf_table.glsl) and the weights of igi_material_weights;
+//     brdf_table_fresnel_weight(ks) (L . F_ggx(roughness, theta_o)) with the HVL gather's tables
+//     (brdf_table.glsl) and the weights of brdf_indirect_weights;
 //   irr: L_o = kd / pi . E + ks . G.
 // Output clamped at 0 per channel (band-limited ringing must not go negative in RGBA16F).
 //! variant o2 SH_BANDS=2
@@ -28,6 +28,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "igi.glsl"
+#include "brdf.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -139,8 +140,8 @@ void main() {
 #if defined(IGI_GGX)
     vec3 kd;
     vec3 ks;
-    igi_material_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
-    ks = igi_ggx_table_weight(ks, dot(n, wo));
+    brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
+    ks = brdf_table_fresnel_weight(ks, dot(n, wo));
     // A shading normal facing away from the viewer is evaluated at grazing view.
     float cos_o = clamp(dot(n, wo), 1e-4, 1.0);
     vec3 t = wo - n * dot(n, wo);
@@ -169,12 +170,12 @@ void main() {
 #elif defined(IGI_IRRADIANCE)
     vec3 kd;
     vec3 ks;
-    igi_material_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
+    brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
     result = kd / IGI_PI * (sum[0] / count) + ks * (sum[1] / count);
 #else
     vec3 kd;
     vec3 ks;
-    igi_material_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
+    brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
     float exponent = igi_phong_exponent(roughness_metallic.x);
     float b_lambert[SH_COEFFS];
     float b_phong[SH_COEFFS];

@@ -17,6 +17,7 @@ use shine_sh::zonal::{cap_sh, cap_zh, sphere_half_angle};
 
 use crate::passes::hvl::{
     EMISSION_MAX_BANDS, GatherBrdf, Hvl, HvlError, HvlParams, Path, RadiusHeuristic, RsmProjection,
+    indirect_weights, table_fresnel_weight,
 };
 
 /// ε of the r1 weights `w_n = 1 / (|d - d_n| + ε)`, metres (eq. 23, paper 003); the GLSL
@@ -96,14 +97,15 @@ pub struct Receiver {
 }
 
 impl Receiver {
-    /// Diffuse weight `kd = albedo (1 - metallic)`.
-    pub fn kd(&self) -> Vec3 {
-        self.albedo * (1.0 - self.metallic)
-    }
-
-    /// Glossy weight `ks = mix(1, albedo, metallic)`.
-    pub fn ks(&self) -> Vec3 {
-        Vec3::ONE.lerp(self.albedo, self.metallic)
+    /// `(kd, ks)` seen from `camera`: [`indirect_weights`] at n·v, the glossy weight through
+    /// [`table_fresnel_weight`] (the gather's GGX tables hold the dielectric Fresnel).
+    pub fn weights(&self, camera: Vec3) -> (Vec3, Vec3) {
+        let n_dot_v = self
+            .normal
+            .normalize()
+            .dot((camera - self.position).normalize());
+        let (kd, ks) = indirect_weights(self.albedo, self.metallic, n_dot_v);
+        (kd, table_fresnel_weight(ks, n_dot_v))
     }
 }
 
@@ -323,7 +325,7 @@ pub fn shade(
     };
     let emission = Emission::Sh(params.emission_bands as usize);
     let (x, n) = (receiver.position, receiver.normal.normalize());
-    let (kd, ks) = (receiver.kd(), receiver.ks());
+    let (kd, ks) = receiver.weights(camera);
     let mut sum = Vec3::ZERO;
     match params.path {
         Path::Full => {
@@ -435,7 +437,8 @@ pub fn integrate_hvl(
         let wi = to_local(w);
         glossy.eval(wi, wo) * wi.z.max(0.0)
     });
-    lj * (receiver.kd() * diffuse as f32 + receiver.ks() * specular as f32)
+    let (kd, ks) = receiver.weights(camera);
+    lj * (kd * diffuse as f32 + ks * specular as f32)
 }
 
 #[cfg(test)]

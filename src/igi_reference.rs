@@ -7,7 +7,7 @@ use glam::{Mat3, Vec3, Vec4};
 use shine_sh::rotation::ShRotation;
 use shine_sh::{ShError, basis, kernels, zonal};
 
-use crate::passes::hvl::{GatherBrdf, Hvl};
+use crate::passes::hvl::{GatherBrdf, Hvl, indirect_weights, table_fresnel_weight};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams, permutation_stride, pixel_set, vpl_cell};
 
 /// `IGI_MIN_DISTANCE` of igi.glsl (metres).
@@ -47,14 +47,6 @@ pub fn phong_exponent(roughness: f32) -> f32 {
     (0.5 / (a * a) - 0.5).clamp(1.0, PHONG_MAX)
 }
 
-/// `igi_material_weights`: `(kd, ks)` with Schlick's Fresnel at the mirror direction.
-pub fn material_weights(albedo: Vec3, metallic: f32, n_dot_v: f32) -> (Vec3, Vec3) {
-    let f0 = Vec3::splat(0.04).lerp(albedo, metallic);
-    let ks = f0 + (Vec3::ONE - f0) * (1.0 - n_dot_v.clamp(0.0, 1.0)).powi(5);
-    let kd = (Vec3::ONE - ks) * (1.0 - metallic) * albedo;
-    (kd, ks)
-}
-
 /// `igi_brdf_lambert` and `igi_brdf_phong` with k_d = k_s = 1: paper 000 §3.3
 /// `B_lm = sqrt(4π/(2l+1)) r_l Y_lm(w_c)` from shine-sh's [`kernels::lambert_r`] about `n` and
 /// [`kernels::phong_r`] about `r`.
@@ -64,16 +56,10 @@ pub fn brdf_sh(n: Vec3, r: Vec3, exponent: f32, bands: usize) -> Result<[Vec<f32
     Ok([lambert, phong])
 }
 
-/// `igi_ggx_table_weight`: `ks` over Schlick's F with F0 = 0.04 at `n_dot_v` (the tables hold the
-/// dielectric Fresnel).
-pub fn ggx_table_weight(ks: Vec3, n_dot_v: f32) -> Vec3 {
-    ks / (0.04 + 0.96 * (1.0 - n_dot_v.clamp(0.0, 1.0)).powi(5))
-}
-
 /// The GGX path of `sh_filter` for one pixel: `sh` (world-frame rgb SH, already filtered)
 /// rotated into the receiver frame of the BRDF SH tables (z = `n`, `wo` in the xz half-plane)
 /// with shine-sh's rotation, dotted with the Lambert and the roughness-blended GGX rows, weighted
-/// by [`material_weights`] (the glossy one through [`ggx_table_weight`]).
+/// by [`indirect_weights`] (the glossy one through [`table_fresnel_weight`]).
 pub fn ggx_resolve(
     sh: &[Vec3],
     n: Vec3,
@@ -84,8 +70,8 @@ pub fn ggx_resolve(
     tables: &GatherBrdf,
 ) -> Result<Vec3, ShError> {
     let bands = basis_bands(sh.len());
-    let (kd, ks) = material_weights(albedo, metallic, n.dot(wo));
-    let ks = ggx_table_weight(ks, n.dot(wo));
+    let (kd, ks) = indirect_weights(albedo, metallic, n.dot(wo));
+    let ks = table_fresnel_weight(ks, n.dot(wo));
     let cos_o = n.dot(wo).clamp(1e-4, 1.0);
     let mut t = wo - n * n.dot(wo);
     if t.length_squared() < 1e-12 {
@@ -258,7 +244,7 @@ pub fn sh_filter(
         let albedo = g.albedo[p].truncate();
         let (roughness, metallic) = (g.material[p].x, g.material[p].y);
         let wo = (camera - x).normalize();
-        let (kd, ks) = material_weights(albedo, metallic, n.dot(wo));
+        let (kd, ks) = indirect_weights(albedo, metallic, n.dot(wo));
         let result = match params.mode {
             FilterMode::Irradiance => {
                 kd / std::f32::consts::PI * (sum[0] / count) + ks * (sum[1] / count)
@@ -313,7 +299,7 @@ pub fn brute_force(
             let wo = (camera - x).normalize();
             let r = (-wo).reflect(n);
             let exponent = phong_exponent(g.material[p].x);
-            let (kd, ks) = material_weights(g.albedo[p].truncate(), g.material[p].y, n.dot(wo));
+            let (kd, ks) = indirect_weights(g.albedo[p].truncate(), g.material[p].y, n.dot(wo));
             let mut sum = Vec3::ZERO;
             for vpl in &vpls[..params.vpl_count as usize] {
                 let Some((dir, e)) = contribution(vpl, x, ng, params.clamp_distance, 1.0) else {

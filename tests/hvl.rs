@@ -743,16 +743,17 @@ fn single_hvl_against_numerical_integration() {
     // Worst relative error (of the largest channel) per variant: against the integral with the
     // same band-limited emission (the convolution's SH truncation alone) and against the exact
     // Lambert emission (everything: the 3-band emission F'·Y overshoots by up to 25% near the
-    // sender's normal, the paper's choice). Measured on lavapipe for these receivers:
-    //   full c3 e3: 0.049 / 0.311    full c5 e3: 0.029 / 0.331    full c9 e3: 0.008 / 0.326
-    //   full c5 e5: 0.029 / 0.209    zonal c3 e3: 0.058 / 0.322   zonal c9 e3: 0.008 / 0.326
-    //   (full c10 e5, not run here for its 13 s lavapipe compile: 0.008 / 0.193)
+    // sender's normal, the paper's choice). The half-metallic receivers carry a GGX lobe
+    // (roughness 0.6) weighted by their own Fresnel (≈ 10× the dielectric one), which 3 and 5
+    // bands truncate visibly. Measured on lavapipe for these receivers:
+    //   full c3 e3: 0.274 / 0.305    full c5 e3: 0.111 / 0.329    full c9 e3: 0.011 / 0.326
+    //   full c5 e5: 0.111 / 0.266    zonal c3 e3: 0.058 / 0.321   zonal c9 e3: 0.008 / 0.326
     // Tolerances: the measured value with a margin for table and quadrature resolution.
     let cases: [(Path, u32, u32, f32, f32); 6] = [
-        (Path::Full, 3, 3, 0.07, 0.40),
-        (Path::Full, 5, 3, 0.045, 0.40),
-        (Path::Full, 5, 5, 0.045, 0.25),
-        (Path::Full, 9, 3, 0.015, 0.40),
+        (Path::Full, 3, 3, 0.32, 0.40),
+        (Path::Full, 5, 3, 0.14, 0.40),
+        (Path::Full, 5, 5, 0.14, 0.32),
+        (Path::Full, 9, 3, 0.02, 0.40),
         (Path::Zonal, 3, 3, 0.08, 0.40),
         (Path::Zonal, 9, 3, 0.015, 0.40),
     ];

@@ -105,4 +105,23 @@ vec3 brdf_sample(vec3 n, vec3 v, float p_specular, float roughness, vec3 xi) {
     return sample_cosine(n, xi.xy);
 }
 
+// Diffuse and specular weights of the metallic-roughness material for indirect light (HVL and
+// IGI), shine::passes::hvl::indirect_weights:
+// Schlick's Fresnel at the mirror direction (v . h = n . v), kd = (1 - F)(1 - metallic) albedo
+// (the direct pass's diffuse), ks = F.
+void brdf_indirect_weights(vec3 albedo, float metallic, float n_dot_v, out vec3 kd, out vec3 ks) {
+    vec3 f0 = mix(vec3(0.04), albedo, metallic);
+    ks = f0 + (1.0 - f0) * pow(1.0 - clamp(n_dot_v, 0.0, 1.0), 5.0);
+    kd = (1.0 - ks) * (1.0 - metallic) * albedo;
+}
+
+// shine::passes::hvl::table_fresnel_weight. Weight of the GGX tables' glossy row (they hold the exact dielectric Fresnel, eta = 1.5): the
+// material's Schlick F over the tables' F at the mirror direction (v . h = n . v), Schlick with
+// F0 = 0.04 standing for the latter: 1 for dielectrics, about albedo / 0.04 at normal view for
+// metals.
+vec3 brdf_table_fresnel_weight(vec3 ks, float n_dot_v) {
+    float f_table = 0.04 + 0.96 * pow(1.0 - clamp(n_dot_v, 0.0, 1.0), 5.0);
+    return ks / f_table;
+}
+
 #endif

@@ -51,24 +51,6 @@ void igi_brdf_phong(vec3 r, float exponent, out float b[SH_COEFFS]) {
     sh_rotate_zh(k, r, b);
 }
 
-// Diffuse and specular weights of the metallic-roughness material for the indirect light:
-// Schlick's Fresnel at the mirror direction (v . h = n . v), kd = (1 - F)(1 - metallic) albedo
-// (the direct pass's diffuse), ks = F.
-void igi_material_weights(vec3 albedo, float metallic, float n_dot_v, out vec3 kd, out vec3 ks) {
-    vec3 f0 = mix(vec3(0.04), albedo, metallic);
-    ks = f0 + (1.0 - f0) * pow(1.0 - clamp(n_dot_v, 0.0, 1.0), 5.0);
-    kd = (1.0 - ks) * (1.0 - metallic) * albedo;
-}
-
-// Weight of the GGX tables' glossy row (they hold the exact dielectric Fresnel, eta = 1.5): the
-// material's Schlick F over the tables' F at the mirror direction (v . h = n . v), Schlick with
-// F0 = 0.04 standing for the latter: 1 for dielectrics, about albedo / 0.04 at normal view for
-// metals.
-vec3 igi_ggx_table_weight(vec3 ks, float n_dot_v) {
-    float f_table = 0.04 + 0.96 * pow(1.0 - clamp(n_dot_v, 0.0, 1.0), 5.0);
-    return ks / f_table;
-}
-
 // The set of pixel px in an n x m interleaving pattern (paper 000 §2.3): s = (x mod n) + n (y mod m).
 uint igi_set(ivec2 px, uvec2 pattern) {
     return uint(px.x) % pattern.x + pattern.x * (uint(px.y) % pattern.y);

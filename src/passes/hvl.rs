@@ -35,8 +35,9 @@
 //!   (shine's extension; measured against the path tracer in the issue notes).
 //! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
 //!   never makes `indirect` negative; the paper's sinc window (§4.2) is not applied.
-//! * **Receiver BRDF.** `kd = albedo (1 - metallic)` times Lambert, `ks = mix(1, albedo,
-//!   metallic)` times GGX (dielectric Fresnel, η = 1.5) at the receiver's roughness: the paper
+//! * **Receiver BRDF.** `kd` times Lambert and `ks` times GGX (its tables hold the dielectric
+//!   Fresnel of η = 1.5; [`table_fresnel_weight`] turns it into the material's) at the
+//!   receiver's roughness, with the weights of [`indirect_weights`]: the paper
 //!   tabulates one table per material; we tabulate [`GLOSSY_TABLES`] roughness nodes
 //!   ([`glossy_roughness`]) and interpolate the two tables around the receiver's roughness
 //!   linearly, which serves every material of every scene with one buffer. Rougher than the
@@ -49,10 +50,11 @@
 //! # Accuracy
 //!
 //! One HVL against a quadrature of eq. 3 with eq. 19–21 (`tests/hvl.rs`, worst relative error
-//! over 8 receivers, GGX α = 0.5 glossy): the SH truncation of the convolution alone is 4.9% at
-//! 3 bands, 2.9% at 5, 0.8% at 9 (zonal: 5.8% at 3, 0.8% at 9); with the exact Lambert emission
-//! as reference the total is 31–33% with 3 emission bands (the band-limited `F'·Y` overshoots
-//! near the sender's normal, the paper's choice) and 19–21% with 5.
+//! over 8 receivers, three of them half-metallic with a GGX lobe of roughness 0.6): the SH
+//! truncation of the convolution alone is 27% at 3 bands, 11% at 5, 1.1% at 9 (the metallic
+//! lobes; zonal, Lambert only: 5.8% at 3, 0.8% at 9); with the exact Lambert emission as
+//! reference the total is 31–33% with 3 emission bands (the band-limited `F'·Y` overshoots
+//! near the sender's normal, the paper's choice) and 27% with 5.
 
 use glam::Vec3;
 use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
@@ -479,6 +481,25 @@ pub fn glossy_blend(roughness: f32) -> (u32, u32, f32) {
     let k0 = (x.floor() as u32).min(GLOSSY_TABLES - 1);
     let k1 = (k0 + 1).min(GLOSSY_TABLES - 1);
     (k0, k1, x - k0 as f32)
+}
+
+/// Diffuse and specular weights `(kd, ks)` of the metallic-roughness material for indirect
+/// light (HVL and IGI; GLSL `brdf_indirect_weights`): Schlick's Fresnel F at the mirror
+/// direction (v·h = n·v), `kd = (1 - F)(1 - metallic) albedo` (the direct pass's diffuse),
+/// `ks = F` with `F0 = mix(0.04, albedo, metallic)`.
+pub fn indirect_weights(albedo: Vec3, metallic: f32, n_dot_v: f32) -> (Vec3, Vec3) {
+    let f0 = Vec3::splat(0.04).lerp(albedo, metallic);
+    let ks = f0 + (Vec3::ONE - f0) * (1.0 - n_dot_v.clamp(0.0, 1.0)).powi(5);
+    let kd = (Vec3::ONE - ks) * (1.0 - metallic) * albedo;
+    (kd, ks)
+}
+
+/// The weight of a GGX table's glossy row for a material whose Fresnel is `ks` (GLSL
+/// `brdf_table_fresnel_weight`): the tables already hold the dielectric Fresnel of
+/// [`GLOSSY_IOR`], so `ks` is divided by Schlick's F with F0 = 0.04 at `n_dot_v` (1 for
+/// dielectrics, about albedo / 0.04 for metals at normal view).
+pub fn table_fresnel_weight(ks: Vec3, n_dot_v: f32) -> Vec3 {
+    ks / (0.04 + 0.96 * (1.0 - n_dot_v.clamp(0.0, 1.0)).powi(5))
 }
 
 /// The receiver BRDF SH tables of the full gather path (paper 003 §4.2, eq. 18): `F` of

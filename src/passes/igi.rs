@@ -33,10 +33,10 @@
 //!   ω_o in the xz half-plane); the filtered radiance is rotated into that frame per pixel
 //!   (`sh_rotation`, Ivanic–Ruedenberg, twin of `shine_sh::rotation`). Weights as the Phong path
 //!   (below), the glossy one divided by the dielectric Schlick F (F0 = 0.04) at n·v because the
-//!   tables already hold the exact η = 1.5 Fresnel (`igi_ggx_table_weight`): 1 for dielectrics,
-//!   ≈ albedo/0.04 for metals. (The HVL gather's `ks = mix(1, albedo, metallic)` keeps the
-//!   dielectric Fresnel for metals: ~20× too dark a metallic lobe; measured here: the IGI mean
-//!   indirect fell to 0.82 of the reference with those weights.) `phong`: paper 000 §3.3 literally — Lambert `r_l` about the normal and
+//!   tables already hold the exact η = 1.5 Fresnel ([`hvl::table_fresnel_weight`], shared with
+//!   the HVL gather): 1 for dielectrics, ≈ albedo/0.04 for metals (weighting the tables by
+//!   `mix(1, albedo, metallic)` instead, as the HVL gather first did, left the metallic lobe
+//!   ~20× too dark: the IGI mean indirect fell to 0.82 of the reference). `phong`: paper 000 §3.3 literally — Lambert `r_l` about the normal and
 //!   a Phong lobe about the reflected direction with exponent `0.5/α² − 0.5`
 //!   (`igi_phong_exponent`, α = roughness²), `kd = (1 − F)(1 − metallic) albedo`, `ks = F`
 //!   (Schlick at the mirror direction). Irradiance mode always uses the Phong weights.
