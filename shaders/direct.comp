@@ -70,7 +70,8 @@ uint cube_face(vec3 d) {
 // Normal-offset PCF lookup in shadow view k: the receiver point moves along its normal by a
 // few shadow-map texels (their world size grows with distance under a perspective light),
 // which removes acne at grazing angles without a large depth bias; the taps stay inside the
-// view's tile. 0 outside the view's frustum.
+// view's tile. 1 outside the view's frustum (nothing is known there: a spot cone wider than
+// the 2.9 rad frustum still lights that ring).
 float shadow_view_visibility(uint k, vec3 p, vec3 n, vec3 light_position) {
     mat4 view_proj = shadow_views.v[k].view_proj;
     vec4 tile = shadow_views.v[k].tile;
@@ -79,12 +80,12 @@ float shadow_view_visibility(uint k, vec3 p, vec3 n, vec3 light_position) {
     p += n * texel * push.shadow.y;
     vec4 clip = view_proj * vec4(p, 1.0);
     if (clip.w <= 0.0) {
-        return 0.0;
+        return 1.0;
     }
     vec3 ndc = clip.xyz / clip.w;
     vec2 uv = ndc.xy * 0.5 + 0.5;
     if (any(lessThan(uv, vec2(0.0))) || any(greaterThan(uv, vec2(1.0)))) {
-        return 0.0;
+        return 1.0;
     }
     vec2 texel_uv = push.shadow.zw;
     vec2 lo = tile.xy + 0.5 * texel_uv;

@@ -29,9 +29,11 @@ void main() {
         // Directional: illuminance E over the texel's footprint A_t perpendicular to the light.
         power = light.color * light.intensity * view.params.x;
     } else {
-        // Spot/point: I(w) times the texel's solid angle, (2 tan(fov/2) / S)^2 cos^3(alpha).
+        // Spot/point: I(w) times the texel's solid angle, (2 tan(fov/2) / S)^2 cos^3(alpha),
+        // alpha the angle to the view's axis (depth_plane.xyz is the unit forward direction:
+        // the spot's direction, or towards the scene for a point light).
         vec3 w = normalize(v_position - view.eye.xyz);
-        float cos_axis = max(dot(w, light.kind == LIGHT_SPOT ? light.direction : w), 0.0);
+        float cos_axis = max(dot(w, normalize(view.depth_plane.xyz)), 0.0);
         float omega = view.params.x * cos_axis * cos_axis * cos_axis;
         power = light_intensity(light, w) * omega * light_range_window(light, distance(v_position, view.eye.xyz));
     }

@@ -391,6 +391,11 @@ impl Renderer {
             "shadow lights",
             bytemuck::cast_slice(&layout.light_records()),
         )?;
+        if self.shadow_layout.is_some() {
+            // Frames a host recorded with `record` may still read the old records, and shine
+            // cannot see host submissions (as in `set_scene`).
+            self.device.wait_idle()?;
+        }
         self.shadow_layout = Some(ShadowCache {
             key,
             layout,

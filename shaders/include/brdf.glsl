@@ -115,7 +115,8 @@ void brdf_indirect_weights(vec3 albedo, float metallic, float n_dot_v, out vec3 
     kd = (1.0 - ks) * (1.0 - metallic) * albedo;
 }
 
-// shine::passes::hvl::table_fresnel_weight. Weight of the GGX tables' glossy row (they hold the exact dielectric Fresnel, eta = 1.5): the
+// shine::passes::hvl::table_fresnel_weight (an n.v approximation: the tables' Fresnel varies
+// with each direction's v.h). Weight of the GGX tables' glossy row (they hold the exact dielectric Fresnel, eta = 1.5): the
 // material's Schlick F over the tables' F at the mirror direction (v . h = n . v), Schlick with
 // F0 = 0.04 standing for the latter: 1 for dielectrics, about albedo / 0.04 at normal view for
 // metals.

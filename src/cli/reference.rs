@@ -92,7 +92,8 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
     let start = Instant::now();
     let step = tracer.samples_per_dispatch();
     while tracer.samples() < args.spp {
-        if budget.is_some_and(|b| start.elapsed() >= b) {
+        // The budget stops after the submission that exceeds it: at least one always runs.
+        if tracer.samples() > 0 && budget.is_some_and(|b| start.elapsed() >= b) {
             break;
         }
         let now = step.min(args.spp - tracer.samples());

@@ -36,7 +36,8 @@
 //! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
 //!   never makes `indirect` negative; the paper's sinc window (§4.2) is not applied.
 //! * **Receiver BRDF.** `kd` times Lambert and `ks` times GGX (its tables hold the dielectric
-//!   Fresnel of η = 1.5; [`table_fresnel_weight`] turns it into the material's) at the
+//!   Fresnel of η = 1.5; [`table_fresnel_weight`] swaps it for the material's, approximately,
+//!   at n·v) at the
 //!   receiver's roughness, with the weights of [`indirect_weights`]: the paper
 //!   tabulates one table per material; we tabulate [`GLOSSY_TABLES`] roughness nodes
 //!   ([`glossy_roughness`]) and interpolate the two tables around the receiver's roughness
@@ -495,9 +496,10 @@ pub fn indirect_weights(albedo: Vec3, metallic: f32, n_dot_v: f32) -> (Vec3, Vec
 }
 
 /// The weight of a GGX table's glossy row for a material whose Fresnel is `ks` (GLSL
-/// `brdf_table_fresnel_weight`): the tables already hold the dielectric Fresnel of
-/// [`GLOSSY_IOR`], so `ks` is divided by Schlick's F with F0 = 0.04 at `n_dot_v` (1 for
-/// dielectrics, about albedo / 0.04 for metals at normal view).
+/// `brdf_table_fresnel_weight`): the tables hold the exact dielectric Fresnel of
+/// [`GLOSSY_IOR`] at each direction's v·h; dividing `ks` by Schlick's F with F0 = 0.04 at
+/// `n_dot_v` swaps it for the material's approximately (an n·v stand-in for v·h): 1 for
+/// dielectrics, about albedo / 0.04 for metals at normal view.
 pub fn table_fresnel_weight(ks: Vec3, n_dot_v: f32) -> Vec3 {
     ks / (0.04 + 0.96 * (1.0 - n_dot_v.clamp(0.0, 1.0)).powi(5))
 }

@@ -10,8 +10,9 @@
 //! * **Tile size** is the `shadow.size` setting for every tile; when the atlas would exceed the
 //!   device's largest 2D image the tiles are halved until it fits (with a warning).
 //! * **Cube faces overlap.** A point-light face covers slightly more than 90° (its central 90°
-//!   leaves a margin of PCF radius + 2 texels on each side), so the PCF kernel of a receiver
-//!   whose major axis picked the face never leaves the face's valid depth.
+//!   leaves a margin of PCF radius + 2 texels of the final tile on each side, at most a quarter
+//!   of the tile), so the PCF kernel of a receiver whose major axis picked the face stays on the
+//!   face's valid depth.
 
 use super::gbuffer::{SceneHandles, View, flip_y, light_view, scene_pipeline};
 use crate::gpu_scene::GpuScene;
@@ -99,18 +100,40 @@ impl ShadowLayout {
         pcf_radius: u32,
         max_dimension: u32,
     ) -> Result<Self, ShadowLayoutError> {
-        let mut views = Vec::new();
+        // Views per light: six cube faces for a point light, one for a spot or directional
+        // light, none for a light of unknown kind.
+        let count = |kind: Option<LightKind>| match kind {
+            Some(LightKind::Point) => 6,
+            Some(_) => 1,
+            None => 0,
+        };
+        let total: u32 = scene.light_list.iter().map(|l| count(l.light_kind())).sum();
+        let n = total.max(1);
+        let columns = (f64::from(n).sqrt().ceil()) as u32;
+        let rows = n.div_ceil(columns);
+        let mut side = tile;
+        while u64::from(columns.max(rows)) * u64::from(side) > u64::from(max_dimension) {
+            side /= 2;
+            if side < MIN_TILE {
+                return Err(ShadowLayoutError {
+                    views: total as usize,
+                    max_dimension,
+                });
+            }
+        }
+        // The cube faces' margin in texels of the final tile (at most a quarter of it).
+        let margin = ((pcf_radius + 2) as f32).min(side as f32 / 4.0);
+        let tan_half = side as f32 / (side as f32 - 2.0 * margin);
+        let mut views = Vec::with_capacity(total as usize);
         let mut lights = Vec::with_capacity(scene.light_list.len());
         for (i, light) in scene.light_list.iter().enumerate() {
             let first_view = views.len() as u32;
             let index = i as u32;
             match light.light_kind() {
                 Some(LightKind::Point) => {
-                    let margin = (pcf_radius + 2) as f32;
                     for (axis, up, face) in CUBE_FACES {
-                        let view = cube_face(scene, Vec3::from(light.position), axis, up, {
-                            tile as f32 / (tile as f32 - 2.0 * margin).max(1.0)
-                        });
+                        let eye = Vec3::from(light.position);
+                        let view = cube_face(scene, eye, axis, up, tan_half);
                         views.push((index, format!("shadow light {i} {face}"), view));
                     }
                 }
@@ -126,19 +149,6 @@ impl ShadowLayout {
                 view_count: views.len() as u32 - first_view,
                 pad: [0; 2],
             });
-        }
-        let n = views.len().max(1) as u32;
-        let columns = (f64::from(n).sqrt().ceil()) as u32;
-        let rows = n.div_ceil(columns);
-        let mut side = tile;
-        while u64::from(columns.max(rows)) * u64::from(side) > u64::from(max_dimension) {
-            side /= 2;
-            if side < MIN_TILE {
-                return Err(ShadowLayoutError {
-                    views: views.len(),
-                    max_dimension,
-                });
-            }
         }
         let warning = (side != tile).then(|| {
             format!(

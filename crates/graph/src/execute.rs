@@ -388,23 +388,8 @@ impl Recorder<'_> {
                 height: extent.height,
             },
         };
+        // Checked against every attachment before recording began (`check_area`).
         let area = work.area.unwrap_or(whole);
-        let (x, y) = (area.offset.x.max(0) as u32, area.offset.y.max(0) as u32);
-        let inside = area.offset.x >= 0
-            && area.offset.y >= 0
-            && u64::from(x) + u64::from(area.extent.width) <= u64::from(extent.width)
-            && u64::from(y) + u64::from(area.extent.height) <= u64::from(extent.height);
-        if !inside {
-            return Err(ExecuteError::RenderArea {
-                pass: pass.name.clone(),
-                x,
-                y,
-                width: area.extent.width,
-                height: area.extent.height,
-                attachment_width: extent.width,
-                attachment_height: extent.height,
-            });
-        }
         let colors: Vec<vk::RenderingAttachmentInfo<'_>> = work
             .colors
             .iter()
@@ -803,6 +788,7 @@ impl Executor {
                     compute_pipeline(&self.device, &mut self.compute_pipelines, c.shader)?;
                 }
                 Work::Raster(r) => {
+                    check_area(&plan, pass, r)?;
                     graphics_pipeline(&self.device, &mut self.graphics_pipelines, &r.pipeline)?;
                 }
                 Work::Declared | Work::Transfer(_) | Work::Raw(_) => {}
@@ -972,6 +958,34 @@ impl Executor {
         }
         Ok(std::mem::take(&mut self.timings))
     }
+}
+
+/// A raster pass's area ([`crate::RasterPass::area`]) must lie inside every attachment.
+fn check_area(plan: &Plan, pass: &PlannedPass, work: &RasterWork) -> Result<(), ExecuteError> {
+    let Some(area) = work.area else {
+        return Ok(());
+    };
+    let attachments = work.colors.iter().chain(work.depth.as_ref());
+    for a in attachments {
+        let extent = image_extent(plan, a.resource);
+        let (x, y) = (area.offset.x.max(0) as u32, area.offset.y.max(0) as u32);
+        let inside = area.offset.x >= 0
+            && area.offset.y >= 0
+            && u64::from(x) + u64::from(area.extent.width) <= u64::from(extent.width)
+            && u64::from(y) + u64::from(area.extent.height) <= u64::from(extent.height);
+        if !inside {
+            return Err(ExecuteError::RenderArea {
+                pass: pass.name.clone(),
+                x,
+                y,
+                width: area.extent.width,
+                height: area.extent.height,
+                attachment_width: extent.width,
+                attachment_height: extent.height,
+            });
+        }
+    }
+    Ok(())
 }
 
 fn read_timings(pool: &TimestampPool, frame: u64) -> Result<Vec<PassTiming>, ExecuteError> {
