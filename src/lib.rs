@@ -6,11 +6,13 @@
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
+pub mod environment_sh;
 pub mod gpu_scene;
 pub mod hvl_reference;
 pub mod image_io;
 pub mod passes;
 pub mod profile_report;
+pub mod proxy_frame;
 pub mod renderer;
 pub mod settings;
 pub mod tonemap;

@@ -9,6 +9,8 @@ use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
 use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
 use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
+use crate::passes::proxy::ProxyError;
+use crate::proxy_frame::ProxyFrame;
 use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::settings::{GatherPath, GiTechnique, RadiusHeuristic};
@@ -54,6 +56,9 @@ pub enum RenderError {
     /// The HVL passes refused their inputs or parameters.
     #[error(transparent)]
     Hvl(#[from] HvlError),
+    /// The proxy passes refused their inputs or parameters.
+    #[error(transparent)]
+    Proxy(#[from] ProxyError),
     /// The receiver or upsample pass refused its inputs.
     #[error(transparent)]
     Receivers(#[from] ReceiverError),
@@ -104,6 +109,8 @@ pub struct Renderer {
     scene: Option<GpuScene>,
     /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
     brdf_tables: Vec<(u32, Buffer)>,
+    /// The scene's proxies and environment for `--gi proxy` (paper 002).
+    proxy: Option<ProxyFrame>,
 }
 
 impl Renderer {
@@ -137,6 +144,7 @@ impl Renderer {
             )?,
             scene: None,
             brdf_tables: Vec::new(),
+            proxy: None,
         })
     }
 
@@ -149,6 +157,7 @@ impl Renderer {
             self.device.wait_idle()?;
         }
         self.scene = Some(uploaded);
+        self.proxy = Some(ProxyFrame::new(&self.device, scene, t));
         Ok(())
     }
 
@@ -317,6 +326,13 @@ impl Renderer {
             )?;
             self.brdf_tables.push((conv_bands, buffer));
         }
+        let proxy = settings.gi.contains(GiTechnique::Proxy);
+        if proxy {
+            self.proxy
+                .as_mut()
+                .ok_or(RenderError::NoScene)?
+                .prepare(settings)?;
+        }
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
         let read_only = ExternalState::new(
             vk::PipelineStageFlags2::ALL_COMMANDS,
@@ -363,8 +379,13 @@ impl Renderer {
             shadow,
             self.nearest.raw(),
         );
-        let indirect = match primary {
-            Some((light, view)) if hvl => {
+        let recv = if hvl || proxy {
+            Some(receivers::receivers(rg, &g, settings.receiver_scale)?)
+        } else {
+            None
+        };
+        let hvl_low = match (primary, &recv) {
+            (Some((light, view)), Some(recv)) if hvl => {
                 if view.orthographic {
                     return Err(RenderError::Invalid(
                         "HVL needs a spot or point primary light (a perspective RSM); this \
@@ -382,7 +403,6 @@ impl Renderer {
                     self.linear.raw(),
                 );
                 let hvls = hvl::hvl_cache(rg, &rsm, &params)?;
-                let recv = receivers::receivers(rg, &g, settings.receiver_scale)?;
                 let table = self
                     .brdf_tables
                     .iter()
@@ -390,13 +410,29 @@ impl Renderer {
                     .map(|(_, buffer)| buffer)
                     .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
                 let brdf = rg.import_gpu_buffer(table, buffer_read, buffer_read);
-                let low = hvl::hvl_gather(rg, &recv, &hvls, &brdf, camera.eye, &params)?;
+                Some(hvl::hvl_gather(
+                    rg, recv, &hvls, &brdf, camera.eye, &params,
+                )?)
+            }
+            _ => None,
+        };
+        let proxy_low = match (&self.proxy, &recv) {
+            (Some(frame), Some(recv)) if proxy => Some(frame.declare(rg, recv, settings)?),
+            _ => None,
+        };
+        // `hvl,proxy`: both indirect terms summed at receiver resolution, one upsample.
+        let low = match (hvl_low, proxy_low) {
+            (Some(a), Some(b)) => Some(crate::passes::proxy::gi_add(rg, &a, &b)?),
+            (a, b) => a.or(b),
+        };
+        let indirect = match (low, &recv) {
+            (Some(low), Some(recv)) => {
                 let upsample_params = UpsampleParams {
                     depth_sigma: settings.upsample.depth_epsilon,
                     normal_power: settings.upsample.normal_power,
                     ..UpsampleParams::default()
                 };
-                Some(upsample::upsample(rg, &low, &recv, &g, &upsample_params)?)
+                Some(upsample::upsample(rg, &low, recv, &g, &upsample_params)?)
             }
             _ => None,
         };

@@ -20,7 +20,7 @@ pub struct SettingsArgs {
     /// Scene time in seconds (animations).
     #[arg(long)]
     time: Option<f32>,
-    /// GI techniques: `hvl` (default), `none`; later `proxy`, `igi`, `aaf`, combined with commas.
+    /// GI techniques: `hvl` (default), `proxy`, `none`, combined with commas (`hvl,proxy`).
     #[arg(long)]
     gi: Option<String>,
     /// Tonemapping: none, aces, pbr-neutral.

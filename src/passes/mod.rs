@@ -6,5 +6,6 @@ pub mod composite;
 pub mod direct;
 pub mod gbuffer;
 pub mod hvl;
+pub mod proxy;
 pub mod receivers;
 pub mod upsample;
