@@ -41,6 +41,8 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #define SH_LOOP_ATTRIBUTES
+#define PROXY_TABLES_BINDING 3
+#include "proxy_tables.glsl"
 #include "sh.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -51,10 +53,6 @@ layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
 layout(set = 0, binding = 2, std430) readonly buffer Proxies {
     vec4 p[];
 } proxies;
-
-layout(set = 0, binding = 3, std430) readonly buffer Tables {
-    float t[];
-} tables;
 
 layout(set = 0, binding = 4, std430) readonly buffer Environment {
     float e[];

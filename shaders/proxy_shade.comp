@@ -26,6 +26,8 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
 #define SH_LOOP_ATTRIBUTES
+#define PROXY_TABLES_BINDING 8
+#include "proxy_tables.glsl"
 #include "sh.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -49,39 +51,14 @@ layout(set = 0, binding = 5, std430) buffer Occlusion {
 
 layout(set = 0, binding = 6, rgba16f) uniform image2D proxy_gi;
 
-#ifdef EXP_OL
-// shine::passes::proxy::ProxyTables::gpu_data: three alpha tables, then the OL table of
-// shine_sh::exp_log::OlTable (step, a[OL_TABLE_SIZE], b[OL_TABLE_SIZE]) at `ol_offset`
-layout(set = 0, binding = 8, std430) readonly buffer Tables {
-    float t[];
-} tables;
-#endif
 
 // shine::passes::proxy::ShadePush
 layout(push_constant) uniform Push {
     uvec2 extent;
-    // float offset of the OL table in `tables` (OL variants)
-    uint ol_offset;
-    // its number of samples (shine_sh::exp_log::OL_TABLE_SIZE)
-    uint ol_count;
+    uint pad0;
+    uint pad1;
 } push;
 
-#ifdef EXP_OL
-// shine_sh::exp_log::OlTable::coefficients over the whole table
-vec2 ol_coefficients(float m) {
-    uint o = push.ol_offset;
-    int n = int(push.ol_count);
-    float x = isnan(m) ? 0.0 : max(m / tables.t[o], 0.0);
-    if (x >= float(n - 1)) {
-        return vec2(tables.t[o + 1u + uint(n - 1)], tables.t[o + 1u + uint(2 * n - 1)]);
-    }
-    int i0 = int(floor(x));
-    float t = x - float(i0);
-    vec2 lo = vec2(tables.t[o + 1u + uint(i0)], tables.t[o + 1u + uint(n + i0)]);
-    vec2 hi = vec2(tables.t[o + 2u + uint(i0)], tables.t[o + 2u + uint(n + i0)]);
-    return lo + t * (hi - lo);
-}
-#endif
 
 void main() {
     uvec2 xy = gl_GlobalInvocationID.xy;
@@ -102,7 +79,7 @@ void main() {
 #elif defined(EXP_PS)
     sh_exp_ps(f, o);
 #elif defined(EXP_OL)
-    sh_exp_ol_ab(f, ol_coefficients(sh_norm_without_dc(f)), o);
+    sh_exp_ol_ab(f, sh_ol_coefficients(sh_norm_without_dc(f)), o);
 #else
     o = f;
 #endif

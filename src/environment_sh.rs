@@ -97,8 +97,8 @@ mod tests {
         for c in 0..3 {
             assert!((sh.radiance[c][0] - l * sqrt_4pi).abs() < 1e-5);
             assert!(sh.radiance[c][1..].iter().all(|x| x.abs() < 1e-5));
-            let e = shine_sh::basis::evaluate(&sh.irradiance[c], Vec3::new(0.3, 0.8, -0.2))
-                .unwrap();
+            let e =
+                shine_sh::basis::evaluate(&sh.irradiance[c], Vec3::new(0.3, 0.8, -0.2)).unwrap();
             assert!((e - std::f32::consts::PI * l).abs() < 1e-4, "{e}");
         }
         assert!(EnvironmentSh::project(&constant(l), 7).is_err());
@@ -114,7 +114,10 @@ mod tests {
         for d in [Vec3::Y, Vec3::X, Vec3::new(0.3, 0.5, -0.8).normalize()] {
             let want = sky.radiance(d);
             let got = shine_sh::basis::evaluate(&sh.radiance[2], d).unwrap();
-            assert!((got - want.z).abs() < 0.1 * want.z.max(0.1), "{d}: {got} vs {want}");
+            assert!(
+                (got - want.z).abs() < 0.1 * want.z.max(0.1),
+                "{d}: {got} vs {want}"
+            );
         }
     }
 }

@@ -18,8 +18,7 @@ use shine::environment_sh::EnvironmentSh;
 use shine::gpu::{Device, vk};
 use shine::graph::{Executor, ExternalState, RenderGraph};
 use shine::passes::proxy::{
-    self, Accumulation, GpuProxy, ProxyInputs, ProxyParams, ProxyTables, ReceiverSample,
-    Receivers,
+    self, Accumulation, GpuProxy, ProxyInputs, ProxyParams, ProxyTables, ReceiverSample, Receivers,
 };
 use shine::settings::ExpMethod;
 use shine_sh::exp_log::ShExp;
@@ -44,11 +43,7 @@ fn receivers() -> Vec<ReceiverSample> {
     (0..SIDE * SIDE)
         .map(|i| {
             let (x, y) = (i % SIDE, i / SIDE);
-            let position = Vec3::new(
-                (x as f32 - 11.5) * 0.25,
-                0.0,
-                (y as f32 - 11.5) * 0.25,
-            );
+            let position = Vec3::new((x as f32 - 11.5) * 0.25, 0.0, (y as f32 - 11.5) * 0.25);
             ReceiverSample {
                 position,
                 valid: x != SIDE - 1,
@@ -62,12 +57,12 @@ fn receivers() -> Vec<ReceiverSample> {
 
 fn proxies() -> Vec<GpuProxy> {
     vec![
-        GpuProxy::new(Vec3::new(0.0, 0.6, 0.0), 0.5, Vec3::new(0.9, 0.2, 0.2)),
-        GpuProxy::new(Vec3::new(1.2, 0.25, -0.8), 0.35, Vec3::new(0.2, 0.9, 0.2)),
+        GpuProxy::new(Vec3::new(0.3, 0.12, 0.2), 0.08, Vec3::new(0.9, 0.2, 0.2)),
+        GpuProxy::new(Vec3::new(0.45, 0.1, 0.3), 0.07, Vec3::new(0.2, 0.9, 0.2)),
         // pokes through the ground: self-shadowing rule 3
-        GpuProxy::new(Vec3::new(-1.5, -0.1, 1.0), 0.3, Vec3::splat(0.7)),
-        // far away: its sphere of influence (≈ 17 r) misses most receivers
-        GpuProxy::new(Vec3::new(-2.8, 0.12, -2.8), 0.05, Vec3::splat(0.5)),
+        GpuProxy::new(Vec3::new(-0.5, -0.02, 0.4), 0.06, Vec3::splat(0.7)),
+        // far away and small: its sphere of influence (≈ 17 r) reaches few receivers
+        GpuProxy::new(Vec3::new(-2.6, 0.05, -2.6), 0.02, Vec3::splat(0.5)),
     ]
 }
 
@@ -122,7 +117,13 @@ impl ReceiverImages {
                 e,
                 &normal,
             ),
-            storage_image_with(device, "recv_albedo", vk::Format::R8G8B8A8_UNORM, e, &albedo),
+            storage_image_with(
+                device,
+                "recv_albedo",
+                vk::Format::R8G8B8A8_UNORM,
+                e,
+                &albedo,
+            ),
             storage_image_with(
                 device,
                 "recv_material",
@@ -193,16 +194,6 @@ fn run_gpu(
         environment: rg.import_gpu_buffer(&env_buffer, uploaded_state(), ExternalState::UNDEFINED),
     };
     let sums = proxy::proxy_accumulate(&mut rg, &recv, &inputs, tables, params).unwrap();
-    let t0 = std::time::Instant::now();
-    if std::env::var_os("ONLY_ACC").is_some() {
-        let mut s = rg.import_gpu_buffer(&sums_out, ExternalState::UNDEFINED, read_by_copy());
-        rg.copy_buffer("read sums", &sums, &mut s);
-        let mut commands = device.begin_commands().unwrap();
-        executor.execute(commands.raw(), rg).unwrap();
-        device.submit(commands).unwrap().wait().unwrap();
-        eprintln!("accumulate only: {:?}", t0.elapsed());
-        std::process::exit(0);
-    }
     let out = proxy::proxy_shade(&mut rg, &recv, &sums, &inputs, tables, params).unwrap();
     let mut s = rg.import_gpu_buffer(&sums_out, ExternalState::UNDEFINED, read_by_copy());
     rg.copy_buffer("read sums", &sums, &mut s);
@@ -287,7 +278,10 @@ fn splat_equals_brute_force_and_cpu() {
         }
         let cpu = proxy::accumulate_cpu(s, &list, &tables, &env, &splat_params, &exp).unwrap();
         for (k, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
-            assert!(close(*g, *c, 2e-4, 2e-5), "receiver {i} sum {k}: {g} vs {c}");
+            assert!(
+                close(*g, *c, 2e-4, 2e-5),
+                "receiver {i} sum {k}: {g} vs {c}"
+            );
             worst.0 = worst.0.max((g - c).abs());
         }
         let (o, rad) = proxy::shade_cpu(s, &cpu, &env, &splat_params, &exp).unwrap();
@@ -312,7 +306,10 @@ fn splat_equals_brute_force_and_cpu() {
          {:e}, worst radiance rel diff {:e}",
         worst.0, worst.1
     );
-    assert!(inside > 50 && outside > 50, "{inside} inside, {outside} outside");
+    assert!(
+        inside > 50 && outside > 50,
+        "{inside} inside, {outside} outside"
+    );
 }
 
 /// The other exponentials (PS, OL) and orders 3 and 6 shade as their CPU twin.
@@ -321,7 +318,12 @@ fn exponentials_and_orders_match_cpu() {
     let device = device();
     let samples = receivers();
     let list = proxies();
-    for (bands, method) in [(4, ExpMethod::Ps), (4, ExpMethod::Ol), (3, ExpMethod::Hyb), (6, ExpMethod::Hyb)] {
+    for (bands, method) in [
+        (4, ExpMethod::Ps),
+        (4, ExpMethod::Ol),
+        (3, ExpMethod::Hyb),
+        (6, ExpMethod::Hyb),
+    ] {
         let tables = ProxyTables::build(bands, 15.0, 10.0).unwrap();
         let env = environment(bands);
         let exp = ShExp::new(bands as usize).unwrap();
@@ -332,7 +334,11 @@ fn exponentials_and_orders_match_cpu() {
         for (i, s) in samples.iter().enumerate().step_by(7) {
             let sums = &gpu.sums[i * stride..(i + 1) * stride];
             let (o, rad) = proxy::shade_cpu(s, sums, &env, &p, &exp).unwrap();
-            for (k, (g, c)) in gpu.occlusion[i * n2..(i + 1) * n2].iter().zip(&o).enumerate() {
+            for (k, (g, c)) in gpu.occlusion[i * n2..(i + 1) * n2]
+                .iter()
+                .zip(&o)
+                .enumerate()
+            {
                 assert!(
                     close(*g, *c, 1e-3, 1e-4),
                     "{method} b{bands} receiver {i} O_{k}: {g} vs {c}"
@@ -367,8 +373,15 @@ fn brute_force_product_matches_cpu() {
     let stride = proxy::sums_stride(bands);
     for (i, s) in samples.iter().enumerate().step_by(5) {
         let cpu = proxy::accumulate_cpu(s, &list, &tables, &env, &p, &exp).unwrap();
-        for (k, (g, c)) in gpu.sums[i * stride..(i + 1) * stride].iter().zip(&cpu).enumerate() {
-            assert!(close(*g, *c, 1e-3, 1e-4), "receiver {i} sum {k}: {g} vs {c}");
+        for (k, (g, c)) in gpu.sums[i * stride..(i + 1) * stride]
+            .iter()
+            .zip(&cpu)
+            .enumerate()
+        {
+            assert!(
+                close(*g, *c, 1e-3, 1e-4),
+                "receiver {i} sum {k}: {g} vs {c}"
+            );
         }
         let (_, rad) = proxy::shade_cpu(s, &cpu, &env, &p, &exp).unwrap();
         for c in 0..3 {

@@ -804,33 +804,49 @@ const float SH_OL_B[180] = float[](
     7.581662536e-1, 7.498210073e-1, 7.416200638e-1, 7.335630059e-1, 7.256458998e-1, 7.178656459e-1);
 // END GENERATED
 
+// Where sh_product and the OL lookup read their tables: the constants above by default. A
+// shader may define these macros before including sh.glsl to read the same numbers (uploaded
+// from shine_sh::glsl_tables::tensor_pairs and shine_sh::exp_log::OlTable) from a buffer:
+// lavapipe turns dynamically indexed constant arrays into branch ladders, which for the
+// 600-1500 tensor entries of 5-6 bands takes minutes to compile.
+#ifndef SH_TENSOR_N
+#define SH_TENSOR_N SH_TENSOR_COUNT[SH_BANDS]
+#define SH_TENSOR_IJK_AT(e) SH_TENSOR_IJK[e]
+#define SH_TENSOR_V_AT(e) SH_TENSOR_V[e]
+#endif
+#ifndef SH_OL_N
+#define SH_OL_N SH_OL_COUNT
+#define SH_OL_STEP_V SH_OL_STEP[SH_BANDS - 1]
+#define SH_OL_A_AT(i) SH_OL_A[(SH_BANDS - 1) * SH_OL_COUNT + (i)]
+#define SH_OL_B_AT(i) SH_OL_B[(SH_BANDS - 1) * SH_OL_COUNT + (i)]
+#endif
+
 // shine_sh::product::TripleProduct::product (projected product, truncated to SH_BANDS)
 void sh_product(float a[SH_COEFFS], float b[SH_COEFFS], out float c[SH_COEFFS]) {
     for (int i = 0; i < SH_COEFFS; ++i) {
         c[i] = 0.0;
     }
-    SH_DONT_UNROLL for (int e = 0; e < SH_TENSOR_COUNT[SH_BANDS]; ++e) {
-        int ijk = SH_TENSOR_IJK[e];
+    SH_DONT_UNROLL for (int e = 0; e < SH_TENSOR_N; ++e) {
+        int ijk = SH_TENSOR_IJK_AT(e);
         int i = ijk & 255;
         int j = (ijk >> 8) & 255;
         int k = ijk >> 16;
-        float v = SH_TENSOR_V[e];
+        float v = SH_TENSOR_V_AT(e);
         c[k] += (i == j) ? v * a[i] * b[i] : v * (a[i] * b[j] + a[j] * b[i]);
     }
 }
 
-// shine_sh::exp_log::OlTable::coefficients for this band count, valid for
-// m <= SH_HYB_MAX_MAGNITUDE (the only range HYB uses)
+// shine_sh::exp_log::OlTable::coefficients for this band count: the whole table when read
+// from a buffer (SH_OL_A_AT above), else valid for m <= SH_HYB_MAX_MAGNITUDE (all HYB uses)
 vec2 sh_ol_coefficients(float m) {
-    int row = (SH_BANDS - 1) * SH_OL_COUNT;
-    float x = max(m / SH_OL_STEP[SH_BANDS - 1], 0.0);
-    if (x >= float(SH_OL_COUNT - 1)) {
-        return vec2(SH_OL_A[row + SH_OL_COUNT - 1], SH_OL_B[row + SH_OL_COUNT - 1]);
+    float x = max(m / SH_OL_STEP_V, 0.0);
+    if (x >= float(SH_OL_N - 1)) {
+        return vec2(SH_OL_A_AT(SH_OL_N - 1), SH_OL_B_AT(SH_OL_N - 1));
     }
     int i0 = int(floor(x));
     float t = x - float(i0);
-    vec2 lo = vec2(SH_OL_A[row + i0], SH_OL_B[row + i0]);
-    vec2 hi = vec2(SH_OL_A[row + i0 + 1], SH_OL_B[row + i0 + 1]);
+    vec2 lo = vec2(SH_OL_A_AT(i0), SH_OL_B_AT(i0));
+    vec2 hi = vec2(SH_OL_A_AT(i0 + 1), SH_OL_B_AT(i0 + 1));
     return lo + t * (hi - lo);
 }
 

@@ -207,6 +207,9 @@ pub struct ProxyTables {
     pub support_indirect: f32,
     /// [`shine_sh::exp_log::OlTable`] of the band count: step, `a` samples, `b` samples.
     pub ol: Vec<f32>,
+    /// [`shine_sh::glsl_tables::tensor_pairs`] of the band count: packed `ijk` (as floats,
+    /// exact below 2²⁴) then values.
+    pub tensor: Vec<f32>,
 }
 
 /// The largest α such that every row of `table` at or below it is all zeros.
@@ -247,8 +250,11 @@ impl ProxyTables {
             .chain(b.iter().copied())
             .map(|x| x as f32)
             .collect();
+        let (ijk, values) = shine_sh::glsl_tables::tensor_pairs(bands)?;
+        let tensor = ijk.iter().map(|&x| x as f32).chain(values).collect();
         Ok(Self {
             ol,
+            tensor,
             support_shadow: support(&log_occlusion),
             support_indirect: support(&visibility),
             log_occlusion,
@@ -264,6 +270,7 @@ impl ProxyTables {
             self.visibility.data(),
             self.visibility_full.data(),
             &self.ol,
+            &self.tensor,
         ]
         .concat()
     }
@@ -317,10 +324,8 @@ pub const TILE_WORDS: u32 = MAX_PROXIES / 32;
 pub struct ShadePush {
     /// Receiver buffer size.
     pub extent: [u32; 2],
-    /// [`ProxyTables::ol_offset`].
-    pub ol_offset: u32,
-    /// Samples of the OL table ([`shine_sh::exp_log::OL_TABLE_SIZE`]).
-    pub ol_count: u32,
+    /// Padding.
+    pub pad: [u32; 2],
 }
 
 /// Push constants of `shaders/gi_add.comp` (8 bytes).
@@ -491,6 +496,14 @@ pub fn proxy_shade(
     params: &ProxyParams,
 ) -> Result<ProxyOutputs, ProxyError> {
     let shader = params.shade_shader()?;
+    let table_bytes = (tables.gpu_data().len() * 4) as u64;
+    if inputs.tables.desc().size != table_bytes {
+        return Err(ProxyError::Size {
+            name: "tables",
+            actual: format!("{} bytes", inputs.tables.desc().size),
+            expected: format!("{table_bytes} bytes"),
+        });
+    }
     let [w, h] = receivers.extent;
     let texels = u64::from(w) * u64::from(h);
     let need = texels * sums_stride(params.bands) as u64 * 4;
@@ -509,8 +522,7 @@ pub fn proxy_shade(
     let mut occlusion = rg.create_buffer("proxy_occlusion", BufferDesc::new(texels * coeffs * 4));
     let push = ShadePush {
         extent: receivers.extent,
-        ol_offset: tables.ol_offset() as u32,
-        ol_count: shine_sh::exp_log::OL_TABLE_SIZE as u32,
+        pad: [0; 2],
     };
     let mut pass = rg.compute("proxy_shade", shader);
     pass.read("recv_position", &receivers.position)
@@ -519,10 +531,8 @@ pub fn proxy_shade(
         .read("recv_material", &receivers.material)
         .read("sums", sums)
         .read("environment", &inputs.environment);
-    if params.exp == ExpMethod::Ol && params.accumulation != Accumulation::Product {
-        pass.read("tables", &inputs.tables);
-    }
-    pass.write("occlusion", &mut occlusion)
+    pass.read("tables", &inputs.tables)
+        .write("occlusion", &mut occlusion)
         .write("proxy_gi", &mut radiance)
         .push(&push)
         .dispatch([w, h, 1]);

@@ -44,10 +44,10 @@ fn float_list(out: &mut String, values: impl IntoIterator<Item = f64>) {
     }
 }
 
-/// The generated GLSL section, markers included, ending with a newline.
-pub fn generated_section() -> Result<String> {
-    let max = GLSL_PRODUCT_MAX_BANDS;
-    let tensor = TripleProduct::new(max)?;
+/// The tensor pairs of [`GLSL_PRODUCT_MAX_BANDS`] bands in the GLSL order (`SH_TENSOR_IJK`,
+/// `SH_TENSOR_V`).
+fn sorted_pairs() -> Result<Vec<crate::product::TensorEntry>> {
+    let tensor = TripleProduct::new(GLSL_PRODUCT_MAX_BANDS)?;
     let mut pairs: Vec<_> = tensor
         .entries()
         .iter()
@@ -55,6 +55,33 @@ pub fn generated_section() -> Result<String> {
         .copied()
         .collect();
     pairs.sort_by_key(|e| (e.i.max(e.j).max(e.k), e.k, e.i, e.j));
+    Ok(pairs)
+}
+
+/// The first `SH_TENSOR_COUNT[bands]` entries of `SH_TENSOR_IJK` (packed `i | j << 8 | k << 16`)
+/// and `SH_TENSOR_V`, for shaders that read the tensor from a buffer instead of GLSL constants
+/// (`SH_TENSOR_IJK_AT` in `sh.glsl`). `bands ≤ GLSL_PRODUCT_MAX_BANDS`.
+pub fn tensor_pairs(bands: usize) -> Result<(Vec<u32>, Vec<f32>)> {
+    if !(1..=GLSL_PRODUCT_MAX_BANDS).contains(&bands) {
+        return Err(crate::ShError::InvalidBands { bands });
+    }
+    let n2 = (bands * bands) as u16;
+    Ok(sorted_pairs()?
+        .iter()
+        .filter(|e| e.i.max(e.j).max(e.k) < n2)
+        .map(|e| {
+            (
+                u32::from(e.i) | u32::from(e.j) << 8 | u32::from(e.k) << 16,
+                e.value as f32,
+            )
+        })
+        .unzip())
+}
+
+/// The generated GLSL section, markers included, ending with a newline.
+pub fn generated_section() -> Result<String> {
+    let max = GLSL_PRODUCT_MAX_BANDS;
+    let pairs = sorted_pairs()?;
     let counts: Vec<usize> = (0..=max)
         .map(|n| {
             let n2 = (n * n) as u16;
