@@ -394,3 +394,53 @@ fn brute_force_product_matches_cpu() {
         }
     }
 }
+
+/// Sanity of the model on the CPU twin: a unit-albedo ground point 0.1 m beside a ball of
+/// radius 0.5 resting on the ground (α = 0.64) loses about 30% of its sky light to the ball's
+/// shadow, half of which the grey ball's indirect light gives back; a far point is unchanged.
+#[test]
+fn a_proxy_shadows_the_ground_beside_it() {
+    let bands = 4;
+    let tables = ProxyTables::build(bands, 15.0, 10.0).unwrap();
+    let env = environment(bands);
+    let exp = ShExp::new(bands as usize).unwrap();
+    let with_indirect = params(bands, Accumulation::Splat, ExpMethod::Hyb);
+    let ball = [GpuProxy::new(
+        Vec3::new(0.0, 0.5, 0.0),
+        0.5,
+        Vec3::splat(0.5),
+    )];
+    let shade_with = |x: f32, proxies: &[GpuProxy], p: &ProxyParams| {
+        let r = ReceiverSample {
+            position: Vec3::new(x, 0.0, 0.0),
+            valid: true,
+            normal: Vec3::Y,
+            albedo: Vec3::ONE,
+            metallic: 0.0,
+        };
+        let sums = proxy::accumulate_cpu(&r, proxies, &tables, &env, p, &exp).unwrap();
+        proxy::shade_cpu(&r, &sums, &env, p, &exp).unwrap().1
+    };
+    let shade = |x: f32, proxies: &[GpuProxy]| shade_with(x, proxies, &with_indirect);
+    let (near, open) = (shade(0.6, &ball), shade(0.6, &[]));
+    let (far, far_open) = (shade(20.0, &ball), shade(20.0, &[]));
+    println!("beside the ball {near} vs open sky {open}; far {far} vs {far_open}");
+    assert!(
+        near.y < 0.95 * open.y && near.y > 0.7 * open.y,
+        "{near} vs {open}"
+    );
+    assert_eq!(far, far_open);
+    let shadow_only = shade_with(
+        0.6,
+        &ball,
+        &ProxyParams {
+            indirect: false,
+            ..with_indirect
+        },
+    );
+    println!("shadow only {shadow_only}");
+    assert!(
+        shadow_only.y < 0.8 * open.y && shadow_only.y < near.y,
+        "{shadow_only}"
+    );
+}
