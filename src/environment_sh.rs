@@ -109,7 +109,7 @@ mod tests {
     #[test]
     fn sky_reconstructs() {
         let scene = shine_scene::Scene::builtin("spheres").unwrap();
-        let sky = scene.environment.clone().unwrap();
+        let sky = scene.environment.unwrap();
         let sh = EnvironmentSh::project(&sky, 6).unwrap();
         for d in [Vec3::Y, Vec3::X, Vec3::new(0.3, 0.5, -0.8).normalize()] {
             let want = sky.radiance(d);

@@ -83,7 +83,7 @@ impl ProxyFrame {
         Self {
             device: device.clone(),
             sources,
-            environment: scene.environment.clone(),
+            environment: scene.environment,
             proxies: None,
             environments: Vec::new(),
             tables: Vec::new(),

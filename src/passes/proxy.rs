@@ -630,7 +630,7 @@ pub fn accumulate_cpu(
             };
             let dv = center - p;
             let dist = dv.length();
-            if !(dist > 0.0) {
+            if dist.is_nan() || dist <= 0.0 {
                 continue;
             }
             let alpha = (radius / dist).min(1.0);
