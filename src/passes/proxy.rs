@@ -207,8 +207,8 @@ pub struct ProxyTables {
     pub support_indirect: f32,
     /// [`shine_sh::exp_log::OlTable`] of the band count: step, `a` samples, `b` samples.
     pub ol: Vec<f32>,
-    /// [`shine_sh::glsl_tables::tensor_pairs`] of the band count: packed `ijk` (as floats,
-    /// exact below 2²⁴) then values.
+    /// [`shine_sh::glsl_tables::tensor_pairs`] of the band count: the entry count, packed
+    /// `ijk` (as floats, exact below 2²⁴), then values.
     pub tensor: Vec<f32>,
 }
 
@@ -251,7 +251,10 @@ impl ProxyTables {
             .map(|x| x as f32)
             .collect();
         let (ijk, values) = shine_sh::glsl_tables::tensor_pairs(bands)?;
-        let tensor = ijk.iter().map(|&x| x as f32).chain(values).collect();
+        let tensor = std::iter::once(ijk.len() as f32)
+            .chain(ijk.iter().map(|&x| x as f32))
+            .chain(values)
+            .collect();
         Ok(Self {
             ol,
             tensor,
