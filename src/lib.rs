@@ -6,6 +6,7 @@
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
+pub mod environment_sh;
 pub mod gpu_bvh;
 pub mod gpu_environment;
 pub mod gpu_scene;
@@ -15,6 +16,7 @@ pub mod image_compare;
 pub mod image_io;
 pub mod passes;
 pub mod profile_report;
+pub mod proxy_frame;
 pub mod reference;
 pub mod renderer;
 pub mod settings;

@@ -11,10 +11,12 @@ use crate::passes::direct::{self, ShadowParams};
 use crate::passes::gbuffer::{self, SceneHandles};
 use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
 use crate::passes::igi::{self, IgiError, IgiParams};
+use crate::passes::proxy::ProxyError;
 use crate::passes::receivers::{self, ReceiverError};
 use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
 use crate::passes::upsample::{self, UpsampleParams};
 use crate::profile_report::PassClock;
+use crate::proxy_frame::ProxyFrame;
 use crate::settings::{Component, GiTechnique, IgiFilter, IgiGlossy};
 use crate::settings::{Settings, SettingsError};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
@@ -55,6 +57,9 @@ pub enum RenderError {
     /// The IGI passes refused their inputs or parameters.
     #[error(transparent)]
     Igi(#[from] IgiError),
+    /// The proxy passes refused their inputs or parameters.
+    #[error(transparent)]
+    Proxy(#[from] ProxyError),
     /// The receiver or upsample pass refused its inputs.
     #[error(transparent)]
     Receivers(#[from] ReceiverError),
@@ -116,6 +121,8 @@ pub struct Renderer {
     shadow_layout: Option<ShadowCache>,
     /// Readback buffers of [`Renderer::render`].
     readback: Option<Readback>,
+    /// The scene's proxies and environment for `--gi proxy` (paper 002).
+    proxy: Option<ProxyFrame>,
 }
 
 /// The buffers a rendered frame is copied into, kept while the frame size is unchanged.
@@ -189,6 +196,7 @@ impl Renderer {
             brdf_tables: Vec::new(),
             shadow_layout: None,
             readback: None,
+            proxy: None,
         })
     }
 
@@ -204,6 +212,7 @@ impl Renderer {
         self.scene = Some(uploaded);
         self.bvh = Some(bvh);
         self.shadow_layout = None;
+        self.proxy = Some(ProxyFrame::new(&self.device, scene, t));
         Ok(())
     }
 
@@ -461,6 +470,13 @@ impl Renderer {
             self.prepare_brdf_tables(igi_params.sh_order)?;
         }
         self.prepare_shadows(settings)?;
+        let proxy = settings.gi.contains(GiTechnique::Proxy);
+        if proxy {
+            self.proxy
+                .as_mut()
+                .ok_or(RenderError::NoScene)?
+                .prepare(settings)?;
+        }
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
         let read_only = ExternalState::new(
             vk::PipelineStageFlags2::ALL_COMMANDS,
@@ -509,8 +525,16 @@ impl Renderer {
             shadow,
             self.nearest.raw(),
         );
-        let indirect = match primary {
-            Some((light, view)) if hvl => {
+        let igi = settings.gi.contains(GiTechnique::Igi);
+        // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
+        // upsample; `hvl,proxy` sums both at receiver resolution first.
+        let recv = if hvl || proxy {
+            Some(receivers::receivers(rg, &g, settings.receiver_scale)?)
+        } else {
+            None
+        };
+        let hvl_low = match (primary, &recv) {
+            (Some((light, view)), Some(recv)) if hvl => {
                 let params = hvl_params(settings);
                 let rsm = gbuffer::rsm(
                     rg,
@@ -521,7 +545,6 @@ impl Renderer {
                     self.linear.raw(),
                 );
                 let hvls = hvl::hvl_cache(rg, &rsm, &params)?;
-                let recv = receivers::receivers(rg, &g, settings.receiver_scale)?;
                 let table = self
                     .brdf_tables
                     .iter()
@@ -533,16 +556,40 @@ impl Renderer {
                     (true, Some(b)) => Some(b.import(rg, buffer_read)),
                     _ => None,
                 };
-                let low =
-                    hvl::hvl_gather(rg, &recv, &hvls, &brdf, bvh.as_ref(), camera.eye, &params)?;
+                Some(hvl::hvl_gather(
+                    rg,
+                    recv,
+                    &hvls,
+                    &brdf,
+                    bvh.as_ref(),
+                    camera.eye,
+                    &params,
+                )?)
+            }
+            _ => None,
+        };
+        let proxy_low = match (&self.proxy, &recv) {
+            (Some(frame), Some(recv)) if proxy => Some(frame.declare(rg, recv, settings)?),
+            _ => None,
+        };
+        let low = match (hvl_low, proxy_low) {
+            (Some(a), Some(b)) => Some(crate::passes::proxy::gi_add(rg, &a, &b)?),
+            (a, b) => a.or(b),
+        };
+        let upsampled = match (low, &recv) {
+            (Some(low), Some(recv)) => {
                 let upsample_params = UpsampleParams {
                     depth_sigma: settings.upsample.depth_epsilon,
                     normal_power: settings.upsample.normal_power,
                     ..UpsampleParams::default()
                 };
-                Some(upsample::upsample(rg, &low, &recv, &g, &upsample_params)?)
+                Some(upsample::upsample(rg, &low, recv, &g, &upsample_params)?)
             }
-            Some((light, view)) if settings.gi.contains(GiTechnique::Igi) => {
+            _ => None,
+        };
+        // IGI runs at full resolution (its interleaving needs the pixel grid).
+        let igi_full = match primary {
+            Some((light, view)) if igi => {
                 let rsm = gbuffer::rsm(
                     rg,
                     &handles,
@@ -568,6 +615,11 @@ impl Renderer {
                 )?)
             }
             _ => None,
+        };
+        // `igi,proxy`: both full-resolution indirect terms summed.
+        let indirect = match (upsampled, igi_full) {
+            (Some(a), Some(b)) => Some(crate::passes::proxy::gi_add(rg, &a, &b)?),
+            (a, b) => a.or(b),
         };
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
         let (first, second) = match (settings.output.component, indirect.as_ref()) {

@@ -9,7 +9,7 @@
 //! ```toml
 //! width = 1280
 //! height = 720
-//! gi = "hvl"            # or "none", later "hvl,proxy"
+//! gi = "hvl"            # or "none", "proxy", "hvl,proxy"
 //! receiver_scale = 2
 //!
 //! [output]
@@ -241,17 +241,37 @@ named_choice! {
         Hvl = "hvl",
         /// Instant GI with interleaved sampling and SH-filtered incoming radiance (paper 000).
         Igi = "igi",
+        /// Sphere proxies under the environment light (paper 002): proxy-shadowed environment
+        /// plus proxy indirect light.
+        Proxy = "proxy",
+    }
+}
+
+named_choice! {
+    /// The SH exponential of the accumulated log-occlusion (paper 002 eq. 4, Ren et al. 2006).
+    pub enum ExpMethod ("SH exponentiation method") {
+        /// Optimal linear: `a(‖f̂‖) 1 + b(‖f̂‖) f̂`.
+        Ol = "ol",
+        /// Product series: Taylor series on a scaled-down vector, then repeated squaring.
+        Ps = "ps",
+        /// Hybrid: OL on a scaled-down vector, then repeated squaring (the paper's choice).
+        Hyb = "hyb",
     }
 }
 
 /// Techniques that later issues add: named so that asking for one says "not implemented yet"
 /// rather than "unknown".
-const PLANNED_GI: [&str; 2] = ["proxy", "aaf"];
+const PLANNED_GI: [&str; 1] = ["aaf"];
 
 /// The name of the empty technique list: direct light only.
 const NO_GI: &str = "none";
 
-/// The set of GI techniques a frame combines, written `hvl`, `none` or `hvl,proxy`.
+/// The set of GI techniques a frame combines, written `hvl`, `none`, `proxy` or `hvl,proxy`.
+///
+/// `hvl,proxy` adds both indirect terms at receiver resolution before one upsample: the HVL
+/// indirect light of the primary light and the proxy-shadowed environment plus proxy indirect
+/// light (paper 002 pairs them the same way). Without `proxy` the environment lights nothing
+/// (direct light and HVL only).
 ///
 /// `none` (the empty list) renders direct light only. Order is kept as given; each technique
 /// appears at most once.
@@ -380,8 +400,8 @@ pub struct Settings {
     pub frames: u32,
     /// Scene animation time of the first frame, in seconds. Range 0.0..=100000.0, default 0.0.
     pub time: f32,
-    /// GI techniques combined in the frame: `hvl`, `none` (direct light only), later
-    /// `hvl,proxy`. Default `hvl`.
+    /// GI techniques combined in the frame: `hvl`, `proxy`, `hvl,proxy` or `none` (direct
+    /// light only). Default `hvl`.
     pub gi: GiTechniques,
     /// Receiver-buffer downscale s: expensive GI runs at W/s × H/s (paper 002 §4.2).
     /// One of 1, 2, 4; default 2.
@@ -398,6 +418,34 @@ pub struct Settings {
     pub upsample: UpsampleSettings,
     /// Instant GI with SH-filtered incoming radiance (paper 000).
     pub igi: IgiSettings,
+    /// Sphere-proxy soft shadows and indirect light under the environment (paper 002).
+    pub proxy: ProxySettings,
+}
+
+/// `[proxy]`: sphere proxies under the environment light (paper 002).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProxySettings {
+    /// SH order n of the occlusion and the environment (n² coefficients). Range 3..=6,
+    /// default 4 (the paper's shadow order).
+    pub sh_order: u32,
+    /// Radius expansion factor η of the shadow sphere of influence (§4.1); 0 picks the paper's
+    /// value for the order: 10 for order 3, 15 for order 4 and above. Range 0 or 2.0..=100.0,
+    /// default 0.
+    pub expansion: f32,
+    /// Expansion factor of the indirect sphere of influence (order-3 indirect: 10 in the
+    /// paper). Range 2.0..=100.0, default 10.0.
+    pub indirect_expansion: f32,
+    /// SH exponential: `ol`, `ps` or `hyb`. Default `hyb`.
+    pub exp: ExpMethod,
+    /// Proxy indirect light (eq. 12–15) on top of the shadowed environment. Default true.
+    pub indirect: bool,
+    /// Brute force: every proxy at every receiver, unclamped tables and the exact chain of SH
+    /// products instead of log/exp (a reference; slow). Default false.
+    pub brute_force: bool,
+    /// 0: the scene's proxies; k in 1..=64: refit k spheres to the mesh of every node that has
+    /// proxies (for profiling with many proxies). Default 0.
+    pub fit_count: u32,
 }
 
 /// `[output]`: how the HDR frame becomes the written image.
@@ -539,6 +587,35 @@ impl Default for Settings {
             shadow: ShadowSettings::default(),
             upsample: UpsampleSettings::default(),
             igi: IgiSettings::default(),
+            proxy: ProxySettings::default(),
+        }
+    }
+}
+
+impl Default for ProxySettings {
+    fn default() -> Self {
+        Self {
+            sh_order: 4,
+            expansion: 0.0,
+            indirect_expansion: 10.0,
+            exp: ExpMethod::Hyb,
+            indirect: true,
+            brute_force: false,
+            fit_count: 0,
+        }
+    }
+}
+
+impl ProxySettings {
+    /// The shadow expansion factor η in use: the setting, or the paper's value for the order
+    /// (§4.1: 15 for order 4, 10 for order 3) when it is 0.
+    pub fn shadow_expansion(&self) -> f32 {
+        if self.expansion > 0.0 {
+            self.expansion
+        } else if self.sh_order <= 3 {
+            10.0 // §4.1, paper 002: order 3
+        } else {
+            15.0 // §4.1, paper 002: order 4
         }
     }
 }
@@ -744,6 +821,16 @@ impl Settings {
             self.upsample.normal_power,
             1.0..=256.0,
         )?;
+        check("proxy.sh_order", self.proxy.sh_order, 3..=6)?;
+        if self.proxy.expansion != 0.0 {
+            check("proxy.expansion", self.proxy.expansion, 2.0..=100.0)?;
+        }
+        check(
+            "proxy.indirect_expansion",
+            self.proxy.indirect_expansion,
+            2.0..=100.0,
+        )?;
+        check("proxy.fit_count", self.proxy.fit_count, 0..=64)?;
         self.validate_igi()?;
         Ok(())
     }
@@ -795,7 +882,13 @@ mod tests {
     #[test]
     fn every_out_of_range_field_is_named() {
         type Edit = fn(&mut Settings);
-        let cases: [(&str, &str, Edit); 24] = [
+        let cases: [(&str, &str, Edit); 28] = [
+            ("proxy.sh_order", "7", |s| s.proxy.sh_order = 7),
+            ("proxy.expansion", "1.0", |s| s.proxy.expansion = 1.0),
+            ("proxy.indirect_expansion", "NaN", |s| {
+                s.proxy.indirect_expansion = f32::NAN
+            }),
+            ("proxy.fit_count", "65", |s| s.proxy.fit_count = 65),
             ("width", "0", |s| s.width = 0),
             ("width", "16385", |s| s.width = 16385),
             ("height", "0", |s| s.height = 0),
@@ -967,6 +1060,9 @@ mod tests {
 
     #[test]
     fn gi_lists_parse() {
+        let both: GiTechniques = "hvl,proxy".parse().unwrap();
+        assert_eq!(both.techniques(), [GiTechnique::Hvl, GiTechnique::Proxy]);
+        assert_eq!(both.to_string(), "hvl,proxy");
         let hvl: GiTechniques = "hvl".parse().unwrap();
         assert_eq!(hvl.techniques(), [GiTechnique::Hvl]);
         assert!(hvl.contains(GiTechnique::Hvl));
@@ -980,10 +1076,10 @@ mod tests {
     fn gi_errors_are_clear() {
         let unknown = "hvl,foo".parse::<GiTechniques>().unwrap_err().to_string();
         assert!(unknown.contains("`foo`"), "{unknown}");
-        assert!(unknown.contains("hvl, igi, none, proxy, aaf"), "{unknown}");
-        let planned = "hvl,proxy".parse::<GiTechniques>().unwrap_err().to_string();
+        assert!(unknown.contains("hvl, igi, proxy, none, aaf"), "{unknown}");
+        let planned = "hvl,aaf".parse::<GiTechniques>().unwrap_err().to_string();
         assert!(
-            planned.contains("`proxy` is not implemented yet"),
+            planned.contains("`aaf` is not implemented yet"),
             "{planned}"
         );
         for bad in ["", "hvl,", "none,hvl", "hvl,hvl"] {

@@ -20,7 +20,8 @@ pub struct SettingsArgs {
     /// Scene time in seconds (animations).
     #[arg(long)]
     time: Option<f32>,
-    /// GI techniques: `hvl` (default), `igi`, `none`; later `proxy`, `aaf`, combined with commas.
+    /// GI techniques: `hvl` (default), `igi`, `proxy`, `none`, combined with commas
+    /// (`hvl,proxy`); later `aaf`.
     #[arg(long)]
     gi: Option<String>,
     /// Tonemapping: none, aces, pbr-neutral.

@@ -8,6 +8,7 @@ pub mod gbuffer;
 pub mod hvl;
 pub mod igi;
 pub mod path_trace;
+pub mod proxy;
 pub mod receivers;
 pub mod shadows;
 pub mod upsample;

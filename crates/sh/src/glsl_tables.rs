@@ -11,12 +11,19 @@
 //!   `c_k += v a_i b_i` when `i = j`, `c_k += v (a_i b_j + a_j b_i)` otherwise
 //!   (= [`crate::product::TripleProduct::product`]);
 //! * the first `SH_OL_COUNT` entries of each band count's [`crate::exp_log::OlTable`] (enough to
-//!   cover magnitudes up to [`crate::exp_log::HYB_MAX_MAGNITUDE`], all that HYB reads).
+//!   cover magnitudes up to [`crate::exp_log::HYB_MAX_MAGNITUDE`], all that HYB reads: the
+//!   whole table as GLSL constants makes lavapipe's shader compiler take tens of seconds; the
+//!   OL exponential takes its coefficients from a buffer, `sh_exp_ol_ab`);
+//! * the HYB and PS scaling thresholds and the PS Taylor order.
+//!
+//! Shaders with more bands (paper 002 orders 5–6) read the same data from a buffer
+//! ([`tensor_pairs`], [`crate::exp_log::OlTable`]): as GLSL constants, 600–1500 tensor entries
+//! make lavapipe compile for minutes.
 
 use std::fmt::Write as _;
 
 use crate::Result;
-use crate::exp_log::{HYB_MAX_MAGNITUDE, OL_TABLE_SIZE, ShExp};
+use crate::exp_log::{HYB_MAX_MAGNITUDE, OL_TABLE_SIZE, PS_MAX_MAGNITUDE, PS_TAYLOR_ORDER, ShExp};
 use crate::product::TripleProduct;
 
 /// Largest band count of the GLSL product and HYB exponential.
@@ -41,10 +48,10 @@ fn float_list(out: &mut String, values: impl IntoIterator<Item = f64>) {
     }
 }
 
-/// The generated GLSL section, markers included, ending with a newline.
-pub fn generated_section() -> Result<String> {
-    let max = GLSL_PRODUCT_MAX_BANDS;
-    let tensor = TripleProduct::new(max)?;
+/// The tensor pairs of `bands` bands in the GLSL order (`SH_TENSOR_IJK`, `SH_TENSOR_V`): by
+/// largest index, then output, then inputs, so the pairs of fewer bands are a prefix.
+fn sorted_pairs(bands: usize) -> Result<Vec<crate::product::TensorEntry>> {
+    let tensor = TripleProduct::new(bands)?;
     let mut pairs: Vec<_> = tensor
         .entries()
         .iter()
@@ -52,6 +59,29 @@ pub fn generated_section() -> Result<String> {
         .copied()
         .collect();
     pairs.sort_by_key(|e| (e.i.max(e.j).max(e.k), e.k, e.i, e.j));
+    Ok(pairs)
+}
+
+/// The tensor of `bands` bands (`1..=MAX_PRODUCT_BANDS`) as `SH_TENSOR_IJK` (packed
+/// `i | j << 8 | k << 16`) and `SH_TENSOR_V` lists, for shaders that read it from a buffer
+/// (`SH_TENSOR_IJK_AT` in `sh.glsl`); for `bands ≤ GLSL_PRODUCT_MAX_BANDS` it equals the
+/// first `SH_TENSOR_COUNT[bands]` entries of the GLSL constants.
+pub fn tensor_pairs(bands: usize) -> Result<(Vec<u32>, Vec<f32>)> {
+    Ok(sorted_pairs(bands)?
+        .iter()
+        .map(|e| {
+            (
+                u32::from(e.i) | u32::from(e.j) << 8 | u32::from(e.k) << 16,
+                e.value as f32,
+            )
+        })
+        .unzip())
+}
+
+/// The generated GLSL section, markers included, ending with a newline.
+pub fn generated_section() -> Result<String> {
+    let max = GLSL_PRODUCT_MAX_BANDS;
+    let pairs = sorted_pairs(max)?;
     let counts: Vec<usize> = (0..=max)
         .map(|n| {
             let n2 = (n * n) as u16;
@@ -74,6 +104,12 @@ pub fn generated_section() -> Result<String> {
         "const float SH_HYB_MAX_MAGNITUDE = {:.9e};",
         HYB_MAX_MAGNITUDE as f32
     );
+    let _ = writeln!(
+        s,
+        "const float SH_PS_MAX_MAGNITUDE = {:.9e};",
+        PS_MAX_MAGNITUDE as f32
+    );
+    let _ = writeln!(s, "const int SH_PS_TAYLOR_ORDER = {PS_TAYLOR_ORDER};");
     let _ = writeln!(s, "const int SH_TENSOR_TOTAL = {};", pairs.len());
     let list: Vec<String> = counts.iter().map(|c| c.to_string()).collect();
     let _ = writeln!(

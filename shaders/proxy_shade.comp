@@ -1,0 +1,117 @@
+// Proxy shading (paper 002 §3-5): rows `sh_exp` and the normalisation of `proxy_indirect` of
+// DESIGN §4. At every receiver:
+//   O_p = exp(sum of log-occlusion)  (OL, PS or HYB; PRODUCT: the sum already is O_p)  eq. 4
+//   psi_shadow = H(N_p) . (O_p * L) = L . (O_p * H(N_p))  per rgb channel             eq. 10
+//   xi_p = (sqrt(4 pi) - (O_p)_0) / (omega_p / sqrt(4 pi)),  I_p . H = xi_p (sum I_i . H)  eq. 12
+//   radiance = kd / pi * max(psi_shadow + xi_p (sum I_i . H), 0),  kd = albedo (1 - metallic)
+// Writes the radiance (RGBA16F, a = 0, 0 on background) and O_p (for tests and debugging).
+// CPU twin: shine::passes::proxy::shade_cpu.
+//! variant hyb_b3 EXP_HYB=1 SH_BANDS=3
+//! variant hyb_b4 EXP_HYB=1 SH_BANDS=4
+//! variant hyb_b5 EXP_HYB=1 SH_BANDS=5
+//! variant hyb_b6 EXP_HYB=1 SH_BANDS=6
+//! variant ps_b3 EXP_PS=1 SH_BANDS=3
+//! variant ps_b4 EXP_PS=1 SH_BANDS=4
+//! variant ps_b5 EXP_PS=1 SH_BANDS=5
+//! variant ps_b6 EXP_PS=1 SH_BANDS=6
+//! variant ol_b3 EXP_OL=1 SH_BANDS=3
+//! variant ol_b4 EXP_OL=1 SH_BANDS=4
+//! variant ol_b5 EXP_OL=1 SH_BANDS=5
+//! variant ol_b6 EXP_OL=1 SH_BANDS=6
+//! variant product_b3 PRODUCT=1 SH_BANDS=3
+//! variant product_b4 PRODUCT=1 SH_BANDS=4
+//! variant product_b5 PRODUCT=1 SH_BANDS=5
+//! variant product_b6 PRODUCT=1 SH_BANDS=6
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
+#define SH_LOOP_ATTRIBUTES
+#define PROXY_TABLES_BINDING 8
+#include "proxy_tables.glsl"
+#include "sh.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba16f) readonly uniform image2D recv_normal;
+layout(set = 0, binding = 7, rgba32f) readonly uniform image2D recv_position;
+layout(set = 0, binding = 1, rgba8) readonly uniform image2D recv_albedo;
+layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_material;
+
+layout(set = 0, binding = 3, std430) readonly buffer Sums {
+    float s[];
+} sums;
+
+layout(set = 0, binding = 4, std430) readonly buffer Environment {
+    float e[];
+} environment;
+
+layout(set = 0, binding = 5, std430) buffer Occlusion {
+    float o[];
+} occlusion;
+
+layout(set = 0, binding = 6, rgba16f) uniform image2D proxy_gi;
+
+
+// shine::passes::proxy::ShadePush
+layout(push_constant) uniform Push {
+    uvec2 extent;
+    uint pad0;
+    uint pad1;
+} push;
+
+
+void main() {
+    uvec2 xy = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(xy, push.extent))) {
+        return;
+    }
+    ivec2 ixy = ivec2(xy);
+    uint r = xy.y * push.extent.x + xy.x;
+    uint base = r * uint(SH_COEFFS + 4);
+    vec4 nw = imageLoad(recv_normal, ixy);
+    float f[SH_COEFFS];
+    for (int k = 0; k < SH_COEFFS; ++k) {
+        f[k] = sums.s[base + uint(k)];
+    }
+    float o[SH_COEFFS];
+#if defined(EXP_HYB)
+    sh_exp_hyb(f, o);
+#elif defined(EXP_PS)
+    sh_exp_ps(f, o);
+#elif defined(EXP_OL)
+    sh_exp_ol_ab(f, sh_ol_coefficients(sh_norm_without_dc(f)), o);
+#else
+    o = f;
+#endif
+    for (int k = 0; k < SH_COEFFS; ++k) {
+        occlusion.o[r * uint(SH_COEFFS) + uint(k)] = o[k];
+    }
+    vec3 n = nw.xyz;
+    if (!(imageLoad(recv_position, ixy).w > 0.0) || dot(n, n) <= 0.0) {
+        // background receiver: no light
+        imageStore(proxy_gi, ixy, vec4(0.0));
+        return;
+    }
+    n = normalize(n);
+    float cc[SH_BANDS];
+    sh_clamped_cosine_zh(cc);
+    float hn[SH_COEFFS];
+    sh_rotate_zh(cc, n, hn);
+    // H . (O * L) = L . (O * H): the triple product is symmetric, so one product serves the
+    // three channels
+    float oh[SH_COEFFS];
+    sh_product(o, hn, oh);
+    vec3 psi = vec3(0.0);
+    for (int k = 0; k < SH_COEFFS; ++k) {
+        psi += oh[k] * vec3(environment.e[k], environment.e[SH_COEFFS + k],
+            environment.e[2 * SH_COEFFS + k]);
+    }
+    vec3 summed = vec3(sums.s[base + uint(SH_COEFFS)], sums.s[base + uint(SH_COEFFS) + 1u],
+        sums.s[base + uint(SH_COEFFS) + 2u]);
+    float xi = sh_overlap_normalisation(o[0], sums.s[base + uint(SH_COEFFS) + 3u]);
+    vec3 albedo = imageLoad(recv_albedo, ixy).rgb;
+    float metallic = imageLoad(recv_material, ixy).g;
+    vec3 kd = albedo * (1.0 - metallic);
+    vec3 radiance = kd / SH_PI * max(psi + xi * summed, vec3(0.0));
+    imageStore(proxy_gi, ixy, vec4(radiance, 0.0));
+}

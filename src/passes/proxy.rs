@@ -1,0 +1,716 @@
+//! Sphere proxies under the environment light (paper 002): the `proxy_accumulate` and
+//! `proxy_shade` passes, their GPU data and their CPU twin.
+//!
+//! * [`proxy_accumulate`] sums, at every receiver, the rotated log-occlusion ZH vectors of the
+//!   proxies (eq. 4, 8) and their indirect shading `I_i · H(N_p)` with the summed solid angle
+//!   `ω_p` (eq. 12–15): DESIGN §4's `proxy_occlusion` and the accumulation half of
+//!   `proxy_indirect`, in one tiled compute "splat" (docs/frame.md, "Proxy GI", says why).
+//! * [`proxy_shade`] exponentiates the sum (OL, PS or HYB: DESIGN §4's `sh_exp`), shades the
+//!   environment through the occlusion (eq. 10), normalises the indirect sum (eq. 12) and
+//!   writes the outgoing diffuse radiance at receiver resolution (`proxy_gi`).
+//!
+//! Every formula comes from shine-sh ([`shine_sh::sphere_blocker`], [`shine_sh::exp_log`],
+//! [`shine_sh::proxy_indirect`]) on the CPU and from `shaders/include/sh.glsl` on the GPU;
+//! [`accumulate_cpu`] and [`shade_cpu`] compose the shine-sh functions exactly as the shaders
+//! compose their GLSL twins, and `tests/proxy.rs` ties the two.
+//!
+//! # Decisions
+//!
+//! * **Tables.** `O^log(α)` and `V(α)` are [`AlphaTable`]s of [`TABLE_ENTRIES`] rows, smoothly
+//!   clamped (§4.1) with the shadow and indirect expansion factors; a third, unclamped `V(α)`
+//!   serves the brute-force product. A clamped table is exactly 0 at and below its *support*
+//!   `α_0` (the last all-zero row), so the sphere of influence of a proxy of radius `r` is
+//!   `r / α_0`: slightly larger than `η r` (17.0 r for η = 15 with 256 rows) because the
+//!   smooth ramp starts one row below `1/η`. Splatting with that radius loses nothing: splat
+//!   and brute force agree exactly.
+//! * **Self-shadowing** ([`self_shadow_substitute`]) replaces the proxy for both the shadow and
+//!   the indirect accumulation, so a receiver on a proxied object neither shadows nor lights
+//!   itself through its own proxy.
+//! * **Indirect light** is order 3 (the D(θ) fit of eq. 15): `I_i = (ρ_i/π) κ_i V_i`, with the
+//!   proxy's albedo `ρ_i` (base colour of its node's first material) turning the irradiance
+//!   `L̃` on the proxy into exitant radiance (the paper leaves the albedo implicit).
+//! * **Receiver BRDF.** Lambert, `kd = albedo (1 − metallic)`: outgoing radiance
+//!   `kd/π · max(ψ_p, 0)` per channel (band-limited ringing clamped at 0).
+
+use glam::Vec3;
+use shine_sh::ShError;
+use shine_sh::exp_log::ShExp;
+use shine_sh::kernels::clamped_cosine_zh;
+use shine_sh::proxy_indirect::{averaged_operator_fit, overlap_normalisation};
+use shine_sh::sphere_blocker::{AlphaTable, BlockerSubstitute, self_shadow_substitute};
+use shine_sh::zonal::rotate_zh;
+
+use crate::environment_sh::EnvironmentSh;
+use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::settings::ExpMethod;
+use crate::shaders;
+
+pub use super::receivers::Receivers;
+
+/// Rows of the α tables (α = sin θ uniformly in [0, 1]).
+pub const TABLE_ENTRIES: usize = 256;
+/// Most proxies a frame takes: the accumulation shader's tile mask has 64 words of 32 bits.
+pub const MAX_PROXIES: u32 = 2048;
+/// SH orders (bands) of the occlusion and the environment.
+pub const ORDERS: std::ops::RangeInclusive<u32> = 3..=6;
+/// Bands of the proxy indirect light: the averaged operator D(θ) is fitted to order 3
+/// (eq. 15, paper 002).
+pub const INDIRECT_BANDS: usize = 3;
+
+const SQRT_4PI: f32 = 3.544_907_7;
+
+/// One proxy on the GPU (std430, 32 bytes): `proxies.p[2i]` and `proxies.p[2i + 1]` in
+/// `shaders/proxy_accumulate.comp`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuProxy {
+    /// xyz world centre, w radius (metres).
+    pub sphere: [f32; 4],
+    /// rgb albedo of the proxied surface, a unused.
+    pub albedo: [f32; 4],
+}
+
+impl GpuProxy {
+    /// A proxy at `center` of `radius` and `albedo`.
+    pub fn new(center: Vec3, radius: f32, albedo: Vec3) -> Self {
+        Self {
+            sphere: center.extend(radius).to_array(),
+            albedo: albedo.extend(0.0).to_array(),
+        }
+    }
+
+    fn center(&self) -> Vec3 {
+        Vec3::new(self.sphere[0], self.sphere[1], self.sphere[2])
+    }
+
+    fn albedo(&self) -> Vec3 {
+        Vec3::new(self.albedo[0], self.albedo[1], self.albedo[2])
+    }
+}
+
+/// How proxies are accumulated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Accumulation {
+    /// Image-space splatting: per 8×8 receiver tile, proxies whose sphere of influence misses
+    /// the tile are culled; each receiver takes the proxies whose sphere contains it.
+    Splat,
+    /// Every proxy at every receiver, log-occlusion sums as [`Accumulation::Splat`] (tests).
+    Brute,
+    /// Every proxy at every receiver with unclamped tables; the occlusion is the exact chain of
+    /// SH products (no log, no exponential): the brute-force reference mode.
+    Product,
+}
+
+impl Accumulation {
+    fn name(self) -> &'static str {
+        match self {
+            Accumulation::Splat => "splat",
+            Accumulation::Brute => "brute",
+            Accumulation::Product => "product",
+        }
+    }
+}
+
+/// Parameters of the proxy passes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProxyParams {
+    /// SH bands n of the occlusion and environment, in [`ORDERS`].
+    pub bands: u32,
+    /// How proxies are accumulated.
+    pub accumulation: Accumulation,
+    /// The SH exponential (unused by [`Accumulation::Product`]).
+    pub exp: ExpMethod,
+    /// Whether the proxy indirect light is accumulated.
+    pub indirect: bool,
+}
+
+/// What the proxy passes refuse.
+#[derive(Debug, thiserror::Error)]
+pub enum ProxyError {
+    /// A parameter out of its range.
+    #[error("proxy parameter `{name}` = {value} is out of range: {expected}")]
+    OutOfRange {
+        /// The parameter.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+        /// The allowed range.
+        expected: &'static str,
+    },
+    /// An input of the wrong size.
+    #[error("proxy input `{name}` is {actual}, expected {expected}")]
+    Size {
+        /// Which input.
+        name: &'static str,
+        /// What it is.
+        actual: String,
+        /// What it should be.
+        expected: String,
+    },
+    /// No compiled shader for the parameters.
+    #[error("no compiled shader `{0}` (see the variants of shaders/proxy_*.comp)")]
+    Variant(String),
+    /// An SH table or projection failed.
+    #[error("proxy SH: {0}")]
+    Sh(#[from] ShError),
+}
+
+impl ProxyParams {
+    fn check(&self) -> Result<usize, ProxyError> {
+        if !ORDERS.contains(&self.bands) {
+            return Err(ProxyError::OutOfRange {
+                name: "bands",
+                value: f64::from(self.bands),
+                expected: "3..=6",
+            });
+        }
+        Ok(self.bands as usize)
+    }
+
+    fn accumulate_shader(&self) -> Result<&'static crate::gpu::ShaderDesc, ProxyError> {
+        self.check()?;
+        let name = format!(
+            "proxy_accumulate.comp:{}_b{}",
+            self.accumulation.name(),
+            self.bands
+        );
+        shaders::get(&name).ok_or(ProxyError::Variant(name))
+    }
+
+    fn shade_shader(&self) -> Result<&'static crate::gpu::ShaderDesc, ProxyError> {
+        self.check()?;
+        let method = match (self.accumulation, self.exp) {
+            (Accumulation::Product, _) => "product",
+            (_, ExpMethod::Hyb) => "hyb",
+            (_, ExpMethod::Ps) => "ps",
+            (_, ExpMethod::Ol) => "ol",
+        };
+        let name = format!("proxy_shade.comp:{method}_b{}", self.bands);
+        shaders::get(&name).ok_or(ProxyError::Variant(name))
+    }
+}
+
+/// The α tables of the accumulation (GPU buffer `tables`): clamped log-occlusion, clamped
+/// visibility, unclamped visibility, each [`TABLE_ENTRIES`] rows of `bands` floats, then the
+/// OL exponential's table of shine-sh (step, `a`, `b`; read by the OL shading variant).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ProxyTables {
+    /// `O^log(α)` smoothly clamped with the shadow expansion factor.
+    pub log_occlusion: AlphaTable,
+    /// `V(α)` smoothly clamped with the indirect expansion factor.
+    pub visibility: AlphaTable,
+    /// `V(α)` unclamped (brute-force product).
+    pub visibility_full: AlphaTable,
+    /// Largest α at which `log_occlusion` is exactly 0 (its rows up to it are all zero).
+    pub support_shadow: f32,
+    /// Largest α at which `visibility` is exactly 0.
+    pub support_indirect: f32,
+    /// [`shine_sh::exp_log::OlTable`] of the band count: step, `a` samples, `b` samples.
+    pub ol: Vec<f32>,
+    /// [`shine_sh::glsl_tables::tensor_pairs`] of the band count: the entry count, packed
+    /// `ijk` (as floats, exact below 2²⁴), then values.
+    pub tensor: Vec<f32>,
+}
+
+/// The largest α such that every row of `table` at or below it is all zeros.
+fn support(table: &AlphaTable) -> f32 {
+    let n = table.bands();
+    let zero_rows = table
+        .data()
+        .chunks_exact(n)
+        .take_while(|row| row.iter().all(|&x| x == 0.0))
+        .count();
+    if zero_rows == 0 {
+        0.0
+    } else {
+        (zero_rows - 1) as f32 / (table.entries() - 1) as f32
+    }
+}
+
+impl ProxyTables {
+    /// Builds the tables for `bands` bands and the shadow / indirect expansion factors η
+    /// (§4.1: 15 for order 4, 10 for order 3).
+    pub fn build(bands: u32, eta_shadow: f32, eta_indirect: f32) -> Result<Self, ProxyError> {
+        let bands = ProxyParams {
+            bands,
+            accumulation: Accumulation::Splat,
+            exp: ExpMethod::Hyb,
+            indirect: true,
+        }
+        .check()?;
+        let mut log_occlusion = AlphaTable::log_visibility(bands, TABLE_ENTRIES)?;
+        log_occlusion.smooth_clamp(eta_shadow)?;
+        let mut visibility = AlphaTable::visibility(bands, TABLE_ENTRIES)?;
+        visibility.smooth_clamp(eta_indirect)?;
+        let visibility_full = AlphaTable::visibility(bands, TABLE_ENTRIES)?;
+        let exp = ShExp::new(bands)?;
+        let (a, b) = exp.ol_table().samples();
+        let ol = std::iter::once(exp.ol_table().step())
+            .chain(a.iter().copied())
+            .chain(b.iter().copied())
+            .map(|x| x as f32)
+            .collect();
+        let (ijk, values) = shine_sh::glsl_tables::tensor_pairs(bands)?;
+        let tensor = std::iter::once(ijk.len() as f32)
+            .chain(ijk.iter().map(|&x| x as f32))
+            .chain(values)
+            .collect();
+        Ok(Self {
+            ol,
+            tensor,
+            support_shadow: support(&log_occlusion),
+            support_indirect: support(&visibility),
+            log_occlusion,
+            visibility,
+            visibility_full,
+        })
+    }
+
+    /// The GPU buffer `tables`.
+    pub fn gpu_data(&self) -> Vec<f32> {
+        [
+            self.log_occlusion.data(),
+            self.visibility.data(),
+            self.visibility_full.data(),
+            &self.ol,
+            &self.tensor,
+        ]
+        .concat()
+    }
+
+    /// Float offset of the OL table in [`ProxyTables::gpu_data`].
+    pub fn ol_offset(&self) -> usize {
+        3 * TABLE_ENTRIES * self.log_occlusion.bands()
+    }
+}
+
+/// Push constants of `shaders/proxy_accumulate.comp` (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct AccumulatePush {
+    /// Receiver buffer size.
+    pub extent: [u32; 2],
+    /// Number of proxies.
+    pub proxy_count: u32,
+    /// Rows of each α table.
+    pub table_entries: u32,
+    /// [`ProxyTables::support_shadow`].
+    pub support_shadow: f32,
+    /// [`ProxyTables::support_indirect`] (the shadow one when indirect light is off).
+    pub support_indirect: f32,
+    /// 1: accumulate the indirect sums.
+    pub indirect: u32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// Push constants of `shaders/proxy_tiles.comp` (16 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TilesPush {
+    /// Receiver buffer size.
+    pub extent: [u32; 2],
+    /// Number of proxies.
+    pub proxy_count: u32,
+    /// The smaller of the two supports in [`AccumulatePush`].
+    pub support: f32,
+}
+
+/// Side of a culling tile in receivers.
+pub const TILE: u32 = 8;
+/// Words of a tile's proxy mask (`MAX_PROXIES / 32`).
+pub const TILE_WORDS: u32 = MAX_PROXIES / 32;
+
+/// Push constants of `shaders/proxy_shade.comp` (16 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ShadePush {
+    /// Receiver buffer size.
+    pub extent: [u32; 2],
+    /// Padding.
+    pub pad: [u32; 2],
+}
+
+/// Push constants of `shaders/gi_add.comp` (8 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct AddPush {
+    /// Image size.
+    pub extent: [u32; 2],
+}
+
+/// Floats per receiver in the `proxy_sums` buffer: `bands²` (log-occlusion, or occlusion for
+/// [`Accumulation::Product`]), then rgb `Σ I_i · H(N_p)` and `ω_p`.
+pub fn sums_stride(bands: u32) -> usize {
+    (bands * bands) as usize + 4
+}
+
+/// The GPU buffers the proxy passes read.
+#[derive(Debug, Clone, Copy)]
+pub struct ProxyInputs {
+    /// [`GpuProxy`] records.
+    pub proxies: Handle<Buffer>,
+    /// How many records `proxies` holds (at most [`MAX_PROXIES`]).
+    pub count: u32,
+    /// [`ProxyTables::gpu_data`] at the parameters' band count.
+    pub tables: Handle<Buffer>,
+    /// [`EnvironmentSh::gpu_data`] at the parameters' band count.
+    pub environment: Handle<Buffer>,
+}
+
+/// The outputs of [`proxy_shade`].
+#[derive(Debug, Clone, Copy)]
+pub struct ProxyOutputs {
+    /// `proxy_gi`: RGBA16F at receiver resolution, outgoing radiance (a = 0, 0 on background).
+    pub radiance: Handle<Image>,
+    /// `proxy_occlusion`: `bands²` floats per receiver, the occlusion vector `O_p`.
+    pub occlusion: Handle<Buffer>,
+}
+
+fn check_inputs(
+    receivers: &Receivers,
+    inputs: &ProxyInputs,
+    tables: &ProxyTables,
+    params: &ProxyParams,
+) -> Result<(), ProxyError> {
+    let bands = params.check()?;
+    if inputs.count > MAX_PROXIES {
+        return Err(ProxyError::OutOfRange {
+            name: "proxy count",
+            value: f64::from(inputs.count),
+            expected: "0..=2048",
+        });
+    }
+    let need = u64::from(inputs.count.max(1)) * std::mem::size_of::<GpuProxy>() as u64;
+    let sizes = [
+        ("proxies", inputs.proxies.desc().size, need),
+        (
+            "tables",
+            inputs.tables.desc().size,
+            (tables.gpu_data().len() * 4) as u64,
+        ),
+        (
+            "environment",
+            inputs.environment.desc().size,
+            (6 * bands * bands * 4) as u64,
+        ),
+    ];
+    for (name, actual, expected) in sizes {
+        let ok = if name == "proxies" {
+            actual >= expected
+        } else {
+            actual == expected
+        };
+        if !ok {
+            return Err(ProxyError::Size {
+                name,
+                actual: format!("{actual} bytes"),
+                expected: format!("{expected} bytes"),
+            });
+        }
+    }
+    if tables.log_occlusion.bands() != bands {
+        return Err(ProxyError::Size {
+            name: "tables",
+            actual: format!("{} bands", tables.log_occlusion.bands()),
+            expected: format!("{bands} bands"),
+        });
+    }
+    let [w, h] = receivers.extent;
+    if w == 0 || h == 0 {
+        return Err(ProxyError::Size {
+            name: "receivers",
+            actual: format!("{w}×{h}"),
+            expected: "a non-empty extent".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Adds the `proxy_accumulate` pass: a new `proxy_sums` buffer ([`sums_stride`] floats per
+/// receiver, row-major), returned.
+pub fn proxy_accumulate(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    inputs: &ProxyInputs,
+    tables: &ProxyTables,
+    params: &ProxyParams,
+) -> Result<Handle<Buffer>, ProxyError> {
+    check_inputs(receivers, inputs, tables, params)?;
+    let shader = params.accumulate_shader()?;
+    let [w, h] = receivers.extent;
+    let support_indirect = if params.indirect {
+        tables.support_indirect
+    } else {
+        tables.support_shadow
+    };
+    let masks = if params.accumulation == Accumulation::Splat {
+        let tiles = [w.div_ceil(TILE), h.div_ceil(TILE)];
+        let bytes = u64::from(tiles[0]) * u64::from(tiles[1]) * u64::from(TILE_WORDS) * 4;
+        let mut masks = rg.create_buffer("proxy_tile_masks", BufferDesc::new(bytes));
+        rg.compute("proxy_tiles", &shaders::PROXY_TILES_COMP)
+            .read("recv_position", &receivers.position)
+            .read("proxies", &inputs.proxies)
+            .write("tile_masks", &mut masks)
+            .push(&TilesPush {
+                extent: receivers.extent,
+                proxy_count: inputs.count,
+                support: tables.support_shadow.min(support_indirect),
+            })
+            .dispatch([tiles[0], tiles[1], 1]);
+        Some(masks)
+    } else {
+        None
+    };
+    let bytes = u64::from(w) * u64::from(h) * sums_stride(params.bands) as u64 * 4;
+    let mut sums = rg.create_buffer("proxy_sums", BufferDesc::new(bytes));
+    let push = AccumulatePush {
+        extent: receivers.extent,
+        proxy_count: inputs.count,
+        table_entries: TABLE_ENTRIES as u32,
+        support_shadow: tables.support_shadow,
+        support_indirect,
+        indirect: u32::from(params.indirect),
+        pad: 0,
+    };
+    let mut pass = rg.compute("proxy_accumulate", shader);
+    pass.read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("proxies", &inputs.proxies)
+        .read("tables", &inputs.tables)
+        .read("environment", &inputs.environment);
+    if let Some(masks) = &masks {
+        pass.read("tile_masks", masks);
+    }
+    pass.write("sums", &mut sums)
+        .push(&push)
+        .dispatch([w, h, 1]);
+    Ok(sums)
+}
+
+/// Adds the `proxy_shade` pass over the sums of [`proxy_accumulate`] (`inputs.proxies` is not
+/// read).
+pub fn proxy_shade(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    sums: &Handle<Buffer>,
+    inputs: &ProxyInputs,
+    tables: &ProxyTables,
+    params: &ProxyParams,
+) -> Result<ProxyOutputs, ProxyError> {
+    let shader = params.shade_shader()?;
+    let table_bytes = (tables.gpu_data().len() * 4) as u64;
+    if inputs.tables.desc().size != table_bytes {
+        return Err(ProxyError::Size {
+            name: "tables",
+            actual: format!("{} bytes", inputs.tables.desc().size),
+            expected: format!("{table_bytes} bytes"),
+        });
+    }
+    let [w, h] = receivers.extent;
+    let texels = u64::from(w) * u64::from(h);
+    let need = texels * sums_stride(params.bands) as u64 * 4;
+    if sums.desc().size != need {
+        return Err(ProxyError::Size {
+            name: "proxy_sums",
+            actual: format!("{} bytes", sums.desc().size),
+            expected: format!("{need} bytes"),
+        });
+    }
+    let mut radiance = rg.create_image(
+        "proxy_gi",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    let coeffs = u64::from(params.bands * params.bands);
+    let mut occlusion = rg.create_buffer("proxy_occlusion", BufferDesc::new(texels * coeffs * 4));
+    let push = ShadePush {
+        extent: receivers.extent,
+        pad: [0; 2],
+    };
+    let mut pass = rg.compute("proxy_shade", shader);
+    pass.read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("recv_albedo", &receivers.albedo)
+        .read("recv_material", &receivers.material)
+        .read("sums", sums)
+        .read("environment", &inputs.environment);
+    pass.read("tables", &inputs.tables)
+        .write("occlusion", &mut occlusion)
+        .write("proxy_gi", &mut radiance)
+        .push(&push)
+        .dispatch([w, h, 1]);
+    Ok(ProxyOutputs {
+        radiance,
+        occlusion,
+    })
+}
+
+/// Adds a `gi_add` pass: `first + second` (RGBA16F images of one extent) in a new image.
+pub fn gi_add(
+    rg: &mut RenderGraph,
+    first: &Handle<Image>,
+    second: &Handle<Image>,
+) -> Result<Handle<Image>, ProxyError> {
+    let (a, b) = (first.desc().extent, second.desc().extent);
+    if (a.width, a.height) != (b.width, b.height) {
+        return Err(ProxyError::Size {
+            name: "gi_add second",
+            actual: format!("{}×{}", b.width, b.height),
+            expected: format!("{}×{}", a.width, a.height),
+        });
+    }
+    let mut sum = rg.create_image(
+        "gi_sum",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, a.width, a.height),
+    );
+    rg.compute("gi_add", &shaders::GI_ADD_COMP)
+        .read("first", first)
+        .read("second", second)
+        .write("sum", &mut sum)
+        .push(&AddPush {
+            extent: [a.width, a.height],
+        })
+        .dispatch([a.width, a.height, 1]);
+    Ok(sum)
+}
+
+fn check_exp(params: &ProxyParams, exp: &ShExp) -> Result<usize, ProxyError> {
+    let bands = params.check()?;
+    if exp.bands() != bands {
+        return Err(ProxyError::Size {
+            name: "ShExp",
+            actual: format!("{} bands", exp.bands()),
+            expected: format!("{bands} bands"),
+        });
+    }
+    Ok(bands)
+}
+
+/// One receiver as the CPU twin sees it (the receiver buffer's texel, decoded).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ReceiverSample {
+    /// World position.
+    pub position: Vec3,
+    /// False for a background receiver (`recv_position.w == 0`).
+    pub valid: bool,
+    /// World normal (normalised here).
+    pub normal: Vec3,
+    /// Linear albedo.
+    pub albedo: Vec3,
+    /// Metallic factor.
+    pub metallic: f32,
+}
+
+/// CPU twin of `proxy_accumulate` at one receiver: the [`sums_stride`] floats it writes. Every
+/// proxy is visited (the splat only skips proxies whose contribution is exactly 0). `exp` is
+/// the SH machinery of the parameters' band count.
+pub fn accumulate_cpu(
+    receiver: &ReceiverSample,
+    proxies: &[GpuProxy],
+    tables: &ProxyTables,
+    environment: &EnvironmentSh,
+    params: &ProxyParams,
+    exp: &ShExp,
+) -> Result<Vec<f32>, ProxyError> {
+    let bands = check_exp(params, exp)?;
+    let n2 = bands * bands;
+    let product = params.accumulation == Accumulation::Product;
+    let mut acc = vec![0.0f32; n2];
+    if product {
+        acc[0] = SQRT_4PI;
+    }
+    let mut indirect = Vec3::ZERO;
+    let mut omega = 0.0f32;
+    if receiver.valid {
+        let p = receiver.position;
+        let n = receiver.normal.normalize();
+        let hn = rotate_zh(&clamped_cosine_zh(bands)?, n)?;
+        for proxy in proxies {
+            let Ok(BlockerSubstitute::Use { center, radius }) =
+                self_shadow_substitute(p, n, proxy.center(), proxy.sphere[3])
+            else {
+                continue;
+            };
+            let dv = center - p;
+            let dist = dv.length();
+            if dist.is_nan() || dist <= 0.0 {
+                continue;
+            }
+            let alpha = (radius / dist).min(1.0);
+            let dir = dv / dist;
+            if product {
+                let mut o = rotate_zh(&tables.visibility_full.lookup(alpha), dir)?;
+                o.iter_mut().for_each(|x| *x = -*x);
+                o[0] += SQRT_4PI;
+                acc = exp.tensor().product(&acc, &o)?;
+            } else {
+                let log = rotate_zh(&tables.log_occlusion.lookup(alpha), dir)?;
+                acc.iter_mut().zip(&log).for_each(|(a, l)| *a += l);
+            }
+            if params.indirect {
+                let table = if product {
+                    &tables.visibility_full
+                } else {
+                    &tables.visibility
+                };
+                let mut zh = table.lookup(alpha);
+                zh[INDIRECT_BANDS..].iter_mut().for_each(|x| *x = 0.0);
+                let v = rotate_zh(&zh, dir)?;
+                let vh = shine_sh::dot(&v, &hn)?;
+                omega += v[0] * SQRT_4PI;
+                let d = averaged_operator_fit(alpha);
+                let d_sh = rotate_zh(&d, dir)?;
+                let kappa = Vec3::from_array(std::array::from_fn(|c| {
+                    shine_sh::dot(&d_sh, &environment.irradiance[c][..9]).unwrap_or(0.0)
+                }));
+                indirect += proxy.albedo() / std::f32::consts::PI * kappa * vh;
+            }
+        }
+    }
+    acc.extend(indirect.to_array());
+    acc.push(omega);
+    Ok(acc)
+}
+
+/// CPU twin of `proxy_shade` at one receiver, from its [`accumulate_cpu`] sums: the occlusion
+/// vector `O_p` and the outgoing radiance.
+pub fn shade_cpu(
+    receiver: &ReceiverSample,
+    sums: &[f32],
+    environment: &EnvironmentSh,
+    params: &ProxyParams,
+    exp: &ShExp,
+) -> Result<(Vec<f32>, Vec3), ProxyError> {
+    let bands = check_exp(params, exp)?;
+    let n2 = bands * bands;
+    if sums.len() != n2 + 4 {
+        return Err(ProxyError::Size {
+            name: "sums",
+            actual: sums.len().to_string(),
+            expected: (n2 + 4).to_string(),
+        });
+    }
+    let f = &sums[..n2];
+    let o = match (params.accumulation, params.exp) {
+        (Accumulation::Product, _) => f.to_vec(),
+        (_, ExpMethod::Hyb) => exp.exp_hyb(f)?,
+        (_, ExpMethod::Ps) => exp.exp_ps(f)?,
+        (_, ExpMethod::Ol) => exp.exp_ol(f)?,
+    };
+    if !receiver.valid {
+        return Ok((o, Vec3::ZERO));
+    }
+    let hn = rotate_zh(&clamped_cosine_zh(bands)?, receiver.normal.normalize())?;
+    // H · (O ∗ L) = L · (O ∗ H): one product for the three channels, as the shader
+    let oh = exp.tensor().product(&o, &hn)?;
+    let mut psi = [0.0f32; 3];
+    for (c, out) in psi.iter_mut().enumerate() {
+        *out = shine_sh::dot(&oh, &environment.radiance[c])?;
+    }
+    let summed = Vec3::new(sums[n2], sums[n2 + 1], sums[n2 + 2]);
+    let xi = overlap_normalisation(o[0], sums[n2 + 3]);
+    let kd = receiver.albedo * (1.0 - receiver.metallic);
+    let radiance =
+        kd / std::f32::consts::PI * (Vec3::from_array(psi) + xi * summed).max(Vec3::ZERO);
+    Ok((o, radiance))
+}
