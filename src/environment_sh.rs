@@ -84,6 +84,7 @@ mod tests {
             horizon: Vec3::splat(l),
             ground: Vec3::splat(l),
             intensity: 1.0,
+            map: None,
         }
     }
 

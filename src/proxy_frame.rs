@@ -83,7 +83,7 @@ impl ProxyFrame {
         Self {
             device: device.clone(),
             sources,
-            environment: scene.environment,
+            environment: scene.environment.clone(),
             proxies: None,
             environments: Vec::new(),
             tables: Vec::new(),

@@ -206,3 +206,76 @@ fn profile_refuses_an_unknown_clock() {
         "{stderr}"
     );
 }
+
+/// `--environment FILE` lights the spheres with an equirectangular map: a brighter constant
+/// map gives a brighter proxy-lit frame than a dimmer one, and a missing or undecodable map is
+/// a clear error.
+#[test]
+fn render_lights_the_scene_with_an_environment_map() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_environment");
+    std::fs::create_dir_all(&dir).expect("tmp dir");
+    let mut means = Vec::new();
+    for level in [0.25f32, 1.0] {
+        let map = dir.join(format!("constant_{level}.exr"));
+        image::DynamicImage::ImageRgb32F(image::Rgb32FImage::from_pixel(
+            16,
+            8,
+            image::Rgb([level; 3]),
+        ))
+        .save(&map)
+        .expect("map written");
+        let out = dir.join(format!("lit_{level}.exr"));
+        let run = shine()
+            .args([
+                "render",
+                "builtin:spheres",
+                "--width",
+                "32",
+                "--height",
+                "32",
+            ])
+            .args(["--gi", "proxy", "--set", "shadow.size=128", "--environment"])
+            .arg(&map)
+            .arg("-o")
+            .arg(&out)
+            .output()
+            .expect("run shine render");
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let frame = shine::image_io::read_exr(&out).expect("EXR");
+        let mean: f32 = frame.texels.iter().map(|t| t[0] + t[1] + t[2]).sum::<f32>()
+            / frame.texels.len() as f32;
+        means.push(mean);
+    }
+    assert!(
+        means[1] > 2.0 * means[0],
+        "a 4× brighter map lit the frame only {means:?}"
+    );
+    std::fs::write(dir.join("broken.hdr"), b"not an image").expect("write");
+    for (file, message) in [
+        ("missing.exr", "cannot read environment map"),
+        ("broken.hdr", "cannot be decoded"),
+    ] {
+        let run = shine()
+            .args([
+                "render",
+                "builtin:spheres",
+                "--gi",
+                "proxy",
+                "-o",
+                "x.png",
+                "--environment",
+            ])
+            .arg(dir.join(file))
+            .current_dir(&dir)
+            .output()
+            .expect("run shine render");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{file}: {stderr}");
+        assert!(stderr.contains(message), "{file}: {stderr}");
+    }
+    assert!(!dir.join("x.png").exists());
+}

@@ -183,6 +183,7 @@ fn uniform_environment_on_a_convex_sphere() {
         horizon: Vec3::splat(l),
         ground: Vec3::splat(l),
         intensity: 1.0,
+        map: None,
     };
     let camera = Mat4::from_translation(Vec3::new(0.0, 0.0, 3.0));
     let scene = one_mesh_scene(

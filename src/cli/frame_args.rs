@@ -3,6 +3,7 @@
 use super::CliError;
 use shine::settings::Settings;
 use shine_scene::Scene;
+use shine_scene::environment::Environment;
 use std::path::PathBuf;
 
 /// Settings from a TOML file, then flags over it (DESIGN: one serde struct, file and flags).
@@ -33,6 +34,39 @@ pub struct SettingsArgs {
     /// Any setting by its TOML key, e.g. `--set hvl.count=2000` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     overrides: Vec<String>,
+    #[command(flatten)]
+    environment: EnvironmentArgs,
+}
+
+/// An environment map replacing the scene's environment (`shine render`, `profile`,
+/// `reference`).
+#[derive(clap::Args, Debug)]
+pub struct EnvironmentArgs {
+    /// Equirectangular environment map (.hdr or .exr, linear radiance) lighting the scene
+    /// instead of its own environment.
+    #[arg(long, value_name = "FILE")]
+    environment: Option<PathBuf>,
+    /// Multiplier of the --environment map.
+    #[arg(long, default_value_t = 1.0)]
+    environment_intensity: f32,
+}
+
+impl EnvironmentArgs {
+    /// Replaces `scene`'s environment by the map, if one was given.
+    pub fn apply(&self, scene: &mut Scene) -> Result<(), CliError> {
+        let Some(path) = &self.environment else {
+            return Ok(());
+        };
+        if !(self.environment_intensity.is_finite() && self.environment_intensity >= 0.0) {
+            return Err(format!(
+                "--environment-intensity must be a finite number ≥ 0, got {}",
+                self.environment_intensity
+            )
+            .into());
+        }
+        scene.environment = Some(Environment::load_map(path, self.environment_intensity)?);
+        Ok(())
+    }
 }
 
 impl SettingsArgs {
@@ -66,14 +100,23 @@ impl SettingsArgs {
     }
 }
 
-/// Loads `builtin:NAME` or a .gltf/.glb path, printing the loader's warnings.
-pub fn load_scene(argument: &str) -> Result<Scene, CliError> {
-    let scene = match argument.strip_prefix("builtin:") {
+impl SettingsArgs {
+    /// Loads the scene `argument` with the `--environment` map applied.
+    pub fn load_scene(&self, argument: &str) -> Result<Scene, CliError> {
+        load_scene(argument, &self.environment)
+    }
+}
+
+/// Loads `builtin:NAME` or a .gltf/.glb path, printing the loader's warnings, and applies
+/// `environment`.
+pub fn load_scene(argument: &str, environment: &EnvironmentArgs) -> Result<Scene, CliError> {
+    let mut scene = match argument.strip_prefix("builtin:") {
         Some(name) => Scene::builtin(name)?,
         None => shine_scene::load(argument)?,
     };
     for warning in &scene.warnings {
         eprintln!("warning: {warning}");
     }
+    environment.apply(&mut scene)?;
     Ok(scene)
 }

@@ -3,7 +3,7 @@
 //! CPU devices (lavapipe) by the host clock around each pass submitted alone.
 
 use super::CliError;
-use super::frame_args::{SettingsArgs, load_scene};
+use super::frame_args::SettingsArgs;
 use shine::gpu::{Device, DeviceDesc};
 use shine::profile_report::{PassClock, ProfileReport, ReportFormat, write_chrome_trace};
 use shine::renderer::Renderer;
@@ -41,7 +41,7 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
         return Err("--frames must be at least 1".into());
     }
     let settings = args.settings.resolve()?;
-    let scene = load_scene(&args.scene)?;
+    let scene = args.settings.load_scene(&args.scene)?;
     let device = Device::new(&DeviceDesc::from_env())?;
     let clock = match args.clock.as_str() {
         "auto" => PassClock::for_device(device.info().device_type),

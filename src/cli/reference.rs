@@ -3,7 +3,7 @@
 //! progress bar and a samples-per-pixel or time budget.
 
 use super::CliError;
-use super::frame_args::load_scene;
+use super::frame_args::{EnvironmentArgs, load_scene};
 use glam::Vec3;
 use shine::gpu::{Device, DeviceDesc};
 use shine::image_io::{LdrImage, OutputFormat, write_exr, write_png};
@@ -20,6 +20,8 @@ pub struct ReferenceArgs {
     /// Output image: .exr (linear HDR radiance) or .png (a tonemapped preview).
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    environment: EnvironmentArgs,
     /// Samples per pixel (the most, when --seconds stops earlier).
     #[arg(long, default_value_t = 256)]
     spp: u32,
@@ -79,7 +81,7 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
         lambert_only: false,
         seed: args.seed,
     };
-    let scene = load_scene(&args.scene)?;
+    let scene = load_scene(&args.scene, &args.environment)?;
     let device = Device::new(&DeviceDesc::from_env())?;
     let mut tracer = PathTracer::new(&device, &scene, args.time, &params)?;
     let bar = indicatif::ProgressBar::new(u64::from(args.spp));

@@ -1,7 +1,7 @@
 //! `shine render`: headless capture of a scene to PNG (tonemapped) or EXR (linear HDR).
 
 use super::CliError;
-use super::frame_args::{SettingsArgs, load_scene};
+use super::frame_args::SettingsArgs;
 use shine::gpu::{Device, DeviceDesc};
 use shine::image_io::{OutputFormat, write_frame};
 use shine::renderer::Renderer;
@@ -34,7 +34,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         settings.set("frames", &frames.to_string())?;
         settings.validate()?;
     }
-    let scene = load_scene(&args.scene)?;
+    let scene = args.settings.load_scene(&args.scene)?;
     let device = Device::new(&DeviceDesc::from_env())?;
     let mut renderer = Renderer::new(&device)?;
     let animated = !scene.animations.is_empty();

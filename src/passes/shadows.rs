@@ -272,7 +272,8 @@ pub fn shadow_atlas(
     if layout.views.is_empty() {
         // Nothing casts a shadow: the atlas is one cleared tile the direct pass never reads.
         rg.raster("shadow clear", shadow_pipeline())
-            .depth(&mut depth, DepthLoad::Clear(1.0));
+            .depth(&mut depth, DepthLoad::Clear(1.0))
+            .push(&super::gbuffer::ViewConstants::default());
     }
     for (k, (_, name, view)) in layout.views.iter().enumerate() {
         rg.raster(name, shadow_pipeline())

@@ -23,6 +23,7 @@ pub fn sky() -> Environment {
         horizon: Vec3::new(0.95, 0.95, 1.0),
         ground: Vec3::new(0.35, 0.30, 0.25),
         intensity: 1.0,
+        map: None,
     }
 }
 

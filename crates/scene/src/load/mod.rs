@@ -191,8 +191,9 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
         let v: serde_json::Value = serde_json::from_str(raw.get())
             .map_err(|e| ctx.invalid("extras", format!("not JSON: {e}")))?;
         if let Some(env) = v.get(environment::EXTRAS_KEY) {
+            let fetch = |uri: &str| uri::fetch(uri, base_dir);
             scene.environment = Some(
-                Environment::from_json(env)
+                Environment::from_json(env, &fetch)
                     .map_err(|m| ctx.invalid(format!("extras.{}", environment::EXTRAS_KEY), m))?,
             );
         }
