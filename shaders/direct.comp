@@ -1,6 +1,6 @@
 // Direct light (docs/frame.md): every punctual light on the G-buffer with the metallic-
 // roughness BRDF, each shadowed through its tiles of the shadow atlas with a PCF kernel (soft
-// edges), plus emission. CPU side: src/passes/direct.rs, src/passes/shadows.rs.
+// edges), plus emission; background pixels show the environment. CPU side: src/passes/direct.rs, src/passes/shadows.rs.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "scene.glsl"
@@ -46,7 +46,14 @@ layout(set = 0, binding = 10, std430) readonly buffer ShadowLights {
     LightShadow l[];
 } shadow_lights;
 
+// The environment seen through background pixels (black without one).
+#define ENVIRONMENT_BINDING 11
+#define ENVIRONMENT_SAMPLER_BINDING 12
+#include "environment.glsl"
+
 layout(push_constant) uniform Push {
+    // Clip space of the camera to world (background pixels look up the environment).
+    mat4 inv_view_proj;
     vec4 eye;
     // x: light count, y: PCF radius in texels, z: 1 when the frame has a shadow atlas
     uvec4 counts;
@@ -126,7 +133,14 @@ void main() {
     }
     vec4 position = imageLoad(gb_position, pixel);
     if (position.w <= 0.0) {
-        imageStore(direct, pixel, vec4(0.0));
+        // Background: the environment along the camera ray through the pixel centre (between
+        // two depths in front of the camera, so perspective, infinite and orthographic
+        // projections all work).
+        vec2 ndc = (vec2(pixel) + 0.5) / vec2(imageSize(direct)) * 2.0 - 1.0;
+        vec4 near = push.inv_view_proj * vec4(ndc, 0.0, 1.0);
+        vec4 mid = push.inv_view_proj * vec4(ndc, 0.5, 1.0);
+        vec3 ray = mid.xyz / mid.w - near.xyz / near.w;
+        imageStore(direct, pixel, vec4(environment_radiance(ray), 1.0));
         return;
     }
     vec3 p = position.xyz;

@@ -114,6 +114,10 @@ pub struct Renderer {
     /// The scene's BVH for shadow rays (HVL visibility, IGI's VPL visibility), uploaded with
     /// the scene.
     bvh: Option<GpuBvh>,
+    /// The scene's environment baked for the background (black without one).
+    environment: Option<shine_gpu::Image>,
+    /// Linear, repeating in u and clamped in v: the environment texture's sampler.
+    environment_sampler: Sampler,
     /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
     brdf_tables: Vec<(u32, Buffer)>,
     /// The shadow atlas layout of the current scene and its GPU records, for one
@@ -193,6 +197,17 @@ impl Renderer {
             )?,
             scene: None,
             bvh: None,
+            environment: None,
+            environment_sampler: Sampler::new(
+                device,
+                &vk::SamplerCreateInfo::default()
+                    .mag_filter(vk::Filter::LINEAR)
+                    .min_filter(vk::Filter::LINEAR)
+                    .address_mode_u(vk::SamplerAddressMode::REPEAT)
+                    .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .max_lod(0.0),
+            )?,
             brdf_tables: Vec::new(),
             shadow_layout: None,
             readback: None,
@@ -206,11 +221,13 @@ impl Renderer {
     pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
         let uploaded = GpuScene::upload(&self.device, scene, t)?;
         let bvh = GpuBvh::upload(&self.device, scene, t)?;
+        let environment = crate::gpu_environment::upload(&self.device, scene.environment.as_ref())?;
         if self.scene.is_some() {
             self.device.wait_idle()?;
         }
         self.scene = Some(uploaded);
         self.bvh = Some(bvh);
+        self.environment = Some(environment);
         self.shadow_layout = None;
         self.proxy = Some(ProxyFrame::new(&self.device, scene, t));
         Ok(())
@@ -515,13 +532,19 @@ impl Renderer {
         let shadow_views = rg.import_gpu_buffer(&cache.views, buffer_read, buffer_read);
         let shadow_lights = rg.import_gpu_buffer(&cache.lights, buffer_read, buffer_read);
         let atlas = shadows::shadow_atlas(rg, &handles, &cache.layout, shadow_views, shadow_lights);
+        let environment = self.environment.as_ref().ok_or(RenderError::NoScene)?;
+        let background = direct::Background {
+            environment: rg.import_gpu_image(environment, read_only, read_only),
+            sampler: self.environment_sampler.raw(),
+        };
         let direct = direct::direct(
             rg,
             &g,
             &handles,
             light_count,
             &atlas,
-            camera.eye,
+            &camera,
+            &background,
             shadow,
             self.nearest.raw(),
         );

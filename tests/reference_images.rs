@@ -102,10 +102,9 @@ fn hvl_indirect_light_against_the_path_traced_reference() {
 
 /// Paper 002's frame (`--gi proxy`: the sky shadowed by the sphere proxies plus their indirect
 /// light) of the `spheres` scene against the path-traced reference of the same scene with the
-/// proxies' real meshes, lit by the same sky, one bounce. Compared where the raster frame is
-/// not black: the background (the raster leaves it 0, the tracer sees the sky) and the fully
-/// metallic torus (the proxy path shades Lambert only; its specular environment term is not
-/// part of paper 002) are left out.
+/// proxies' real meshes, lit by the same sky, one bounce; both show the sky behind the scene.
+/// Compared where the raster frame is not black: the fully metallic torus (the proxy path
+/// shades Lambert only; its specular environment term is not part of paper 002) is left out.
 #[test]
 fn spheres_proxy_frame_against_the_path_traced_reference() {
     const SIDE: u32 = 64;
@@ -139,7 +138,7 @@ fn spheres_proxy_frame_against_the_path_traced_reference() {
     let shaded = |t: &[f32; 4]| t[0] + t[1] + t[2] > 0.0;
     let masked = frame.texels.iter().filter(|t| !shaded(t)).count();
     assert!(
-        masked < (SIDE * SIDE / 2) as usize,
+        masked < (SIDE * SIDE / 10) as usize,
         "{masked} of {} pixels are black in the raster frame",
         SIDE * SIDE
     );
@@ -166,8 +165,8 @@ fn spheres_proxy_frame_against_the_path_traced_reference() {
     report("spheres, brute-force proxy frame vs reference", &exact);
     let ratio = sum(&frame) / sum(&reference.full);
     println!("mean ratio {ratio:.3}, {masked} pixels masked");
-    // Measured on lavapipe (64², 256 spp): PSNR 32.4 dB (brute force 32.45), SSIM 0.961, mean 0.976× the
-    // reference, 1416 pixels masked.
+    // Measured on lavapipe (64², 256 spp): PSNR 32.4 dB (brute force 32.45), SSIM 0.961,
+    // mean 0.990× the reference, 136 pixels (the torus) masked.
     assert!(
         splat.psnr > 30.0 && splat.ssim > 0.94,
         "PSNR {} SSIM {}",

@@ -1,17 +1,19 @@
 //! `direct`: the punctual lights on the G-buffer (Lambert + GGX), each shadowed through its
-//! tiles of the shadow atlas ([`super::shadows`]) with a PCF kernel, plus emission
-//! (docs/frame.md).
+//! tiles of the shadow atlas ([`super::shadows`]) with a PCF kernel, plus emission; the
+//! environment behind the scene (docs/frame.md).
 
-use super::gbuffer::{GBuffer, SceneHandles};
+use super::gbuffer::{GBuffer, SceneHandles, View};
 use super::shadows::ShadowAtlas;
 use crate::shaders;
 use shine_gpu::vk;
 use shine_graph::{Handle, Image, ImageDesc, RenderGraph};
 
-/// Push constants of direct.comp (48 bytes).
+/// Push constants of direct.comp (112 bytes).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct DirectConstants {
+    /// Camera clip space to world (background pixels look up the environment).
+    pub inv_view_proj: [[f32; 4]; 4],
     /// Camera position.
     pub eye: [f32; 4],
     /// Light count, PCF radius (texels), 1 when the atlas holds views, 0.
@@ -31,7 +33,18 @@ pub struct ShadowParams {
     pub normal_offset: f32,
 }
 
-/// Adds the direct-light pass; returns `direct` (RGBA16F, full resolution).
+/// The environment seen behind the scene: the baked equirectangular texture
+/// (`crate::gpu_environment`) and a sampler repeating in u, clamped in v.
+#[derive(Clone, Copy, Debug)]
+pub struct Background {
+    /// The environment texture.
+    pub environment: Handle<Image>,
+    /// Its sampler.
+    pub sampler: vk::Sampler,
+}
+
+/// Adds the direct-light pass; returns `direct` (RGBA16F, full resolution; background pixels
+/// hold the environment seen by `camera`).
 #[allow(clippy::too_many_arguments)]
 pub fn direct(
     rg: &mut RenderGraph,
@@ -39,7 +52,8 @@ pub fn direct(
     scene: &SceneHandles,
     light_count: u32,
     atlas: &ShadowAtlas,
-    eye: glam::Vec3,
+    camera: &View,
+    background: &Background,
     shadow: ShadowParams,
     sampler: vk::Sampler,
 ) -> Handle<Image> {
@@ -49,7 +63,8 @@ pub fn direct(
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
     let constants = DirectConstants {
-        eye: eye.extend(1.0).to_array(),
+        inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
+        eye: camera.eye.extend(1.0).to_array(),
         counts: [
             light_count,
             shadow.pcf_radius,
@@ -74,6 +89,8 @@ pub fn direct(
         .read("shadow_views", &atlas.views)
         .read("shadow_lights", &atlas.lights)
         .sampler("shadow_sampler", sampler)
+        .read("environment", &background.environment)
+        .sampler("environment_sampler", background.sampler)
         .write("direct", &mut out)
         .push(&constants)
         .dispatch([w, h, 1]);
