@@ -52,7 +52,8 @@ layout(set = 0, binding = 10, std430) readonly buffer ShadowLights {
 #include "environment.glsl"
 
 layout(push_constant) uniform Push {
-    // Clip space of the camera to world (background pixels look up the environment).
+    // Clip space of the camera to world, without the camera's translation (background pixels
+    // look up the environment along the direction between two unprojected points).
     mat4 inv_view_proj;
     vec4 eye;
     // x: light count, y: PCF radius in texels, z: 1 when the frame has a shadow atlas

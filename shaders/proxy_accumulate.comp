@@ -202,7 +202,12 @@ void main() {
                     }
                     sh_rotate_zh_basis(zh, y, rotated);
                     float vh = sh_dot(rotated, hn);
-                    omega += rotated[0] * SH_SQRT_4PI;
+                    // eq. 12, paper 002: the proxy's true solid angle 2π(1 - cos θ), sin θ = α,
+                    // wherever its (clamped) visibility is not 0 — not the clamped table's DC,
+                    // which would cancel the indirect fade of §4.1
+                    if (zh[0] > 0.0) {
+                        omega += 2.0 * SH_PI * (1.0 - sqrt(max(0.0, 1.0 - alpha * alpha)));
+                    }
                     vec3 d3 = sh_proxy_d_fit(alpha);
                     for (int l = 0; l < SH_BANDS; ++l) {
                         zh[l] = l < 3 ? d3[l] : 0.0;

@@ -18,7 +18,8 @@ layout(set = 0, binding = ENVIRONMENT_SAMPLER_BINDING) uniform sampler environme
 vec3 environment_radiance(vec3 dir) {
     vec3 d = normalize(dir);
     const float PI = 3.14159265358979323846;
-    float u = atan(d.x, -d.z) / (2.0 * PI) + 0.5;
+    // atan(0, 0) is undefined: straight up or down any azimuth will do.
+    float u = abs(d.x) + abs(d.z) > 0.0 ? atan(d.x, -d.z) / (2.0 * PI) + 0.5 : 0.5;
     float v = acos(clamp(d.y, -1.0, 1.0)) / PI;
     return textureLod(sampler2D(environment, environment_sampler), vec2(u, v), 0.0).rgb;
 }

@@ -52,7 +52,8 @@ pub struct EnvironmentArgs {
 }
 
 impl EnvironmentArgs {
-    /// Replaces `scene`'s environment by the map, if one was given.
+    /// Replaces `scene`'s environment by the map, if one was given (dropping the default sun
+    /// the loader adds to a scene with no light and no environment).
     pub fn apply(&self, scene: &mut Scene) -> Result<(), CliError> {
         let Some(path) = &self.environment else {
             return Ok(());
@@ -65,6 +66,14 @@ impl EnvironmentArgs {
             .into());
         }
         scene.environment = Some(Environment::load_map(path, self.environment_intensity)?);
+        // The loader lights a scene with neither lights nor environment by a default sun
+        // (node u32::MAX); the map now lights it.
+        if scene.lights.iter().any(|l| l.node == u32::MAX) {
+            scene.lights.retain(|l| l.node != u32::MAX);
+            scene
+                .warnings
+                .retain(|w| !w.contains("default directional sun"));
+        }
         Ok(())
     }
 }
@@ -114,9 +123,9 @@ pub fn load_scene(argument: &str, environment: &EnvironmentArgs) -> Result<Scene
         Some(name) => Scene::builtin(name)?,
         None => shine_scene::load(argument)?,
     };
+    environment.apply(&mut scene)?;
     for warning in &scene.warnings {
         eprintln!("warning: {warning}");
     }
-    environment.apply(&mut scene)?;
     Ok(scene)
 }

@@ -12,7 +12,8 @@ use shine_graph::{Handle, Image, ImageDesc, RenderGraph};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct DirectConstants {
-    /// Camera clip space to world (background pixels look up the environment).
+    /// Camera clip space to world directions (the view without its translation): background
+    /// pixels look up the environment.
     pub inv_view_proj: [[f32; 4]; 4],
     /// Camera position.
     pub eye: [f32; 4],
@@ -63,7 +64,11 @@ pub fn direct(
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
     let constants = DirectConstants {
-        inv_view_proj: camera.view_proj().inverse().to_cols_array_2d(),
+        // Rotation only: the background needs directions, and dropping the translation keeps
+        // them precise far from the origin.
+        inv_view_proj: (camera.proj * glam::Mat4::from_mat3(glam::Mat3::from_mat4(camera.view)))
+            .inverse()
+            .to_cols_array_2d(),
         eye: camera.eye.extend(1.0).to_array(),
         counts: [
             light_count,

@@ -657,7 +657,12 @@ pub fn accumulate_cpu(
                 zh[INDIRECT_BANDS..].iter_mut().for_each(|x| *x = 0.0);
                 let v = rotate_zh(&zh, dir)?;
                 let vh = shine_sh::dot(&v, &hn)?;
-                omega += v[0] * SQRT_4PI;
+                // eq. 12, paper 002: the proxy's true solid angle 2π(1 − cos θ), sin θ = α,
+                // wherever its (clamped) visibility is not 0 — not the clamped table's DC, which
+                // would cancel the indirect fade of §4.1.
+                if zh[0] > 0.0 {
+                    omega += std::f32::consts::TAU * (1.0 - (1.0 - alpha * alpha).max(0.0).sqrt());
+                }
                 let d = averaged_operator_fit(alpha);
                 let d_sh = rotate_zh(&d, dir)?;
                 let kappa = Vec3::from_array(std::array::from_fn(|c| {

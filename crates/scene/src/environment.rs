@@ -54,8 +54,18 @@ impl EquirectMap {
         Self::decode(&bytes, uri)
     }
 
-    /// Decodes `.hdr` or `.exr` bytes (the format is sniffed from the contents).
+    /// Decodes `.hdr` or `.exr` bytes (the format is sniffed from the contents; 8-bit formats
+    /// are refused: they do not hold linear radiance).
     pub fn decode(bytes: &[u8], uri: &str) -> Result<EquirectMap, String> {
+        match image::guess_format(bytes) {
+            Ok(image::ImageFormat::Hdr | image::ImageFormat::OpenExr) => {}
+            Ok(other) => {
+                return Err(format!(
+                    "environment map {uri:?} is {other:?}: only Radiance .hdr and OpenEXR .exr hold linear radiance"
+                ));
+            }
+            Err(e) => return Err(format!("environment map {uri:?} cannot be decoded: {e}")),
+        }
         let image = image::load_from_memory(bytes)
             .map_err(|e| format!("environment map {uri:?} cannot be decoded: {e}"))?
             .into_rgb32f();
@@ -163,12 +173,12 @@ impl Environment {
         v: &Value,
         fetch: &dyn Fn(&str) -> Result<Vec<u8>, String>,
     ) -> Result<Environment, String> {
-        let intensity = match v.get("intensity") {
+        let intensity = match v.get("intensity").map(|x| x.as_f64().map(|i| i as f32)) {
             None => 1.0,
-            Some(x) => match x.as_f64() {
-                Some(i) if i.is_finite() && i >= 0.0 => i as f32,
-                _ => return Err("\"intensity\" must be a finite non-negative number".to_string()),
-            },
+            Some(Some(i)) if i.is_finite() && i >= 0.0 => i,
+            Some(_) => {
+                return Err("\"intensity\" must be a finite non-negative number".to_string());
+            }
         };
         match v.get("type").and_then(Value::as_str) {
             Some("sky") => {}
@@ -199,8 +209,7 @@ impl Environment {
                 .ok_or(format!("missing colour {key:?}"))?;
             let f: Vec<f32> = a
                 .iter()
-                .filter_map(Value::as_f64)
-                .map(|x| x as f32)
+                .map(|x| x.as_f64().map_or(f32::NAN, |x| x as f32))
                 .collect();
             match f.as_slice() {
                 [r, g, b] if f.iter().all(|x| x.is_finite() && *x >= 0.0) => {
@@ -245,6 +254,14 @@ mod tests {
         assert!((e.radiance(-Vec3::Y) - e.ground * 2.0).length() < 1e-6);
         let short = json!({"type": "sky", "zenith": [1, 2]});
         assert!(Environment::from_json(&short, &no_files).is_err());
+        let sky = |intensity: Value, zenith: Value| {
+            json!({"type": "sky", "zenith": zenith, "horizon": [1, 1, 1], "ground": [1, 1, 1],
+                   "intensity": intensity})
+        };
+        assert!(Environment::from_json(&sky(json!(1e39), json!([1, 1, 1])), &no_files).is_err());
+        assert!(
+            Environment::from_json(&sky(json!(1.0), json!(["a", 1, 1, 1])), &no_files).is_err()
+        );
         let missing = json!({"type": "map", "uri": "sky.hdr"});
         let err = Environment::from_json(&missing, &no_files).unwrap_err();
         assert!(err.contains("no file sky.hdr"), "{err}");
@@ -292,5 +309,11 @@ mod tests {
         }
         assert_eq!(e.to_json()["uri"], "sky.exr");
         assert!(EquirectMap::decode(b"not an image", "x.hdr").is_err());
+        let mut png = std::io::Cursor::new(Vec::new());
+        image::DynamicImage::ImageRgb8(image::RgbImage::new(4, 2))
+            .write_to(&mut png, image::ImageFormat::Png)
+            .unwrap();
+        let err = EquirectMap::decode(&png.into_inner(), "sky.png").unwrap_err();
+        assert!(err.contains("only Radiance .hdr and OpenEXR"), "{err}");
     }
 }
