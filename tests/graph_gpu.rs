@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{assert_clean, buffer_with, device};
+use common::{assert_clean, buffer_with, device, read_by_copy};
 use shine::gpu::{
     Blend, DepthState, Device, GraphicsPipelineDesc, MemoryLocation, VertexBufferLayout,
 };
@@ -24,11 +24,6 @@ fn readback_buffer(device: &Device, name: &str, size: u64) -> shine::gpu::Buffer
         location: MemoryLocation::GpuOnly,
     };
     shine::gpu::Buffer::new(device, &desc).unwrap()
-}
-
-/// The readback copy that follows the graph reads in the COPY stage.
-fn read_by_copy() -> ExternalState {
-    ExternalState::new(S::COPY, A::TRANSFER_READ, L::UNDEFINED)
 }
 
 fn floats(device: &Device, buffer: &shine::gpu::Buffer) -> Vec<f32> {

@@ -4,11 +4,14 @@
 
 mod common;
 
-use common::{assert_clean, device, f16_to_f32, f32_to_f16, storage_image_with};
+use common::{
+    assert_clean, bytes_f16, bytes_unorm8, device, f16_to_f32, q16, read_by_copy,
+    storage_image_with, transfer_storage, uploaded_state,
+};
 use glam::{Vec3, Vec4};
-use shine::gpu::{Device, MemoryLocation};
+use shine::gpu::Device;
 use shine::gpu_bvh::GpuBvh;
-use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::hvl_reference::{
     self as reference, Emission, Receiver, ReceiverData, RsmData, integrate_hvl,
@@ -35,28 +38,8 @@ const GLOSSY: BrdfModel = BrdfModel::Ggx {
 // Half floats (the RGBA16F images): tests/common rounds to nearest even.
 // ---------------------------------------------------------------------------------------------
 
-/// A value as an RGBA16F texel stores it.
-fn q16(v: Vec4) -> Vec4 {
-    Vec4::from_array(v.to_array().map(|c| f16_to_f32(f32_to_f16(c))))
-}
-
 fn bytes_f32(texels: &[Vec4]) -> Vec<u8> {
     bytemuck::cast_slice(texels).to_vec()
-}
-
-fn bytes_f16(texels: &[Vec4]) -> Vec<u8> {
-    texels
-        .iter()
-        .flat_map(|t| t.to_array().map(f32_to_f16))
-        .flat_map(u16::to_le_bytes)
-        .collect()
-}
-
-fn bytes_unorm8(texels: &[Vec4]) -> Vec<u8> {
-    texels
-        .iter()
-        .flat_map(|t| t.to_array().map(|c| (c * 255.0).round() as u8))
-        .collect()
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -188,29 +171,6 @@ fn tables(conv_bands: u32, sampling: [usize; 2]) -> GatherBrdf {
 
 /// Final state of inputs nothing uses after the graph.
 const UNUSED_AFTER: ExternalState = ExternalState::UNDEFINED;
-
-fn uploaded_state() -> ExternalState {
-    ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::GENERAL)
-}
-
-fn read_by_copy() -> ExternalState {
-    ExternalState::new(S::COPY, A::TRANSFER_READ, L::UNDEFINED)
-}
-
-fn buffer(device: &Device, name: &str, size: u64, data: Option<&[u8]>) -> shine::gpu::Buffer {
-    let desc = shine::gpu::BufferDesc {
-        name,
-        size,
-        usage: vk::BufferUsageFlags::STORAGE_BUFFER
-            | vk::BufferUsageFlags::TRANSFER_SRC
-            | vk::BufferUsageFlags::TRANSFER_DST,
-        location: MemoryLocation::GpuOnly,
-    };
-    match data {
-        Some(d) => shine::gpu::Buffer::with_data(device, &desc, d).unwrap(),
-        None => shine::gpu::Buffer::new(device, &desc).unwrap(),
-    }
-}
 
 /// The RSM's GPU images (kept alive by the caller for the graph's frame).
 struct RsmImages([shine::gpu::Image; 3]);
@@ -346,21 +306,21 @@ fn gpu_gather(
     bvh: Option<&GpuBvh>,
 ) -> Vec<Vec4> {
     let images = ReceiverImages::new(device, receivers);
-    let hvl_buffer = buffer(
+    let hvl_buffer = transfer_storage(
         device,
         "hvls",
         std::mem::size_of_val(hvls) as u64,
         Some(bytemuck::cast_slice(hvls)),
     );
     let brdf_data = brdf.gpu_data();
-    let brdf_buffer = buffer(
+    let brdf_buffer = transfer_storage(
         device,
         "brdf",
         (brdf_data.len() * 4) as u64,
         Some(bytemuck::cast_slice(&brdf_data)),
     );
     let [w, h] = receivers.extent;
-    let readback = buffer(device, "indirect_readback", u64::from(w * h) * 8, None);
+    let readback = transfer_storage(device, "indirect_readback", u64::from(w * h) * 8, None);
     let mut executor = Executor::new(device, 1).unwrap();
     let mut rg = executor.begin_frame();
     let recv = images.import(&mut rg, receivers.extent);
@@ -386,7 +346,7 @@ fn gpu_gather(
 /// Runs the cache alone and returns its records.
 fn gpu_cache(device: &Device, rsm: &RsmData, params: &HvlParams) -> Vec<Hvl> {
     let images = RsmImages::new(device, rsm);
-    let readback = buffer(
+    let readback = transfer_storage(
         device,
         "hvl_readback",
         shine::passes::hvl::cache_bytes(params.count),
@@ -813,14 +773,14 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
     let p = params(Path::Full, 5, 3);
     let brdf = tables(5, [24, 48]);
     let brdf_data = brdf.gpu_data();
-    let brdf_buffer = buffer(
+    let brdf_buffer = transfer_storage(
         &device,
         "brdf",
         (brdf_data.len() * 4) as u64,
         Some(bytemuck::cast_slice(&brdf_data)),
     );
     let recv_images = ReceiverImages::new(&device, &receivers);
-    let readback = buffer(
+    let readback = transfer_storage(
         &device,
         "indirect_readback",
         u64::from(RECV[0] * RECV[1]) * 8,

@@ -7,11 +7,14 @@ mod common;
 
 use std::sync::OnceLock;
 
-use common::{assert_clean, device, f16_to_f32, f32_to_f16, storage_image_with};
+use common::{
+    assert_clean, bytes_f16, bytes_unorm8, device, f16_to_f32, f32_to_f16, q16, read_by_copy,
+    storage_image_with, transfer_storage, uploaded_state,
+};
 use glam::{Vec3, Vec4};
-use shine::gpu::{Device, MemoryLocation};
+use shine::gpu::Device;
 use shine::gpu_bvh::TraceBuffers;
-use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
+use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, RenderGraph};
 use shine::igi_reference::{self as reference, GBufferData};
 use shine::image_compare::compare;
@@ -32,11 +35,6 @@ const CAMERA: Vec3 = Vec3::new(0.0, 2.0, 4.0);
 // ---------------------------------------------------------------------------------------------
 // Synthetic inputs.
 // ---------------------------------------------------------------------------------------------
-
-/// A value as an RGBA16F texel stores it.
-fn q16(v: Vec4) -> Vec4 {
-    Vec4::from_array(v.to_array().map(|c| f16_to_f32(f32_to_f16(c))))
-}
 
 /// A value as an RGBA8 UNORM texel stores it.
 fn q8(v: Vec4) -> Vec4 {
@@ -157,44 +155,6 @@ fn tables(bands: u32) -> GatherBrdf {
 // GPU plumbing.
 // ---------------------------------------------------------------------------------------------
 
-fn uploaded_state() -> ExternalState {
-    ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::GENERAL)
-}
-
-fn read_by_copy() -> ExternalState {
-    ExternalState::new(S::COPY, A::TRANSFER_READ, L::UNDEFINED)
-}
-
-fn buffer(device: &Device, name: &str, size: u64, data: Option<&[u8]>) -> shine::gpu::Buffer {
-    let desc = shine::gpu::BufferDesc {
-        name,
-        size,
-        usage: vk::BufferUsageFlags::STORAGE_BUFFER
-            | vk::BufferUsageFlags::TRANSFER_SRC
-            | vk::BufferUsageFlags::TRANSFER_DST,
-        location: MemoryLocation::GpuOnly,
-    };
-    match data {
-        Some(d) => shine::gpu::Buffer::with_data(device, &desc, d).expect("buffer"),
-        None => shine::gpu::Buffer::new(device, &desc).expect("buffer"),
-    }
-}
-
-fn bytes_f16(texels: &[Vec4]) -> Vec<u8> {
-    texels
-        .iter()
-        .flat_map(|t| t.to_array().map(f32_to_f16))
-        .flat_map(u16::to_le_bytes)
-        .collect()
-}
-
-fn bytes_unorm8(texels: &[Vec4]) -> Vec<u8> {
-    texels
-        .iter()
-        .flat_map(|t| t.to_array().map(|c| (c * 255.0).round() as u8))
-        .collect()
-}
-
 /// Packed halves of `vpl_sh` → rgb per coefficient.
 fn unpack(words: &[u32]) -> Vec<Vec3> {
     words
@@ -272,7 +232,7 @@ fn run_gpu(
             &bytes_unorm8(&g.material),
         ),
     ];
-    let vpl_buffer = buffer(
+    let vpl_buffer = transfer_storage(
         device,
         "vpls",
         std::mem::size_of_val(vpls) as u64,
@@ -289,13 +249,13 @@ fn run_gpu(
             ..Default::default()
         })
         .collect();
-    let nodes = buffer(
+    let nodes = transfer_storage(
         device,
         "bvh nodes",
         std::mem::size_of_val(bvh.nodes.as_slice()) as u64,
         Some(bytemuck::cast_slice(&bvh.nodes)),
     );
-    let tris = buffer(
+    let tris = transfer_storage(
         device,
         "bvh triangles",
         std::mem::size_of_val(triangles.as_slice()) as u64,
@@ -304,7 +264,7 @@ fn run_gpu(
     let sh_bytes = params.sh_bytes(e).expect("size");
     let field_buffer = field.map(|f| {
         let words: Vec<u32> = f.iter().flat_map(|c| pack(c)).collect();
-        buffer(
+        transfer_storage(
             device,
             "field",
             sh_bytes,
@@ -313,16 +273,16 @@ fn run_gpu(
     });
     let brdf_buffer = params.needs_brdf_tables().then(|| {
         let data = tables(params.sh_order).gpu_data();
-        buffer(
+        transfer_storage(
             device,
             "brdf",
             (data.len() * 4) as u64,
             Some(bytemuck::cast_slice(&data)),
         )
     });
-    let sh_readback = buffer(device, "sh readback", sh_bytes, None);
+    let sh_readback = transfer_storage(device, "sh readback", sh_bytes, None);
     let pixels = u64::from(e[0] * e[1]);
-    let indirect_readback = buffer(device, "indirect readback", pixels * 8, None);
+    let indirect_readback = transfer_storage(device, "indirect readback", pixels * 8, None);
     let mut executor = Executor::new(device, 1).expect("executor");
     let mut rg = executor.begin_frame();
     let [position, normal, geometric_normal, albedo, material] = images

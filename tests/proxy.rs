@@ -12,7 +12,9 @@
 
 mod common;
 
-use common::{assert_clean, device, f16_to_f32, f32_to_f16, storage_image_with};
+use common::{
+    assert_clean, device, f16_to_f32, f32_to_f16, read_by_copy, storage_image_with, uploaded_state,
+};
 use glam::{Vec3, Vec4};
 use shine::environment_sh::EnvironmentSh;
 use shine::gpu::{Device, vk};
@@ -23,19 +25,7 @@ use shine::passes::proxy::{
 use shine::settings::ExpMethod;
 use shine_sh::exp_log::ShExp;
 
-use vk::AccessFlags2 as A;
-use vk::ImageLayout as L;
-use vk::PipelineStageFlags2 as S;
-
 const SIDE: u32 = 24;
-
-fn uploaded_state() -> ExternalState {
-    ExternalState::new(S::COPY, A::TRANSFER_WRITE, L::GENERAL)
-}
-
-fn read_by_copy() -> ExternalState {
-    ExternalState::new(S::COPY, A::TRANSFER_READ, L::UNDEFINED)
-}
 
 /// The synthetic receiver buffer: ground samples 0.25 m apart around the origin; the last
 /// column is background.

@@ -2,10 +2,12 @@
 //! small resources and dispatches several tests share. (Each test crate uses a subset.)
 #![allow(dead_code)]
 
+use glam::Vec4;
 use shine::gpu::{
     Buffer, BufferDesc, ComputePipeline, Descriptor, Device, DeviceDesc, MemoryLocation,
     ShaderDesc, Validation, vk,
 };
+use shine::graph::ExternalState;
 
 /// Creates the test device with the validation layer (synchronization validation on).
 ///
@@ -180,4 +182,61 @@ pub fn storage_image_with(
         .upload_image(&image, data, vk::ImageLayout::GENERAL)
         .expect("image upload");
     image
+}
+
+/// The state an uploaded input is in when a graph imports it (a copy wrote it, `GENERAL`).
+pub fn uploaded_state() -> ExternalState {
+    ExternalState::new(
+        vk::PipelineStageFlags2::COPY,
+        vk::AccessFlags2::TRANSFER_WRITE,
+        vk::ImageLayout::GENERAL,
+    )
+}
+
+/// The state a readback buffer is left in: a copy reads it next.
+pub fn read_by_copy() -> ExternalState {
+    ExternalState::new(
+        vk::PipelineStageFlags2::COPY,
+        vk::AccessFlags2::TRANSFER_READ,
+        vk::ImageLayout::UNDEFINED,
+    )
+}
+
+/// A device-local storage buffer that transfers can fill and read: holding `data`, or `size`
+/// uninitialised bytes.
+pub fn transfer_storage(device: &Device, name: &str, size: u64, data: Option<&[u8]>) -> Buffer {
+    let desc = BufferDesc {
+        name,
+        size,
+        usage: vk::BufferUsageFlags::STORAGE_BUFFER
+            | vk::BufferUsageFlags::TRANSFER_SRC
+            | vk::BufferUsageFlags::TRANSFER_DST,
+        location: MemoryLocation::GpuOnly,
+    };
+    match data {
+        Some(d) => Buffer::with_data(device, &desc, d).expect("buffer"),
+        None => Buffer::new(device, &desc).expect("buffer"),
+    }
+}
+
+/// A value as an RGBA16F texel stores it.
+pub fn q16(v: Vec4) -> Vec4 {
+    Vec4::from_array(v.to_array().map(|c| f16_to_f32(f32_to_f16(c))))
+}
+
+/// RGBA16F texel bytes of `texels`.
+pub fn bytes_f16(texels: &[Vec4]) -> Vec<u8> {
+    texels
+        .iter()
+        .flat_map(|t| t.to_array().map(f32_to_f16))
+        .flat_map(u16::to_le_bytes)
+        .collect()
+}
+
+/// RGBA8_UNORM texel bytes of `texels` (rounded).
+pub fn bytes_unorm8(texels: &[Vec4]) -> Vec<u8> {
+    texels
+        .iter()
+        .flat_map(|t| t.to_array().map(|c| (c * 255.0).round() as u8))
+        .collect()
 }
