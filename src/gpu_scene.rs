@@ -10,6 +10,7 @@
 
 use glam::{Mat3, Mat4, Vec3};
 use shine_gpu::{Buffer, BufferDesc, Device, Image, ImageDesc, MemoryLocation, vk};
+use shine_graph::ExternalState;
 use shine_scene::{Light, LightKind, Material, Scene};
 
 /// Edge of every layer of the texture arrays, in texels.
@@ -17,6 +18,21 @@ pub const TEXTURE_SIZE: u32 = 256;
 
 /// Marks "no texture" in [`GpuMaterial`] (as in shine-scene).
 pub const NO_TEXTURE: u32 = u32::MAX;
+
+/// Persistent buffers the frame reads (scene, BVH, tables, shadow records): read by any stage,
+/// before and after the frame.
+pub const BUFFER_READ: ExternalState = ExternalState::new(
+    vk::PipelineStageFlags2::ALL_COMMANDS,
+    vk::AccessFlags2::MEMORY_READ,
+    vk::ImageLayout::UNDEFINED,
+);
+
+/// Persistent sampled images (texture arrays, environment): read-only, before and after.
+pub const SAMPLED_READ: ExternalState = ExternalState::new(
+    vk::PipelineStageFlags2::ALL_COMMANDS,
+    vk::AccessFlags2::SHADER_READ,
+    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+);
 
 /// One vertex of the flattened scene, in world space (64 bytes; locations 0–4 of the raster
 /// shaders).

@@ -9,7 +9,7 @@
 
 use glam::{Mat4, Vec3};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
-use shine_graph::{ExternalState, Handle, Image, RenderGraph};
+use shine_graph::{Handle, Image, RenderGraph};
 use shine_scene::environment::Environment;
 use shine_scene::proxies::{self, ProxySphere};
 use shine_scene::{Mesh, Scene};
@@ -209,11 +209,7 @@ impl ProxyFrame {
             .as_ref()
             .filter(|(k, _, _)| *k == p.fit_count)
             .ok_or_else(missing)?;
-        let read = ExternalState::new(
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::AccessFlags2::MEMORY_READ,
-            vk::ImageLayout::UNDEFINED,
-        );
+        let read = crate::gpu_scene::BUFFER_READ;
         let inputs = ProxyInputs {
             proxies: rg.import_gpu_buffer(proxy_buffer, read, read),
             count: *count,

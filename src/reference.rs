@@ -213,15 +213,9 @@ impl PathTracer {
 
     fn dispatch(&mut self, samples: u32) -> Result<(), RenderError> {
         let scene = &self.scene;
-        let read = ExternalState::new(
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::AccessFlags2::MEMORY_READ,
-            vk::ImageLayout::UNDEFINED,
-        );
-        let sampled = ExternalState::new(
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::AccessFlags2::SHADER_READ,
-            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+        let (read, sampled) = (
+            crate::gpu_scene::BUFFER_READ,
+            crate::gpu_scene::SAMPLED_READ,
         );
         let accumulated = ExternalState::new(
             vk::PipelineStageFlags2::ALL_COMMANDS,
@@ -229,15 +223,7 @@ impl PathTracer {
             vk::ImageLayout::UNDEFINED,
         );
         let mut rg = self.executor.begin_frame();
-        let handles = SceneHandles {
-            vertices: rg.import_gpu_buffer(&scene.vertices, read, read),
-            indices: rg.import_gpu_buffer(&scene.indices, read, read),
-            materials: rg.import_gpu_buffer(&scene.materials, read, read),
-            lights: rg.import_gpu_buffer(&scene.lights, read, read),
-            srgb_textures: rg.import_gpu_image(&scene.srgb_textures, sampled, sampled),
-            linear_textures: rg.import_gpu_image(&scene.linear_textures, sampled, sampled),
-            index_count: scene.index_count,
-        };
+        let handles = SceneHandles::import(&mut rg, scene);
         let trace = TraceHandles {
             nodes: rg.import_gpu_buffer(&self.bvh.nodes, read, read),
             triangles: rg.import_gpu_buffer(&self.bvh.triangles, read, read),

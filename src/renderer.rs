@@ -4,7 +4,7 @@
 //! (cached while the shape is unchanged), records it and times every pass.
 
 use crate::gpu_bvh::GpuBvh;
-use crate::gpu_scene::{GpuScene, SceneUploadError};
+use crate::gpu_scene::{BUFFER_READ, GpuScene, SAMPLED_READ, SceneUploadError};
 use crate::image_io::{HdrImage, ImageIoError, LdrImage};
 use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
 use crate::passes::direct::{self, ShadowParams};
@@ -25,6 +25,25 @@ use shine_graph::{
 };
 use shine_scene::Scene;
 use shine_sh::brdf_table::HemisphereSampling;
+
+/// A linear or nearest sampler without mips, addressing u and v as given.
+fn sampler(
+    device: &Device,
+    filter: vk::Filter,
+    u: vk::SamplerAddressMode,
+    v: vk::SamplerAddressMode,
+) -> Result<Sampler, shine_gpu::Error> {
+    Sampler::new(
+        device,
+        &vk::SamplerCreateInfo::default()
+            .mag_filter(filter)
+            .min_filter(filter)
+            .address_mode_u(u)
+            .address_mode_v(v)
+            .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+            .max_lod(0.0),
+    )
+}
 
 /// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
 const FRAMES_IN_FLIGHT: usize = 2;
@@ -169,45 +188,21 @@ struct ShadowCache {
 impl Renderer {
     /// A renderer on `device` (shine's own, or a host's wrapped with `Device::from_raw`).
     pub fn new(device: &Device) -> Result<Self, RenderError> {
-        let sampler = |filter| {
-            Sampler::new(
-                device,
-                &vk::SamplerCreateInfo::default()
-                    .mag_filter(filter)
-                    .min_filter(filter)
-                    .address_mode_u(vk::SamplerAddressMode::REPEAT)
-                    .address_mode_v(vk::SamplerAddressMode::REPEAT)
-                    .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .max_lod(0.0),
-            )
-        };
+        use vk::SamplerAddressMode as A;
         Ok(Self {
             device: device.clone(),
             executor: Executor::new(device, FRAMES_IN_FLIGHT)?,
-            linear: sampler(vk::Filter::LINEAR)?,
-            nearest: Sampler::new(
+            linear: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::REPEAT)?,
+            nearest: sampler(
                 device,
-                &vk::SamplerCreateInfo::default()
-                    .mag_filter(vk::Filter::NEAREST)
-                    .min_filter(vk::Filter::NEAREST)
-                    .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .max_lod(0.0),
+                vk::Filter::NEAREST,
+                A::CLAMP_TO_EDGE,
+                A::CLAMP_TO_EDGE,
             )?,
             scene: None,
             bvh: None,
             environment: None,
-            environment_sampler: Sampler::new(
-                device,
-                &vk::SamplerCreateInfo::default()
-                    .mag_filter(vk::Filter::LINEAR)
-                    .min_filter(vk::Filter::LINEAR)
-                    .address_mode_u(vk::SamplerAddressMode::REPEAT)
-                    .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .address_mode_w(vk::SamplerAddressMode::CLAMP_TO_EDGE)
-                    .max_lod(0.0),
-            )?,
+            environment_sampler: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::CLAMP_TO_EDGE)?,
             brdf_tables: Vec::new(),
             shadow_layout: None,
             readback: None,
@@ -457,18 +452,13 @@ impl Renderer {
         rg: &mut RenderGraph,
         bands: u32,
     ) -> Result<shine_graph::Handle<shine_graph::Buffer>, RenderError> {
-        let buffer_read = ExternalState::new(
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::AccessFlags2::MEMORY_READ,
-            vk::ImageLayout::UNDEFINED,
-        );
         let table = self
             .brdf_tables
             .iter()
             .find(|(b, _)| *b == bands)
             .map(|(_, buffer)| buffer)
             .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
-        Ok(rg.import_gpu_buffer(table, buffer_read, buffer_read))
+        Ok(rg.import_gpu_buffer(table, BUFFER_READ, BUFFER_READ))
     }
 
     /// Declares every pass of a frame; returns its HDR and LDR images.
@@ -495,25 +485,7 @@ impl Renderer {
                 .prepare(settings)?;
         }
         let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
-        let read_only = ExternalState::new(
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::AccessFlags2::SHADER_READ,
-            vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
-        );
-        let buffer_read = ExternalState::new(
-            vk::PipelineStageFlags2::ALL_COMMANDS,
-            vk::AccessFlags2::MEMORY_READ,
-            vk::ImageLayout::UNDEFINED,
-        );
-        let handles = SceneHandles {
-            vertices: rg.import_gpu_buffer(&scene.vertices, buffer_read, buffer_read),
-            indices: rg.import_gpu_buffer(&scene.indices, buffer_read, buffer_read),
-            materials: rg.import_gpu_buffer(&scene.materials, buffer_read, buffer_read),
-            lights: rg.import_gpu_buffer(&scene.lights, buffer_read, buffer_read),
-            srgb_textures: rg.import_gpu_image(&scene.srgb_textures, read_only, read_only),
-            linear_textures: rg.import_gpu_image(&scene.linear_textures, read_only, read_only),
-            index_count: scene.index_count,
-        };
+        let handles = SceneHandles::import(rg, scene);
         let extent = [settings.width, settings.height];
         let camera = gbuffer::camera_view(scene, settings.width, settings.height);
         let g = gbuffer::gbuffer(rg, &handles, &camera, extent, self.linear.raw());
@@ -529,12 +501,12 @@ impl Renderer {
             normal_offset: SHADOW_NORMAL_OFFSET,
         };
         let cache = self.shadow_layout.as_ref().ok_or(RenderError::NoScene)?;
-        let shadow_views = rg.import_gpu_buffer(&cache.views, buffer_read, buffer_read);
-        let shadow_lights = rg.import_gpu_buffer(&cache.lights, buffer_read, buffer_read);
+        let shadow_views = rg.import_gpu_buffer(&cache.views, BUFFER_READ, BUFFER_READ);
+        let shadow_lights = rg.import_gpu_buffer(&cache.lights, BUFFER_READ, BUFFER_READ);
         let atlas = shadows::shadow_atlas(rg, &handles, &cache.layout, shadow_views, shadow_lights);
         let environment = self.environment.as_ref().ok_or(RenderError::NoScene)?;
         let background = direct::Background {
-            environment: rg.import_gpu_image(environment, read_only, read_only),
+            environment: rg.import_gpu_image(environment, SAMPLED_READ, SAMPLED_READ),
             sampler: self.environment_sampler.raw(),
         };
         let direct = direct::direct(
@@ -568,15 +540,9 @@ impl Renderer {
                     self.linear.raw(),
                 );
                 let hvls = hvl::hvl_cache(rg, &rsm, &params)?;
-                let table = self
-                    .brdf_tables
-                    .iter()
-                    .find(|(b, _)| *b == conv_bands)
-                    .map(|(_, buffer)| buffer)
-                    .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
-                let brdf = rg.import_gpu_buffer(table, buffer_read, buffer_read);
+                let brdf = self.import_brdf_tables(rg, conv_bands)?;
                 let bvh = match (params.visibility, self.bvh.as_ref()) {
-                    (true, Some(b)) => Some(b.import(rg, buffer_read)),
+                    (true, Some(b)) => Some(b.import(rg, BUFFER_READ)),
                     _ => None,
                 };
                 Some(hvl::hvl_gather(
@@ -677,12 +643,7 @@ fn igi_indirect(
     brdf: Option<&shine_graph::Handle<shine_graph::Buffer>>,
     camera: glam::Vec3,
 ) -> Result<shine_graph::Handle<shine_graph::Image>, RenderError> {
-    let buffer_read = ExternalState::new(
-        vk::PipelineStageFlags2::ALL_COMMANDS,
-        vk::AccessFlags2::MEMORY_READ,
-        vk::ImageLayout::UNDEFINED,
-    );
-    let trace = bvh.import(rg, buffer_read);
+    let trace = bvh.import(rg, BUFFER_READ);
     Ok(igi::igi(rg, g, rsm, &trace, brdf, camera, params)?)
 }
 

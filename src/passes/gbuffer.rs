@@ -220,6 +220,26 @@ pub struct SceneHandles {
     pub index_count: u32,
 }
 
+impl SceneHandles {
+    /// Imports the persistent buffers and texture arrays of `scene` into `rg` (read-only).
+    pub fn import(rg: &mut RenderGraph, scene: &GpuScene) -> Self {
+        use crate::gpu_scene::{BUFFER_READ, SAMPLED_READ};
+        Self {
+            vertices: rg.import_gpu_buffer(&scene.vertices, BUFFER_READ, BUFFER_READ),
+            indices: rg.import_gpu_buffer(&scene.indices, BUFFER_READ, BUFFER_READ),
+            materials: rg.import_gpu_buffer(&scene.materials, BUFFER_READ, BUFFER_READ),
+            lights: rg.import_gpu_buffer(&scene.lights, BUFFER_READ, BUFFER_READ),
+            srgb_textures: rg.import_gpu_image(&scene.srgb_textures, SAMPLED_READ, SAMPLED_READ),
+            linear_textures: rg.import_gpu_image(
+                &scene.linear_textures,
+                SAMPLED_READ,
+                SAMPLED_READ,
+            ),
+            index_count: scene.index_count,
+        }
+    }
+}
+
 /// The pipeline of every scene raster pass: the flattened scene's vertices through
 /// `gbuffer.vert`, an optional fragment shader and colour targets, depth tested and written.
 pub(crate) fn scene_pipeline(

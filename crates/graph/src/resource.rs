@@ -172,7 +172,7 @@ impl ExternalState {
     };
 
     /// A state with the given masks and layout.
-    pub fn new(
+    pub const fn new(
         stage: vk::PipelineStageFlags2,
         access: vk::AccessFlags2,
         layout: vk::ImageLayout,
