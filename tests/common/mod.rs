@@ -12,7 +12,7 @@ use shine::graph::ExternalState;
 /// Creates the test device with the validation layer (synchronization validation on).
 ///
 /// Never skips: without a Vulkan device or, under `CI`, without the validation layer, the test
-/// fails with the install command (DESIGN §8).
+/// fails with the install command (docs/architecture.md, "Tests").
 pub fn device() -> Device {
     let validation = if std::env::var_os("CI").is_some() {
         Validation::Required
@@ -64,17 +64,7 @@ pub fn buffer(device: &Device, name: &str, size: u64, usage: vk::BufferUsageFlag
 
 /// A device-local storage buffer holding `data`.
 pub fn storage_with(device: &Device, name: &str, data: &[u8]) -> Buffer {
-    Buffer::with_data(
-        device,
-        &BufferDesc {
-            name,
-            size: 0,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::GpuOnly,
-        },
-        data,
-    )
-    .expect("storage buffer")
+    Buffer::storage_with_data(device, name, data).expect("storage buffer")
 }
 
 /// Runs a `sh_eval.comp` variant of `coeffs` coefficients over `dirs`; returns the basis values.

@@ -5,15 +5,19 @@
 
 use crate::error::{Error, Result, VkContext};
 use crate::features::{FeatureStatus, Support};
+use crate::instance::{
+    InstanceGuard, OwnedGuard, choose, create_instance, destroy_owned, list_adapters,
+    messenger_info, physical_name,
+};
 use crate::retire::Tracker;
-use crate::validation::{self, MessageCounts, MessageLog, Validation};
+use crate::validation::{MessageCounts, MessageLog, Validation};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
 use std::ffi::CStr;
 use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+pub(crate) const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// How to create a headless device.
 #[derive(Clone, Debug, Default)]
@@ -98,8 +102,9 @@ pub(crate) struct Inner {
 }
 
 /// Objects shine created and must destroy (absent for a wrapped host device).
-struct Owned {
-    debug_instance: Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+pub(crate) struct Owned {
+    pub(crate) debug_instance:
+        Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
 }
 
 /// The engine's handle to a Vulkan device. Clone freely.
@@ -130,7 +135,7 @@ pub struct Adapter {
 }
 
 impl Device {
-    /// What a host must enable to wrap its device (DESIGN §2).
+    /// What a host must enable to wrap its device (docs/architecture.md, "Device layer").
     pub fn requirements() -> crate::Requirements {
         crate::REQUIREMENTS
     }
@@ -491,206 +496,6 @@ pub(crate) fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
     mutex
         .lock()
         .unwrap_or_else(std::sync::PoisonError::into_inner)
-}
-
-fn messenger_info(log: &MessageLog) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
-    vk::DebugUtilsMessengerCreateInfoEXT::default()
-        .message_severity(validation::severities())
-        .message_type(validation::message_types())
-        .pfn_user_callback(Some(validation::callback))
-        .user_data(log as *const MessageLog as *mut std::ffi::c_void)
-}
-
-fn create_instance(
-    entry: &ash::Entry,
-    validation: bool,
-    debug_utils: bool,
-    log: Option<&MessageLog>,
-) -> Result<ash::Instance> {
-    let app = vk::ApplicationInfo::default()
-        .application_name(c"shine")
-        .engine_name(c"shine")
-        .api_version(vk::API_VERSION_1_3);
-    let layers = if validation {
-        vec![VALIDATION_LAYER.as_ptr()]
-    } else {
-        vec![]
-    };
-    let mut extensions = Vec::new();
-    if debug_utils {
-        extensions.push(ash::ext::debug_utils::NAME.as_ptr());
-    }
-    if validation {
-        extensions.push(ash::ext::validation_features::NAME.as_ptr());
-    }
-    let enables = [vk::ValidationFeatureEnableEXT::SYNCHRONIZATION_VALIDATION];
-    let mut features = vk::ValidationFeaturesEXT::default().enabled_validation_features(&enables);
-    let mut messenger = log.map(messenger_info);
-    let mut info = vk::InstanceCreateInfo::default()
-        .application_info(&app)
-        .enabled_layer_names(&layers)
-        .enabled_extension_names(&extensions);
-    if validation {
-        info = info.push_next(&mut features);
-    }
-    if let Some(messenger) = messenger.as_mut() {
-        info = info.push_next(messenger);
-    }
-    // SAFETY: every pointer in `info` outlives this call.
-    unsafe { entry.create_instance(&info, None) }.map_err(|result| match result {
-        vk::Result::ERROR_INCOMPATIBLE_DRIVER => Error::NoDevice {
-            detail: " (the loader found no Vulkan driver)".into(),
-        },
-        other => Error::vk("creating the Vulkan instance", other),
-    })
-}
-
-fn physical_name(instance: &ash::Instance, physical: vk::PhysicalDevice) -> String {
-    // SAFETY: the physical device belongs to the instance.
-    let properties = unsafe { instance.get_physical_device_properties(physical) };
-    properties.device_name_as_c_str().map_or_else(
-        |_| "unnamed device".into(),
-        |n| n.to_string_lossy().into_owned(),
-    )
-}
-
-fn list_adapters(instance: &ash::Instance) -> Result<Vec<(Adapter, vk::PhysicalDevice)>> {
-    // SAFETY: the instance is alive.
-    let physicals = match unsafe { instance.enumerate_physical_devices() } {
-        Ok(list) => list,
-        Err(vk::Result::ERROR_INITIALIZATION_FAILED) => Vec::new(),
-        Err(e) => return Err(Error::vk("enumerating physical devices", e)),
-    };
-    Ok(physicals
-        .into_iter()
-        .enumerate()
-        .map(|(index, physical)| {
-            // SAFETY: enumerated from this instance.
-            let properties = unsafe { instance.get_physical_device_properties(physical) };
-            let adapter = Adapter {
-                index,
-                name: physical_name(instance, physical),
-                device_type: properties.device_type,
-                missing: Support::query(instance, physical).missing(),
-            };
-            (adapter, physical)
-        })
-        .collect())
-}
-
-fn type_rank(t: vk::PhysicalDeviceType) -> u32 {
-    match t {
-        vk::PhysicalDeviceType::DISCRETE_GPU => 0,
-        vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
-        vk::PhysicalDeviceType::VIRTUAL_GPU => 2,
-        vk::PhysicalDeviceType::CPU => 3,
-        _ => 4,
-    }
-}
-
-fn choose<'a>(
-    adapters: &'a [(Adapter, vk::PhysicalDevice)],
-    selector: Option<&str>,
-) -> Result<(&'a Adapter, vk::PhysicalDevice)> {
-    if adapters.is_empty() {
-        return Err(Error::NoDevice {
-            detail: String::new(),
-        });
-    }
-    if let Some(selector) = selector {
-        let wanted = selector.to_lowercase();
-        let found = match selector.parse::<usize>() {
-            Ok(index) => adapters.iter().find(|(a, _)| a.index == index),
-            Err(_) => adapters
-                .iter()
-                .find(|(a, _)| a.name.to_lowercase().contains(&wanted)),
-        };
-        return found
-            .map(|(a, p)| (a, *p))
-            .ok_or_else(|| Error::DeviceNotFound {
-                selector: selector.to_string(),
-                available: adapters
-                    .iter()
-                    .map(|(a, _)| format!("{}: {}", a.index, a.name))
-                    .collect::<Vec<_>>()
-                    .join(", "),
-            });
-    }
-    let usable = adapters
-        .iter()
-        .filter(|(a, _)| a.missing.is_empty())
-        .min_by_key(|(a, _)| (type_rank(a.device_type), a.index));
-    match usable {
-        Some((a, p)) => Ok((a, *p)),
-        // No device meets the requirements: report the best one's shortfall.
-        None => {
-            let (a, _) = adapters
-                .iter()
-                .min_by_key(|(a, _)| (type_rank(a.device_type), a.index))
-                .ok_or_else(|| Error::NoDevice {
-                    detail: String::new(),
-                })?;
-            Err(Error::MissingFeatures {
-                device: a.name.clone(),
-                missing: a.missing.clone(),
-            })
-        }
-    }
-}
-
-fn destroy_owned(instance: &ash::Instance, owned: Owned) {
-    if let Some((loader, messenger)) = owned.debug_instance {
-        // SAFETY: created by shine on this instance.
-        unsafe { loader.destroy_debug_utils_messenger(messenger, None) };
-    }
-    // SAFETY: created by shine; every child object is gone.
-    unsafe { instance.destroy_instance(None) };
-}
-
-/// Destroys a freshly created instance if device creation fails part-way.
-struct InstanceGuard(Option<ash::Instance>);
-
-impl InstanceGuard {
-    fn get(&self) -> &ash::Instance {
-        // The option is only emptied by `release`, which consumes the guard.
-        match &self.0 {
-            Some(instance) => instance,
-            None => unreachable!("InstanceGuard used after release"),
-        }
-    }
-
-    fn release(mut self) -> ash::Instance {
-        match self.0.take() {
-            Some(instance) => instance,
-            None => unreachable!("InstanceGuard released twice"),
-        }
-    }
-}
-
-impl Drop for InstanceGuard {
-    fn drop(&mut self) {
-        if let Some(instance) = self.0.take() {
-            // SAFETY: no child objects remain (the messenger guard runs first).
-            unsafe { instance.destroy_instance(None) };
-        }
-    }
-}
-
-/// Destroys the messenger if device creation fails part-way (before the instance guard runs).
-struct OwnedGuard {
-    owned: Option<Owned>,
-}
-
-impl Drop for OwnedGuard {
-    fn drop(&mut self) {
-        if let Some(Owned {
-            debug_instance: Some((loader, messenger)),
-        }) = self.owned.take()
-        {
-            // SAFETY: created by shine on the instance, which outlives this guard.
-            unsafe { loader.destroy_debug_utils_messenger(messenger, None) };
-        }
-    }
 }
 
 impl Drop for Inner {

@@ -13,6 +13,7 @@ mod descriptors;
 mod device;
 mod error;
 mod features;
+mod instance;
 mod memory;
 mod pipeline;
 mod retire;

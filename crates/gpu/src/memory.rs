@@ -97,6 +97,21 @@ impl Buffer {
         Ok(buffer)
     }
 
+    /// A device-local storage buffer named `name` initialised with `data` (not empty): the
+    /// constructor of the read-only tables passes bind (BRDF tables, proxies, shadow records).
+    pub fn storage_with_data(device: &Device, name: &str, data: &[u8]) -> Result<Self> {
+        Self::with_data(
+            device,
+            &BufferDesc {
+                name,
+                size: 0,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+            data,
+        )
+    }
+
     /// The Vulkan handle.
     pub fn raw(&self) -> vk::Buffer {
         self.raw
