@@ -1,6 +1,8 @@
 //! Compiles every shader under shaders/ to SPIR-V 1.5 with glslang, validates and reflects it
-//! with naga, and writes `$OUT_DIR/shaders.rs` (DESIGN §5). A GLSL error or a construct naga
+//! with naga, and writes `$OUT_DIR/shaders.rs` (docs/architecture.md, "Shaders"). A GLSL error or a construct naga
 //! cannot read fails the build with the file and line.
+
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 #[path = "build/shader_build.rs"]
 mod shader_build;

@@ -462,7 +462,7 @@ fn check_naga_subset(path: &Path, text: &str) -> Result<(), ShaderError> {
                     file: path.to_path_buf(),
                     line: Some(index as u32 + 1),
                     message: format!(
-                        "`{needle}`: naga's SPIR-V reader cannot read {what} (DESIGN §5)"
+                        "`{needle}`: naga's SPIR-V reader cannot read {what} (docs/architecture.md, section Shaders)"
                     ),
                 });
             }

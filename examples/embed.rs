@@ -5,9 +5,9 @@
 //!
 //! `cargo run --example embed -- out.png`
 
+use shine::frame::renderer::{HostTarget, Renderer};
 use shine::gpu::{Device, Image, ImageDesc, RawDevice, ash, vk};
 use shine::graph::ExternalState;
-use shine::renderer::{HostTarget, Renderer};
 use shine::settings::Settings;
 use std::error::Error;
 

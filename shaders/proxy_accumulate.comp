@@ -1,7 +1,6 @@
 // Proxy accumulation (paper 002 §3-5): at every receiver, the summed log-occlusion SH vector of
 // the proxy spheres (eq. 4) and the summed indirect shading I_i . H(N_p) with the summed solid
-// angle omega_p (eq. 12-15). Rows `proxy_occlusion` and `proxy_indirect` of DESIGN §4 in one
-// compute pass (docs/frame.md, "Proxy GI", says why compute and not raster).
+// angle omega_p (eq. 12-15), in one compute pass (docs/frame.md, "Proxy GI", says why compute and not raster).
 //
 // SPLAT: image-space splatting as a tiled compute pass. shaders/proxy_tiles.comp culled, per
 //   8x8 tile of the receiver buffer, every proxy whose sphere of influence (radius r / support,

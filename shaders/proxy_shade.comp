@@ -1,11 +1,11 @@
-// Proxy shading (paper 002 §3-5): rows `sh_exp` and the normalisation of `proxy_indirect` of
-// DESIGN §4. At every receiver:
+// Proxy shading (paper 002 §3-5): the SH exponential of the summed log-occlusion and the
+// normalisation of the proxy indirect light. At every receiver:
 //   O_p = exp(sum of log-occlusion)  (OL, PS or HYB; PRODUCT: the sum already is O_p)  eq. 4
 //   psi_shadow = H(N_p) . (O_p * L) = L . (O_p * H(N_p))  per rgb channel             eq. 10
 //   xi_p = (sqrt(4 pi) - (O_p)_0) / (omega_p / sqrt(4 pi)),  I_p . H = xi_p (sum I_i . H)  eq. 12
 //   radiance = kd / pi * max(psi_shadow + xi_p (sum I_i . H), 0),  kd = albedo (1 - metallic)
 // Writes the radiance (RGBA16F, a = 0, 0 on background) and O_p (for tests and debugging).
-// CPU twin: shine::passes::proxy::shade_cpu.
+// CPU twin: shine::reference::proxy::shade_cpu.
 //! variant hyb_b3 EXP_HYB=1 SH_BANDS=3
 //! variant hyb_b4 EXP_HYB=1 SH_BANDS=4
 //! variant hyb_b5 EXP_HYB=1 SH_BANDS=5

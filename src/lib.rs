@@ -1,26 +1,25 @@
 //! shine: a real-time soft global-illumination engine on Vulkan 1.3.
 //!
-//! The engine is a set of compute and raster passes (DESIGN §4) on [`shine_gpu`]; every
+//! The engine is a set of compute and raster passes (docs/architecture.md, "The frame") on [`shine_gpu`]; every
 //! shader under `shaders/` is compiled and reflected at build time into [`shaders`].
+
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
 
-pub mod environment_sh;
-pub mod gpu_bvh;
-pub mod gpu_environment;
+pub mod capture;
+pub mod choice;
+pub mod frame;
 pub mod gpu_scene;
-pub mod hvl_reference;
-pub mod igi_reference;
-pub mod image_compare;
-pub mod image_io;
 pub mod passes;
-pub mod profile_report;
-pub mod proxy_frame;
+pub mod profile;
 pub mod reference;
-pub mod renderer;
 pub mod settings;
-pub mod tonemap;
+
+pub use frame::RenderError;
+pub use frame::renderer::{FrameImage, HostTarget, Renderer};
+pub use settings::Settings;
 
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.
 ///

@@ -1,6 +1,8 @@
 //! The `shine` command-line tool: device report today; headless capture and profiling as the
 //! frame lands (see README).
 
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+
 mod cli;
 
 use clap::Parser;

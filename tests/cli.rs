@@ -247,7 +247,7 @@ fn render_lights_the_scene_with_an_environment_map() {
             "{}",
             String::from_utf8_lossy(&run.stderr)
         );
-        let frame = shine::image_io::read_exr(&out).expect("EXR");
+        let frame = shine::capture::image_io::read_exr(&out).expect("EXR");
         let mean: f32 = frame.texels.iter().map(|t| t[0] + t[1] + t[2]).sum::<f32>()
             / frame.texels.len() as f32;
         means.push(mean);

@@ -1,23 +1,23 @@
 //! The composite pass on a real device (lavapipe in CI) against its CPU reference
-//! (`shine::passes::composite::composite_texel`, built on `shine::tonemap`), for every tonemap
+//! (`shine::passes::composite::composite_texel`, built on `shine::capture::tonemap`), for every tonemap
 //! operator, with and without indirect light. This also ties `shaders/include/tonemap.glsl` to
-//! `src/tonemap.rs`.
+//! `src/capture/tonemap.rs`.
 //!
 //! Input: a 32×32 RGBA16F ramp from 0 through mid greys to 65504, including values at and
 //! around the PBR Neutral knee (0.8 = K_s + F90) and its black offset (2·F90 = 0.08).
 //! Tolerances: HDR within one f32 ulp (relative 2⁻²³), LDR within one 8-bit level.
-//! Zero validation messages. Never skips (DESIGN §8).
+//! Zero validation messages. Never skips (docs/architecture.md, "Tests").
 
 mod common;
 
 use common::{assert_clean, buffer_with as buffer, device};
+use shine::capture::tonemap::Tonemap;
 use shine::gpu::Device;
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
 use shine::graph::*;
 use shine::passes::composite::{
     CompositeParams, HDR_FORMAT, INPUT_FORMAT, LDR_FORMAT, composite, composite_texel,
 };
-use shine::tonemap::Tonemap;
 
 const W: u32 = 32;
 const H: u32 = 32;

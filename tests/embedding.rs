@@ -219,7 +219,7 @@ fn a_frame_recorded_into_a_host_command_buffer_lands_in_the_host_image() {
         ..Default::default()
     };
     settings.shadow.size = 256;
-    let mut renderer = shine::renderer::Renderer::new(&device).expect("renderer");
+    let mut renderer = shine::frame::renderer::Renderer::new(&device).expect("renderer");
     renderer.set_scene(&scene, 0.0).expect("upload");
     let reference = renderer.render(&settings).expect("reference frame");
 
@@ -262,7 +262,7 @@ fn a_frame_recorded_into_a_host_command_buffer_lands_in_the_host_image() {
         renderer
             .record(
                 cb,
-                &shine::renderer::HostTarget {
+                &shine::frame::renderer::HostTarget {
                     image: target.raw(),
                     view: target.view(),
                     format: target.format(),

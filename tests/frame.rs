@@ -4,7 +4,7 @@
 mod common;
 
 use glam::{Mat4, Vec3};
-use shine::renderer::Renderer;
+use shine::frame::renderer::Renderer;
 use shine::settings::{GiTechniques, Settings};
 use shine_scene::{LightKind, Scene};
 
@@ -51,7 +51,7 @@ fn radiance_bound(scene: &Scene) -> f32 {
     emission + 2.0 * lights / std::f32::consts::PI
 }
 
-fn render(name: &str, settings: &Settings) -> shine::renderer::FrameImage {
+fn render(name: &str, settings: &Settings) -> shine::frame::renderer::FrameImage {
     let device = common::device();
     let scene = Scene::builtin(name).expect("built-in scene");
     let mut renderer = Renderer::new(&device).expect("renderer");
@@ -89,7 +89,7 @@ fn small_hvl() -> Settings {
 }
 
 /// Sum of RGB over the frame.
-fn energy(frame: &shine::renderer::FrameImage) -> f64 {
+fn energy(frame: &shine::frame::renderer::FrameImage) -> f64 {
     frame
         .hdr
         .texels

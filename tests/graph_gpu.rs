@@ -2,7 +2,7 @@
 //! validation on: multi-pass graphs whose readback matches a CPU computation, temporal
 //! resources over frames, aliased transients, and bit-identical reruns. Zero messages allowed.
 //!
-//! Never skips: without a Vulkan device the tests fail (DESIGN §8).
+//! Never skips: without a Vulkan device the tests fail (docs/architecture.md, "Tests").
 
 mod common;
 

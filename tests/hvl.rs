@@ -1,6 +1,6 @@
 //! The HVL passes (paper 003) on a real device (lavapipe in CI) against their CPU reference
-//! (`shine::hvl_reference`) and a numerical integration of eq. 3 with eq. 19–21, with the
-//! validation layer reporting nothing. Never skips (DESIGN §8).
+//! (`shine::reference::hvl`) and a numerical integration of eq. 3 with eq. 19–21, with the
+//! validation layer reporting nothing. Never skips (docs/architecture.md, "Tests").
 
 mod common;
 
@@ -10,15 +10,18 @@ use common::{
 };
 use glam::{Vec3, Vec4};
 use shine::gpu::Device;
-use shine::gpu_bvh::GpuBvh;
+use shine::gpu_scene::bvh::GpuBvh;
 use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
-use shine::hvl_reference::{
-    self as reference, Emission, Receiver, ReceiverData, RsmData, integrate_hvl,
-};
+use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::hvl::{
-    CONV_BANDS, CachePush, GatherBrdf, GatherPush, Hvl, HvlError, HvlParams, Path, RadiusHeuristic,
-    Receivers, Rsm, RsmProjection, gather_variants, hvl_cache, hvl_gather,
+    CONV_BANDS, CachePush, GatherPath, GatherPush, Hvl, HvlError, HvlParams, RadiusHeuristic,
+    gather_variants, hvl_cache, hvl_gather,
+};
+use shine::passes::receivers::Receivers;
+use shine::passes::rsm::{Rsm, RsmProjection};
+use shine::reference::hvl::{
+    self as reference, Emission, Receiver, ReceiverData, RsmData, integrate_hvl,
 };
 use shine::shaders;
 use shine_sh::brdf_table::{BrdfModel, HemisphereSampling};
@@ -145,7 +148,7 @@ fn synthetic_receivers() -> ReceiverData {
 
 const CAMERA: Vec3 = Vec3::new(2.0, 1.5, 2.5);
 
-fn params(path: Path, conv_bands: u32, emission_bands: u32) -> HvlParams {
+fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
     HvlParams {
         count: 64,
         radius: RadiusHeuristic::R2,
@@ -400,7 +403,7 @@ fn records_and_push_constants_match_the_shaders() {
 
 #[test]
 fn bad_parameters_are_errors() {
-    let ok = params(Path::Full, 5, 3);
+    let ok = params(GatherPath::Full, 5, 3);
     assert!(ok.validate_cache(16).is_ok());
     // Any count in 64..=10000 that the RSM's texels can hold.
     for count in [65, 70, 255, 256] {
@@ -422,19 +425,19 @@ fn bad_parameters_are_errors() {
         .validate_cache(4096),
         Err(HvlError::Count { .. })
     ));
-    let emission_above_conv = params(Path::Full, 3, 5);
+    let emission_above_conv = params(GatherPath::Full, 3, 5);
     assert!(matches!(
         emission_above_conv.validate_gather(),
         Err(HvlError::OutOfRange { .. })
     ));
     for conv in [0, 11] {
         assert!(matches!(
-            params(Path::Full, conv, 1).validate_gather(),
+            params(GatherPath::Full, conv, 1).validate_gather(),
             Err(HvlError::OutOfRange { .. })
         ));
     }
     // Every convolution band count of both paths has a variant, with every emission count.
-    for path in [Path::Full, Path::Zonal] {
+    for path in [GatherPath::Full, GatherPath::Zonal] {
         for conv in CONV_BANDS {
             for emission in 1..=conv.min(5) {
                 assert!(params(path, conv, emission).validate_gather().is_ok());
@@ -469,7 +472,7 @@ fn cache_matches_the_cpu_reference() {
         let p = HvlParams {
             radius,
             count,
-            ..params(Path::Full, 5, 3)
+            ..params(GatherPath::Full, 5, 3)
         };
         let cpu = reference::build_cache(rsm, &p).unwrap();
         let gpu = gpu_cache(&device, rsm, &p);
@@ -525,16 +528,16 @@ fn gather_matches_the_cpu_reference() {
     let device = device();
     let rsm = synthetic_rsm(1.0);
     let receivers = synthetic_receivers();
-    let hvls = reference::build_cache(&rsm, &params(Path::Full, 5, 3)).unwrap();
+    let hvls = reference::build_cache(&rsm, &params(GatherPath::Full, 5, 3)).unwrap();
     // Some of the variants: a lavapipe compile of the 9- and 10-band variants costs seconds
     // each (the 9-band ones are checked against the quadrature below).
     let variants = [
-        (Path::Full, 2, 1),
-        (Path::Full, 3, 3),
-        (Path::Full, 5, 5),
-        (Path::Full, 6, 4),
-        (Path::Zonal, 1, 1),
-        (Path::Zonal, 5, 3),
+        (GatherPath::Full, 2, 1),
+        (GatherPath::Full, 3, 3),
+        (GatherPath::Full, 5, 5),
+        (GatherPath::Full, 6, 4),
+        (GatherPath::Zonal, 1, 1),
+        (GatherPath::Zonal, 5, 3),
     ];
     for (path, conv, emission) in variants {
         let p = params(path, conv, emission);
@@ -585,9 +588,9 @@ fn gather_visibility_matches_the_cpu_shadow_rays() {
     let device = device();
     let rsm = synthetic_rsm(1.0);
     let receivers = synthetic_receivers();
-    let hvls = reference::build_cache(&rsm, &params(Path::Full, 3, 3)).unwrap();
+    let hvls = reference::build_cache(&rsm, &params(GatherPath::Full, 3, 3)).unwrap();
     let brdf = tables(3, [12, 24]);
-    let unshadowed = params(Path::Full, 3, 3);
+    let unshadowed = params(GatherPath::Full, 3, 3);
     let shadowed = HvlParams {
         visibility: true,
         ..unshadowed
@@ -709,13 +712,13 @@ fn single_hvl_against_numerical_integration() {
     //   full c3 e3: 0.274 / 0.305    full c5 e3: 0.111 / 0.329    full c9 e3: 0.011 / 0.326
     //   full c5 e5: 0.111 / 0.266    zonal c3 e3: 0.058 / 0.321   zonal c9 e3: 0.008 / 0.326
     // Tolerances: the measured value with a margin for table and quadrature resolution.
-    let cases: [(Path, u32, u32, f32, f32); 6] = [
-        (Path::Full, 3, 3, 0.32, 0.40),
-        (Path::Full, 5, 3, 0.14, 0.40),
-        (Path::Full, 5, 5, 0.14, 0.32),
-        (Path::Full, 9, 3, 0.02, 0.40),
-        (Path::Zonal, 3, 3, 0.08, 0.40),
-        (Path::Zonal, 9, 3, 0.015, 0.40),
+    let cases: [(GatherPath, u32, u32, f32, f32); 6] = [
+        (GatherPath::Full, 3, 3, 0.32, 0.40),
+        (GatherPath::Full, 5, 3, 0.14, 0.40),
+        (GatherPath::Full, 5, 5, 0.14, 0.32),
+        (GatherPath::Full, 9, 3, 0.02, 0.40),
+        (GatherPath::Zonal, 3, 3, 0.08, 0.40),
+        (GatherPath::Zonal, 9, 3, 0.015, 0.40),
     ];
     let mut report = Vec::new();
     for (path, conv, emission, tol_conv, tol_all) in cases {
@@ -726,8 +729,8 @@ fn single_hvl_against_numerical_integration() {
         let brdf = tables(conv, [48, 96]);
         let gpu = gpu_gather(&device, &receivers, &[hvl], &brdf, camera, &p, None);
         let glossy = match path {
-            Path::Full => GLOSSY,
-            Path::Zonal => BrdfModel::Lambert { albedo: 0.0 },
+            GatherPath::Full => GLOSSY,
+            GatherPath::Zonal => BrdfModel::Lambert { albedo: 0.0 },
         };
         let (mut worst_conv, mut worst_all) = (0.0f32, 0.0f32);
         for (i, g) in gpu.iter().enumerate() {
@@ -770,7 +773,7 @@ fn single_hvl_against_numerical_integration() {
 fn indirect_is_linear_in_flux_and_zero_without_flux() {
     let device = device();
     let receivers = synthetic_receivers();
-    let p = params(Path::Full, 5, 3);
+    let p = params(GatherPath::Full, 5, 3);
     let brdf = tables(5, [24, 48]);
     let brdf_data = brdf.gpu_data();
     let brdf_buffer = transfer_storage(

@@ -1,7 +1,7 @@
 //! IGI with SH-filtered incident radiance (paper 000) on a real device (lavapipe in CI): the
-//! passes against their CPU twin (`shine::igi_reference`, SH math from shine-sh) on synthetic
+//! passes against their CPU twin (`shine::reference::igi`, SH math from shine-sh) on synthetic
 //! inputs, and the `room` frame against the path-traced reference, with the validation layer
-//! reporting nothing. Never skips (DESIGN §8).
+//! reporting nothing. Never skips (docs/architecture.md, "Tests").
 
 mod common;
 
@@ -12,19 +12,21 @@ use common::{
     storage_image_with, transfer_storage, uploaded_state,
 };
 use glam::{Vec3, Vec4};
+use shine::capture::image_compare::compare;
+use shine::capture::image_io::HdrImage;
+use shine::frame::renderer::Renderer;
 use shine::gpu::Device;
-use shine::gpu_bvh::TraceBuffers;
+use shine::gpu_scene::bvh::TraceBuffers;
 use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, RenderGraph};
-use shine::igi_reference::{self as reference, GBufferData};
-use shine::image_compare::compare;
-use shine::image_io::HdrImage;
+use shine::passes::brdf_tables::GatherBrdf;
+use shine::passes::composite::Component;
 use shine::passes::gbuffer::GBuffer;
-use shine::passes::hvl::{GatherBrdf, Hvl};
+use shine::passes::hvl::Hvl;
 use shine::passes::igi::{self, FilterMode, Glossy, IgiParams};
+use shine::reference::igi::{self as reference, GBufferData};
 use shine::reference::{ReferenceImages, ReferenceParams, render_reference};
-use shine::renderer::Renderer;
-use shine::settings::{Component, GiTechniques, IgiFilter, Settings};
+use shine::settings::{GiTechniques, Settings};
 use shine_scene::bvh::{Bvh, BvhTriangle, Ray};
 use shine_scene::{LightKind, Scene};
 use shine_sh::brdf_table::HemisphereSampling;
@@ -238,10 +240,10 @@ fn run_gpu(
         std::mem::size_of_val(vpls) as u64,
         Some(bytemuck::cast_slice(vpls)),
     );
-    let triangles: Vec<shine::gpu_bvh::GpuBvhTriangle> = bvh
+    let triangles: Vec<shine::gpu_scene::bvh::GpuBvhTriangle> = bvh
         .triangles
         .iter()
-        .map(|t| shine::gpu_bvh::GpuBvhTriangle {
+        .map(|t| shine::gpu_scene::bvh::GpuBvhTriangle {
             v0: t.v0,
             index: t.triangle,
             v1: t.v1,
@@ -657,7 +659,7 @@ fn room_igi_against_the_path_traced_reference() {
         c.rmse, c.psnr, c.ssim
     );
     let phong = compare(
-        &room_igi(|s| s.igi.glossy = shine::settings::IgiGlossy::Phong),
+        &room_igi(|s| s.igi.glossy = Glossy::Phong),
         &reference.indirect,
     )
     .expect("compare");
@@ -691,7 +693,7 @@ fn sh_filtering_beats_irradiance_filtering_on_the_room() {
     let reference = room_reference();
     let sh = compare(&room_igi(|_| {}), &reference.indirect).expect("compare");
     let irradiance = compare(
-        &room_igi(|s| s.igi.filter = IgiFilter::Irradiance),
+        &room_igi(|s| s.igi.filter = FilterMode::Irradiance),
         &reference.indirect,
     )
     .expect("compare");

@@ -1,12 +1,12 @@
-//! The reference path tracer (src/reference.rs, shaders/path_trace.comp) against closed-form
+//! The reference path tracer (src/reference/mod.rs, shaders/path_trace.comp) against closed-form
 //! answers, and its BVH traversal (shaders/include/trace.glsl) against the CPU BVH.
 
 mod common;
 
 use glam::{Mat4, Quat, Vec3};
+use shine::capture::image_compare::rmse;
 use shine::gpu::{ComputePipeline, Descriptor, vk};
-use shine::gpu_bvh::GpuBvh;
-use shine::image_compare::rmse;
+use shine::gpu_scene::bvh::GpuBvh;
 use shine::reference::{PathTracer, ReferenceImages, ReferenceParams, render_reference};
 use shine_scene::bvh::Ray;
 use shine_scene::environment::Environment;
@@ -127,7 +127,12 @@ fn params(size: u32, bounces: u32) -> ReferenceParams {
     }
 }
 
-fn assert_all(image: &shine::image_io::HdrImage, expected: f32, tolerance: f32, what: &str) {
+fn assert_all(
+    image: &shine::capture::image_io::HdrImage,
+    expected: f32,
+    tolerance: f32,
+    what: &str,
+) {
     for (i, t) in image.texels.iter().enumerate() {
         for c in &t[..3] {
             assert!(

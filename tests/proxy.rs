@@ -16,13 +16,14 @@ use common::{
     assert_clean, device, f16_to_f32, f32_to_f16, read_by_copy, storage_image_with, uploaded_state,
 };
 use glam::{Vec3, Vec4};
-use shine::environment_sh::EnvironmentSh;
 use shine::gpu::{Device, vk};
+use shine::gpu_scene::environment_sh::EnvironmentSh;
 use shine::graph::{Executor, ExternalState, RenderGraph};
 use shine::passes::proxy::{
-    self, Accumulation, GpuProxy, ProxyInputs, ProxyParams, ProxyTables, ReceiverSample, Receivers,
+    self, Accumulation, ExpMethod, GpuProxy, ProxyInputs, ProxyParams, ProxyTables,
 };
-use shine::settings::ExpMethod;
+use shine::passes::receivers::Receivers;
+use shine::reference::proxy::{ReceiverSample, accumulate_cpu, shade_cpu};
 use shine_sh::exp_log::ShExp;
 
 const SIDE: u32 = 24;
@@ -266,7 +267,7 @@ fn splat_equals_brute_force_and_cpu() {
             outside += 1;
             assert!(gpu.iter().all(|&x| x == 0.0), "receiver {i}: {gpu:?}");
         }
-        let cpu = proxy::accumulate_cpu(s, &list, &tables, &env, &splat_params, &exp).unwrap();
+        let cpu = accumulate_cpu(s, &list, &tables, &env, &splat_params, &exp).unwrap();
         for (k, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
             assert!(
                 close(*g, *c, 2e-4, 2e-5),
@@ -274,7 +275,7 @@ fn splat_equals_brute_force_and_cpu() {
             );
             worst.0 = worst.0.max((g - c).abs());
         }
-        let (o, rad) = proxy::shade_cpu(s, &cpu, &env, &splat_params, &exp).unwrap();
+        let (o, rad) = shade_cpu(s, &cpu, &env, &splat_params, &exp).unwrap();
         let go = &splat.occlusion[i * 16..(i + 1) * 16];
         for (k, (g, c)) in go.iter().zip(&o).enumerate() {
             assert!(close(*g, *c, 1e-3, 1e-4), "receiver {i} O_{k}: {g} vs {c}");
@@ -323,7 +324,7 @@ fn exponentials_and_orders_match_cpu() {
         let n2 = (bands * bands) as usize;
         for (i, s) in samples.iter().enumerate().step_by(7) {
             let sums = &gpu.sums[i * stride..(i + 1) * stride];
-            let (o, rad) = proxy::shade_cpu(s, sums, &env, &p, &exp).unwrap();
+            let (o, rad) = shade_cpu(s, sums, &env, &p, &exp).unwrap();
             for (k, (g, c)) in gpu.occlusion[i * n2..(i + 1) * n2]
                 .iter()
                 .zip(&o)
@@ -362,7 +363,7 @@ fn brute_force_product_matches_cpu() {
     assert_clean(&device);
     let stride = proxy::sums_stride(bands);
     for (i, s) in samples.iter().enumerate().step_by(5) {
-        let cpu = proxy::accumulate_cpu(s, &list, &tables, &env, &p, &exp).unwrap();
+        let cpu = accumulate_cpu(s, &list, &tables, &env, &p, &exp).unwrap();
         for (k, (g, c)) in gpu.sums[i * stride..(i + 1) * stride]
             .iter()
             .zip(&cpu)
@@ -373,7 +374,7 @@ fn brute_force_product_matches_cpu() {
                 "receiver {i} sum {k}: {g} vs {c}"
             );
         }
-        let (_, rad) = proxy::shade_cpu(s, &cpu, &env, &p, &exp).unwrap();
+        let (_, rad) = shade_cpu(s, &cpu, &env, &p, &exp).unwrap();
         for c in 0..3 {
             assert!(
                 close(gpu.radiance[i][c], rad[c], 3e-3, 1e-4),
@@ -408,8 +409,8 @@ fn a_proxy_shadows_the_ground_beside_it() {
             albedo: Vec3::ONE,
             metallic: 0.0,
         };
-        let sums = proxy::accumulate_cpu(&r, proxies, &tables, &env, p, &exp).unwrap();
-        proxy::shade_cpu(&r, &sums, &env, p, &exp).unwrap().1
+        let sums = accumulate_cpu(&r, proxies, &tables, &env, p, &exp).unwrap();
+        shade_cpu(&r, &sums, &env, p, &exp).unwrap().1
     };
     let shade = |x: f32, proxies: &[GpuProxy]| shade_with(x, proxies, &with_indirect);
     let (near, open) = (shade(0.6, &ball), shade(0.6, &[]));

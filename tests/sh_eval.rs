@@ -1,4 +1,4 @@
-//! `sh_eval.comp` on the GPU against a CPU evaluation of the real SH basis (DESIGN §6), for
+//! `sh_eval.comp` on the GPU against a CPU evaluation of the real SH basis (docs/architecture.md, "Conventions"), for
 //! bands 1 to 8, with the validation layer reporting nothing.
 
 mod common;

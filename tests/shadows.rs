@@ -9,7 +9,7 @@ mod common;
 
 use glam::{Quat, Vec2, Vec3};
 use serde_json::{Value, json};
-use shine::renderer::Renderer;
+use shine::frame::renderer::Renderer;
 use shine::settings::{GiTechniques, Settings};
 use shine_scene::Scene;
 use shine_scene::builtin::shapes::MeshData;

@@ -1,4 +1,4 @@
-// The environment light (src/gpu_environment.rs): an equirectangular RGBA32F texture baked
+// The environment light (src/gpu_scene/environment.rs): an equirectangular RGBA32F texture baked
 // from shine_scene::Environment::radiance, black without an environment. Define
 // ENVIRONMENT_BINDING and ENVIRONMENT_SAMPLER_BINDING before the #include; the sampler must be
 // linear, repeating in u and clamped in v.

@@ -1,4 +1,4 @@
-// Tonemapping and sRGB encoding: the GLSL twin of src/tonemap.rs (which documents the
+// Tonemapping and sRGB encoding: the GLSL twin of src/capture/tonemap.rs (which documents the
 // operators and their sources). One function per formula; tests/composite.rs checks these
 // against the Rust on the same inputs.
 #ifndef SHINE_TONEMAP_GLSL

@@ -1,4 +1,4 @@
-// Ray traversal of the scene BVH (src/gpu_bvh.rs): closest hit and occlusion (any hit) with a
+// Ray traversal of the scene BVH (src/gpu_scene/bvh.rs): closest hit and occlusion (any hit) with a
 // fixed-size stack. Any compute pass can include it; before the #include define the binding
 // numbers of the two buffers it declares (set 0, names fixed so the graph binds them by name):
 //

@@ -18,7 +18,7 @@
 //!   clamped values sRGB-encoded to 8 bits (what a display shows at exposure 1), at the
 //!   binding's default 67 pixels per degree (a 0.7 m viewing distance from a 24" monitor).
 
-use crate::image_io::HdrImage;
+use crate::capture::image_io::HdrImage;
 
 /// Dynamic range `L` of the clamped values.
 pub const DYNAMIC_RANGE: f64 = 1.0;
@@ -186,7 +186,7 @@ fn srgb8(image: &HdrImage) -> Vec<u8> {
         .iter()
         .take(n)
         .flat_map(|t| [t[0], t[1], t[2]])
-        .map(|c| (crate::tonemap::srgb_oetf(c.clamp(0.0, 1.0)) * 255.0).round() as u8)
+        .map(|c| (crate::capture::tonemap::srgb_oetf(c.clamp(0.0, 1.0)) * 255.0).round() as u8)
         .collect()
 }
 

@@ -1,6 +1,6 @@
 //! Frame output: PNG (8-bit, sRGB-encoded, tonemapped) and OpenEXR (32-bit float, linear HDR).
 //!
-//! Every write is atomic (DESIGN §7): the image is encoded into a temporary file in the target's
+//! Every write is atomic (docs/architecture.md, "Errors and bad input"): the image is encoded into a temporary file in the target's
 //! directory, flushed to disk, then renamed over the target. A failure at any step removes the
 //! temporary file, so the target is either the complete new image or left as it was — never a
 //! half-written file.

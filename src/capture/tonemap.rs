@@ -23,7 +23,21 @@
 
 use glam::Vec3;
 
-pub use crate::settings::Tonemap;
+/// Linear exposure factors a frame takes (`output.exposure`).
+pub const EXPOSURE: std::ops::RangeInclusive<f32> = 1e-6..=1e6;
+
+crate::choice::named_choice! {
+    /// The tonemapping operator that turns the HDR frame into the LDR one (see [`crate::capture::tonemap`]).
+    /// EXR output is never tonemapped.
+    pub enum Tonemap ("tonemap operator") {
+        /// No curve: exposed radiance clamped to [0, 1].
+        None = "none",
+        /// ACES filmic (Narkowicz 2015 fit of the RRT+ODT).
+        Aces = "aces",
+        /// Khronos PBR Neutral: colour-preserving, identity below its knee.
+        PbrNeutral = "pbr-neutral",
+    }
+}
 
 impl Tonemap {
     /// The operator's id in the `op` push constant of `composite.comp`; it matches the

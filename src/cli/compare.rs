@@ -1,9 +1,9 @@
 //! `shine compare`: RMSE, PSNR and SSIM of an image against a reference (both EXR), as a table
-//! or JSON (definitions in `shine::image_compare`).
+//! or JSON (definitions in `shine::capture::image_compare`).
 
 use super::CliError;
-use shine::image_compare::compare;
-use shine::image_io::read_exr;
+use shine::capture::image_compare::compare;
+use shine::capture::image_io::read_exr;
 use std::path::PathBuf;
 
 /// Arguments of `shine compare`.

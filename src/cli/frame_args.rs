@@ -6,7 +6,7 @@ use shine_scene::Scene;
 use shine_scene::environment::Environment;
 use std::path::PathBuf;
 
-/// Settings from a TOML file, then flags over it (DESIGN: one serde struct, file and flags).
+/// Settings from a TOML file, then flags over it (one serde struct, file and flags).
 #[derive(clap::Args, Debug)]
 pub struct SettingsArgs {
     /// Settings file (TOML); flags override it.

@@ -4,9 +4,9 @@
 
 use super::CliError;
 use super::frame_args::SettingsArgs;
+use shine::frame::renderer::Renderer;
 use shine::gpu::{Device, DeviceDesc};
-use shine::profile_report::{PassClock, ProfileReport, ReportFormat, write_chrome_trace};
-use shine::renderer::Renderer;
+use shine::profile::report::{PassClock, ProfileReport, ReportFormat, write_chrome_trace};
 use std::path::PathBuf;
 
 /// Arguments of `shine profile`.

@@ -5,10 +5,10 @@
 use super::CliError;
 use super::frame_args::{EnvironmentArgs, load_scene};
 use glam::Vec3;
+use shine::capture::image_io::{LdrImage, OutputFormat, write_exr, write_png};
+use shine::capture::tonemap::{Tonemap, encode_ldr};
 use shine::gpu::{Device, DeviceDesc};
-use shine::image_io::{LdrImage, OutputFormat, write_exr, write_png};
 use shine::reference::{PathTracer, ReferenceParams};
-use shine::tonemap::{Tonemap, encode_ldr};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 

@@ -2,9 +2,9 @@
 
 use super::CliError;
 use super::frame_args::SettingsArgs;
+use shine::capture::image_io::{OutputFormat, write_frame};
+use shine::frame::renderer::Renderer;
 use shine::gpu::{Device, DeviceDesc};
-use shine::image_io::{OutputFormat, write_frame};
-use shine::renderer::Renderer;
 use std::path::PathBuf;
 
 /// Frames per second of the scene clock in multi-frame renders.

@@ -1,25 +1,25 @@
-//! The `proxy` GI technique in a frame (paper 002): the scene's proxy spheres and environment
-//! on the GPU, and the passes it adds to the frame graph (`src/passes/proxy.rs`).
+//! The proxy technique (paper 002) as the frame uses it: the scene's proxy spheres and
+//! environment on the GPU, and the passes it adds to a frame (`src/passes/proxy.rs`).
 //!
-//! The proxies are taken at the scene time given to [`crate::renderer::Renderer::set_scene`]
+//! The proxies are taken at the scene time given to [`crate::Renderer::set_scene`]
 //! (`Scene::world_transforms_at`), with the albedo of their node's first material. With the
 //! setting `proxy.fit_count = k > 0`, every node that has proxies gets `k` spheres fitted to its
 //! mesh instead ([`shine_scene::proxies::fit`]): the built-in `spheres` scene has 4 proxied
 //! objects, so `k` = 2, 8, 32 gives 8, 32, 128 proxies (the profiling cases of issue 8).
 
 use glam::{Mat4, Vec3};
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_gpu::{Buffer, Device};
 use shine_graph::{Handle, Image, RenderGraph};
 use shine_scene::environment::Environment;
 use shine_scene::proxies::{self, ProxySphere};
 use shine_scene::{Mesh, Scene};
 
-use crate::environment_sh::EnvironmentSh;
-use crate::passes::proxy::{
-    self, Accumulation, GpuProxy, MAX_PROXIES, ProxyInputs, ProxyParams, ProxyTables, Receivers,
-};
-use crate::renderer::RenderError;
-use crate::settings::Settings;
+use super::error::RenderError;
+use super::params::ProxySetup;
+use crate::gpu_scene::BUFFER_READ;
+use crate::gpu_scene::environment_sh::EnvironmentSh;
+use crate::passes::proxy::{self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyTables};
+use crate::passes::receivers::Receivers;
 
 /// One node's proxies as set up from the scene.
 #[derive(Debug, Clone)]
@@ -30,8 +30,9 @@ struct ProxySource {
     albedo: Vec3,
 }
 
-/// The scene side of the proxy technique and its GPU buffers, built on demand and cached.
-pub struct ProxyFrame {
+/// The proxy technique's persistent state: the scene's proxies and environment, and their GPU
+/// buffers, built on demand and kept per setting.
+pub struct ProxyTechnique {
     device: Device,
     sources: Vec<ProxySource>,
     environment: Option<Environment>,
@@ -40,23 +41,20 @@ pub struct ProxyFrame {
     /// Environment SH per band count.
     environments: Vec<(u32, Buffer)>,
     /// Tables per (bands, η shadow, η indirect).
-    tables: Vec<((u32, u32, u32), ProxyTables, Buffer)>,
+    tables: Vec<(TableKey, ProxyTables, Buffer)>,
 }
 
-fn storage(device: &Device, name: &'static str, data: &[u8]) -> Result<Buffer, RenderError> {
-    Ok(Buffer::with_data(
-        device,
-        &BufferDesc {
-            name,
-            size: 0,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::GpuOnly,
-        },
-        data,
-    )?)
+/// The α tables' cache key: bands and the bits of both expansion factors.
+type TableKey = (u32, u32, u32);
+
+/// A proxy frame ready to be declared: the GPU data of its setup imported into the graph.
+pub struct PreparedProxy<'a> {
+    setup: ProxySetup,
+    inputs: ProxyInputs,
+    tables: &'a ProxyTables,
 }
 
-impl ProxyFrame {
+impl ProxyTechnique {
     /// The proxies and environment of `scene` at time `t`; nothing is uploaded yet.
     pub fn new(device: &Device, scene: &Scene, t: f32) -> Self {
         let world = scene.world_transforms_at(t);
@@ -120,114 +118,102 @@ impl ProxyFrame {
         out
     }
 
-    /// Uploads what a frame with `settings` needs (once per distinct setting).
-    pub fn prepare(&mut self, settings: &Settings) -> Result<(), RenderError> {
-        let p = &settings.proxy;
-        let environment = self.environment.as_ref().ok_or_else(|| {
-            RenderError::Invalid(
-                "--gi proxy needs an environment light: this scene has none (add \
-                 `shine_environment` to the glTF root extras, or pass --environment FILE)"
-                    .into(),
-            )
-        })?;
-        if !self.environments.iter().any(|(b, _)| *b == p.sh_order) {
-            let sh = EnvironmentSh::project(environment, p.sh_order as usize)
-                .map_err(proxy::ProxyError::from)?;
-            let buffer = storage(
-                &self.device,
-                "proxy environment sh",
-                bytemuck::cast_slice(&sh.gpu_data()),
-            )?;
-            self.environments.push((p.sh_order, buffer));
-        }
+    /// Uploads what `setup` needs (once per distinct setup) and imports it into `rg`.
+    pub fn prepare(
+        &mut self,
+        rg: &mut RenderGraph,
+        setup: &ProxySetup,
+    ) -> Result<PreparedProxy<'_>, RenderError> {
+        let bands = setup.pass.bands;
+        let environment = self.environment.as_ref().ok_or(ProxyError::NoEnvironment)?;
+        let environment_index = match self.environments.iter().position(|(b, _)| *b == bands) {
+            Some(i) => i,
+            None => {
+                let sh = EnvironmentSh::project(environment, bands as usize)
+                    .map_err(ProxyError::from)?;
+                let buffer = Buffer::storage_with_data(
+                    &self.device,
+                    "proxy environment sh",
+                    bytemuck::cast_slice(&sh.gpu_data()),
+                )?;
+                self.environments.push((bands, buffer));
+                self.environments.len() - 1
+            }
+        };
         let key = (
-            p.sh_order,
-            p.shadow_expansion().to_bits(),
-            p.indirect_expansion.to_bits(),
+            bands,
+            setup.shadow_expansion.to_bits(),
+            setup.indirect_expansion.to_bits(),
         );
-        if !self.tables.iter().any(|(k, _, _)| *k == key) {
-            let tables =
-                ProxyTables::build(p.sh_order, p.shadow_expansion(), p.indirect_expansion)?;
-            let buffer = storage(
-                &self.device,
-                "proxy tables",
-                bytemuck::cast_slice(&tables.gpu_data()),
-            )?;
-            self.tables.push((key, tables, buffer));
-        }
-        if self.proxies.as_ref().map(|(k, _, _)| *k) != Some(p.fit_count) {
-            let list = self.proxies(p.fit_count);
-            let count = u32::try_from(list.len())
-                .ok()
-                .filter(|&c| c <= MAX_PROXIES)
-                .ok_or_else(|| {
-                    RenderError::Invalid(format!(
-                        "{} proxy spheres: at most {MAX_PROXIES} are supported",
-                        list.len()
-                    ))
-                })?;
-            // A storage buffer cannot be empty: one zero record stands for "no proxy".
-            let data = if list.is_empty() {
-                vec![GpuProxy::new(Vec3::ZERO, 0.0, Vec3::ZERO)]
-            } else {
-                list
-            };
-            let buffer = storage(&self.device, "proxies", bytemuck::cast_slice(&data))?;
-            self.proxies = Some((p.fit_count, count, buffer));
-        }
-        Ok(())
+        let table_index = match self.tables.iter().position(|(k, _, _)| *k == key) {
+            Some(i) => i,
+            None => {
+                let tables =
+                    ProxyTables::build(bands, setup.shadow_expansion, setup.indirect_expansion)?;
+                let buffer = Buffer::storage_with_data(
+                    &self.device,
+                    "proxy tables",
+                    bytemuck::cast_slice(&tables.gpu_data()),
+                )?;
+                self.tables.push((key, tables, buffer));
+                self.tables.len() - 1
+            }
+        };
+        let proxies = match self.proxies.take() {
+            Some(cached) if cached.0 == setup.fit_count => cached,
+            _ => self.upload_proxies(setup.fit_count)?,
+        };
+        let (_, count, proxy_buffer) = self.proxies.insert(proxies);
+        let (_, tables, table_buffer) = &self.tables[table_index];
+        let inputs = ProxyInputs {
+            proxies: rg.import_gpu_buffer(proxy_buffer, BUFFER_READ, BUFFER_READ),
+            count: *count,
+            tables: rg.import_gpu_buffer(table_buffer, BUFFER_READ, BUFFER_READ),
+            environment: rg.import_gpu_buffer(
+                &self.environments[environment_index].1,
+                BUFFER_READ,
+                BUFFER_READ,
+            ),
+        };
+        Ok(PreparedProxy {
+            setup: *setup,
+            inputs,
+            tables,
+        })
     }
+}
 
-    /// Adds the proxy passes over `receivers`; returns `proxy_gi` (RGBA16F outgoing radiance
-    /// at receiver resolution). [`ProxyFrame::prepare`] must have run with the same settings.
+impl ProxyTechnique {
+    /// The proxies for `fit_count` on the device: `(fit_count, count, buffer)`.
+    fn upload_proxies(&self, fit_count: u32) -> Result<(u32, u32, Buffer), RenderError> {
+        let list = self.proxies(fit_count);
+        let count = u32::try_from(list.len())
+            .ok()
+            .filter(|&c| c <= MAX_PROXIES)
+            .ok_or(ProxyError::TooMany(list.len()))?;
+        // A storage buffer cannot be empty: one zero record stands for "no proxy".
+        let data = if list.is_empty() {
+            vec![GpuProxy::new(Vec3::ZERO, 0.0, Vec3::ZERO)]
+        } else {
+            list
+        };
+        let buffer =
+            Buffer::storage_with_data(&self.device, "proxies", bytemuck::cast_slice(&data))?;
+        Ok((fit_count, count, buffer))
+    }
+}
+
+impl PreparedProxy<'_> {
+    /// Adds `proxy_tiles`, `proxy_accumulate` and `proxy_shade` over `receivers`; returns
+    /// `proxy_gi` (RGBA16F outgoing radiance at receiver resolution).
     pub fn declare(
-        &self,
+        self,
         rg: &mut RenderGraph,
         receivers: &Receivers,
-        settings: &Settings,
     ) -> Result<Handle<Image>, RenderError> {
-        let p = &settings.proxy;
-        let missing = || RenderError::Invalid("proxy buffers not prepared".into());
-        let environment = self
-            .environments
-            .iter()
-            .find(|(b, _)| *b == p.sh_order)
-            .map(|(_, b)| b)
-            .ok_or_else(missing)?;
-        let key = (
-            p.sh_order,
-            p.shadow_expansion().to_bits(),
-            p.indirect_expansion.to_bits(),
-        );
-        let (_, tables, table_buffer) = self
-            .tables
-            .iter()
-            .find(|(k, _, _)| *k == key)
-            .ok_or_else(missing)?;
-        let (_, count, proxy_buffer) = self
-            .proxies
-            .as_ref()
-            .filter(|(k, _, _)| *k == p.fit_count)
-            .ok_or_else(missing)?;
-        let read = crate::gpu_scene::BUFFER_READ;
-        let inputs = ProxyInputs {
-            proxies: rg.import_gpu_buffer(proxy_buffer, read, read),
-            count: *count,
-            tables: rg.import_gpu_buffer(table_buffer, read, read),
-            environment: rg.import_gpu_buffer(environment, read, read),
-        };
-        let params = ProxyParams {
-            bands: p.sh_order,
-            accumulation: if p.brute_force {
-                Accumulation::Product
-            } else {
-                Accumulation::Splat
-            },
-            exp: p.exp,
-            indirect: p.indirect,
-        };
-        let sums = proxy::proxy_accumulate(rg, receivers, &inputs, tables, &params)?;
-        let out = proxy::proxy_shade(rg, receivers, &sums, &inputs, tables, &params)?;
+        let params = &self.setup.pass;
+        let sums = proxy::proxy_accumulate(rg, receivers, &self.inputs, self.tables, params)?;
+        let out = proxy::proxy_shade(rg, receivers, &sums, &self.inputs, self.tables, params)?;
         Ok(out.radiance)
     }
 }

@@ -3,28 +3,24 @@
 //! Each frame declares its passes (docs/frame.md) into a fresh graph; the executor compiles it
 //! (cached while the shape is unchanged), records it and times every pass.
 
-use crate::gpu_bvh::GpuBvh;
-use crate::gpu_scene::{BUFFER_READ, GpuScene, SAMPLED_READ, SceneUploadError};
-use crate::image_io::{HdrImage, ImageIoError, LdrImage};
-use crate::passes::composite::{self, CompositeOutputs, CompositeParams};
-use crate::passes::direct::{self, ShadowParams};
+use super::error::RenderError;
+use super::hvl::{HvlInputs, HvlTechnique};
+use super::igi::{IgiInputs, IgiTechnique};
+use super::params::FrameParams;
+use super::proxy::ProxyTechnique;
+use super::shadows::ShadowState;
+use crate::capture::image_io::{HdrImage, LdrImage};
+use crate::gpu_scene::bvh::GpuBvh;
+use crate::gpu_scene::{GpuScene, SAMPLED_READ};
+use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::gbuffer::{self, SceneHandles};
-use crate::passes::hvl::{self, GatherBrdf, HvlError, HvlParams};
-use crate::passes::igi::{self, IgiError, IgiParams};
-use crate::passes::proxy::ProxyError;
-use crate::passes::receivers::{self, ReceiverError};
-use crate::passes::shadows::{self, ShadowLayout, ShadowLayoutError};
-use crate::passes::upsample::{self, UpsampleParams};
-use crate::profile_report::PassClock;
-use crate::proxy_frame::ProxyFrame;
-use crate::settings::{Component, GiTechnique, IgiFilter, IgiGlossy};
-use crate::settings::{Settings, SettingsError};
+use crate::passes::gi_add::gi_add;
+use crate::passes::{direct, receivers, rsm, upsample};
+use crate::profile::report::PassClock;
+use crate::settings::Settings;
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
-use shine_graph::{
-    ExecuteError, Executor, ExternalState, ImageDesc, ImageImport, PassTiming, RenderGraph,
-};
+use shine_graph::{Executor, ExternalState, ImageDesc, ImageImport, PassTiming, RenderGraph};
 use shine_scene::Scene;
-use shine_sh::brdf_table::HemisphereSampling;
 
 /// A linear or nearest sampler without mips, addressing u and v as given.
 fn sampler(
@@ -47,51 +43,6 @@ fn sampler(
 
 /// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
 const FRAMES_IN_FLIGHT: usize = 2;
-/// Shadow-map depth bias in NDC depth units, on top of the raster slope bias.
-const SHADOW_DEPTH_BIAS: f32 = 1e-4;
-/// Receiver offset along its normal in shadow-map texels (removes acne at grazing angles).
-const SHADOW_NORMAL_OFFSET: f32 = 1.5;
-
-/// What can go wrong while rendering.
-#[derive(Debug, thiserror::Error)]
-pub enum RenderError {
-    /// A device-layer failure.
-    #[error(transparent)]
-    Gpu(#[from] shine_gpu::Error),
-    /// The frame graph could not be compiled or recorded.
-    #[error("frame graph: {0}")]
-    Graph(#[from] ExecuteError),
-    /// The scene could not be uploaded.
-    #[error(transparent)]
-    Scene(#[from] SceneUploadError),
-    /// The settings are invalid.
-    #[error(transparent)]
-    Settings(#[from] SettingsError),
-    /// A read-back frame did not match its expected size.
-    #[error(transparent)]
-    Image(#[from] ImageIoError),
-    /// The HVL passes refused their inputs or parameters.
-    #[error(transparent)]
-    Hvl(#[from] HvlError),
-    /// The IGI passes refused their inputs or parameters.
-    #[error(transparent)]
-    Igi(#[from] IgiError),
-    /// The proxy passes refused their inputs or parameters.
-    #[error(transparent)]
-    Proxy(#[from] ProxyError),
-    /// The receiver or upsample pass refused its inputs.
-    #[error(transparent)]
-    Receivers(#[from] ReceiverError),
-    /// The scene's lights do not fit one shadow atlas.
-    #[error(transparent)]
-    Shadows(#[from] ShadowLayoutError),
-    /// `render` was called before `set_scene`.
-    #[error("no scene: call set_scene first")]
-    NoScene,
-    /// A parameter is out of range.
-    #[error("{0}")]
-    Invalid(String),
-}
 
 /// A rendered frame read back to the CPU.
 #[derive(Clone, Debug)]
@@ -123,29 +74,36 @@ pub struct HostTarget {
     pub after: ExternalState,
 }
 
-/// Renders scenes on a [`Device`].
+/// Renders scenes on a [`Device`]: the scene's resources, the techniques' persistent state, and
+/// the composition of every frame's passes ([`Renderer::declare_frame`]).
 pub struct Renderer {
     device: Device,
     executor: Executor,
     linear: Sampler,
     nearest: Sampler,
-    scene: Option<GpuScene>,
-    /// The scene's BVH for shadow rays (HVL visibility, IGI's VPL visibility), uploaded with
-    /// the scene.
-    bvh: Option<GpuBvh>,
-    /// The scene's environment baked for the background (black without one).
-    environment: Option<shine_gpu::Image>,
     /// Linear, repeating in u and clamped in v: the environment texture's sampler.
     environment_sampler: Sampler,
-    /// The gather's BRDF SH tables on the GPU, built once per convolution band count.
-    brdf_tables: Vec<(u32, Buffer)>,
-    /// The shadow atlas layout of the current scene and its GPU records, for one
-    /// `(shadow.size, PCF radius)`.
-    shadow_layout: Option<ShadowCache>,
+    /// The current scene on the device.
+    scene: Option<SceneState>,
+    /// The shadow atlas layout of the current scene and its records.
+    shadows: Option<ShadowState>,
+    /// Harmonics Virtual Lights (paper 003).
+    hvl: HvlTechnique,
+    /// Instant GI (paper 000).
+    igi: IgiTechnique,
     /// Readback buffers of [`Renderer::render`].
     readback: Option<Readback>,
-    /// The scene's proxies and environment for `--gi proxy` (paper 002).
-    proxy: Option<ProxyFrame>,
+}
+
+/// A scene on the device: what every frame of it reads.
+struct SceneState {
+    gpu: GpuScene,
+    /// The BVH for rays (path tracer, HVL visibility, IGI's VPL shadow rays).
+    bvh: GpuBvh,
+    /// The environment baked for the background (black without one).
+    environment: shine_gpu::Image,
+    /// Sphere proxies under the environment (paper 002): scene-bound state.
+    proxy: ProxyTechnique,
 }
 
 /// The buffers a rendered frame is copied into, kept while the frame size is unchanged.
@@ -177,14 +135,6 @@ impl Readback {
     }
 }
 
-/// A [`ShadowLayout`] and its records on the GPU.
-struct ShadowCache {
-    key: (u32, u32),
-    layout: ShadowLayout,
-    views: Buffer,
-    lights: Buffer,
-}
-
 impl Renderer {
     /// A renderer on `device` (shine's own, or a host's wrapped with `Device::from_raw`).
     pub fn new(device: &Device) -> Result<Self, RenderError> {
@@ -199,14 +149,12 @@ impl Renderer {
                 A::CLAMP_TO_EDGE,
                 A::CLAMP_TO_EDGE,
             )?,
-            scene: None,
-            bvh: None,
-            environment: None,
             environment_sampler: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::CLAMP_TO_EDGE)?,
-            brdf_tables: Vec::new(),
-            shadow_layout: None,
+            scene: None,
+            shadows: None,
+            hvl: HvlTechnique::new(device),
+            igi: IgiTechnique::new(device),
             readback: None,
-            proxy: None,
         })
     }
 
@@ -214,17 +162,20 @@ impl Renderer {
     /// queue to go idle: frames a host recorded with [`Renderer::record`] may still read the
     /// old one, and shine cannot see host submissions.
     pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
-        let uploaded = GpuScene::upload(&self.device, scene, t)?;
-        let bvh = GpuBvh::upload(&self.device, scene, t)?;
-        let environment = crate::gpu_environment::upload(&self.device, scene.environment.as_ref())?;
+        let state = SceneState {
+            gpu: GpuScene::upload(&self.device, scene, t)?,
+            bvh: GpuBvh::upload(&self.device, scene, t)?,
+            environment: crate::gpu_scene::environment::upload(
+                &self.device,
+                scene.environment.as_ref(),
+            )?,
+            proxy: ProxyTechnique::new(&self.device, scene, t),
+        };
         if self.scene.is_some() {
             self.device.wait_idle()?;
         }
-        self.scene = Some(uploaded);
-        self.bvh = Some(bvh);
-        self.environment = Some(environment);
-        self.shadow_layout = None;
-        self.proxy = Some(ProxyFrame::new(&self.device, scene, t));
+        self.scene = Some(state);
+        self.shadows = None;
         Ok(())
     }
 
@@ -237,7 +188,7 @@ impl Renderer {
             _ => Readback::new(&self.device, [width, height])?,
         };
         let mut rg = self.executor.begin_frame();
-        let frame = self.declare_frame(&mut rg, settings)?;
+        let frame = self.declare_frame(&mut rg, &FrameParams::from_settings(settings))?;
         let read_by_copy = ExternalState::new(
             vk::PipelineStageFlags2::COPY,
             vk::AccessFlags2::TRANSFER_READ,
@@ -281,10 +232,11 @@ impl Renderer {
         // The frame's outputs must reach something outside the graph, or every pass is culled:
         // the LDR image is handed to a throw-away import.
         let sink = self.sink(settings)?;
+        let params = FrameParams::from_settings(settings);
         let mut timings = Vec::new();
         for _ in 0..count {
             let mut rg = self.executor.begin_frame();
-            let frame = self.declare_frame(&mut rg, settings)?;
+            let frame = self.declare_frame(&mut rg, &params)?;
             let mut out = rg.import_gpu_image(
                 &sink,
                 ExternalState::UNDEFINED,
@@ -346,7 +298,7 @@ impl Renderer {
         };
         settings.validate()?;
         let mut rg = self.executor.begin_frame();
-        let frame = self.declare_frame(&mut rg, &settings)?;
+        let frame = self.declare_frame(&mut rg, &FrameParams::from_settings(&settings))?;
         let mut host = rg.import_vk_image(
             "host target",
             ImageDesc::new_2d(target.format, width, height),
@@ -373,9 +325,9 @@ impl Renderer {
     /// What the last frame had to compromise on (e.g. shadow tiles shrunk to fit the device),
     /// for the caller to report.
     pub fn warnings(&self) -> Vec<String> {
-        self.shadow_layout
+        self.shadows
             .iter()
-            .filter_map(|c| c.layout.warning.clone())
+            .filter_map(|s| s.warning().map(str::to_owned))
             .collect()
     }
 
@@ -384,129 +336,41 @@ impl Renderer {
         Ok(self.executor.timings()?)
     }
 
-    /// Lays out the shadow atlas of the current scene for `settings` and uploads its records,
-    /// unless the cached layout already matches.
-    fn prepare_shadows(&mut self, settings: &Settings) -> Result<(), RenderError> {
-        let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
-        let pcf_radius = settings.shadow.filter_radius.round() as u32;
-        let key = (settings.shadow.size, pcf_radius);
-        if self.shadow_layout.as_ref().is_some_and(|c| c.key == key) {
-            return Ok(());
-        }
-        let max_dimension = self.device.limits().max_image_dimension2_d;
-        let layout = ShadowLayout::new(scene, settings.shadow.size, pcf_radius, max_dimension)?;
-        let upload = |name, bytes: &[u8]| {
-            Buffer::with_data(
-                &self.device,
-                &BufferDesc {
-                    name,
-                    size: 0,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::GpuOnly,
-                },
-                bytes,
-            )
-        };
-        let views = upload("shadow views", bytemuck::cast_slice(&layout.view_records()))?;
-        let lights = upload(
-            "shadow lights",
-            bytemuck::cast_slice(&layout.light_records()),
-        )?;
-        if self.shadow_layout.is_some() {
-            // Frames a host recorded with `record` may still read the old records, and shine
-            // cannot see host submissions (as in `set_scene`).
-            self.device.wait_idle()?;
-        }
-        self.shadow_layout = Some(ShadowCache {
-            key,
-            layout,
-            views,
-            lights,
-        });
-        Ok(())
-    }
-
-    /// Builds and uploads the BRDF SH tables ([`GatherBrdf`]) at `bands` bands unless cached.
-    fn prepare_brdf_tables(&mut self, bands: u32) -> Result<(), RenderError> {
-        if self.brdf_tables.iter().any(|(b, _)| *b == bands) {
-            return Ok(());
-        }
-        let tables = GatherBrdf::build(bands, HemisphereSampling::default())?;
-        let buffer = Buffer::with_data(
-            &self.device,
-            &BufferDesc {
-                name: "brdf tables",
-                size: 0,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                location: MemoryLocation::GpuOnly,
-            },
-            bytemuck::cast_slice(&tables.gpu_data()),
-        )?;
-        self.brdf_tables.push((bands, buffer));
-        Ok(())
-    }
-
-    /// The cached BRDF SH tables at `bands` bands, imported into `rg`.
-    fn import_brdf_tables(
-        &self,
-        rg: &mut RenderGraph,
-        bands: u32,
-    ) -> Result<shine_graph::Handle<shine_graph::Buffer>, RenderError> {
-        let table = self
-            .brdf_tables
-            .iter()
-            .find(|(b, _)| *b == bands)
-            .map(|(_, buffer)| buffer)
-            .ok_or_else(|| RenderError::Invalid("BRDF tables missing".into()))?;
-        Ok(rg.import_gpu_buffer(table, BUFFER_READ, BUFFER_READ))
-    }
-
-    /// Declares every pass of a frame; returns its HDR and LDR images.
+    /// Declares every pass of a frame: each technique first prepares its persistent state
+    /// (uploads, imports), then the frame's passes are composed in dependency order (G-buffer,
+    /// shadows, direct light, RSM, the techniques, upsample, composite). Returns the HDR and
+    /// LDR images.
     fn declare_frame(
         &mut self,
         rg: &mut RenderGraph,
-        settings: &Settings,
+        p: &FrameParams,
     ) -> Result<CompositeOutputs, RenderError> {
-        let hvl = settings.gi.contains(GiTechnique::Hvl);
-        let conv_bands = settings.hvl.convolution_bands;
-        if hvl {
-            self.prepare_brdf_tables(conv_bands)?;
-        }
-        let igi_params = igi_params(settings);
-        if settings.gi.contains(GiTechnique::Igi) && igi_params.needs_brdf_tables() {
-            self.prepare_brdf_tables(igi_params.sh_order)?;
-        }
-        self.prepare_shadows(settings)?;
-        let proxy = settings.gi.contains(GiTechnique::Proxy);
-        if proxy {
-            self.proxy
-                .as_mut()
-                .ok_or(RenderError::NoScene)?
-                .prepare(settings)?;
-        }
-        let scene = self.scene.as_ref().ok_or(RenderError::NoScene)?;
-        let handles = SceneHandles::import(rg, scene);
-        let extent = [settings.width, settings.height];
-        let camera = gbuffer::camera_view(scene, settings.width, settings.height);
-        let g = gbuffer::gbuffer(rg, &handles, &camera, extent, self.linear.raw());
-        let primary = scene
-            .primary_light()
-            .and_then(|i| Some((i as u32, gbuffer::light_view(scene, i)?)));
-        let light_count = u32::try_from(scene.light_list.len())
+        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        let shadows = ShadowState::prepare(
+            &self.device,
+            self.shadows.take(),
+            &scene.gpu,
+            p.shadow_size,
+            p.shadow.pcf_radius,
+        )?;
+        let shadows = self.shadows.insert(shadows);
+        let hvl = p.hvl.map(|h| self.hvl.prepare(rg, h)).transpose()?;
+        let igi = p.igi.map(|i| self.igi.prepare(rg, i)).transpose()?;
+        let proxy = p
+            .proxy
+            .as_ref()
+            .map(|setup| scene.proxy.prepare(rg, setup))
+            .transpose()?;
+
+        let handles = SceneHandles::import(rg, &scene.gpu);
+        let [width, height] = p.extent;
+        let camera = gbuffer::camera_view(&scene.gpu, width, height);
+        let g = gbuffer::gbuffer(rg, &handles, &camera, p.extent, self.linear.raw());
+        let light_count = u32::try_from(scene.gpu.light_list.len())
             .map_err(|_| RenderError::Invalid("too many lights".into()))?;
-        let shadow = ShadowParams {
-            // The setting is a radius in texels; the kernel covers whole texels around it.
-            pcf_radius: settings.shadow.filter_radius.round() as u32,
-            bias: SHADOW_DEPTH_BIAS,
-            normal_offset: SHADOW_NORMAL_OFFSET,
-        };
-        let cache = self.shadow_layout.as_ref().ok_or(RenderError::NoScene)?;
-        let shadow_views = rg.import_gpu_buffer(&cache.views, BUFFER_READ, BUFFER_READ);
-        let shadow_lights = rg.import_gpu_buffer(&cache.lights, BUFFER_READ, BUFFER_READ);
-        let atlas = shadows::shadow_atlas(rg, &handles, &cache.layout, shadow_views, shadow_lights);
-        let environment = self.environment.as_ref().ok_or(RenderError::NoScene)?;
+        let atlas = shadows.declare(rg, &handles);
         let background = direct::Background {
-            environment: rg.import_gpu_image(environment, SAMPLED_READ, SAMPLED_READ),
+            environment: rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ),
             sampler: self.environment_sampler.raw(),
         };
         let direct = direct::direct(
@@ -517,101 +381,78 @@ impl Renderer {
             &atlas,
             &camera,
             &background,
-            shadow,
+            p.shadow,
             self.nearest.raw(),
         );
-        let igi = settings.gi.contains(GiTechnique::Igi);
+
+        // HVL and IGI bounce the primary light (the first spot or directional light) off its
+        // RSM; without one they add nothing.
+        let primary = scene
+            .gpu
+            .primary_light()
+            .and_then(|i| Some((i as u32, gbuffer::light_view(&scene.gpu, i)?)));
+        let rsm = match primary {
+            Some((light, view)) if hvl.is_some() || igi.is_some() => Some(rsm::rsm(
+                rg,
+                &handles,
+                view,
+                light,
+                p.rsm_size,
+                self.linear.raw(),
+            )),
+            _ => None,
+        };
         // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
         // upsample; `hvl,proxy` sums both at receiver resolution first.
-        let recv = if hvl || proxy {
-            Some(receivers::receivers(rg, &g, settings.receiver_scale)?)
+        let recv = if hvl.is_some() || proxy.is_some() {
+            Some(receivers::receivers(rg, &g, p.receiver_scale)?)
         } else {
             None
         };
-        let hvl_low = match (primary, &recv) {
-            (Some((light, view)), Some(recv)) if hvl => {
-                let params = hvl_params(settings);
-                let rsm = gbuffer::rsm(
-                    rg,
-                    &handles,
-                    view,
-                    light,
-                    settings.rsm.size,
-                    self.linear.raw(),
-                );
-                let hvls = hvl::hvl_cache(rg, &rsm, &params)?;
-                let brdf = self.import_brdf_tables(rg, conv_bands)?;
-                let bvh = match (params.visibility, self.bvh.as_ref()) {
-                    (true, Some(b)) => Some(b.import(rg, BUFFER_READ)),
-                    _ => None,
-                };
-                Some(hvl::hvl_gather(
-                    rg,
-                    recv,
-                    &hvls,
-                    &brdf,
-                    bvh.as_ref(),
-                    camera.eye,
-                    &params,
-                )?)
-            }
+        let hvl_low = match (hvl, &rsm, &recv) {
+            (Some(hvl), Some(rsm), Some(receivers)) => Some(hvl.declare(
+                rg,
+                &HvlInputs {
+                    receivers,
+                    rsm,
+                    bvh: &scene.bvh,
+                    camera: camera.eye,
+                },
+            )?),
             _ => None,
         };
-        let proxy_low = match (&self.proxy, &recv) {
-            (Some(frame), Some(recv)) if proxy => Some(frame.declare(rg, recv, settings)?),
+        let proxy_low = match (proxy, &recv) {
+            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers)?),
             _ => None,
         };
         let low = match (hvl_low, proxy_low) {
-            (Some(a), Some(b)) => Some(crate::passes::proxy::gi_add(rg, &a, &b)?),
+            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
             (a, b) => a.or(b),
         };
         let upsampled = match (low, &recv) {
-            (Some(low), Some(recv)) => {
-                let upsample_params = UpsampleParams {
-                    depth_sigma: settings.upsample.depth_epsilon,
-                    normal_power: settings.upsample.normal_power,
-                    ..UpsampleParams::default()
-                };
-                Some(upsample::upsample(rg, &low, recv, &g, &upsample_params)?)
-            }
+            (Some(low), Some(recv)) => Some(upsample::upsample(rg, &low, recv, &g, &p.upsample)?),
             _ => None,
         };
         // IGI runs at full resolution (its interleaving needs the pixel grid).
-        let igi_full = match primary {
-            Some((light, view)) if igi => {
-                let rsm = gbuffer::rsm(
-                    rg,
-                    &handles,
-                    view,
-                    light,
-                    settings.rsm.size,
-                    self.linear.raw(),
-                );
-                let brdf = if igi_params.needs_brdf_tables() {
-                    Some(self.import_brdf_tables(rg, igi_params.sh_order)?)
-                } else {
-                    None
-                };
-                let bvh = self.bvh.as_ref().ok_or(RenderError::NoScene)?;
-                Some(igi_indirect(
-                    rg,
-                    &igi_params,
-                    &g,
-                    &rsm,
-                    bvh,
-                    brdf.as_ref(),
-                    camera.eye,
-                )?)
-            }
+        let igi_full = match (igi, &rsm) {
+            (Some(igi), Some(rsm)) => Some(igi.declare(
+                rg,
+                &IgiInputs {
+                    gbuffer: &g,
+                    rsm,
+                    bvh: &scene.bvh,
+                    camera: camera.eye,
+                },
+            )?),
             _ => None,
         };
         // `igi,proxy`: both full-resolution indirect terms summed.
         let indirect = match (upsampled, igi_full) {
-            (Some(a), Some(b)) => Some(crate::passes::proxy::gi_add(rg, &a, &b)?),
+            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
             (a, b) => a.or(b),
         };
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
-        let (first, second) = match (settings.output.component, indirect.as_ref()) {
+        let (first, second) = match (p.component, indirect.as_ref()) {
             (Component::Full, indirect) => (&direct, indirect),
             (Component::Direct, _) => (&direct, None),
             (Component::Indirect, Some(indirect)) => (indirect, None),
@@ -625,61 +466,9 @@ impl Renderer {
             rg,
             first,
             second,
-            extent,
-            &CompositeParams::from_settings(&settings.output),
+            p.extent,
+            &p.composite,
         ))
-    }
-}
-
-/// Paper 000's branch of the frame: VPLs from the primary light's RSM, per-pixel incident
-/// radiance SH with shadow rays through `bvh`, the discontinuity filter and the BRDF; returns the
-/// full-resolution indirect image (no receiver buffer: the interleaving needs the pixel grid).
-fn igi_indirect(
-    rg: &mut RenderGraph,
-    params: &IgiParams,
-    g: &gbuffer::GBuffer,
-    rsm: &hvl::Rsm,
-    bvh: &GpuBvh,
-    brdf: Option<&shine_graph::Handle<shine_graph::Buffer>>,
-    camera: glam::Vec3,
-) -> Result<shine_graph::Handle<shine_graph::Image>, RenderError> {
-    let trace = bvh.import(rg, BUFFER_READ);
-    Ok(igi::igi(rg, g, rsm, &trace, brdf, camera, params)?)
-}
-
-/// The IGI parameters of `settings.igi` (paper 000).
-pub fn igi_params(settings: &Settings) -> IgiParams {
-    let i = &settings.igi;
-    IgiParams {
-        pattern: [i.n, i.m],
-        vpl_count: i.vpl_count,
-        sh_order: i.sh_order,
-        filter_radius: i.filter_radius,
-        mode: match i.filter {
-            IgiFilter::Sh => igi::FilterMode::Sh,
-            IgiFilter::Irradiance => igi::FilterMode::Irradiance,
-        },
-        glossy: match i.glossy {
-            IgiGlossy::Ggx => igi::Glossy::Ggx,
-            IgiGlossy::Phong => igi::Glossy::Phong,
-        },
-        clamp_distance: i.clamp_distance,
-        depth_tolerance: i.depth_tolerance,
-        normal_threshold: i.normal_threshold,
-    }
-}
-
-/// The HVL parameters of `settings.hvl` (paper 003).
-fn hvl_params(settings: &Settings) -> HvlParams {
-    let h = &settings.hvl;
-    HvlParams {
-        count: h.count,
-        radius: h.radius,
-        radius_scale: h.radius_scale,
-        conv_bands: h.convolution_bands,
-        emission_bands: h.emission_bands,
-        path: h.gather,
-        visibility: h.visibility,
     }
 }
 

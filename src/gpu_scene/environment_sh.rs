@@ -18,7 +18,7 @@ pub const PROJECTION_NODES_Z: usize = 128;
 /// Uniform nodes in φ of the projection.
 pub const PROJECTION_NODES_PHI: usize = 256;
 /// SH orders (bands) the projection accepts: paper 002 uses 3 and 4; shine goes to 6.
-pub const ORDERS: std::ops::RangeInclusive<usize> = 3..=6;
+pub const ORDERS: std::ops::RangeInclusive<u32> = 3..=6;
 
 /// The environment's radiance `L` and diffuse irradiance `L̃` as SH vectors, per channel.
 #[derive(Debug, Clone, PartialEq)]
@@ -34,7 +34,7 @@ pub struct EnvironmentSh {
 impl EnvironmentSh {
     /// Projects `environment` to `bands` bands (3..=6).
     pub fn project(environment: &Environment, bands: usize) -> Result<Self, ShError> {
-        if !ORDERS.contains(&bands) {
+        if !u32::try_from(bands).is_ok_and(|b| ORDERS.contains(&b)) {
             return Err(ShError::InvalidBands { bands });
         }
         let quadrature = SphereQuadrature::new(PROJECTION_NODES_Z, PROJECTION_NODES_PHI);

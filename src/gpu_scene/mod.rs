@@ -8,6 +8,10 @@
 //! colour textures live in an sRGB array and data textures (normal, metallic-roughness) in a
 //! linear one.
 
+pub mod bvh;
+pub mod environment;
+pub mod environment_sh;
+
 use glam::{Mat3, Mat4, Vec3};
 use shine_gpu::{Buffer, BufferDesc, Device, Image, ImageDesc, MemoryLocation, vk};
 use shine_graph::ExternalState;

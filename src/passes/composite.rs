@@ -7,10 +7,9 @@
 
 use glam::Vec3;
 
+use crate::capture::tonemap::{self, Tonemap};
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
-use crate::settings::OutputSettings;
 use crate::shaders;
-use crate::tonemap::{self, Tonemap};
 
 /// Format of the `hdr` output: linear radiance, exposure applied.
 pub const HDR_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
@@ -28,13 +27,16 @@ pub struct CompositeParams {
     pub tonemap: Tonemap,
 }
 
-impl CompositeParams {
-    /// The parameters chosen by the `[output]` settings.
-    pub fn from_settings(output: &OutputSettings) -> Self {
-        Self {
-            exposure: output.exposure,
-            tonemap: output.tonemap,
-        }
+crate::choice::named_choice! {
+    /// Which part of the radiance the frame shows (image tests compare each against the
+    /// path-traced reference, `crate::reference`): what the composite sums.
+    pub enum Component ("output component") {
+        /// Direct + indirect light.
+        Full = "full",
+        /// The direct pass only (emission and punctual lights).
+        Direct = "direct",
+        /// The GI technique's indirect light only (needs a GI technique).
+        Indirect = "indirect",
     }
 }
 

@@ -35,7 +35,7 @@ pub struct ShadowParams {
 }
 
 /// The environment seen behind the scene: the baked equirectangular texture
-/// (`crate::gpu_environment`) and a sampler repeating in u, clamped in v.
+/// (`crate::gpu_scene::environment`) and a sampler repeating in u, clamped in v.
 #[derive(Clone, Copy, Debug)]
 pub struct Background {
     /// The environment texture.

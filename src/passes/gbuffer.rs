@@ -1,5 +1,5 @@
-//! `gbuffer` and `rsm`: the scene rasterised from the camera into the G-buffer, and from the
-//! primary light into the reflective shadow map.
+//! `gbuffer`: the scene rasterised from the camera into the G-buffer; the camera and light
+//! views and the scene raster pipeline every raster pass shares (shadows, RSM).
 
 use crate::gpu_scene::{GpuScene, Vertex};
 use crate::shaders;
@@ -7,9 +7,6 @@ use glam::{Mat4, Vec3};
 use shine_gpu::{Blend, DepthState, GraphicsPipelineDesc, VertexBufferLayout, vk};
 use shine_graph::{ColorLoad, DepthLoad, Handle, Image, ImageDesc, RenderGraph};
 use shine_scene::LightKind;
-
-pub use super::hvl::Rsm;
-use super::hvl::RsmProjection;
 
 /// Push constants of `view.glsl` (112 bytes).
 #[repr(C)]
@@ -317,57 +314,4 @@ pub fn gbuffer(
         .push(&view.constants(None))
         .draw_indexed(scene.index_count, 1);
     g
-}
-
-/// Rasterises the scene from the primary light (perspective or orthographic) into a new `size`²
-/// reflective shadow map (docs/frame.md).
-pub fn rsm(
-    rg: &mut RenderGraph,
-    scene: &SceneHandles,
-    view: View,
-    light: u32,
-    size: u32,
-    sampler: vk::Sampler,
-) -> Rsm {
-    let image = |rg: &mut RenderGraph, name, format| {
-        rg.create_image(name, ImageDesc::new_2d(format, size, size))
-    };
-    let mut depth = image(rg, "rsm_depth", vk::Format::D32_SFLOAT);
-    let mut r = Rsm {
-        position: image(rg, "rsm_position", vk::Format::R32G32B32A32_SFLOAT),
-        normal: image(rg, "rsm_normal", vk::Format::R16G16B16A16_SFLOAT),
-        flux: image(rg, "rsm_flux", vk::Format::R32G32B32A32_SFLOAT),
-        light_position: view.eye,
-        light_direction: view.forward(),
-        projection: if view.orthographic {
-            RsmProjection::Orthographic { width: view.extent }
-        } else {
-            RsmProjection::Perspective { fov: view.extent }
-        },
-        size,
-    };
-    let pipeline = scene_pipeline(
-        Some(&shaders::RSM_FRAG),
-        &[
-            vk::Format::R32G32B32A32_SFLOAT,
-            vk::Format::R16G16B16A16_SFLOAT,
-            vk::Format::R32G32B32A32_SFLOAT,
-        ],
-        None,
-    );
-    rg.raster("rsm", pipeline)
-        .color(&mut r.position, ColorLoad::Clear([0.0; 4]))
-        .color(&mut r.normal, ColorLoad::Clear([0.0; 4]))
-        .color(&mut r.flux, ColorLoad::Clear([0.0; 4]))
-        .depth(&mut depth, DepthLoad::Clear(1.0))
-        .read("materials", &scene.materials)
-        .read("srgb_textures", &scene.srgb_textures)
-        .read("linear_textures", &scene.linear_textures)
-        .read("lights", &scene.lights)
-        .sampler("texture_sampler", sampler)
-        .vertex_buffer(&scene.vertices)
-        .index_buffer(&scene.indices, vk::IndexType::UINT32)
-        .push(&view.constants(Some((size, light))))
-        .draw_indexed(scene.index_count, 1);
-    r
 }

@@ -28,12 +28,12 @@
 //!   default 0.1 m; the classic bounded-geometry-term clamp of IGI). The energy it removes is
 //!   measured by `tests/igi.rs` against the path-traced reference.
 //! * **Glossy BRDF** ([`Glossy`], `igi.glossy`). `ggx` (default): the HVL gather's BRDF SH
-//!   tables (Lambert + GGX at 5 roughness nodes blended linearly, [`hvl::GatherBrdf`], built at
+//!   tables (Lambert + GGX at 5 roughness nodes blended linearly, [`brdf_tables::GatherBrdf`], built at
 //!   `sh_order` bands, the renderer's cached buffer) in the receiver frame (z = shading normal,
 //!   ω_o in the xz half-plane); the filtered radiance is rotated into that frame per pixel
 //!   (`sh_rotation`, Ivanic–Ruedenberg, twin of `shine_sh::rotation`). Weights as the Phong path
 //!   (below), the glossy one divided by the dielectric Schlick F (F0 = 0.04) at n·v because the
-//!   tables already hold the exact η = 1.5 Fresnel ([`hvl::table_fresnel_weight`], shared with
+//!   tables already hold the exact η = 1.5 Fresnel ([`brdf_tables::table_fresnel_weight`], shared with
 //!   the HVL gather): 1 for dielectrics, ≈ albedo/0.04 for metals (weighting the tables by
 //!   `mix(1, albedo, metallic)` instead, as the HVL gather first did, left the metallic lobe
 //!   ~20× too dark: the IGI mean indirect fell to 0.82 of the reference). `phong`: paper 000 §3.3 literally — Lambert `r_l` about the normal and
@@ -61,12 +61,16 @@
 //!   5785 / 1682 / 555 ms and sh_filter 90 / 93 / 127 ms for n×m = 1×1 / 2×2 / 4×4 (256 VPLs,
 //!   order 3); the shadow rays dominate and scale as 1/(nm).
 
+use std::ops::RangeInclusive;
+
 use glam::Vec3;
 
-use crate::gpu_bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::brdf_tables;
 use crate::passes::gbuffer::GBuffer;
-use crate::passes::hvl::{self, HvlError, HvlParams, Rsm};
+use crate::passes::hvl::{self, HvlError, HvlParams};
+use crate::passes::rsm::Rsm;
 use crate::shaders;
 
 /// Largest storage buffer every Vulkan device allows (`maxStorageBufferRange` ≥ 2²⁷ bytes).
@@ -75,24 +79,40 @@ pub const MAX_STORAGE_BUFFER: u64 = 1 << 27;
 /// Bytes per stored rgb coefficient of `vpl_sh` (two u32 of packed halves).
 pub const COEFFICIENT_BYTES: u64 = 8;
 
-/// What the discontinuity filter averages.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum FilterMode {
-    /// Paper 000: the incident radiance SH.
-    Sh,
-    /// Classic IGI: irradiance about the shading normal and glossy radiance.
-    Irradiance,
+/// Interleaving pattern sides n and m (paper 000 §2.2 uses 4×4 and 8×8 patterns).
+pub const PATTERN: RangeInclusive<u32> = 1..=8;
+/// VPL counts: the RSM is cut into cells by the HVL cache pass, one VPL each.
+pub const VPL_COUNT: RangeInclusive<u32> = hvl::CACHE_COUNT;
+/// SH orders of the per-pixel incident radiance (paper 000 §3.1 uses 3).
+pub const SH_ORDERS: RangeInclusive<u32> = 2..=4;
+/// Discontinuity-filter window sizes k, in interleaving tiles (0: no filter).
+pub const FILTER_RADIUS: RangeInclusive<u32> = 0..=4;
+/// VPL singularity clamp distances d_min, metres.
+pub const CLAMP_DISTANCE: RangeInclusive<f32> = 0.0..=10.0;
+/// Relative depth tolerances of the discontinuity filter.
+pub const DEPTH_TOLERANCE: RangeInclusive<f32> = 1e-4..=1.0;
+/// Cosine thresholds of the filter's geometric-normal test.
+pub const NORMAL_THRESHOLD: RangeInclusive<f32> = -1.0..=1.0;
+
+crate::choice::named_choice! {
+    /// What the discontinuity filter averages (paper 000 §2.3 against §3).
+    pub enum FilterMode ("IGI filter mode") {
+        /// The per-pixel incident radiance as SH (paper 000): the BRDF is applied after filtering.
+        Sh = "sh",
+        /// Classic IGI: the per-pixel irradiance (and glossy radiance) about the shading normal.
+        Irradiance = "irradiance",
+    }
 }
 
-/// The glossy lobe of the SH resolve.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Glossy {
-    /// GGX through the BRDF SH tables of the HVL gather ([`hvl::GatherBrdf`]), the filtered
-    /// radiance rotated into the receiver frame (sh.glsl `sh_rotation`).
-    Ggx,
-    /// Paper 000 §3.3.2: a Phong lobe about the reflected direction standing for the GGX
-    /// (`igi_phong_exponent`), Lambert r_l about the normal (§3.3.1).
-    Phong,
+crate::choice::named_choice! {
+    /// The glossy lobe of IGI's SH resolve (`src/passes/igi.rs`).
+    pub enum Glossy ("IGI glossy lobe") {
+        /// GGX through the BRDF SH tables ([`crate::passes::brdf_tables`]), the filtered
+        /// radiance rotated into the receiver frame (sh.glsl `sh_rotation`).
+        Ggx = "ggx",
+        /// Paper 000 §3.3: Lambert and Phong r_l, the Phong lobe standing for the GGX.
+        Phong = "phong",
+    }
 }
 
 /// Parameters of the IGI passes.
@@ -169,7 +189,7 @@ pub struct FilterPush {
     pub depth_tolerance: f32,
     /// Cosine threshold of the geometric normals.
     pub normal_threshold: f32,
-    /// Number of glossy tables ([`hvl::GLOSSY_TABLES`], GGX path).
+    /// Number of glossy tables ([`brdf_tables::GLOSSY_TABLES`], GGX path).
     pub glossy_tables: u32,
     /// Roughness of the first glossy table and the step between tables (GGX path).
     pub roughness_nodes: [f32; 2],
@@ -188,7 +208,7 @@ pub enum IgiError {
         /// Value given.
         value: f64,
         /// Expected range in words.
-        expected: &'static str,
+        expected: String,
     },
     /// The per-pixel SH buffer would exceed one storage buffer.
     #[error(
@@ -212,56 +232,30 @@ pub enum IgiError {
 impl IgiParams {
     /// Checks every parameter (ranges as documented on the fields).
     pub fn validate(&self) -> Result<(), IgiError> {
-        let range = |name, value: f64, ok: bool, expected| {
-            if ok {
+        fn check<T: PartialOrd + std::fmt::Debug + Into<f64> + Copy>(
+            name: &'static str,
+            value: T,
+            range: &RangeInclusive<T>,
+        ) -> Result<(), IgiError> {
+            if range.contains(&value) {
                 Ok(())
             } else {
                 Err(IgiError::OutOfRange {
                     name,
-                    value,
-                    expected,
+                    value: value.into(),
+                    expected: format!("{range:?}"),
                 })
             }
-        };
+        }
         let [n, m] = self.pattern;
-        range("n", f64::from(n), (1..=8).contains(&n), "1..=8")?;
-        range("m", f64::from(m), (1..=8).contains(&m), "1..=8")?;
-        range(
-            "vpl_count",
-            f64::from(self.vpl_count),
-            (64..=10_000).contains(&self.vpl_count),
-            "64..=10000",
-        )?;
-        range(
-            "sh_order",
-            f64::from(self.sh_order),
-            (2..=4).contains(&self.sh_order),
-            "2..=4",
-        )?;
-        range(
-            "filter_radius",
-            f64::from(self.filter_radius),
-            self.filter_radius <= 4,
-            "0..=4",
-        )?;
-        range(
-            "clamp_distance",
-            f64::from(self.clamp_distance),
-            (0.0..=10.0).contains(&self.clamp_distance),
-            "0..=10 metres",
-        )?;
-        range(
-            "depth_tolerance",
-            f64::from(self.depth_tolerance),
-            self.depth_tolerance > 0.0 && self.depth_tolerance.is_finite(),
-            "a finite value > 0",
-        )?;
-        range(
-            "normal_threshold",
-            f64::from(self.normal_threshold),
-            (-1.0..=1.0).contains(&self.normal_threshold),
-            "-1..=1",
-        )
+        check("n", n, &PATTERN)?;
+        check("m", m, &PATTERN)?;
+        check("vpl_count", self.vpl_count, &VPL_COUNT)?;
+        check("sh_order", self.sh_order, &SH_ORDERS)?;
+        check("filter_radius", self.filter_radius, &FILTER_RADIUS)?;
+        check("clamp_distance", self.clamp_distance, &CLAMP_DISTANCE)?;
+        check("depth_tolerance", self.depth_tolerance, &DEPTH_TOLERANCE)?;
+        check("normal_threshold", self.normal_threshold, &NORMAL_THRESHOLD)
     }
 
     /// Coefficients stored per pixel: order² (SH) or 2 (irradiance and glossy radiance).
@@ -344,7 +338,7 @@ pub fn vpls(
         radius_scale: 1.0,
         conv_bands: 3,
         emission_bands: 1,
-        path: hvl::Path::Zonal,
+        path: hvl::GatherPath::Zonal,
         visibility: false,
     };
     Ok(hvl::hvl_cache(rg, rsm, &cache)?)
@@ -367,7 +361,7 @@ pub fn vpl_sh(
         return Err(IgiError::OutOfRange {
             name: "vpls buffer bytes",
             value: vpls.desc().size as f64,
-            expected: "at least vpl_count × 80 bytes",
+            expected: "at least vpl_count × 80 bytes".to_owned(),
         });
     }
     let shader = shader("vpl_sh.comp", params, false)?;
@@ -398,7 +392,7 @@ pub fn vpl_sh(
 
 /// Adds `sh_filter`: the discontinuity filter over `sh` and the BRDF at every pixel; returns
 /// the full-resolution `indirect` image (RGBA16F outgoing radiance towards `camera`). `brdf`
-/// holds [`hvl::GatherBrdf::gpu_data`] at `params.sh_order` bands; only the GGX path reads it.
+/// holds [`brdf_tables::GatherBrdf::gpu_data`] at `params.sh_order` bands; only the GGX path reads it.
 pub fn sh_filter(
     rg: &mut RenderGraph,
     g: &GBuffer,
@@ -413,18 +407,21 @@ pub fn sh_filter(
         return Err(IgiError::OutOfRange {
             name: "vpl_sh buffer bytes",
             value: sh.desc().size as f64,
-            expected: "W × H × coefficients × 8 bytes",
+            expected: "W × H × coefficients × 8 bytes".to_owned(),
         });
     }
     let shader = shader("sh_filter.comp", params, true)?;
     let brdf = match (params.needs_brdf_tables(), brdf) {
         (false, _) => None,
-        (true, Some(b)) if b.desc().size == hvl::GatherBrdf::gpu_bytes(params.sh_order) => Some(b),
+        (true, Some(b)) if b.desc().size == brdf_tables::GatherBrdf::gpu_bytes(params.sh_order) => {
+            Some(b)
+        }
         (true, _) => {
             return Err(IgiError::OutOfRange {
                 name: "brdf tables bytes",
                 value: brdf.map_or(0.0, |b| b.desc().size as f64),
-                expected: "GatherBrdf::gpu_data at sh_order bands (the GGX path needs them)",
+                expected: "GatherBrdf::gpu_data at sh_order bands (the GGX path needs them)"
+                    .to_owned(),
             });
         }
     };
@@ -440,8 +437,11 @@ pub fn sh_filter(
         radius: params.filter_radius,
         depth_tolerance: params.depth_tolerance,
         normal_threshold: params.normal_threshold,
-        glossy_tables: hvl::GLOSSY_TABLES,
-        roughness_nodes: [hvl::GLOSSY_ROUGHNESS_MIN, hvl::glossy_roughness_step()],
+        glossy_tables: brdf_tables::GLOSSY_TABLES,
+        roughness_nodes: [
+            brdf_tables::GLOSSY_ROUGHNESS_MIN,
+            brdf_tables::glossy_roughness_step(),
+        ],
         pad: [0.0; 2],
     };
     let mut pass = rg.compute("sh_filter", shader);
@@ -485,7 +485,7 @@ fn shader(
     shaders::get(&format!("{file}:{}", params.variant(filter))).ok_or(IgiError::OutOfRange {
         name: "sh_order",
         value: f64::from(params.sh_order),
-        expected: "a compiled variant: SH order 2..=4",
+        expected: format!("a compiled variant: SH order {SH_ORDERS:?}"),
     })
 }
 

@@ -59,7 +59,7 @@ pub struct PathTraceParams {
     pub samples: u32,
 }
 
-/// The BVH and environment bindings of the tracer (src/gpu_bvh.rs, src/gpu_environment.rs).
+/// The BVH and environment bindings of the tracer (src/gpu_scene/bvh.rs, src/gpu_scene/environment.rs).
 #[derive(Debug)]
 pub struct TraceHandles {
     /// `bvh_nodes`.

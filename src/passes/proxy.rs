@@ -1,18 +1,18 @@
 //! Sphere proxies under the environment light (paper 002): the `proxy_accumulate` and
-//! `proxy_shade` passes, their GPU data and their CPU twin.
+//! `proxy_shade` passes and their GPU data (CPU twin: [`crate::reference::proxy`]).
 //!
 //! * [`proxy_accumulate`] sums, at every receiver, the rotated log-occlusion ZH vectors of the
 //!   proxies (eq. 4, 8) and their indirect shading `I_i · H(N_p)` with the summed solid angle
-//!   `ω_p` (eq. 12–15): DESIGN §4's `proxy_occlusion` and the accumulation half of
+//!   `ω_p` (eq. 12–15): the `proxy_occlusion` and the accumulation half of
 //!   `proxy_indirect`, in one tiled compute "splat" (docs/frame.md, "Proxy GI", says why).
-//! * [`proxy_shade`] exponentiates the sum (OL, PS or HYB: DESIGN §4's `sh_exp`), shades the
+//! * [`proxy_shade`] exponentiates the sum (OL, PS or HYB), shades the
 //!   environment through the occlusion (eq. 10), normalises the indirect sum (eq. 12) and
 //!   writes the outgoing diffuse radiance at receiver resolution (`proxy_gi`).
 //!
 //! Every formula comes from shine-sh ([`shine_sh::sphere_blocker`], [`shine_sh::exp_log`],
 //! [`shine_sh::proxy_indirect`]) on the CPU and from `shaders/include/sh.glsl` on the GPU;
-//! [`accumulate_cpu`] and [`shade_cpu`] compose the shine-sh functions exactly as the shaders
-//! compose their GLSL twins, and `tests/proxy.rs` ties the two.
+//! the CPU twin composes the shine-sh functions exactly as the shaders compose their GLSL
+//! twins, and `tests/proxy.rs` ties the two.
 //!
 //! # Decisions
 //!
@@ -35,29 +35,44 @@
 use glam::Vec3;
 use shine_sh::ShError;
 use shine_sh::exp_log::ShExp;
-use shine_sh::kernels::clamped_cosine_zh;
-use shine_sh::proxy_indirect::{averaged_operator_fit, overlap_normalisation};
-use shine_sh::sphere_blocker::{AlphaTable, BlockerSubstitute, self_shadow_substitute};
-use shine_sh::zonal::rotate_zh;
+use shine_sh::sphere_blocker::AlphaTable;
 
-use crate::environment_sh::EnvironmentSh;
+use crate::gpu_scene::environment_sh::ORDERS;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
-use crate::settings::ExpMethod;
 use crate::shaders;
 
 pub use super::receivers::Receivers;
+
+crate::choice::named_choice! {
+    /// The SH exponential of the accumulated log-occlusion (paper 002 eq. 4, Ren et al. 2006).
+    pub enum ExpMethod ("SH exponentiation method") {
+        /// Optimal linear: `a(‖f̂‖) 1 + b(‖f̂‖) f̂`.
+        Ol = "ol",
+        /// Product series: Taylor series on a scaled-down vector, then repeated squaring.
+        Ps = "ps",
+        /// Hybrid: OL on a scaled-down vector, then repeated squaring (the paper's choice).
+        Hyb = "hyb",
+    }
+}
 
 /// Rows of the α tables (α = sin θ uniformly in [0, 1]).
 pub const TABLE_ENTRIES: usize = 256;
 /// Most proxies a frame takes: the accumulation shader's tile mask has 64 words of 32 bits.
 pub const MAX_PROXIES: u32 = 2048;
-/// SH orders (bands) of the occlusion and the environment.
-pub const ORDERS: std::ops::RangeInclusive<u32> = 3..=6;
+/// The paper's shadow expansion factor η for SH order `bands` (§4.1, paper 002: 10 at order 3,
+/// 15 at order 4; shine keeps 15 above).
+pub fn paper_expansion(bands: u32) -> f32 {
+    if bands <= 3 { 10.0 } else { 15.0 }
+}
+
+/// Radius expansion factors η of the spheres of influence (§4.1: 10 at order 3, 15 above).
+pub const EXPANSION: std::ops::RangeInclusive<f32> = 2.0..=100.0;
+/// Spheres refitted to the mesh of each proxied object (0: the scene's own proxies); a
+/// profiling knob of the proxy technique.
+pub const FIT_COUNT: std::ops::RangeInclusive<u32> = 0..=64;
 /// Bands of the proxy indirect light: the averaged operator D(θ) is fitted to order 3
 /// (eq. 15, paper 002).
 pub const INDIRECT_BANDS: usize = 3;
-
-const SQRT_4PI: f32 = 3.544_907_7;
 
 /// One proxy on the GPU (std430, 32 bytes): `proxies.p[2i]` and `proxies.p[2i + 1]` in
 /// `shaders/proxy_accumulate.comp`.
@@ -79,11 +94,11 @@ impl GpuProxy {
         }
     }
 
-    fn center(&self) -> Vec3 {
+    pub(crate) fn center(&self) -> Vec3 {
         Vec3::new(self.sphere[0], self.sphere[1], self.sphere[2])
     }
 
-    fn albedo(&self) -> Vec3 {
+    pub(crate) fn albedo(&self) -> Vec3 {
         Vec3::new(self.albedo[0], self.albedo[1], self.albedo[2])
     }
 }
@@ -135,7 +150,7 @@ pub enum ProxyError {
         /// Its value.
         value: f64,
         /// The allowed range.
-        expected: &'static str,
+        expected: String,
     },
     /// An input of the wrong size.
     #[error("proxy input `{name}` is {actual}, expected {expected}")]
@@ -153,15 +168,24 @@ pub enum ProxyError {
     /// An SH table or projection failed.
     #[error("proxy SH: {0}")]
     Sh(#[from] ShError),
+    /// The scene has no environment to light it.
+    #[error(
+        "--gi proxy needs an environment light: this scene has none (add `shine_environment` \
+         to the glTF root extras, or pass --environment FILE)"
+    )]
+    NoEnvironment,
+    /// More proxy spheres than one frame takes.
+    #[error("{0} proxy spheres: at most {max} are supported", max = MAX_PROXIES)]
+    TooMany(usize),
 }
 
 impl ProxyParams {
-    fn check(&self) -> Result<usize, ProxyError> {
+    pub(crate) fn check(&self) -> Result<usize, ProxyError> {
         if !ORDERS.contains(&self.bands) {
             return Err(ProxyError::OutOfRange {
                 name: "bands",
                 value: f64::from(self.bands),
-                expected: "3..=6",
+                expected: format!("{ORDERS:?}"),
             });
         }
         Ok(self.bands as usize)
@@ -331,14 +355,6 @@ pub struct ShadePush {
     pub pad: [u32; 2],
 }
 
-/// Push constants of `shaders/gi_add.comp` (8 bytes).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct AddPush {
-    /// Image size.
-    pub extent: [u32; 2],
-}
-
 /// Floats per receiver in the `proxy_sums` buffer: `bands²` (log-occlusion, or occlusion for
 /// [`Accumulation::Product`]), then rgb `Σ I_i · H(N_p)` and `ω_p`.
 pub fn sums_stride(bands: u32) -> usize {
@@ -354,7 +370,7 @@ pub struct ProxyInputs {
     pub count: u32,
     /// [`ProxyTables::gpu_data`] at the parameters' band count.
     pub tables: Handle<Buffer>,
-    /// [`EnvironmentSh::gpu_data`] at the parameters' band count.
+    /// [`EnvironmentSh::gpu_data`](crate::gpu_scene::environment_sh::EnvironmentSh::gpu_data) at the parameters' band count.
     pub environment: Handle<Buffer>,
 }
 
@@ -378,7 +394,7 @@ fn check_inputs(
         return Err(ProxyError::OutOfRange {
             name: "proxy count",
             value: f64::from(inputs.count),
-            expected: "0..=2048",
+            expected: format!("0..={MAX_PROXIES}"),
         });
     }
     let need = u64::from(inputs.count.max(1)) * std::mem::size_of::<GpuProxy>() as u64;
@@ -543,179 +559,4 @@ pub fn proxy_shade(
         radiance,
         occlusion,
     })
-}
-
-/// Adds a `gi_add` pass: `first + second` (RGBA16F images of one extent) in a new image.
-pub fn gi_add(
-    rg: &mut RenderGraph,
-    first: &Handle<Image>,
-    second: &Handle<Image>,
-) -> Result<Handle<Image>, ProxyError> {
-    let (a, b) = (first.desc().extent, second.desc().extent);
-    if (a.width, a.height) != (b.width, b.height) {
-        return Err(ProxyError::Size {
-            name: "gi_add second",
-            actual: format!("{}×{}", b.width, b.height),
-            expected: format!("{}×{}", a.width, a.height),
-        });
-    }
-    let mut sum = rg.create_image(
-        "gi_sum",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, a.width, a.height),
-    );
-    rg.compute("gi_add", &shaders::GI_ADD_COMP)
-        .read("first", first)
-        .read("second", second)
-        .write("sum", &mut sum)
-        .push(&AddPush {
-            extent: [a.width, a.height],
-        })
-        .dispatch([a.width, a.height, 1]);
-    Ok(sum)
-}
-
-fn check_exp(params: &ProxyParams, exp: &ShExp) -> Result<usize, ProxyError> {
-    let bands = params.check()?;
-    if exp.bands() != bands {
-        return Err(ProxyError::Size {
-            name: "ShExp",
-            actual: format!("{} bands", exp.bands()),
-            expected: format!("{bands} bands"),
-        });
-    }
-    Ok(bands)
-}
-
-/// One receiver as the CPU twin sees it (the receiver buffer's texel, decoded).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ReceiverSample {
-    /// World position.
-    pub position: Vec3,
-    /// False for a background receiver (`recv_position.w == 0`).
-    pub valid: bool,
-    /// World normal (normalised here).
-    pub normal: Vec3,
-    /// Linear albedo.
-    pub albedo: Vec3,
-    /// Metallic factor.
-    pub metallic: f32,
-}
-
-/// CPU twin of `proxy_accumulate` at one receiver: the [`sums_stride`] floats it writes. Every
-/// proxy is visited (the splat only skips proxies whose contribution is exactly 0). `exp` is
-/// the SH machinery of the parameters' band count.
-pub fn accumulate_cpu(
-    receiver: &ReceiverSample,
-    proxies: &[GpuProxy],
-    tables: &ProxyTables,
-    environment: &EnvironmentSh,
-    params: &ProxyParams,
-    exp: &ShExp,
-) -> Result<Vec<f32>, ProxyError> {
-    let bands = check_exp(params, exp)?;
-    let n2 = bands * bands;
-    let product = params.accumulation == Accumulation::Product;
-    let mut acc = vec![0.0f32; n2];
-    if product {
-        acc[0] = SQRT_4PI;
-    }
-    let mut indirect = Vec3::ZERO;
-    let mut omega = 0.0f32;
-    if receiver.valid {
-        let p = receiver.position;
-        let n = receiver.normal.normalize();
-        let hn = rotate_zh(&clamped_cosine_zh(bands)?, n)?;
-        for proxy in proxies {
-            let Ok(BlockerSubstitute::Use { center, radius }) =
-                self_shadow_substitute(p, n, proxy.center(), proxy.sphere[3])
-            else {
-                continue;
-            };
-            let dv = center - p;
-            let dist = dv.length();
-            if dist.is_nan() || dist <= 0.0 {
-                continue;
-            }
-            let alpha = (radius / dist).min(1.0);
-            let dir = dv / dist;
-            if product {
-                let mut o = rotate_zh(&tables.visibility_full.lookup(alpha), dir)?;
-                o.iter_mut().for_each(|x| *x = -*x);
-                o[0] += SQRT_4PI;
-                acc = exp.tensor().product(&acc, &o)?;
-            } else {
-                let log = rotate_zh(&tables.log_occlusion.lookup(alpha), dir)?;
-                acc.iter_mut().zip(&log).for_each(|(a, l)| *a += l);
-            }
-            if params.indirect {
-                let table = if product {
-                    &tables.visibility_full
-                } else {
-                    &tables.visibility
-                };
-                let mut zh = table.lookup(alpha);
-                zh[INDIRECT_BANDS..].iter_mut().for_each(|x| *x = 0.0);
-                let v = rotate_zh(&zh, dir)?;
-                let vh = shine_sh::dot(&v, &hn)?;
-                // eq. 12, paper 002: the proxy's true solid angle 2π(1 − cos θ), sin θ = α,
-                // wherever its (clamped) visibility is not 0 — not the clamped table's DC, which
-                // would cancel the indirect fade of §4.1.
-                if zh[0] > 0.0 {
-                    omega += std::f32::consts::TAU * (1.0 - (1.0 - alpha * alpha).max(0.0).sqrt());
-                }
-                let d = averaged_operator_fit(alpha);
-                let d_sh = rotate_zh(&d, dir)?;
-                let kappa = Vec3::from_array(std::array::from_fn(|c| {
-                    shine_sh::dot(&d_sh, &environment.irradiance[c][..9]).unwrap_or(0.0)
-                }));
-                indirect += proxy.albedo() / std::f32::consts::PI * kappa * vh;
-            }
-        }
-    }
-    acc.extend(indirect.to_array());
-    acc.push(omega);
-    Ok(acc)
-}
-
-/// CPU twin of `proxy_shade` at one receiver, from its [`accumulate_cpu`] sums: the occlusion
-/// vector `O_p` and the outgoing radiance.
-pub fn shade_cpu(
-    receiver: &ReceiverSample,
-    sums: &[f32],
-    environment: &EnvironmentSh,
-    params: &ProxyParams,
-    exp: &ShExp,
-) -> Result<(Vec<f32>, Vec3), ProxyError> {
-    let bands = check_exp(params, exp)?;
-    let n2 = bands * bands;
-    if sums.len() != n2 + 4 {
-        return Err(ProxyError::Size {
-            name: "sums",
-            actual: sums.len().to_string(),
-            expected: (n2 + 4).to_string(),
-        });
-    }
-    let f = &sums[..n2];
-    let o = match (params.accumulation, params.exp) {
-        (Accumulation::Product, _) => f.to_vec(),
-        (_, ExpMethod::Hyb) => exp.exp_hyb(f)?,
-        (_, ExpMethod::Ps) => exp.exp_ps(f)?,
-        (_, ExpMethod::Ol) => exp.exp_ol(f)?,
-    };
-    if !receiver.valid {
-        return Ok((o, Vec3::ZERO));
-    }
-    let hn = rotate_zh(&clamped_cosine_zh(bands)?, receiver.normal.normalize())?;
-    // H · (O ∗ L) = L · (O ∗ H): one product for the three channels, as the shader
-    let oh = exp.tensor().product(&o, &hn)?;
-    let mut psi = [0.0f32; 3];
-    for (c, out) in psi.iter_mut().enumerate() {
-        *out = shine_sh::dot(&oh, &environment.radiance[c])?;
-    }
-    let summed = Vec3::new(sums[n2], sums[n2 + 1], sums[n2 + 2]);
-    let xi = overlap_normalisation(o[0], sums[n2 + 3]);
-    let kd = receiver.albedo * (1.0 - receiver.metallic);
-    let radiance =
-        kd / std::f32::consts::PI * (Vec3::from_array(psi) + xi * summed).max(Vec3::ZERO);
-    Ok((o, radiance))
 }

@@ -21,6 +21,12 @@ use shine_gpu::{GraphicsPipelineDesc, vk};
 use shine_graph::{DepthLoad, Handle, Image, ImageDesc, RenderGraph};
 use shine_scene::LightKind;
 
+/// Shadow-map tile sides in texels (`shadow.size`).
+pub const TILE_SIZE: std::ops::RangeInclusive<u32> = 64..=16384;
+
+/// Percentage-closer filter radii in texels (`shadow.filter_radius`; 0: one hard tap).
+pub const FILTER_RADIUS: std::ops::RangeInclusive<f32> = 0.0..=16.0;
+
 /// Smallest tile the atlas shrinks to before refusing (texels).
 pub const MIN_TILE: u32 = 16;
 

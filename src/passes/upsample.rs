@@ -41,6 +41,13 @@ pub const DEPTH_SIGMA: f32 = 0.01;
 /// relative depth difference of 19 σ_z (19 %) or normals 24° apart (`cos(24°)^32 ≈ 0.05`).
 pub const MIN_MATCH_MU: f32 = 0.05;
 
+/// σ_z a frame's settings take (`upsample.depth_epsilon`).
+pub const DEPTH_SIGMA_RANGE: std::ops::RangeInclusive<f32> = 1e-6..=10.0;
+
+/// Normal exponents n a frame's settings take (`upsample.normal_power`; tests use 0, plain
+/// depth weights).
+pub const NORMAL_POWER_RANGE: std::ops::RangeInclusive<f32> = 1.0..=256.0;
+
 /// Tuning of the bilateral weights, passed to the shader as push constants.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]

@@ -22,8 +22,8 @@ use std::str::FromStr;
 
 use serde::Serialize;
 
+use crate::capture::image_io::{self, ImageIoError};
 use crate::graph::PassTiming;
-use crate::image_io::{self, ImageIoError};
 
 /// Why a report could not be made or written.
 #[derive(Debug, thiserror::Error)]

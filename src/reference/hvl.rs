@@ -15,10 +15,11 @@ use shine_sh::legendre::legendre_all;
 use shine_sh::quadrature::SphereQuadrature;
 use shine_sh::zonal::{cap_sh, cap_zh, sphere_half_angle};
 
+use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::{
-    EMISSION_MAX_BANDS, GatherBrdf, Hvl, HvlError, HvlParams, Path, RadiusHeuristic, RsmProjection,
-    indirect_weights, table_fresnel_weight,
+    EMISSION_MAX_BANDS, GatherPath, Hvl, HvlError, HvlParams, RadiusHeuristic,
 };
+use crate::passes::rsm::RsmProjection;
 
 /// ε of the r1 weights `w_n = 1 / (|d - d_n| + ε)`, metres (eq. 23, paper 003); the GLSL
 /// constant `HVL_R1_EPSILON` has the same value.
@@ -328,7 +329,7 @@ pub fn shade(
     let (kd, ks) = receiver.weights(camera);
     let mut sum = Vec3::ZERO;
     match params.path {
-        Path::Full => {
+        GatherPath::Full => {
             let Some((t, b, theta_o)) = receiver_frame(n, (camera - x).normalize()) else {
                 return Ok(Vec3::ZERO);
             };
@@ -348,7 +349,7 @@ pub fn shade(
                 sum += (lj * (kd * diffuse + ks * glossy)).max(Vec3::ZERO);
             }
         }
-        Path::Zonal => {
+        GatherPath::Zonal => {
             let cc: Vec<f32> = clamped_cosine_zh(bands)?
                 .iter()
                 .map(|c| c / std::f32::consts::PI)

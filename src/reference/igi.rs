@@ -7,7 +7,8 @@ use glam::{Mat3, Vec3, Vec4};
 use shine_sh::rotation::ShRotation;
 use shine_sh::{ShError, basis, kernels, zonal};
 
-use crate::passes::hvl::{GatherBrdf, Hvl, indirect_weights, table_fresnel_weight};
+use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
+use crate::passes::hvl::Hvl;
 use crate::passes::igi::{FilterMode, Glossy, IgiParams, permutation_stride, pixel_set, vpl_cell};
 
 /// `IGI_MIN_DISTANCE` of igi.glsl (metres).

@@ -1,6 +1,6 @@
 //! The path-traced reference: renders the loaded scene with `path_trace` (docs/frame.md) into
 //! direct-only, indirect-only and full radiance images — the yardstick every GI technique is
-//! compared against ([`crate::image_compare`]).
+//! compared against ([`crate::capture::image_compare`]).
 //!
 //! ```no_run
 //! # fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -13,12 +13,16 @@
 //! # Ok(()) }
 //! ```
 
-use crate::gpu_bvh::GpuBvh;
+pub mod hvl;
+pub mod igi;
+pub mod proxy;
+
+use crate::capture::image_io::HdrImage;
+use crate::frame::RenderError;
 use crate::gpu_scene::GpuScene;
-use crate::image_io::HdrImage;
+use crate::gpu_scene::bvh::GpuBvh;
 use crate::passes::gbuffer::{self, SceneHandles};
 use crate::passes::path_trace::{self, PathTraceParams, TraceHandles};
-use crate::renderer::RenderError;
 use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, Sampler, vk};
 use shine_graph::{Executor, ExternalState};
 use shine_scene::Scene;
@@ -137,7 +141,8 @@ impl PathTracer {
         params.validate()?;
         let gpu_scene = GpuScene::upload(device, scene, t)?;
         let bvh = GpuBvh::upload(device, scene, t)?;
-        let environment = crate::gpu_environment::upload(device, scene.environment.as_ref())?;
+        let environment =
+            crate::gpu_scene::environment::upload(device, scene.environment.as_ref())?;
         let sampler = |u, v| {
             Sampler::new(
                 device,

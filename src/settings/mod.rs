@@ -4,7 +4,11 @@
 //! command-line flags ([`Settings::set`] with a dotted key such as `hvl.count`), over the
 //! defaults of [`Settings::default`]. Every field documents its range and default;
 //! [`Settings::validate`] rejects a value outside its range with an error naming the field, the
-//! value and what is allowed, so an absurd setting never reaches the GPU (DESIGN §7).
+//! value and what is allowed, so an absurd setting never reaches the GPU.
+//!
+//! The settings only choose: each range, default and named choice belongs to the pass that
+//! uses it (`passes::hvl::CACHE_COUNT`, `passes::igi::FilterMode`, …), and
+//! `frame::params::FrameParams::from_settings` is the one conversion into pass parameters.
 //!
 //! ```toml
 //! width = 1280
@@ -21,371 +25,23 @@
 //! radius = "r2"
 //! ```
 
-use serde::{Deserialize, Deserializer, Serialize, Serializer};
-use std::fmt;
-use std::ops::RangeInclusive;
-use std::path::{Path, PathBuf};
-use std::str::FromStr;
+mod error;
+mod gi;
+mod io;
+mod validate;
 
-/// Why settings were rejected: each variant names the setting and what to do.
-#[derive(Debug, thiserror::Error)]
-pub enum SettingsError {
-    /// A numeric setting lies outside its documented range (or is not a finite number).
-    #[error("setting `{field}` = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        /// Dotted name of the setting, as written in the TOML file (`hvl.count`).
-        field: &'static str,
-        /// The rejected value, as given.
-        value: String,
-        /// The allowed values (`64..=10000`, `1, 2 or 4`).
-        allowed: String,
-    },
-    /// A named choice (tonemap operator, GI technique, …) that shine does not know.
-    #[error("unknown {what} `{name}`: expected one of {known}")]
-    UnknownName {
-        /// What was being named (`tonemap operator`).
-        what: &'static str,
-        /// The name given.
-        name: String,
-        /// The known names, comma-separated.
-        known: String,
-    },
-    /// A GI technique that a later issue adds, not usable yet.
-    #[error(
-        "GI technique `{name}` is not implemented yet: available now are {available} \
-         (combine them with commas, e.g. `--gi hvl`)"
-    )]
-    GiNotImplemented {
-        /// The planned technique that was asked for.
-        name: String,
-        /// The techniques that work today.
-        available: String,
-    },
-    /// A GI list that is malformed: empty entry, duplicate, or `none` combined with others.
-    #[error("invalid GI technique list `{list}`: {reason}")]
-    GiList {
-        /// The list as given.
-        list: String,
-        /// What is wrong with it.
-        reason: &'static str,
-    },
-    /// The settings file could not be read.
-    #[error("cannot read settings file {}: {source}", path.display())]
-    Read {
-        /// The file.
-        path: PathBuf,
-        /// The I/O error.
-        source: std::io::Error,
-    },
-    /// The TOML text is malformed, names an unknown setting, or has a value of the wrong type.
-    #[error("invalid settings{}: {message}", origin(path))]
-    Parse {
-        /// The file the text came from, when it came from one.
-        path: Option<PathBuf>,
-        /// The TOML parser's message (with line and column).
-        message: String,
-    },
-    /// A `key=value` override names no setting or has a value the setting cannot take.
-    #[error("cannot set `{key}` to `{value}`: {reason}")]
-    Override {
-        /// The dotted key (`hvl.count`).
-        key: String,
-        /// The value given.
-        value: String,
-        /// Why it was refused.
-        reason: String,
-    },
-}
+pub use error::SettingsError;
+pub use gi::{GiTechnique, GiTechniques};
+pub use validate::{EXTENT, FRAMES, TIME};
 
-/// ` in FILE` for a parse error from a file, nothing for a string.
-fn origin(path: &Option<PathBuf>) -> String {
-    path.as_ref()
-        .map(|p| format!(" in {}", p.display()))
-        .unwrap_or_default()
-}
+use serde::{Deserialize, Serialize};
 
-/// Defines an enum of named choices whose names are the single source for TOML, the CLI
-/// ([`FromStr`], [`fmt::Display`]) and the error listing the known names.
-macro_rules! named_choice {
-    (
-        $(#[$meta:meta])*
-        $vis:vis enum $name:ident ($what:literal) {
-            $( $(#[$vmeta:meta])* $variant:ident = $text:literal, )+
-        }
-    ) => {
-        $(#[$meta])*
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-        $vis enum $name {
-            $( $(#[$vmeta])* $variant, )+
-        }
-
-        impl $name {
-            /// Every choice, in documentation order.
-            pub const ALL: &'static [$name] = &[$($name::$variant),+];
-
-            /// The name used in settings files and on the command line.
-            pub fn name(self) -> &'static str {
-                match self {
-                    $( $name::$variant => $text, )+
-                }
-            }
-        }
-
-        impl FromStr for $name {
-            type Err = SettingsError;
-
-            fn from_str(s: &str) -> Result<Self, SettingsError> {
-                Self::ALL
-                    .iter()
-                    .copied()
-                    .find(|c| c.name() == s)
-                    .ok_or_else(|| SettingsError::UnknownName {
-                        what: $what,
-                        name: s.to_owned(),
-                        known: Self::ALL.iter().map(|c| c.name()).collect::<Vec<_>>().join(", "),
-                    })
-            }
-        }
-
-        impl fmt::Display for $name {
-            fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-                f.write_str(self.name())
-            }
-        }
-
-        impl Serialize for $name {
-            fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-                s.serialize_str(self.name())
-            }
-        }
-
-        impl<'de> Deserialize<'de> for $name {
-            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-                let text = String::deserialize(d)?;
-                text.parse().map_err(serde::de::Error::custom)
-            }
-        }
-    };
-}
-
-named_choice! {
-    /// The tonemapping operator that turns the HDR frame into the LDR one (see [`crate::tonemap`]).
-    /// EXR output is never tonemapped.
-    pub enum Tonemap ("tonemap operator") {
-        /// No curve: exposed radiance clamped to [0, 1].
-        None = "none",
-        /// ACES filmic (Narkowicz 2015 fit of the RRT+ODT).
-        Aces = "aces",
-        /// Khronos PBR Neutral: colour-preserving, identity below its knee.
-        PbrNeutral = "pbr-neutral",
-    }
-}
-
-named_choice! {
-    /// Which part of the radiance the frame shows (image tests compare each against the
-    /// path-traced reference, src/reference.rs).
-    pub enum Component ("output component") {
-        /// Direct + indirect light.
-        Full = "full",
-        /// The direct pass only (emission and punctual lights).
-        Direct = "direct",
-        /// The GI technique's indirect light only (needs a GI technique).
-        Indirect = "indirect",
-    }
-}
-
-named_choice! {
-    /// How an HVL's radius is estimated from the HVL cache (paper 003 §5.3).
-    pub enum RadiusHeuristic ("HVL radius heuristic") {
-        /// Eq. 23: weighted mean distance to the 8-connected neighbours in the HVL cache.
-        R1 = "r1",
-        /// Eq. 24–26: from the light's field of view, the HVL count and the distance to the light.
-        R2 = "r2",
-    }
-}
-
-named_choice! {
-    /// Which SH convolution the HVL gather uses (paper 003 §4.3 and §6).
-    pub enum GatherPath ("HVL gather path") {
-        /// Full SH convolution, O(n²) in the band count n: any BRDF.
-        Full = "full",
-        /// Zonal-harmonics convolution, O(n): circularly symmetric lobes only.
-        Zonal = "zonal",
-    }
-}
-
-named_choice! {
-    /// What the IGI discontinuity filter averages (paper 000 §2.3 against §3).
-    pub enum IgiFilter ("IGI filter mode") {
-        /// The per-pixel incident radiance as SH (paper 000): the BRDF is applied after filtering.
-        Sh = "sh",
-        /// Classic IGI: the per-pixel irradiance (and glossy radiance) about the shading normal.
-        Irradiance = "irradiance",
-    }
-}
-
-named_choice! {
-    /// The glossy lobe of IGI's SH resolve (`src/passes/igi.rs`).
-    pub enum IgiGlossy ("IGI glossy lobe") {
-        /// GGX through the BRDF SH tables of the HVL gather, radiance rotated per pixel.
-        Ggx = "ggx",
-        /// Paper 000 §3.3: Lambert and Phong r_l, the Phong lobe standing for the GGX.
-        Phong = "phong",
-    }
-}
-
-named_choice! {
-    /// One indirect-light technique of DESIGN §4 that shine implements today.
-    pub enum GiTechnique ("GI technique") {
-        /// Harmonics Virtual Lights (paper 003).
-        Hvl = "hvl",
-        /// Instant GI with interleaved sampling and SH-filtered incoming radiance (paper 000).
-        Igi = "igi",
-        /// Sphere proxies under the environment light (paper 002): proxy-shadowed environment
-        /// plus proxy indirect light.
-        Proxy = "proxy",
-    }
-}
-
-named_choice! {
-    /// The SH exponential of the accumulated log-occlusion (paper 002 eq. 4, Ren et al. 2006).
-    pub enum ExpMethod ("SH exponentiation method") {
-        /// Optimal linear: `a(‖f̂‖) 1 + b(‖f̂‖) f̂`.
-        Ol = "ol",
-        /// Product series: Taylor series on a scaled-down vector, then repeated squaring.
-        Ps = "ps",
-        /// Hybrid: OL on a scaled-down vector, then repeated squaring (the paper's choice).
-        Hyb = "hyb",
-    }
-}
-
-/// Techniques that later issues add: named so that asking for one says "not implemented yet"
-/// rather than "unknown".
-const PLANNED_GI: [&str; 1] = ["aaf"];
-
-/// The name of the empty technique list: direct light only.
-const NO_GI: &str = "none";
-
-/// The set of GI techniques a frame combines, written `hvl`, `none`, `proxy` or `hvl,proxy`.
-///
-/// `hvl,proxy` adds both indirect terms at receiver resolution before one upsample: the HVL
-/// indirect light of the primary light and the proxy-shadowed environment plus proxy indirect
-/// light (paper 002 pairs them the same way). Without `proxy` the environment lights nothing
-/// (direct light and HVL only).
-///
-/// `none` (the empty list) renders direct light only. Order is kept as given; each technique
-/// appears at most once.
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
-pub struct GiTechniques(Vec<GiTechnique>);
-
-impl GiTechniques {
-    /// Direct light only.
-    pub fn none() -> Self {
-        Self(Vec::new())
-    }
-
-    /// The techniques, in the order given.
-    pub fn techniques(&self) -> &[GiTechnique] {
-        &self.0
-    }
-
-    /// Whether `technique` is part of the frame.
-    pub fn contains(&self, technique: GiTechnique) -> bool {
-        self.0.contains(&technique)
-    }
-
-    /// Whether the frame has no indirect light at all.
-    pub fn is_none(&self) -> bool {
-        self.0.is_empty()
-    }
-}
-
-impl Default for GiTechniques {
-    /// `hvl`, the technique of issue 6.
-    fn default() -> Self {
-        Self(vec![GiTechnique::Hvl])
-    }
-}
-
-impl FromStr for GiTechniques {
-    type Err = SettingsError;
-
-    fn from_str(list: &str) -> Result<Self, SettingsError> {
-        let invalid = |reason| SettingsError::GiList {
-            list: list.to_owned(),
-            reason,
-        };
-        let names: Vec<&str> = list.split(',').map(str::trim).collect();
-        if names == [NO_GI] {
-            return Ok(Self::none());
-        }
-        let mut techniques = Vec::with_capacity(names.len());
-        for name in names {
-            if name.is_empty() {
-                return Err(invalid("empty technique name (write e.g. `hvl` or `none`)"));
-            }
-            if name == NO_GI {
-                return Err(invalid("`none` cannot be combined with other techniques"));
-            }
-            if PLANNED_GI.contains(&name) {
-                return Err(SettingsError::GiNotImplemented {
-                    name: name.to_owned(),
-                    available: available_gi(),
-                });
-            }
-            let technique =
-                name.parse::<GiTechnique>()
-                    .map_err(|_| SettingsError::UnknownName {
-                        what: "GI technique",
-                        name: name.to_owned(),
-                        known: known_gi(),
-                    })?;
-            if techniques.contains(&technique) {
-                return Err(invalid("a technique is listed twice"));
-            }
-            techniques.push(technique);
-        }
-        Ok(Self(techniques))
-    }
-}
-
-/// The technique names usable today, `none` included.
-fn available_gi() -> String {
-    let mut names: Vec<&str> = GiTechnique::ALL.iter().map(|t| t.name()).collect();
-    names.push(NO_GI);
-    names.join(", ")
-}
-
-/// Every technique name shine knows, planned ones included.
-fn known_gi() -> String {
-    let mut names: Vec<&str> = GiTechnique::ALL.iter().map(|t| t.name()).collect();
-    names.push(NO_GI);
-    names.extend(PLANNED_GI);
-    names.join(", ")
-}
-
-impl fmt::Display for GiTechniques {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        if self.0.is_empty() {
-            return f.write_str(NO_GI);
-        }
-        let names: Vec<&str> = self.0.iter().map(|t| t.name()).collect();
-        f.write_str(&names.join(","))
-    }
-}
-
-impl Serialize for GiTechniques {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_str(self)
-    }
-}
-
-impl<'de> Deserialize<'de> for GiTechniques {
-    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let text = String::deserialize(d)?;
-        text.parse().map_err(serde::de::Error::custom)
-    }
-}
+use crate::capture::tonemap::Tonemap;
+use crate::passes::composite::Component;
+use crate::passes::hvl::{GatherPath, RadiusHeuristic};
+use crate::passes::igi::{FilterMode, Glossy, IgiParams};
+use crate::passes::proxy::{ExpMethod, INDIRECT_BANDS, paper_expansion};
+use crate::passes::upsample::{DEPTH_SIGMA, NORMAL_POWER_N};
 
 /// Everything that decides what a frame computes and how it is written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -540,10 +196,10 @@ pub struct IgiSettings {
     /// paper 000 §2.3). Range 0..=4, default 1.
     pub filter_radius: u32,
     /// What is filtered: `sh` (paper 000) or `irradiance` (classic IGI). Default `sh`.
-    pub filter: IgiFilter,
+    pub filter: FilterMode,
     /// Glossy lobe of the SH mode: `ggx` (BRDF SH tables) or `phong` (paper 000 §3.3.2).
     /// Default `ggx`.
-    pub glossy: IgiGlossy,
+    pub glossy: Glossy,
     /// Minimum VPL distance d_min in metres: 1/d² is evaluated as 1/max(d², d_min²) (the VPL
     /// singularity clamp). Range 0.0..=10.0, default 0.1.
     pub clamp_distance: f32,
@@ -556,18 +212,20 @@ pub struct IgiSettings {
 }
 
 impl Default for IgiSettings {
+    /// The defaults of the IGI passes ([`IgiParams::default`]).
     fn default() -> Self {
+        let p = IgiParams::default();
         Self {
-            n: 4,
-            m: 4,
-            vpl_count: 256,
-            sh_order: 3,
-            filter_radius: 1,
-            filter: IgiFilter::Sh,
-            glossy: IgiGlossy::Ggx,
-            clamp_distance: 0.1,
-            depth_tolerance: 0.05,
-            normal_threshold: 0.9,
+            n: p.pattern[0],
+            m: p.pattern[1],
+            vpl_count: p.vpl_count,
+            sh_order: p.sh_order,
+            filter_radius: p.filter_radius,
+            filter: p.mode,
+            glossy: p.glossy,
+            clamp_distance: p.clamp_distance,
+            depth_tolerance: p.depth_tolerance,
+            normal_threshold: p.normal_threshold,
         }
     }
 }
@@ -597,25 +255,11 @@ impl Default for ProxySettings {
         Self {
             sh_order: 4,
             expansion: 0.0,
-            indirect_expansion: 10.0,
+            indirect_expansion: paper_expansion(INDIRECT_BANDS as u32),
             exp: ExpMethod::Hyb,
             indirect: true,
             brute_force: false,
             fit_count: 0,
-        }
-    }
-}
-
-impl ProxySettings {
-    /// The shadow expansion factor η in use: the setting, or the paper's value for the order
-    /// (§4.1: 15 for order 4, 10 for order 3) when it is 0.
-    pub fn shadow_expansion(&self) -> f32 {
-        if self.expansion > 0.0 {
-            self.expansion
-        } else if self.sh_order <= 3 {
-            10.0 // §4.1, paper 002: order 3
-        } else {
-            15.0 // §4.1, paper 002: order 4
         }
     }
 }
@@ -662,209 +306,9 @@ impl Default for ShadowSettings {
 impl Default for UpsampleSettings {
     fn default() -> Self {
         Self {
-            depth_epsilon: 0.01,
-            normal_power: 32.0,
+            depth_epsilon: DEPTH_SIGMA,
+            normal_power: NORMAL_POWER_N,
         }
-    }
-}
-
-/// The receiver-buffer scales allowed (DESIGN §4).
-pub const RECEIVER_SCALES: [u32; 3] = [1, 2, 4];
-
-/// Rejects `value` outside `range` (NaN included) with the field's name. Values print with
-/// `Debug` so that floats keep their decimal point (`1.0..=2.0`).
-fn check<T: PartialOrd + fmt::Debug>(
-    field: &'static str,
-    value: T,
-    range: RangeInclusive<T>,
-) -> Result<(), SettingsError> {
-    if range.contains(&value) {
-        Ok(())
-    } else {
-        Err(SettingsError::OutOfRange {
-            field,
-            value: format!("{value:?}"),
-            allowed: format!("{:?}..={:?}", range.start(), range.end()),
-        })
-    }
-}
-
-impl Settings {
-    /// Parses settings from TOML text over the defaults, then validates them.
-    ///
-    /// Unknown settings and wrongly typed values are errors (with line and column).
-    pub fn from_toml_str(text: &str) -> Result<Self, SettingsError> {
-        Self::parse(text, None)
-    }
-
-    /// Reads a TOML settings file over the defaults, then validates it.
-    pub fn load(path: &Path) -> Result<Self, SettingsError> {
-        let text = std::fs::read_to_string(path).map_err(|source| SettingsError::Read {
-            path: path.to_owned(),
-            source,
-        })?;
-        Self::parse(&text, Some(path))
-    }
-
-    /// Parses and validates `text`, naming `path` in errors.
-    fn parse(text: &str, path: Option<&Path>) -> Result<Self, SettingsError> {
-        let settings: Self = toml::from_str(text).map_err(|e| SettingsError::Parse {
-            path: path.map(Path::to_owned),
-            message: e.to_string(),
-        })?;
-        settings.validate()?;
-        Ok(settings)
-    }
-
-    /// The settings as a TOML document that [`Settings::from_toml_str`] reads back unchanged.
-    pub fn to_toml_string(&self) -> Result<String, toml::ser::Error> {
-        toml::to_string(self)
-    }
-
-    /// Overrides one setting by its dotted TOML key (`width`, `hvl.count`, `output.tonemap`)
-    /// with a value written as in TOML (`2000`, `1.5`) or as a bare word (`aces`, `hvl,proxy`).
-    ///
-    /// This is how command-line flags apply over a settings file. The result is not validated:
-    /// call [`Settings::validate`] once every override is applied.
-    pub fn set(&mut self, key: &str, value: &str) -> Result<(), SettingsError> {
-        let refuse = |reason: String| SettingsError::Override {
-            key: key.to_owned(),
-            value: value.to_owned(),
-            reason,
-        };
-        let mut table = toml::Table::try_from(&*self).map_err(|e| refuse(e.to_string()))?;
-        let parsed = toml::from_str::<toml::Table>(&format!("v = {value}"))
-            .ok()
-            .and_then(|mut t| t.remove("v"))
-            .unwrap_or_else(|| toml::Value::String(value.to_owned()));
-        let mut slot = &mut table;
-        let mut section = String::from("the top level");
-        let mut parts = key.split('.').peekable();
-        while let Some(part) = parts.next() {
-            let known = slot.keys().cloned().collect::<Vec<_>>().join(", ");
-            let entry = slot.get_mut(part).ok_or_else(|| {
-                refuse(format!("no setting `{part}` in {section} (known: {known})"))
-            })?;
-            if parts.peek().is_none() {
-                if entry.is_table() {
-                    return Err(refuse(format!("`{key}` is a section, not a setting")));
-                }
-                *entry = parsed;
-                break;
-            }
-            slot = entry
-                .as_table_mut()
-                .ok_or_else(|| refuse(format!("`{part}` is a setting, not a section")))?;
-            section = format!("[{part}]");
-        }
-        *self = table
-            .try_into()
-            .map_err(|e: toml::de::Error| refuse(e.message().trim().to_owned()))?;
-        Ok(())
-    }
-
-    /// Checks every setting against its documented range.
-    ///
-    /// The error names the first offending field (dotted, as in the TOML file), its value and
-    /// the allowed range.
-    pub fn validate(&self) -> Result<(), SettingsError> {
-        check("width", self.width, 1..=16384)?;
-        check("height", self.height, 1..=16384)?;
-        check("frames", self.frames, 1..=100_000)?;
-        check("time", self.time, 0.0..=100_000.0)?;
-        if !RECEIVER_SCALES.contains(&self.receiver_scale) {
-            return Err(SettingsError::OutOfRange {
-                field: "receiver_scale",
-                value: self.receiver_scale.to_string(),
-                allowed: "1, 2 or 4".to_owned(),
-            });
-        }
-        check("output.exposure", self.output.exposure, 1e-6..=1e6)?;
-        check("hvl.count", self.hvl.count, 64..=10_000)?;
-        check("hvl.radius_scale", self.hvl.radius_scale, 1.0..=2.0)?;
-        check("hvl.convolution_bands", self.hvl.convolution_bands, 1..=10)?;
-        check("hvl.emission_bands", self.hvl.emission_bands, 1..=5)?;
-        check("rsm.size", self.rsm.size, 16..=4096)?;
-        let rsm_texels = u64::from(self.rsm.size).pow(2);
-        if u64::from(self.hvl.count) > rsm_texels {
-            return Err(SettingsError::OutOfRange {
-                field: "hvl.count",
-                value: self.hvl.count.to_string(),
-                allowed: format!(
-                    "at most rsm.size² = {rsm_texels} (one RSM texel per HVL at least): raise rsm.size"
-                ),
-            });
-        }
-        if self.hvl.emission_bands > self.hvl.convolution_bands {
-            return Err(SettingsError::OutOfRange {
-                field: "hvl.emission_bands",
-                value: self.hvl.emission_bands.to_string(),
-                allowed: format!(
-                    "1..={} (at most hvl.convolution_bands)",
-                    self.hvl.convolution_bands.min(5)
-                ),
-            });
-        }
-        check("shadow.size", self.shadow.size, 64..=16384)?;
-        check(
-            "shadow.filter_radius",
-            self.shadow.filter_radius,
-            0.0..=16.0,
-        )?;
-        check(
-            "upsample.depth_epsilon",
-            self.upsample.depth_epsilon,
-            1e-6..=10.0,
-        )?;
-        check(
-            "upsample.normal_power",
-            self.upsample.normal_power,
-            1.0..=256.0,
-        )?;
-        check("proxy.sh_order", self.proxy.sh_order, 3..=6)?;
-        if self.proxy.expansion != 0.0 {
-            check("proxy.expansion", self.proxy.expansion, 2.0..=100.0)?;
-        }
-        check(
-            "proxy.indirect_expansion",
-            self.proxy.indirect_expansion,
-            2.0..=100.0,
-        )?;
-        check("proxy.fit_count", self.proxy.fit_count, 0..=64)?;
-        self.validate_igi()?;
-        Ok(())
-    }
-
-    /// The `[igi]` checks of [`Settings::validate`], and the combination rule: `igi` and `hvl`
-    /// both compute the one-bounce indirect light of the primary light, so a frame takes one.
-    fn validate_igi(&self) -> Result<(), SettingsError> {
-        let i = &self.igi;
-        check("igi.n", i.n, 1..=8)?;
-        check("igi.m", i.m, 1..=8)?;
-        check("igi.vpl_count", i.vpl_count, 64..=10_000)?;
-        check("igi.sh_order", i.sh_order, 2..=4)?;
-        check("igi.filter_radius", i.filter_radius, 0..=4)?;
-        check("igi.clamp_distance", i.clamp_distance, 0.0..=10.0)?;
-        check("igi.depth_tolerance", i.depth_tolerance, 1e-4..=1.0)?;
-        check("igi.normal_threshold", i.normal_threshold, -1.0..=1.0)?;
-        let rsm_texels = u64::from(self.rsm.size).pow(2);
-        if u64::from(i.vpl_count) > rsm_texels {
-            return Err(SettingsError::OutOfRange {
-                field: "igi.vpl_count",
-                value: i.vpl_count.to_string(),
-                allowed: format!(
-                    "at most rsm.size² = {rsm_texels} (one RSM texel per VPL at least): raise rsm.size"
-                ),
-            });
-        }
-        if self.gi.contains(GiTechnique::Igi) && self.gi.contains(GiTechnique::Hvl) {
-            return Err(SettingsError::GiList {
-                list: self.gi.to_string(),
-                reason: "`igi` and `hvl` both compute the one-bounce indirect light of the \
-                         primary light: choose one",
-            });
-        }
-        Ok(())
     }
 }
 
@@ -1103,7 +547,7 @@ mod tests {
         let igi =
             Settings::from_toml_str("gi = \"igi\"\n[igi]\nn = 2\nfilter = \"irradiance\"").unwrap();
         assert!(igi.gi.contains(GiTechnique::Igi));
-        assert_eq!((igi.igi.n, igi.igi.filter), (2, IgiFilter::Irradiance));
+        assert_eq!((igi.igi.n, igi.igi.filter), (2, FilterMode::Irradiance));
         type Edit = fn(&mut Settings);
         let cases: [(&str, &str, Edit); 8] = [
             ("igi.n", "0", |s| s.igi.n = 0),

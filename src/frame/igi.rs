@@ -1,0 +1,86 @@
+//! The IGI technique (paper 000) as the frame uses it: the BRDF SH tables of its GGX resolve,
+//! and the passes it adds to a frame at full resolution (VPLs from the primary light's RSM,
+//! `vpl_sh` with shadow rays through the BVH, `sh_filter`; `src/passes/igi.rs`).
+
+use glam::Vec3;
+use shine_gpu::Device;
+use shine_graph::{Buffer, Handle, Image, RenderGraph};
+
+use super::error::RenderError;
+use crate::gpu_scene::BUFFER_READ;
+use crate::gpu_scene::bvh::GpuBvh;
+use crate::passes::brdf_tables::BrdfTables;
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::igi::{self, IgiParams};
+use crate::passes::rsm::Rsm;
+
+/// The IGI technique's persistent state: the BRDF tables of the GGX resolve per SH order.
+pub struct IgiTechnique {
+    device: Device,
+    brdf: BrdfTables,
+}
+
+/// An IGI frame ready to be declared: its parameters and, for the GGX resolve, its tables
+/// imported into the graph.
+pub struct PreparedIgi {
+    params: IgiParams,
+    brdf: Option<Handle<Buffer>>,
+}
+
+/// What the IGI passes read from the rest of the frame.
+pub struct IgiInputs<'a> {
+    /// The full-resolution G-buffer (the interleaving needs the pixel grid).
+    pub gbuffer: &'a GBuffer,
+    /// The primary light's RSM the VPLs are cut from.
+    pub rsm: &'a Rsm,
+    /// The scene's BVH for the VPL shadow rays.
+    pub bvh: &'a GpuBvh,
+    /// The camera position.
+    pub camera: Vec3,
+}
+
+impl IgiTechnique {
+    /// The technique on `device`; nothing is uploaded until the first frame.
+    pub fn new(device: &Device) -> Self {
+        Self {
+            device: device.clone(),
+            brdf: BrdfTables::default(),
+        }
+    }
+
+    /// Uploads the BRDF tables of the GGX resolve when `params` uses it (once per SH order)
+    /// and imports them into `rg`.
+    pub fn prepare(
+        &mut self,
+        rg: &mut RenderGraph,
+        params: IgiParams,
+    ) -> Result<PreparedIgi, RenderError> {
+        let brdf = if params.needs_brdf_tables() {
+            let table = self.brdf.get(&self.device, params.sh_order)?;
+            Some(rg.import_gpu_buffer(table, BUFFER_READ, BUFFER_READ))
+        } else {
+            None
+        };
+        Ok(PreparedIgi { params, brdf })
+    }
+}
+
+impl PreparedIgi {
+    /// Adds the IGI passes; returns the full-resolution indirect light (RGBA16F).
+    pub fn declare(
+        self,
+        rg: &mut RenderGraph,
+        inputs: &IgiInputs<'_>,
+    ) -> Result<Handle<Image>, RenderError> {
+        let trace = inputs.bvh.import(rg, BUFFER_READ);
+        Ok(igi::igi(
+            rg,
+            inputs.gbuffer,
+            inputs.rsm,
+            &trace,
+            self.brdf.as_ref(),
+            inputs.camera,
+            &self.params,
+        )?)
+    }
+}

@@ -1,0 +1,128 @@
+//! [`FrameParams`]: what one frame computes, in the parameter types the passes and techniques
+//! own. [`FrameParams::from_settings`] is the one conversion from [`Settings`]; nothing below
+//! the frame reads the settings.
+
+use crate::passes::composite::{Component, CompositeParams};
+use crate::passes::direct::ShadowParams;
+use crate::passes::hvl::HvlParams;
+use crate::passes::igi::IgiParams;
+use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
+use crate::passes::upsample::UpsampleParams;
+use crate::settings::{GiTechnique, Settings};
+
+/// Shadow-map depth bias in NDC depth units, on top of the raster slope bias.
+pub const SHADOW_DEPTH_BIAS: f32 = 1e-4;
+/// Receiver offset along its normal in shadow-map texels (removes acne at grazing angles).
+pub const SHADOW_NORMAL_OFFSET: f32 = 1.5;
+
+/// Everything a frame needs to know, resolved from the settings: a technique is in the frame
+/// exactly when its parameters are present.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FrameParams {
+    /// Width and height of the frame in pixels.
+    pub extent: [u32; 2],
+    /// Receiver-buffer downscale s (paper 002 §4.2) of the receiver-resolution techniques.
+    pub receiver_scale: u32,
+    /// Side of the primary light's reflective shadow map (HVL and IGI).
+    pub rsm_size: u32,
+    /// Side of each shadow-atlas tile in texels.
+    pub shadow_size: u32,
+    /// How the direct pass filters and biases its shadow lookups.
+    pub shadow: ShadowParams,
+    /// Harmonics Virtual Lights (paper 003), when the frame has them.
+    pub hvl: Option<HvlParams>,
+    /// Instant GI (paper 000), when the frame has it.
+    pub igi: Option<IgiParams>,
+    /// Sphere proxies (paper 002), when the frame has them.
+    pub proxy: Option<ProxySetup>,
+    /// The joint bilateral upsample of the receiver-resolution light.
+    pub upsample: UpsampleParams,
+    /// Exposure and tonemap of the composite.
+    pub composite: CompositeParams,
+    /// Which part of the radiance the frame shows.
+    pub component: Component,
+}
+
+/// The proxy technique's parameters: its passes' and how its GPU data is built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ProxySetup {
+    /// The parameters of the proxy passes.
+    pub pass: ProxyParams,
+    /// Shadow expansion factor η of the α tables (§4.1), resolved from the settings.
+    pub shadow_expansion: f32,
+    /// Indirect expansion factor of the α tables.
+    pub indirect_expansion: f32,
+    /// 0: the scene's proxies; k > 0: k spheres refitted to each proxied mesh.
+    pub fit_count: u32,
+}
+
+impl FrameParams {
+    /// The parameters chosen by `settings` (which the caller has validated).
+    pub fn from_settings(settings: &Settings) -> Self {
+        let gi = &settings.gi;
+        let h = &settings.hvl;
+        let i = &settings.igi;
+        let p = &settings.proxy;
+        Self {
+            extent: [settings.width, settings.height],
+            receiver_scale: settings.receiver_scale,
+            rsm_size: settings.rsm.size,
+            shadow_size: settings.shadow.size,
+            shadow: ShadowParams {
+                // The setting is a radius in texels; the kernel covers whole texels around it.
+                pcf_radius: settings.shadow.filter_radius.round() as u32,
+                bias: SHADOW_DEPTH_BIAS,
+                normal_offset: SHADOW_NORMAL_OFFSET,
+            },
+            hvl: gi.contains(GiTechnique::Hvl).then_some(HvlParams {
+                count: h.count,
+                radius: h.radius,
+                radius_scale: h.radius_scale,
+                conv_bands: h.convolution_bands,
+                emission_bands: h.emission_bands,
+                path: h.gather,
+                visibility: h.visibility,
+            }),
+            igi: gi.contains(GiTechnique::Igi).then_some(IgiParams {
+                pattern: [i.n, i.m],
+                vpl_count: i.vpl_count,
+                sh_order: i.sh_order,
+                filter_radius: i.filter_radius,
+                mode: i.filter,
+                glossy: i.glossy,
+                clamp_distance: i.clamp_distance,
+                depth_tolerance: i.depth_tolerance,
+                normal_threshold: i.normal_threshold,
+            }),
+            proxy: gi.contains(GiTechnique::Proxy).then_some(ProxySetup {
+                pass: ProxyParams {
+                    bands: p.sh_order,
+                    accumulation: if p.brute_force {
+                        Accumulation::Product
+                    } else {
+                        Accumulation::Splat
+                    },
+                    exp: p.exp,
+                    indirect: p.indirect,
+                },
+                shadow_expansion: if p.expansion > 0.0 {
+                    p.expansion
+                } else {
+                    paper_expansion(p.sh_order)
+                },
+                indirect_expansion: p.indirect_expansion,
+                fit_count: p.fit_count,
+            }),
+            upsample: UpsampleParams {
+                depth_sigma: settings.upsample.depth_epsilon,
+                normal_power: settings.upsample.normal_power,
+                ..UpsampleParams::default()
+            },
+            composite: CompositeParams {
+                exposure: settings.output.exposure,
+                tonemap: settings.output.tonemap,
+            },
+            component: settings.output.component,
+        }
+    }
+}

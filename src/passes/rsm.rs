@@ -1,0 +1,100 @@
+//! `rsm`: the reflective shadow map of the primary light (Dachsbacher and Stamminger 2005), the
+//! source of the HVLs (paper 003) and of IGI's VPLs (paper 000); docs/frame.md, "Reflective
+//! shadow map", fixes its formats and units.
+
+use glam::Vec3;
+use shine_graph::{ColorLoad, DepthLoad, Handle, Image, ImageDesc, RenderGraph};
+
+use super::gbuffer::{SceneHandles, View, scene_pipeline};
+use crate::gpu::vk;
+use crate::shaders;
+
+/// RSM sides S in texels (S×S per primary light).
+pub const SIZE: std::ops::RangeInclusive<u32> = 16..=4096;
+
+/// The reflective shadow map of one primary light (docs/frame.md, "Reflective shadow map").
+#[derive(Debug, Clone, Copy)]
+pub struct Rsm {
+    /// `rsm_position`, RGBA32F: xyz world position, w = 1 (0 where empty).
+    pub position: Handle<Image>,
+    /// `rsm_normal`, RGBA16F: xyz unit world normal.
+    pub normal: Handle<Image>,
+    /// `rsm_flux`, RGBA32F: rgb reflected flux Φ of the texel (W).
+    pub flux: Handle<Image>,
+    /// Position of the primary light (perspective) or the RSM's eye (orthographic).
+    pub light_position: Vec3,
+    /// Unit axis of the RSM's view (the light's direction for a directional light).
+    pub light_direction: Vec3,
+    /// How the RSM was projected.
+    pub projection: RsmProjection,
+    /// Side S of the RSM in texels.
+    pub size: u32,
+}
+
+/// The projection of an RSM: it decides the r2 heuristic and the distance `d_j` to the light.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RsmProjection {
+    /// A point or spot light's square frustum of full field of view λ (radians, eq. 24).
+    Perspective {
+        /// λ.
+        fov: f32,
+    },
+    /// A directional light's box of width W (metres) across.
+    Orthographic {
+        /// W.
+        width: f32,
+    },
+}
+
+/// Rasterises the scene from the primary light (perspective or orthographic) into a new `size`²
+/// reflective shadow map (docs/frame.md).
+pub fn rsm(
+    rg: &mut RenderGraph,
+    scene: &SceneHandles,
+    view: View,
+    light: u32,
+    size: u32,
+    sampler: vk::Sampler,
+) -> Rsm {
+    let image = |rg: &mut RenderGraph, name, format| {
+        rg.create_image(name, ImageDesc::new_2d(format, size, size))
+    };
+    let mut depth = image(rg, "rsm_depth", vk::Format::D32_SFLOAT);
+    let mut r = Rsm {
+        position: image(rg, "rsm_position", vk::Format::R32G32B32A32_SFLOAT),
+        normal: image(rg, "rsm_normal", vk::Format::R16G16B16A16_SFLOAT),
+        flux: image(rg, "rsm_flux", vk::Format::R32G32B32A32_SFLOAT),
+        light_position: view.eye,
+        light_direction: view.forward(),
+        projection: if view.orthographic {
+            RsmProjection::Orthographic { width: view.extent }
+        } else {
+            RsmProjection::Perspective { fov: view.extent }
+        },
+        size,
+    };
+    let pipeline = scene_pipeline(
+        Some(&shaders::RSM_FRAG),
+        &[
+            vk::Format::R32G32B32A32_SFLOAT,
+            vk::Format::R16G16B16A16_SFLOAT,
+            vk::Format::R32G32B32A32_SFLOAT,
+        ],
+        None,
+    );
+    rg.raster("rsm", pipeline)
+        .color(&mut r.position, ColorLoad::Clear([0.0; 4]))
+        .color(&mut r.normal, ColorLoad::Clear([0.0; 4]))
+        .color(&mut r.flux, ColorLoad::Clear([0.0; 4]))
+        .depth(&mut depth, DepthLoad::Clear(1.0))
+        .read("materials", &scene.materials)
+        .read("srgb_textures", &scene.srgb_textures)
+        .read("linear_textures", &scene.linear_textures)
+        .read("lights", &scene.lights)
+        .sampler("texture_sampler", sampler)
+        .vertex_buffer(&scene.vertices)
+        .index_buffer(&scene.indices, vk::IndexType::UINT32)
+        .push(&view.constants(Some((size, light))))
+        .draw_indexed(scene.index_count, 1);
+    r
+}

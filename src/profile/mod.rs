@@ -1,0 +1,3 @@
+//! Per-pass timing reports of `shine profile`.
+
+pub mod report;

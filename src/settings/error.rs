@@ -1,0 +1,75 @@
+//! Why settings were rejected.
+
+use std::path::PathBuf;
+
+use crate::choice::UnknownChoice;
+
+/// Why settings were rejected: each variant names the setting and what to do.
+#[derive(Debug, thiserror::Error)]
+pub enum SettingsError {
+    /// A numeric setting lies outside its documented range (or is not a finite number).
+    #[error("setting `{field}` = {value} is out of range: allowed {allowed}")]
+    OutOfRange {
+        /// Dotted name of the setting, as written in the TOML file (`hvl.count`).
+        field: &'static str,
+        /// The rejected value, as given.
+        value: String,
+        /// The allowed values (`64..=10000`, `1, 2 or 4`).
+        allowed: String,
+    },
+    /// A named choice (tonemap operator, GI technique, …) that shine does not know.
+    #[error(transparent)]
+    UnknownName(#[from] UnknownChoice),
+    /// A GI technique that a later issue adds, not usable yet.
+    #[error(
+        "GI technique `{name}` is not implemented yet: available now are {available} \
+         (combine them with commas, e.g. `--gi hvl`)"
+    )]
+    GiNotImplemented {
+        /// The planned technique that was asked for.
+        name: String,
+        /// The techniques that work today.
+        available: String,
+    },
+    /// A GI list that is malformed: empty entry, duplicate, or `none` combined with others.
+    #[error("invalid GI technique list `{list}`: {reason}")]
+    GiList {
+        /// The list as given.
+        list: String,
+        /// What is wrong with it.
+        reason: &'static str,
+    },
+    /// The settings file could not be read.
+    #[error("cannot read settings file {}: {source}", path.display())]
+    Read {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The TOML text is malformed, names an unknown setting, or has a value of the wrong type.
+    #[error("invalid settings{}: {message}", origin(path))]
+    Parse {
+        /// The file the text came from, when it came from one.
+        path: Option<PathBuf>,
+        /// The TOML parser's message (with line and column).
+        message: String,
+    },
+    /// A `key=value` override names no setting or has a value the setting cannot take.
+    #[error("cannot set `{key}` to `{value}`: {reason}")]
+    Override {
+        /// The dotted key (`hvl.count`).
+        key: String,
+        /// The value given.
+        value: String,
+        /// Why it was refused.
+        reason: String,
+    },
+}
+
+/// ` in FILE` for a parse error from a file, nothing for a string.
+fn origin(path: &Option<PathBuf>) -> String {
+    path.as_ref()
+        .map(|p| format!(" in {}", p.display()))
+        .unwrap_or_default()
+}

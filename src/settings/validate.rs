@@ -1,0 +1,165 @@
+//! [`Settings::validate`]: every setting against its range, each range one named constant
+//! (the pass that owns the parameter owns its range).
+
+use std::fmt;
+use std::ops::RangeInclusive;
+
+use super::{GiTechnique, Settings, SettingsError};
+use crate::capture::tonemap;
+use crate::gpu_scene::environment_sh;
+use crate::passes::{hvl, igi, proxy, receivers, rsm, shadows, upsample};
+
+/// Output sides in pixels.
+pub const EXTENT: RangeInclusive<u32> = 1..=16384;
+/// Frames of one render.
+pub const FRAMES: RangeInclusive<u32> = 1..=100_000;
+/// Scene times in seconds.
+pub const TIME: RangeInclusive<f32> = 0.0..=100_000.0;
+
+/// Rejects `value` outside `range` (NaN included) with the field's name. Values print with
+/// `Debug` so that floats keep their decimal point (`1.0..=2.0`).
+fn check<T: PartialOrd + fmt::Debug>(
+    field: &'static str,
+    value: T,
+    range: &RangeInclusive<T>,
+) -> Result<(), SettingsError> {
+    if range.contains(&value) {
+        Ok(())
+    } else {
+        Err(SettingsError::OutOfRange {
+            field,
+            value: format!("{value:?}"),
+            allowed: format!("{:?}..={:?}", range.start(), range.end()),
+        })
+    }
+}
+
+impl Settings {
+    /// Checks every setting against its documented range.
+    ///
+    /// The error names the first offending field (dotted, as in the TOML file), its value and
+    /// the allowed range.
+    pub fn validate(&self) -> Result<(), SettingsError> {
+        check("width", self.width, &EXTENT)?;
+        check("height", self.height, &EXTENT)?;
+        check("frames", self.frames, &FRAMES)?;
+        check("time", self.time, &TIME)?;
+        if !receivers::SCALES.contains(&self.receiver_scale) {
+            return Err(SettingsError::OutOfRange {
+                field: "receiver_scale",
+                value: self.receiver_scale.to_string(),
+                allowed: format!("one of {:?}", receivers::SCALES),
+            });
+        }
+        check("output.exposure", self.output.exposure, &tonemap::EXPOSURE)?;
+        check("hvl.count", self.hvl.count, &hvl::CACHE_COUNT)?;
+        check(
+            "hvl.radius_scale",
+            self.hvl.radius_scale,
+            &hvl::RADIUS_SCALE,
+        )?;
+        check(
+            "hvl.convolution_bands",
+            self.hvl.convolution_bands,
+            &hvl::CONV_BANDS,
+        )?;
+        check(
+            "hvl.emission_bands",
+            self.hvl.emission_bands,
+            &hvl::EMISSION_BANDS,
+        )?;
+        check("rsm.size", self.rsm.size, &rsm::SIZE)?;
+        let rsm_texels = u64::from(self.rsm.size).pow(2);
+        if u64::from(self.hvl.count) > rsm_texels {
+            return Err(SettingsError::OutOfRange {
+                field: "hvl.count",
+                value: self.hvl.count.to_string(),
+                allowed: format!(
+                    "at most rsm.size² = {rsm_texels} (one RSM texel per HVL at least): raise rsm.size"
+                ),
+            });
+        }
+        if self.hvl.emission_bands > self.hvl.convolution_bands {
+            return Err(SettingsError::OutOfRange {
+                field: "hvl.emission_bands",
+                value: self.hvl.emission_bands.to_string(),
+                allowed: format!(
+                    "1..={} (at most hvl.convolution_bands)",
+                    self.hvl.convolution_bands.min(*hvl::EMISSION_BANDS.end())
+                ),
+            });
+        }
+        check("shadow.size", self.shadow.size, &shadows::TILE_SIZE)?;
+        check(
+            "shadow.filter_radius",
+            self.shadow.filter_radius,
+            &shadows::FILTER_RADIUS,
+        )?;
+        check(
+            "upsample.depth_epsilon",
+            self.upsample.depth_epsilon,
+            &upsample::DEPTH_SIGMA_RANGE,
+        )?;
+        check(
+            "upsample.normal_power",
+            self.upsample.normal_power,
+            &upsample::NORMAL_POWER_RANGE,
+        )?;
+        check(
+            "proxy.sh_order",
+            self.proxy.sh_order,
+            &environment_sh::ORDERS,
+        )?;
+        if self.proxy.expansion != 0.0 {
+            check("proxy.expansion", self.proxy.expansion, &proxy::EXPANSION)?;
+        }
+        check(
+            "proxy.indirect_expansion",
+            self.proxy.indirect_expansion,
+            &proxy::EXPANSION,
+        )?;
+        check("proxy.fit_count", self.proxy.fit_count, &proxy::FIT_COUNT)?;
+        self.validate_igi()?;
+        Ok(())
+    }
+
+    /// The `[igi]` checks of [`Settings::validate`], and the combination rule: `igi` and `hvl`
+    /// both compute the one-bounce indirect light of the primary light, so a frame takes one.
+    fn validate_igi(&self) -> Result<(), SettingsError> {
+        let i = &self.igi;
+        check("igi.n", i.n, &igi::PATTERN)?;
+        check("igi.m", i.m, &igi::PATTERN)?;
+        check("igi.vpl_count", i.vpl_count, &igi::VPL_COUNT)?;
+        check("igi.sh_order", i.sh_order, &igi::SH_ORDERS)?;
+        check("igi.filter_radius", i.filter_radius, &igi::FILTER_RADIUS)?;
+        check("igi.clamp_distance", i.clamp_distance, &igi::CLAMP_DISTANCE)?;
+        check(
+            "igi.depth_tolerance",
+            i.depth_tolerance,
+            &igi::DEPTH_TOLERANCE,
+        )?;
+        check(
+            "igi.normal_threshold",
+            i.normal_threshold,
+            &igi::NORMAL_THRESHOLD,
+        )?;
+        let rsm_texels = u64::from(self.rsm.size).pow(2);
+        if u64::from(i.vpl_count) > rsm_texels {
+            return Err(SettingsError::OutOfRange {
+                field: "igi.vpl_count",
+                value: i.vpl_count.to_string(),
+                allowed: format!(
+                    "at most rsm.size² = {rsm_texels} (one RSM texel per VPL at least): raise rsm.size"
+                ),
+            });
+        }
+        if self.gi.contains(GiTechnique::Igi) && self.gi.contains(GiTechnique::Hvl) {
+            return Err(SettingsError::GiList {
+                list: self.gi.to_string(),
+                reason: "`igi` and `hvl` both compute the one-bounce indirect light of the \
+                         primary light: choose one",
+            });
+        }
+        Ok(())
+    }
+}
