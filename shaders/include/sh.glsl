@@ -1,4 +1,4 @@
-// Real spherical harmonics, GLSL twin of shine-sh (DESIGN §6): orthonormal, index l*l+l+m,
+// Real spherical harmonics, GLSL twin of shine-sh (docs/architecture.md, "Conventions"): orthonormal, index l*l+l+m,
 // with the Condon–Shortley phase. Y(1,-1) = -0.4886025 y, Y(1,0) = 0.4886025 z,
 // Y(1,1) = -0.4886025 x.
 //

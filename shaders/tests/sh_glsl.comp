@@ -1,5 +1,5 @@
 // Runs every per-pixel function of sh.glsl on a buffer of cases so tests/sh_glsl.rs can compare
-// them with shine-sh on the same inputs (DESIGN §6: one formula in Rust, one in GLSL, tied by a
+// them with shine-sh on the same inputs (docs/architecture.md, "Conventions": one formula in Rust, one in GLSL, tied by a
 // test). Layouts are documented in tests/sh_glsl.rs.
 //! variant bands2 SH_BANDS=2
 //! variant bands3 SH_BANDS=3

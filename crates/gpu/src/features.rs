@@ -1,7 +1,7 @@
 //! What the engine needs from a device, what it can use when present, and the check of both.
 //!
 //! The baseline is Vulkan 1.3 core with synchronization2, dynamic rendering and timestamps:
-//! what Mesa 22.3 lavapipe offers (DESIGN §2). Everything else is optional and reported.
+//! what Mesa 22.3 lavapipe offers (docs/architecture.md, "Device layer"). Everything else is optional and reported.
 
 use ash::vk;
 use std::ffi::CStr;

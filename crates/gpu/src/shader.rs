@@ -1,4 +1,4 @@
-//! Shader descriptions produced by build.rs from naga's reflection (DESIGN §5).
+//! Shader descriptions produced by build.rs from naga's reflection (docs/architecture.md, "Shaders").
 //!
 //! Every pipeline layout in shine is derived from these; none is written by hand.
 

@@ -1,7 +1,7 @@
 //! Circularly symmetric kernels as ZH vectors, convolution, and windowing against ringing.
 //!
 //! Kernels are functions `k(cos θ)` of the angle to +z; their ZH coefficients are
-//! `k_l = 2π ∫ k(μ) Y_l0(μ) dμ`. Convolution (paper 002 eq. 7, DESIGN §6) is
+//! `k_l = 2π ∫ k(μ) Y_l0(μ) dμ`. Convolution (paper 002 eq. 7, docs/architecture.md "Conventions") is
 //! `(f ⋆ k)_lm = sqrt(4π/(2l+1)) k_l f_lm`, so that `(f ⋆ k)(n) = ∫ f(s) k(n·s) ds`
 //! (Funk–Hecke). All closed forms below use ratio recurrences (no factorials).
 

@@ -1,6 +1,6 @@
 //! shine-sh: spherical-harmonics arithmetic for shine, the one trusted CPU implementation.
 //!
-//! # Conventions (DESIGN §6)
+//! # Conventions (docs/architecture.md, "Conventions")
 //!
 //! * Real orthonormal SH, coefficient index `l*l + l + m`, **with** the Condon–Shortley phase:
 //!   `Y(0,0) = 0.2820948`, `Y(1,-1) = -0.4886025·y`, `Y(1,0) = 0.4886025·z`,
@@ -122,7 +122,7 @@ pub const fn num_coeffs(bands: usize) -> usize {
     bands * bands
 }
 
-/// Coefficient index of `(l, m)`, `-l ≤ m ≤ l`: `l*l + l + m` (DESIGN §6).
+/// Coefficient index of `(l, m)`, `-l ≤ m ≤ l`: `l*l + l + m` (docs/architecture.md, "Conventions").
 #[inline]
 pub const fn index(l: usize, m: i32) -> usize {
     (l * l + l).wrapping_add_signed(m as isize)

@@ -5,7 +5,7 @@
 //! carried along with the rotation, so "rotate then evaluate at `R d`" equals "evaluate at `d`".
 //! `D` is block diagonal; band `l` has a `(2l+1)²` orthogonal block. The recurrence builds band
 //! `l` from band `l-1` and band 1 in the basis *without* the Condon–Shortley phase; the blocks are
-//! then conjugated by `diag((-1)^m)` to our basis (DESIGN §6). Cost `O(n³)` to build, `O(n³)` to
+//! then conjugated by `diag((-1)^m)` to our basis (docs/architecture.md, "Conventions"). Cost `O(n³)` to build, `O(n³)` to
 //! apply (`Σ (2l+1)²`); meant for bands ≤ 8 per frame, correct (tested) to 20.
 //!
 //! Zonal vectors never need this: use [`crate::zonal::rotate_zh`] (paper 003 eq. 15).
