@@ -16,8 +16,9 @@ use crate::compiler::Compiler;
 use crate::error::GraphError;
 use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate};
 use crate::graph::{External, RenderGraph};
-use crate::handle::{Buffer, Handle, Image, ResourceId};
+use crate::handle::ResourceId;
 use crate::plan::{Plan, PlannedPass, ResourceKind, Usage};
+use crate::raw::RawContext;
 use crate::resource::AnyDesc;
 use crate::work::{Bound, ComputeWork, Draw, RasterWork, TransferOp, Work};
 
@@ -75,33 +76,6 @@ pub enum ExecuteError {
         /// Attachment height.
         attachment_height: u32,
     },
-}
-
-/// What a raw pass gets: the device, the command buffer and the graph's resources.
-pub struct RawContext<'a> {
-    /// The device.
-    pub device: &'a Device,
-    /// The command buffer being recorded.
-    pub cb: vk::CommandBuffer,
-    resources: &'a [Option<GpuResource>],
-}
-
-impl RawContext<'_> {
-    /// The image and view behind a handle (any version).
-    pub fn image(&self, handle: &Handle<Image>) -> Option<(vk::Image, vk::ImageView)> {
-        match self.resources.get(handle.id.0 as usize).copied().flatten() {
-            Some(GpuResource::Image { image, view }) => Some((image, view)),
-            _ => None,
-        }
-    }
-
-    /// The buffer behind a handle (any version).
-    pub fn buffer(&self, handle: &Handle<Buffer>) -> Option<vk::Buffer> {
-        match self.resources.get(handle.id.0 as usize).copied().flatten() {
-            Some(GpuResource::Buffer(b)) => Some(b),
-            _ => None,
-        }
-    }
 }
 
 /// The transients of one plan for one frame slot: memory blocks and the objects bound into them.
@@ -890,11 +864,7 @@ impl Executor {
                     Ok(())
                 }
                 Work::Raw(f) => {
-                    let mut ctx = RawContext {
-                        device: &self.device,
-                        cb: pass_cb,
-                        resources: &objects,
-                    };
+                    let mut ctx = RawContext::new(&self.device, pass_cb, &objects);
                     f(&mut ctx).map_err(ExecuteError::from)
                 }
             };
