@@ -2,81 +2,30 @@
 //! with its barriers, a debug label and a GPU timestamp scope into the caller's command buffer.
 
 use std::collections::HashMap;
-use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
 use shine_gpu::{
-    ComputePipeline, Descriptor, DescriptorArena, Device, GraphicsPipeline, GraphicsPipelineDesc,
-    MemoryBlock, PipelineLayout, ShaderDesc, TimestampPool, vk,
+    ComputePipeline, Descriptor, DescriptorArena, Device, GraphicsPipeline, MemoryBlock,
+    PipelineLayout, vk,
 };
 
 use crate::alias::{HeapClass, MemoryNeeds};
 use crate::barrier::Barrier;
 use crate::compiler::Compiler;
-use crate::error::GraphError;
+use crate::error::ExecuteError;
 use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate};
 use crate::graph::{External, RenderGraph};
 use crate::handle::ResourceId;
+use crate::pipelines::PipelineCache;
 use crate::plan::{Plan, PlannedPass, ResourceKind, Usage};
 use crate::raw::RawContext;
 use crate::resource::AnyDesc;
+use crate::timing::{PassTiming, SlotTimestamps};
 use crate::work::{Bound, ComputeWork, Draw, RasterWork, TransferOp, Work};
-
-/// Timestamp scopes one frame may hold (one per pass).
-const SCOPES_PER_FRAME: u32 = 512;
 
 /// Transient sets kept per frame slot for plans seen recently; older ones are destroyed (after a
 /// device wait).
 const KEPT_TRANSIENT_SETS: usize = 8;
-
-/// GPU time of one executed pass.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PassTiming {
-    /// The pass name.
-    pub name: String,
-    /// Start in ns, relative to the first pass of the frame.
-    pub begin_ns: f64,
-    /// End in ns, same origin.
-    pub end_ns: f64,
-    /// The frame number.
-    pub frame: u64,
-}
-
-/// Why a frame could not be executed.
-#[derive(Debug, thiserror::Error)]
-pub enum ExecuteError {
-    /// The graph does not compile.
-    #[error(transparent)]
-    Graph(#[from] GraphError),
-    /// A Vulkan operation failed.
-    #[error(transparent)]
-    Gpu(#[from] shine_gpu::Error),
-    /// An imported resource was declared without its Vulkan object.
-    #[error(
-        "imported resource `{0}` has no Vulkan object: import it with import_vk_* or import_gpu_*"
-    )]
-    MissingObject(String),
-    /// A raster pass's area does not lie inside its attachments.
-    #[error(
-        "raster pass `{pass}`: area {width}×{height} at ({x}, {y}) is outside its {attachment_width}×{attachment_height} attachments"
-    )]
-    RenderArea {
-        /// The pass.
-        pass: String,
-        /// Area origin x.
-        x: u32,
-        /// Area origin y.
-        y: u32,
-        /// Area width.
-        width: u32,
-        /// Area height.
-        height: u32,
-        /// Attachment width.
-        attachment_width: u32,
-        /// Attachment height.
-        attachment_height: u32,
-    },
-}
 
 /// The transients of one plan for one frame slot: memory blocks and the objects bound into them.
 /// Frames in flight use different slots, so they never share transient memory; a slot is reused
@@ -100,9 +49,7 @@ struct TemporalObject {
 /// Per-slot recording state: descriptor sets and timestamps of one frame in flight.
 struct FrameSlot {
     descriptors: DescriptorArena,
-    timestamps: TimestampPool,
-    /// The frame recorded with this slot whose timings were not read yet.
-    unread: Option<u64>,
+    timestamps: SlotTimestamps,
 }
 
 /// Runs render graphs on a device, frame after frame.
@@ -117,8 +64,7 @@ pub struct Executor {
     compiler: Compiler,
     slots: Vec<FrameSlot>,
     frame: u64,
-    compute_pipelines: HashMap<&'static str, ComputePipeline>,
-    graphics_pipelines: HashMap<String, GraphicsPipeline>,
+    pipelines: PipelineCache,
     transients: Vec<TransientSet>,
     temporal: HashMap<String, TemporalObject>,
     timings: Vec<PassTiming>,
@@ -131,44 +77,6 @@ impl std::fmt::Debug for Executor {
             .field("frames_in_flight", &self.slots.len())
             .finish_non_exhaustive()
     }
-}
-
-fn pipeline_key(desc: &GraphicsPipelineDesc) -> String {
-    format!(
-        "{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
-        desc.vertex.name,
-        desc.fragment.map(|f| f.name),
-        desc.vertex_buffers,
-        desc.topology,
-        desc.cull_mode,
-        desc.color_targets,
-        desc.depth,
-        desc.depth_bias
-    )
-}
-
-/// The compute pipeline of `shader`, created on first use.
-fn compute_pipeline<'a>(
-    device: &Device,
-    cache: &'a mut HashMap<&'static str, ComputePipeline>,
-    shader: &'static ShaderDesc,
-) -> Result<&'a ComputePipeline, ExecuteError> {
-    Ok(match cache.entry(shader.name) {
-        Entry::Occupied(e) => e.into_mut(),
-        Entry::Vacant(e) => e.insert(ComputePipeline::new(device, shader)?),
-    })
-}
-
-/// The graphics pipeline of `desc`, created on first use.
-fn graphics_pipeline<'a>(
-    device: &Device,
-    cache: &'a mut HashMap<String, GraphicsPipeline>,
-    desc: &GraphicsPipelineDesc,
-) -> Result<&'a GraphicsPipeline, ExecuteError> {
-    Ok(match cache.entry(pipeline_key(desc)) {
-        Entry::Occupied(e) => e.into_mut(),
-        Entry::Vacant(e) => e.insert(GraphicsPipeline::new(device, desc)?),
-    })
 }
 
 fn image_extent(plan: &Plan, id: ResourceId) -> vk::Extent3D {
@@ -550,8 +458,7 @@ impl Executor {
             .map(|_| {
                 Ok(FrameSlot {
                     descriptors: DescriptorArena::new(device),
-                    timestamps: TimestampPool::new(device, SCOPES_PER_FRAME)?,
-                    unread: None,
+                    timestamps: SlotTimestamps::new(device)?,
                 })
             })
             .collect::<Result<Vec<_>, shine_gpu::Error>>()?;
@@ -560,8 +467,7 @@ impl Executor {
             compiler: Compiler::new(),
             slots,
             frame: 0,
-            compute_pipelines: HashMap::new(),
-            graphics_pipelines: HashMap::new(),
+            pipelines: PipelineCache::default(),
             transients: Vec::new(),
             temporal: HashMap::new(),
             timings: Vec::new(),
@@ -759,11 +665,11 @@ impl Executor {
         for pass in &plan.passes {
             match &graph.works[pass.id.0 as usize] {
                 Work::Compute(c) => {
-                    compute_pipeline(&self.device, &mut self.compute_pipelines, c.shader)?;
+                    self.pipelines.compute(&self.device, c.shader)?;
                 }
                 Work::Raster(r) => {
                     check_area(&plan, pass, r)?;
-                    graphics_pipeline(&self.device, &mut self.graphics_pipelines, &r.pipeline)?;
+                    self.pipelines.graphics(&self.device, &r.pipeline)?;
                 }
                 Work::Declared | Work::Transfer(_) | Work::Raw(_) => {}
             }
@@ -797,12 +703,10 @@ impl Executor {
         }
 
         let slot = &mut self.slots[slot_index];
-        if let Some(frame) = slot.unread.take() {
-            self.timings.extend(read_timings(&slot.timestamps, frame)?);
-        }
+        self.timings.extend(slot.timestamps.take()?);
         slot.descriptors.reset()?;
         if let Some(cb) = cb {
-            slot.timestamps.reset(cb);
+            slot.timestamps.pool.reset(cb);
         }
         let mut host_timings = Vec::new();
         let start = std::time::Instant::now();
@@ -821,17 +725,18 @@ impl Executor {
             };
             recorder.barriers(&pass.barriers);
             if cb.is_some() {
-                slot.timestamps.begin(pass_cb, &pass.name)?;
+                slot.timestamps.pool.begin(pass_cb, &pass.name)?;
             }
             self.device.begin_label(pass_cb, &pass.name);
             let work = std::mem::replace(&mut graph.works[pass.id.0 as usize], Work::Declared);
             let recorded = match work {
                 Work::Declared => Ok(()),
                 // The pipelines were created above; an error here still closes the scopes.
-                Work::Compute(c) => {
-                    compute_pipeline(&self.device, &mut self.compute_pipelines, c.shader)
-                        .and_then(|p| recorder.compute(pass, &c, p, &mut slot.descriptors))
-                }
+                Work::Compute(c) => self
+                    .pipelines
+                    .compute(&self.device, c.shader)
+                    .map_err(ExecuteError::from)
+                    .and_then(|p| recorder.compute(pass, &c, p, &mut slot.descriptors)),
                 Work::Raster(r) => {
                     // Store ops follow from the plan: nothing for a read-only depth, don't-care
                     // at a transient's last use, store otherwise.
@@ -854,7 +759,9 @@ impl Executor {
                         };
                         (layout, store)
                     };
-                    graphics_pipeline(&self.device, &mut self.graphics_pipelines, &r.pipeline)
+                    self.pipelines
+                        .graphics(&self.device, &r.pipeline)
+                        .map_err(ExecuteError::from)
                         .and_then(|p| {
                             recorder.raster(pass, &r, p, &mut slot.descriptors, attachment)
                         })
@@ -870,7 +777,7 @@ impl Executor {
             };
             self.device.end_label(pass_cb);
             if cb.is_some() {
-                slot.timestamps.end(pass_cb)?;
+                slot.timestamps.pool.end(pass_cb)?;
             }
             recorded?;
             if let Some(commands) = own {
@@ -893,7 +800,7 @@ impl Executor {
                     objects: &objects,
                 }
                 .barriers(&plan.final_barriers);
-                slot.unread = Some(self.frame);
+                slot.timestamps.recorded(self.frame);
             }
             None => {
                 let mut commands = self.device.begin_commands()?;
@@ -915,16 +822,15 @@ impl Executor {
     /// Per-pass GPU times of every executed frame not reported yet, oldest first. Call only
     /// once those frames' submissions have completed.
     pub fn timings(&mut self) -> Result<Vec<PassTiming>, ExecuteError> {
-        let mut slots: Vec<&mut FrameSlot> = self
+        let mut unread: Vec<&mut SlotTimestamps> = self
             .slots
             .iter_mut()
-            .filter(|s| s.unread.is_some())
+            .map(|s| &mut s.timestamps)
+            .filter(|t| t.unread().is_some())
             .collect();
-        slots.sort_by_key(|s| s.unread);
-        for slot in slots {
-            if let Some(frame) = slot.unread.take() {
-                self.timings.extend(read_timings(&slot.timestamps, frame)?);
-            }
+        unread.sort_by_key(|t| t.unread());
+        for timestamps in unread {
+            self.timings.extend(timestamps.take()?);
         }
         Ok(std::mem::take(&mut self.timings))
     }
@@ -956,19 +862,6 @@ fn check_area(plan: &Plan, pass: &PlannedPass, work: &RasterWork) -> Result<(), 
         }
     }
     Ok(())
-}
-
-fn read_timings(pool: &TimestampPool, frame: u64) -> Result<Vec<PassTiming>, ExecuteError> {
-    Ok(pool
-        .read()?
-        .into_iter()
-        .map(|t| PassTiming {
-            name: t.name,
-            begin_ns: t.begin_ns,
-            end_ns: t.end_ns,
-            frame,
-        })
-        .collect())
 }
 
 impl Drop for Executor {
