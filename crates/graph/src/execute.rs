@@ -1,50 +1,25 @@
 //! Execution: compile (cached), create or reuse the graph's own resources, and record every pass
 //! with its barriers, a debug label and a GPU timestamp scope into the caller's command buffer.
 
-use std::collections::HashMap;
 use std::sync::Arc;
 
 use shine_gpu::{
-    ComputePipeline, Descriptor, DescriptorArena, Device, GraphicsPipeline, MemoryBlock,
-    PipelineLayout, vk,
+    ComputePipeline, Descriptor, DescriptorArena, Device, GraphicsPipeline, PipelineLayout, vk,
 };
 
-use crate::alias::{HeapClass, MemoryNeeds};
 use crate::barrier::Barrier;
 use crate::compiler::Compiler;
 use crate::error::ExecuteError;
-use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate};
-use crate::graph::{External, RenderGraph};
+use crate::gpu_resources::{DeviceMemory, GpuResource};
+use crate::graph::RenderGraph;
 use crate::handle::ResourceId;
+use crate::objects::GraphObjects;
 use crate::pipelines::PipelineCache;
-use crate::plan::{Plan, PlannedPass, ResourceKind, Usage};
+use crate::plan::{Plan, PlannedPass};
 use crate::raw::RawContext;
 use crate::resource::AnyDesc;
 use crate::timing::{PassTiming, SlotTimestamps};
 use crate::work::{Bound, ComputeWork, Draw, RasterWork, TransferOp, Work};
-
-/// Transient sets kept per frame slot for plans seen recently; older ones are destroyed (after a
-/// device wait).
-const KEPT_TRANSIENT_SETS: usize = 8;
-
-/// The transients of one plan for one frame slot: memory blocks and the objects bound into them.
-/// Frames in flight use different slots, so they never share transient memory; a slot is reused
-/// only once its previous frame has completed (the [`Executor`] contract).
-struct TransientSet {
-    plan: Arc<Plan>,
-    slot: usize,
-    /// Keeps the blocks allocated while the objects live.
-    _heaps: Vec<MemoryBlock>,
-    objects: Vec<(ResourceId, RawObject)>,
-}
-
-/// A temporal resource on the GPU.
-struct TemporalObject {
-    desc: AnyDesc,
-    usage: Usage,
-    object: RawObject,
-    _memory: MemoryBlock,
-}
 
 /// Per-slot recording state: descriptor sets and timestamps of one frame in flight.
 struct FrameSlot {
@@ -65,8 +40,7 @@ pub struct Executor {
     slots: Vec<FrameSlot>,
     frame: u64,
     pipelines: PipelineCache,
-    transients: Vec<TransientSet>,
-    temporal: HashMap<String, TemporalObject>,
+    objects: GraphObjects,
     timings: Vec<PassTiming>,
 }
 
@@ -468,8 +442,7 @@ impl Executor {
             slots,
             frame: 0,
             pipelines: PipelineCache::default(),
-            transients: Vec::new(),
-            temporal: HashMap::new(),
+            objects: GraphObjects::default(),
             timings: Vec::new(),
         })
     }
@@ -487,138 +460,6 @@ impl Executor {
     /// The compiler (plan cache and temporal history).
     pub fn compiler(&self) -> &Compiler {
         &self.compiler
-    }
-
-    /// Waits for the device, then destroys `objects`.
-    fn destroy_after_idle(&self, objects: Vec<RawObject>) -> Result<(), ExecuteError> {
-        if !objects.is_empty() {
-            self.device.wait_idle()?;
-            for o in objects {
-                o.destroy(&self.device);
-            }
-        }
-        Ok(())
-    }
-
-    /// The transients of `plan` for frame slot `slot`, created and bound into aliased memory on
-    /// first use.
-    fn transients_for(&mut self, plan: &Arc<Plan>, slot: usize) -> Result<usize, ExecuteError> {
-        if let Some(i) = self
-            .transients
-            .iter()
-            .position(|t| t.slot == slot && Arc::ptr_eq(&t.plan, plan))
-        {
-            // Most recently used last, so eviction takes the least recently used.
-            let set = self.transients.remove(i);
-            self.transients.push(set);
-            return Ok(self.transients.len() - 1);
-        }
-        if self.transients.len() >= KEPT_TRANSIENT_SETS * self.slots.len() {
-            let old = self.transients.remove(0);
-            // The objects go first, then (when `old` drops) the memory they were bound to.
-            self.destroy_after_idle(old.objects.into_iter().map(|(_, o)| o).collect())?;
-        }
-        let heaps = plan
-            .memory
-            .heaps
-            .iter()
-            .enumerate()
-            .map(|(i, h)| {
-                allocate(
-                    &self.device,
-                    &format!("graph heap {i}"),
-                    MemoryNeeds {
-                        size: h.size,
-                        alignment: h.alignment,
-                        type_bits: h.type_bits,
-                    },
-                    h.class == HeapClass::Buffers,
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let mut objects = Vec::new();
-        for p in &plan.memory.placements {
-            let Some(r) = plan.resource(p.resource) else {
-                continue;
-            };
-            let usage = match r.usage {
-                Usage::Image(u) => u.as_raw(),
-                Usage::Buffer(u) => u.as_raw(),
-            };
-            match RawObject::create(
-                &self.device,
-                &r.name,
-                &r.desc,
-                usage,
-                &heaps[p.heap],
-                p.offset,
-            ) {
-                Ok(o) => objects.push((p.resource, o)),
-                Err(e) => {
-                    self.destroy_after_idle(objects.into_iter().map(|(_, o)| o).collect())?;
-                    return Err(e.into());
-                }
-            }
-        }
-        self.transients.push(TransientSet {
-            plan: Arc::clone(plan),
-            slot,
-            _heaps: heaps,
-            objects,
-        });
-        Ok(self.transients.len() - 1)
-    }
-
-    /// Temporal resources of `plan`, (re)created when new or when their description changed.
-    fn ensure_temporal(&mut self, plan: &Plan) -> Result<(), ExecuteError> {
-        for r in &plan.resources {
-            let ResourceKind::Temporal(key) = &r.kind else {
-                continue;
-            };
-            // No declared pass touches it: nothing to create (usage 0 is invalid in Vulkan), and
-            // whatever is kept under the key stays.
-            let untouched = match r.usage {
-                Usage::Image(u) => u.is_empty(),
-                Usage::Buffer(u) => u.is_empty(),
-            };
-            if untouched
-                || self
-                    .temporal
-                    .get(key)
-                    .is_some_and(|t| t.desc == r.desc && t.usage == r.usage)
-            {
-                continue;
-            }
-            let (usage, needs) = match (r.desc, r.usage) {
-                (AnyDesc::Image(d), Usage::Image(u)) => (
-                    u.as_raw(),
-                    crate::MemoryRequirements::image(&DeviceMemory(&self.device), &d, u),
-                ),
-                (AnyDesc::Buffer(d), Usage::Buffer(u)) => (
-                    u.as_raw(),
-                    crate::MemoryRequirements::buffer(&DeviceMemory(&self.device), &d, u),
-                ),
-                _ => continue,
-            };
-            let memory = allocate(
-                &self.device,
-                key,
-                needs,
-                matches!(r.desc, AnyDesc::Buffer(_)),
-            )?;
-            let object = RawObject::create(&self.device, key, &r.desc, usage, &memory, 0)?;
-            let new = TemporalObject {
-                desc: r.desc,
-                usage: r.usage,
-                object,
-                _memory: memory,
-            };
-            if let Some(old) = self.temporal.insert(key.clone(), new) {
-                // The object goes first, then (when `old` drops) its memory.
-                self.destroy_after_idle(vec![old.object])?;
-            }
-        }
-        Ok(())
     }
 
     /// Compiles `graph` (cached while its shape is unchanged) and records it into `cb`, which
@@ -660,8 +501,10 @@ impl Executor {
     ) -> Result<(Arc<Plan>, Vec<PassTiming>), ExecuteError> {
         let plan = self.compiler.compile(&graph, &DeviceMemory(&self.device))?;
         let slot_index = (self.frame % self.slots.len() as u64) as usize;
-        let set = self.transients_for(&plan, slot_index)?;
-        self.ensure_temporal(&plan)?;
+        let set = self
+            .objects
+            .transients_for(&self.device, &plan, slot_index, self.slots.len())?;
+        self.objects.ensure_temporal(&self.device, &plan)?;
         for pass in &plan.passes {
             match &graph.works[pass.id.0 as usize] {
                 Work::Compute(c) => {
@@ -675,32 +518,7 @@ impl Executor {
             }
         }
 
-        let mut objects: Vec<Option<GpuResource>> = vec![None; plan.resources.len()];
-        for (id, o) in &self.transients[set].objects {
-            objects[id.0 as usize] = Some(o.0);
-        }
-        for r in &plan.resources {
-            let slot = &mut objects[r.id.0 as usize];
-            match &r.kind {
-                ResourceKind::Transient => {}
-                ResourceKind::Temporal(key) => {
-                    *slot = self
-                        .temporal
-                        .get(key)
-                        .filter(|t| t.desc == r.desc && t.usage == r.usage)
-                        .map(|t| t.object.0)
-                }
-                ResourceKind::Imported => {
-                    *slot = graph.externals[r.id.0 as usize].map(|e| match e {
-                        External::Image { image, view } => GpuResource::Image { image, view },
-                        External::Buffer(b) => GpuResource::Buffer(b),
-                    });
-                    if slot.is_none() && r.used {
-                        return Err(ExecuteError::MissingObject(r.name.clone()));
-                    }
-                }
-            }
-        }
+        let objects = self.objects.table(&plan, set, &graph.externals)?;
 
         let slot = &mut self.slots[slot_index];
         self.timings.extend(slot.timestamps.take()?);
@@ -870,14 +688,6 @@ impl Drop for Executor {
         // caller made itself. If waiting fails the device is lost and nothing can still be
         // using the objects.
         let _ = self.device.wait_idle();
-        for set in self.transients.drain(..) {
-            for (_, o) in set.objects {
-                o.destroy(&self.device);
-            }
-            // The set's memory blocks are freed here, after the objects bound to them.
-        }
-        for (_, t) in self.temporal.drain() {
-            t.object.destroy(&self.device);
-        }
+        self.objects.destroy(&self.device);
     }
 }

@@ -51,6 +51,7 @@ mod execute;
 mod gpu_resources;
 mod graph;
 mod handle;
+mod objects;
 mod pass;
 mod pipelines;
 mod plan;
