@@ -56,6 +56,7 @@ mod pass;
 mod pipelines;
 mod plan;
 mod raw;
+mod record;
 mod resource;
 mod temporal;
 mod timing;
