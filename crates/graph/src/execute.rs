@@ -153,11 +153,14 @@ impl Executor {
         let start = std::time::Instant::now();
         for (position, pass) in plan.passes.iter().enumerate() {
             // Serialized: a command buffer of its own for this pass.
-            let mut own = match cb {
-                Some(_) => None,
-                None => Some(self.device.begin_commands()?),
+            let (own, pass_cb) = match cb {
+                Some(cb) => (None, cb),
+                None => {
+                    let mut commands = self.device.begin_commands()?;
+                    let raw = commands.raw();
+                    (Some(commands), raw)
+                }
             };
-            let pass_cb = cb.or(own.as_mut().map(|c| c.raw())).unwrap_or_default();
             let recorder = Recorder::new(&self.device, pass_cb, &plan, &objects);
             recorder.barriers(&pass.barriers);
             if cb.is_some() {
