@@ -1,5 +1,9 @@
 //! Execution: compile (cached), create or reuse the graph's own resources, and record every pass
 //! with its barriers, a debug label and a GPU timestamp scope into the caller's command buffer.
+//!
+//! [`Executor`] drives a frame; the pieces it drives live beside it: the objects it keeps across
+//! frames in `objects`, its pipelines in `pipelines`, the recording of a pass in `record` and
+//! the reading of timestamps in `timing`.
 
 use std::sync::Arc;
 
@@ -18,7 +22,9 @@ use crate::work::Work;
 
 /// Per-slot recording state: descriptor sets and timestamps of one frame in flight.
 struct FrameSlot {
+    /// Descriptor sets of the slot's frame, reset when the slot is reused.
     descriptors: DescriptorArena,
+    /// One timestamp scope per pass of the slot's frame.
     timestamps: SlotTimestamps,
 }
 
@@ -32,10 +38,13 @@ struct FrameSlot {
 pub struct Executor {
     device: Device,
     compiler: Compiler,
+    /// One per frame in flight: frame `f` uses `slots[f % slots.len()]`.
     slots: Vec<FrameSlot>,
+    /// The number of the next frame.
     frame: u64,
     pipelines: PipelineCache,
     objects: GraphObjects,
+    /// Timings read from a slot before its reuse, not returned by [`Executor::timings`] yet.
     timings: Vec<PassTiming>,
 }
 

@@ -23,25 +23,33 @@ const KEPT_TRANSIENT_SETS: usize = 8;
 /// Frames in flight use different slots, so they never share transient memory; a slot is reused
 /// only once its previous frame has completed (the [`crate::Executor`] contract).
 struct TransientSet {
+    /// The plan whose placements the set follows (the same `Arc` while the plan is cached).
     plan: Arc<Plan>,
+    /// The frame slot using the set.
     slot: usize,
     /// Keeps the blocks allocated while the objects live.
     _heaps: Vec<MemoryBlock>,
+    /// The transient resources of the plan, each bound at its placement.
     objects: Vec<(ResourceId, RawObject)>,
 }
 
 /// A temporal resource on the GPU.
 struct TemporalObject {
+    /// The description it was created for: a change recreates it.
     desc: AnyDesc,
+    /// The usage it was created with: a change recreates it.
     usage: Usage,
     object: RawObject,
+    /// Keeps the block allocated while the object lives.
     _memory: MemoryBlock,
 }
 
 /// The graph's own objects: transient sets, most recently used last, and temporal resources.
 #[derive(Default)]
 pub(crate) struct GraphObjects {
+    /// At most [`KEPT_TRANSIENT_SETS`] per frame slot, least recently used first.
     transients: Vec<TransientSet>,
+    /// By the key of the temporal resource ([`ResourceKind::Temporal`]).
     temporal: HashMap<String, TemporalObject>,
 }
 

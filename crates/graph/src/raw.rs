@@ -15,6 +15,7 @@ pub struct RawContext<'a> {
     pub device: &'a Device,
     /// The command buffer being recorded.
     pub cb: vk::CommandBuffer,
+    /// The object behind each resource, indexed by resource id.
     resources: &'a [Option<GpuResource>],
 }
 

@@ -46,6 +46,7 @@ pub(crate) struct Recorder<'a> {
     device: &'a Device,
     cb: vk::CommandBuffer,
     plan: &'a Plan,
+    /// The object behind each resource of `plan`, indexed by resource id.
     objects: &'a [Option<GpuResource>],
 }
 
