@@ -7,10 +7,10 @@ use shine_gpu::{Blend, DescriptorKind, GraphicsPipelineDesc, ShaderDesc, vk};
 
 use crate::access::{BufferAccess, ImageAccess};
 use crate::error::GraphError;
-use crate::execute::RawContext;
 use crate::graph::{PassBuilder, RenderGraph};
 use crate::handle::{Buffer, Handle, Image, ResourceType};
 use crate::pass::PassKind;
+use crate::raw::RawContext;
 use crate::work::{
     Attachment, Bound, ColorLoad, ComputeWork, DepthLoad, Draw, RasterWork, TransferOp, Work,
 };

@@ -1,4 +1,5 @@
-//! Errors of graph declaration and compilation.
+//! Errors of the graph: [`GraphError`] for declaration and compilation, [`ExecuteError`] for
+//! running a frame on a device (which wraps the former).
 
 /// A render graph that cannot be compiled, and why.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
@@ -126,5 +127,41 @@ pub enum GraphError {
         binding: String,
         /// What is wrong.
         message: String,
+    },
+}
+
+/// Why a frame could not be executed.
+#[derive(Debug, thiserror::Error)]
+pub enum ExecuteError {
+    /// The graph does not compile.
+    #[error(transparent)]
+    Graph(#[from] GraphError),
+    /// A Vulkan operation failed.
+    #[error(transparent)]
+    Gpu(#[from] shine_gpu::Error),
+    /// An imported resource was declared without its Vulkan object.
+    #[error(
+        "imported resource `{0}` has no Vulkan object: import it with import_vk_* or import_gpu_*"
+    )]
+    MissingObject(String),
+    /// A raster pass's area does not lie inside its attachments.
+    #[error(
+        "raster pass `{pass}`: area {width}×{height} at ({x}, {y}) is outside its {attachment_width}×{attachment_height} attachments"
+    )]
+    RenderArea {
+        /// The pass.
+        pass: String,
+        /// Area origin x.
+        x: u32,
+        /// Area origin y.
+        y: u32,
+        /// Area width.
+        width: u32,
+        /// Area height.
+        height: u32,
+        /// Attachment width.
+        attachment_width: u32,
+        /// Attachment height.
+        attachment_height: u32,
     },
 }

@@ -1,134 +1,31 @@
 //! Execution: compile (cached), create or reuse the graph's own resources, and record every pass
 //! with its barriers, a debug label and a GPU timestamp scope into the caller's command buffer.
+//!
+//! [`Executor`] drives a frame; the pieces it drives live beside it: the objects it keeps across
+//! frames in `objects`, its pipelines in `pipelines`, the recording of a pass in `record` and
+//! the reading of timestamps in `timing`.
 
-use std::collections::HashMap;
-use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
-use shine_gpu::{
-    ComputePipeline, Descriptor, DescriptorArena, Device, GraphicsPipeline, GraphicsPipelineDesc,
-    MemoryBlock, PipelineLayout, ShaderDesc, TimestampPool, vk,
-};
+use shine_gpu::{DescriptorArena, Device, vk};
 
-use crate::alias::{HeapClass, MemoryNeeds};
-use crate::barrier::Barrier;
 use crate::compiler::Compiler;
-use crate::error::GraphError;
-use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate};
-use crate::graph::{External, RenderGraph};
-use crate::handle::{Buffer, Handle, Image, ResourceId};
-use crate::plan::{Plan, PlannedPass, ResourceKind, Usage};
-use crate::resource::AnyDesc;
-use crate::work::{Bound, ComputeWork, Draw, RasterWork, TransferOp, Work};
-
-/// Timestamp scopes one frame may hold (one per pass).
-const SCOPES_PER_FRAME: u32 = 512;
-
-/// Transient sets kept per frame slot for plans seen recently; older ones are destroyed (after a
-/// device wait).
-const KEPT_TRANSIENT_SETS: usize = 8;
-
-/// GPU time of one executed pass.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PassTiming {
-    /// The pass name.
-    pub name: String,
-    /// Start in ns, relative to the first pass of the frame.
-    pub begin_ns: f64,
-    /// End in ns, same origin.
-    pub end_ns: f64,
-    /// The frame number.
-    pub frame: u64,
-}
-
-/// Why a frame could not be executed.
-#[derive(Debug, thiserror::Error)]
-pub enum ExecuteError {
-    /// The graph does not compile.
-    #[error(transparent)]
-    Graph(#[from] GraphError),
-    /// A Vulkan operation failed.
-    #[error(transparent)]
-    Gpu(#[from] shine_gpu::Error),
-    /// An imported resource was declared without its Vulkan object.
-    #[error(
-        "imported resource `{0}` has no Vulkan object: import it with import_vk_* or import_gpu_*"
-    )]
-    MissingObject(String),
-    /// A raster pass's area does not lie inside its attachments.
-    #[error(
-        "raster pass `{pass}`: area {width}×{height} at ({x}, {y}) is outside its {attachment_width}×{attachment_height} attachments"
-    )]
-    RenderArea {
-        /// The pass.
-        pass: String,
-        /// Area origin x.
-        x: u32,
-        /// Area origin y.
-        y: u32,
-        /// Area width.
-        width: u32,
-        /// Area height.
-        height: u32,
-        /// Attachment width.
-        attachment_width: u32,
-        /// Attachment height.
-        attachment_height: u32,
-    },
-}
-
-/// What a raw pass gets: the device, the command buffer and the graph's resources.
-pub struct RawContext<'a> {
-    /// The device.
-    pub device: &'a Device,
-    /// The command buffer being recorded.
-    pub cb: vk::CommandBuffer,
-    resources: &'a [Option<GpuResource>],
-}
-
-impl RawContext<'_> {
-    /// The image and view behind a handle (any version).
-    pub fn image(&self, handle: &Handle<Image>) -> Option<(vk::Image, vk::ImageView)> {
-        match self.resources.get(handle.id.0 as usize).copied().flatten() {
-            Some(GpuResource::Image { image, view }) => Some((image, view)),
-            _ => None,
-        }
-    }
-
-    /// The buffer behind a handle (any version).
-    pub fn buffer(&self, handle: &Handle<Buffer>) -> Option<vk::Buffer> {
-        match self.resources.get(handle.id.0 as usize).copied().flatten() {
-            Some(GpuResource::Buffer(b)) => Some(b),
-            _ => None,
-        }
-    }
-}
-
-/// The transients of one plan for one frame slot: memory blocks and the objects bound into them.
-/// Frames in flight use different slots, so they never share transient memory; a slot is reused
-/// only once its previous frame has completed (the [`Executor`] contract).
-struct TransientSet {
-    plan: Arc<Plan>,
-    slot: usize,
-    /// Keeps the blocks allocated while the objects live.
-    _heaps: Vec<MemoryBlock>,
-    objects: Vec<(ResourceId, RawObject)>,
-}
-
-/// A temporal resource on the GPU.
-struct TemporalObject {
-    desc: AnyDesc,
-    usage: Usage,
-    object: RawObject,
-    _memory: MemoryBlock,
-}
+use crate::error::ExecuteError;
+use crate::gpu_resources::DeviceMemory;
+use crate::graph::RenderGraph;
+use crate::objects::GraphObjects;
+use crate::pipelines::PipelineCache;
+use crate::plan::Plan;
+use crate::record::{Recorder, check_area};
+use crate::timing::{PassTiming, SlotTimestamps};
+use crate::work::Work;
 
 /// Per-slot recording state: descriptor sets and timestamps of one frame in flight.
 struct FrameSlot {
+    /// Descriptor sets of the slot's frame, reset when the slot is reused.
     descriptors: DescriptorArena,
-    timestamps: TimestampPool,
-    /// The frame recorded with this slot whose timings were not read yet.
-    unread: Option<u64>,
+    /// One timestamp scope per pass of the slot's frame.
+    timestamps: SlotTimestamps,
 }
 
 /// Runs render graphs on a device, frame after frame.
@@ -141,12 +38,13 @@ struct FrameSlot {
 pub struct Executor {
     device: Device,
     compiler: Compiler,
+    /// One per frame in flight: frame `f` uses `slots[f % slots.len()]`.
     slots: Vec<FrameSlot>,
+    /// The number of the next frame.
     frame: u64,
-    compute_pipelines: HashMap<&'static str, ComputePipeline>,
-    graphics_pipelines: HashMap<String, GraphicsPipeline>,
-    transients: Vec<TransientSet>,
-    temporal: HashMap<String, TemporalObject>,
+    pipelines: PipelineCache,
+    objects: GraphObjects,
+    /// Timings read from a slot before its reuse, not returned by [`Executor::timings`] yet.
     timings: Vec<PassTiming>,
 }
 
@@ -159,416 +57,6 @@ impl std::fmt::Debug for Executor {
     }
 }
 
-fn pipeline_key(desc: &GraphicsPipelineDesc) -> String {
-    format!(
-        "{}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}|{:?}",
-        desc.vertex.name,
-        desc.fragment.map(|f| f.name),
-        desc.vertex_buffers,
-        desc.topology,
-        desc.cull_mode,
-        desc.color_targets,
-        desc.depth,
-        desc.depth_bias
-    )
-}
-
-/// The compute pipeline of `shader`, created on first use.
-fn compute_pipeline<'a>(
-    device: &Device,
-    cache: &'a mut HashMap<&'static str, ComputePipeline>,
-    shader: &'static ShaderDesc,
-) -> Result<&'a ComputePipeline, ExecuteError> {
-    Ok(match cache.entry(shader.name) {
-        Entry::Occupied(e) => e.into_mut(),
-        Entry::Vacant(e) => e.insert(ComputePipeline::new(device, shader)?),
-    })
-}
-
-/// The graphics pipeline of `desc`, created on first use.
-fn graphics_pipeline<'a>(
-    device: &Device,
-    cache: &'a mut HashMap<String, GraphicsPipeline>,
-    desc: &GraphicsPipelineDesc,
-) -> Result<&'a GraphicsPipeline, ExecuteError> {
-    Ok(match cache.entry(pipeline_key(desc)) {
-        Entry::Occupied(e) => e.into_mut(),
-        Entry::Vacant(e) => e.insert(GraphicsPipeline::new(device, desc)?),
-    })
-}
-
-fn image_extent(plan: &Plan, id: ResourceId) -> vk::Extent3D {
-    match plan.resource(id).map(|r| r.desc) {
-        Some(AnyDesc::Image(d)) => d.extent,
-        _ => vk::Extent3D::default(),
-    }
-}
-
-fn image_range(plan: &Plan, id: ResourceId) -> vk::ImageSubresourceRange {
-    match plan.resource(id).map(|r| r.desc) {
-        Some(AnyDesc::Image(d)) => d.full_range(),
-        _ => vk::ImageSubresourceRange::default(),
-    }
-}
-
-fn buffer_size(plan: &Plan, id: ResourceId) -> u64 {
-    match plan.resource(id).map(|r| r.desc) {
-        Some(AnyDesc::Buffer(d)) => d.size,
-        _ => 0,
-    }
-}
-
-/// Everything recording needs besides the pipelines.
-struct Recorder<'a> {
-    device: &'a Device,
-    cb: vk::CommandBuffer,
-    plan: &'a Plan,
-    objects: &'a [Option<GpuResource>],
-}
-
-impl Recorder<'_> {
-    fn image(&self, id: ResourceId) -> (vk::Image, vk::ImageView) {
-        match self.objects[id.0 as usize] {
-            Some(GpuResource::Image { image, view }) => (image, view),
-            _ => (vk::Image::null(), vk::ImageView::null()),
-        }
-    }
-
-    fn buffer(&self, id: ResourceId) -> vk::Buffer {
-        match self.objects[id.0 as usize] {
-            Some(GpuResource::Buffer(b)) => b,
-            _ => vk::Buffer::null(),
-        }
-    }
-
-    fn barriers(&self, barriers: &[Barrier]) {
-        if barriers.is_empty() {
-            return;
-        }
-        let mut images = Vec::new();
-        let mut buffers = Vec::new();
-        for b in barriers {
-            match self.objects[b.resource.0 as usize] {
-                Some(GpuResource::Image { image, .. }) => images.push(
-                    vk::ImageMemoryBarrier2::default()
-                        .src_stage_mask(b.src.stage)
-                        .src_access_mask(b.src.access)
-                        .dst_stage_mask(b.dst.stage)
-                        .dst_access_mask(b.dst.access)
-                        .old_layout(b.old_layout)
-                        .new_layout(b.new_layout)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .image(image)
-                        .subresource_range(image_range(self.plan, b.resource)),
-                ),
-                Some(GpuResource::Buffer(buffer)) => buffers.push(
-                    vk::BufferMemoryBarrier2::default()
-                        .src_stage_mask(b.src.stage)
-                        .src_access_mask(b.src.access)
-                        .dst_stage_mask(b.dst.stage)
-                        .dst_access_mask(b.dst.access)
-                        .src_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .dst_queue_family_index(vk::QUEUE_FAMILY_IGNORED)
-                        .buffer(buffer)
-                        .offset(0)
-                        .size(vk::WHOLE_SIZE),
-                ),
-                None => {}
-            }
-        }
-        let dependency = vk::DependencyInfo::default()
-            .image_memory_barriers(&images)
-            .buffer_memory_barriers(&buffers);
-        // SAFETY: `cb` is recording; every object belongs to this device and lives for the frame.
-        unsafe {
-            self.device
-                .raw()
-                .cmd_pipeline_barrier2(self.cb, &dependency)
-        };
-    }
-
-    /// The descriptors of `bindings`. An image is described in the layout the plan gives it
-    /// in `pass` (a sampled depth attachment is in DEPTH_STENCIL_READ_ONLY_OPTIMAL), which is
-    /// the binding's own layout otherwise.
-    fn descriptors(
-        &self,
-        pass: &PlannedPass,
-        bindings: &[(&'static str, Bound)],
-    ) -> Vec<(&'static str, Descriptor)> {
-        bindings
-            .iter()
-            .map(|(name, bound)| {
-                let d = match *bound {
-                    Bound::Sampler(s) => Descriptor::Sampler(s),
-                    Bound::Resource(id, bound_layout) => match self.objects[id.0 as usize] {
-                        Some(GpuResource::Image { view, .. }) => Descriptor::Image {
-                            view,
-                            layout: pass
-                                .resources
-                                .iter()
-                                .find(|r| r.resource == id)
-                                .map_or(bound_layout, |r| r.info.layout),
-                        },
-                        _ => Descriptor::Buffer {
-                            buffer: self.buffer(id),
-                            offset: 0,
-                            range: vk::WHOLE_SIZE,
-                        },
-                    },
-                };
-                (*name, d)
-            })
-            .collect()
-    }
-
-    fn push(&self, layout: &PipelineLayout, data: &[u8]) -> Result<(), ExecuteError> {
-        let (size, stages) = layout.push_constants;
-        if data.len() != size as usize {
-            return Err(shine_gpu::Error::Binding {
-                pipeline: layout.name.clone(),
-                message: format!(
-                    "push constants are {size} bytes in the shader, {} given",
-                    data.len()
-                ),
-            }
-            .into());
-        }
-        if size > 0 {
-            // SAFETY: the range matches the layout's push-constant range.
-            unsafe {
-                self.device
-                    .raw()
-                    .cmd_push_constants(self.cb, layout.raw, stages, 0, data)
-            };
-        }
-        Ok(())
-    }
-
-    fn compute(
-        &self,
-        pass: &PlannedPass,
-        work: &ComputeWork,
-        pipeline: &ComputePipeline,
-        arena: &mut DescriptorArena,
-    ) -> Result<(), ExecuteError> {
-        let raw = self.device.raw();
-        // SAFETY: `cb` is recording; the pipeline belongs to this device.
-        unsafe { raw.cmd_bind_pipeline(self.cb, vk::PipelineBindPoint::COMPUTE, pipeline.raw()) };
-        arena.bind(
-            self.cb,
-            vk::PipelineBindPoint::COMPUTE,
-            pipeline.layout(),
-            &self.descriptors(pass, &work.bindings),
-        )?;
-        self.push(pipeline.layout(), &work.push)?;
-        let [x, y, z] = work.shader.groups_for(work.threads);
-        // SAFETY: a compute pipeline and its sets are bound.
-        unsafe { raw.cmd_dispatch(self.cb, x, y, z) };
-        Ok(())
-    }
-
-    fn raster(
-        &self,
-        pass: &PlannedPass,
-        work: &RasterWork,
-        pipeline: &GraphicsPipeline,
-        arena: &mut DescriptorArena,
-        attachment: impl Fn(ResourceId) -> (vk::ImageLayout, vk::AttachmentStoreOp),
-    ) -> Result<(), ExecuteError> {
-        let raw = self.device.raw();
-        let first = work.colors.first().or(work.depth.as_ref());
-        let extent = first.map_or_else(vk::Extent3D::default, |a| {
-            image_extent(self.plan, a.resource)
-        });
-        let whole = vk::Rect2D {
-            offset: vk::Offset2D::default(),
-            extent: vk::Extent2D {
-                width: extent.width,
-                height: extent.height,
-            },
-        };
-        // Checked against every attachment before recording began (`check_area`).
-        let area = work.area.unwrap_or(whole);
-        let colors: Vec<vk::RenderingAttachmentInfo<'_>> = work
-            .colors
-            .iter()
-            .map(|a| {
-                let (layout, store) = attachment(a.resource);
-                vk::RenderingAttachmentInfo::default()
-                    .image_view(self.image(a.resource).1)
-                    .image_layout(layout)
-                    .load_op(a.load)
-                    .store_op(store)
-                    .clear_value(vk::ClearValue {
-                        color: vk::ClearColorValue { float32: a.clear },
-                    })
-            })
-            .collect();
-        let depth = work.depth.map(|a| {
-            let (layout, store) = attachment(a.resource);
-            vk::RenderingAttachmentInfo::default()
-                .image_view(self.image(a.resource).1)
-                .image_layout(layout)
-                .load_op(a.load)
-                .store_op(store)
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: a.clear[0],
-                        stencil: 0,
-                    },
-                })
-        });
-        let mut rendering = vk::RenderingInfo::default()
-            .render_area(area)
-            .layer_count(1)
-            .color_attachments(&colors);
-        if let Some(d) = depth.as_ref() {
-            rendering = rendering.depth_attachment(d);
-        }
-        let viewport = vk::Viewport {
-            x: area.offset.x as f32,
-            y: area.offset.y as f32,
-            width: area.extent.width as f32,
-            height: area.extent.height as f32,
-            min_depth: 0.0,
-            max_depth: 1.0,
-        };
-        // SAFETY: `cb` is recording outside rendering; attachments are in the planned layouts.
-        unsafe {
-            raw.cmd_begin_rendering(self.cb, &rendering);
-            raw.cmd_bind_pipeline(self.cb, vk::PipelineBindPoint::GRAPHICS, pipeline.raw());
-            raw.cmd_set_viewport(self.cb, 0, &[viewport]);
-            raw.cmd_set_scissor(self.cb, 0, &[area]);
-        }
-        let bound = arena
-            .bind(
-                self.cb,
-                vk::PipelineBindPoint::GRAPHICS,
-                pipeline.layout(),
-                &self.descriptors(pass, &work.bindings),
-            )
-            .map_err(ExecuteError::from)
-            .and_then(|()| self.push(pipeline.layout(), &work.push));
-        if bound.is_ok() {
-            let buffers: Vec<vk::Buffer> = work
-                .vertex_buffers
-                .iter()
-                .map(|&b| self.buffer(b))
-                .collect();
-            let offsets = vec![0; buffers.len()];
-            // SAFETY: the pipeline is bound inside rendering; buffers live for the frame.
-            unsafe {
-                if !buffers.is_empty() {
-                    raw.cmd_bind_vertex_buffers(self.cb, 0, &buffers, &offsets);
-                }
-                if let Some((index, index_type)) = work.index_buffer {
-                    raw.cmd_bind_index_buffer(self.cb, self.buffer(index), 0, index_type);
-                }
-                for draw in &work.draws {
-                    match *draw {
-                        Draw::Vertices { count, instances } => {
-                            raw.cmd_draw(self.cb, count, instances, 0, 0)
-                        }
-                        Draw::Indexed { count, instances } => {
-                            raw.cmd_draw_indexed(self.cb, count, instances, 0, 0, 0)
-                        }
-                    }
-                }
-            }
-        }
-        // SAFETY: rendering was begun above in this command buffer.
-        unsafe { raw.cmd_end_rendering(self.cb) };
-        bound
-    }
-
-    fn transfer(&self, op: TransferOp) {
-        let raw = self.device.raw();
-        let layer0 = |id: ResourceId| {
-            let range = image_range(self.plan, id);
-            vk::ImageSubresourceLayers {
-                aspect_mask: range.aspect_mask,
-                mip_level: 0,
-                base_array_layer: 0,
-                layer_count: 1,
-            }
-        };
-        let corner = |id: ResourceId| {
-            let e = image_extent(self.plan, id);
-            vk::Offset3D {
-                x: e.width as i32,
-                y: e.height as i32,
-                z: e.depth as i32,
-            }
-        };
-        let copy = |image: ResourceId| vk::BufferImageCopy {
-            buffer_offset: 0,
-            buffer_row_length: 0,
-            buffer_image_height: 0,
-            image_subresource: layer0(image),
-            image_offset: vk::Offset3D::default(),
-            image_extent: image_extent(self.plan, image),
-        };
-        let cb = self.cb;
-        // SAFETY: `cb` is recording outside rendering; the plan put every resource in the
-        // layout and scope of its transfer access.
-        unsafe {
-            match op {
-                TransferOp::CopyBuffer { src, dst } => {
-                    let size = buffer_size(self.plan, src).min(buffer_size(self.plan, dst));
-                    let region = vk::BufferCopy {
-                        src_offset: 0,
-                        dst_offset: 0,
-                        size,
-                    };
-                    raw.cmd_copy_buffer(cb, self.buffer(src), self.buffer(dst), &[region]);
-                }
-                TransferOp::CopyImageToBuffer { src, dst } => raw.cmd_copy_image_to_buffer(
-                    cb,
-                    self.image(src).0,
-                    vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                    self.buffer(dst),
-                    &[copy(src)],
-                ),
-                TransferOp::CopyBufferToImage { src, dst } => raw.cmd_copy_buffer_to_image(
-                    cb,
-                    self.buffer(src),
-                    self.image(dst).0,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &[copy(dst)],
-                ),
-                TransferOp::ClearImage { dst, color } => raw.cmd_clear_color_image(
-                    cb,
-                    self.image(dst).0,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &vk::ClearColorValue { float32: color },
-                    &[image_range(self.plan, dst)],
-                ),
-                TransferOp::FillBuffer { dst, value } => {
-                    raw.cmd_fill_buffer(cb, self.buffer(dst), 0, vk::WHOLE_SIZE, value)
-                }
-                TransferOp::Blit { src, dst, filter } => {
-                    let region = vk::ImageBlit {
-                        src_subresource: layer0(src),
-                        src_offsets: [vk::Offset3D::default(), corner(src)],
-                        dst_subresource: layer0(dst),
-                        dst_offsets: [vk::Offset3D::default(), corner(dst)],
-                    };
-                    raw.cmd_blit_image(
-                        cb,
-                        self.image(src).0,
-                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
-                        self.image(dst).0,
-                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                        &[region],
-                        filter,
-                    )
-                }
-            }
-        }
-    }
-}
-
 impl Executor {
     /// An executor for `device` with `frames_in_flight` (at least 1) recordings in flight.
     pub fn new(device: &Device, frames_in_flight: usize) -> Result<Self, ExecuteError> {
@@ -576,8 +64,7 @@ impl Executor {
             .map(|_| {
                 Ok(FrameSlot {
                     descriptors: DescriptorArena::new(device),
-                    timestamps: TimestampPool::new(device, SCOPES_PER_FRAME)?,
-                    unread: None,
+                    timestamps: SlotTimestamps::new(device)?,
                 })
             })
             .collect::<Result<Vec<_>, shine_gpu::Error>>()?;
@@ -586,10 +73,8 @@ impl Executor {
             compiler: Compiler::new(),
             slots,
             frame: 0,
-            compute_pipelines: HashMap::new(),
-            graphics_pipelines: HashMap::new(),
-            transients: Vec::new(),
-            temporal: HashMap::new(),
+            pipelines: PipelineCache::default(),
+            objects: GraphObjects::default(),
             timings: Vec::new(),
         })
     }
@@ -607,138 +92,6 @@ impl Executor {
     /// The compiler (plan cache and temporal history).
     pub fn compiler(&self) -> &Compiler {
         &self.compiler
-    }
-
-    /// Waits for the device, then destroys `objects`.
-    fn destroy_after_idle(&self, objects: Vec<RawObject>) -> Result<(), ExecuteError> {
-        if !objects.is_empty() {
-            self.device.wait_idle()?;
-            for o in objects {
-                o.destroy(&self.device);
-            }
-        }
-        Ok(())
-    }
-
-    /// The transients of `plan` for frame slot `slot`, created and bound into aliased memory on
-    /// first use.
-    fn transients_for(&mut self, plan: &Arc<Plan>, slot: usize) -> Result<usize, ExecuteError> {
-        if let Some(i) = self
-            .transients
-            .iter()
-            .position(|t| t.slot == slot && Arc::ptr_eq(&t.plan, plan))
-        {
-            // Most recently used last, so eviction takes the least recently used.
-            let set = self.transients.remove(i);
-            self.transients.push(set);
-            return Ok(self.transients.len() - 1);
-        }
-        if self.transients.len() >= KEPT_TRANSIENT_SETS * self.slots.len() {
-            let old = self.transients.remove(0);
-            // The objects go first, then (when `old` drops) the memory they were bound to.
-            self.destroy_after_idle(old.objects.into_iter().map(|(_, o)| o).collect())?;
-        }
-        let heaps = plan
-            .memory
-            .heaps
-            .iter()
-            .enumerate()
-            .map(|(i, h)| {
-                allocate(
-                    &self.device,
-                    &format!("graph heap {i}"),
-                    MemoryNeeds {
-                        size: h.size,
-                        alignment: h.alignment,
-                        type_bits: h.type_bits,
-                    },
-                    h.class == HeapClass::Buffers,
-                )
-            })
-            .collect::<Result<Vec<_>, _>>()?;
-        let mut objects = Vec::new();
-        for p in &plan.memory.placements {
-            let Some(r) = plan.resource(p.resource) else {
-                continue;
-            };
-            let usage = match r.usage {
-                Usage::Image(u) => u.as_raw(),
-                Usage::Buffer(u) => u.as_raw(),
-            };
-            match RawObject::create(
-                &self.device,
-                &r.name,
-                &r.desc,
-                usage,
-                &heaps[p.heap],
-                p.offset,
-            ) {
-                Ok(o) => objects.push((p.resource, o)),
-                Err(e) => {
-                    self.destroy_after_idle(objects.into_iter().map(|(_, o)| o).collect())?;
-                    return Err(e.into());
-                }
-            }
-        }
-        self.transients.push(TransientSet {
-            plan: Arc::clone(plan),
-            slot,
-            _heaps: heaps,
-            objects,
-        });
-        Ok(self.transients.len() - 1)
-    }
-
-    /// Temporal resources of `plan`, (re)created when new or when their description changed.
-    fn ensure_temporal(&mut self, plan: &Plan) -> Result<(), ExecuteError> {
-        for r in &plan.resources {
-            let ResourceKind::Temporal(key) = &r.kind else {
-                continue;
-            };
-            // No declared pass touches it: nothing to create (usage 0 is invalid in Vulkan), and
-            // whatever is kept under the key stays.
-            let untouched = match r.usage {
-                Usage::Image(u) => u.is_empty(),
-                Usage::Buffer(u) => u.is_empty(),
-            };
-            if untouched
-                || self
-                    .temporal
-                    .get(key)
-                    .is_some_and(|t| t.desc == r.desc && t.usage == r.usage)
-            {
-                continue;
-            }
-            let (usage, needs) = match (r.desc, r.usage) {
-                (AnyDesc::Image(d), Usage::Image(u)) => (
-                    u.as_raw(),
-                    crate::MemoryRequirements::image(&DeviceMemory(&self.device), &d, u),
-                ),
-                (AnyDesc::Buffer(d), Usage::Buffer(u)) => (
-                    u.as_raw(),
-                    crate::MemoryRequirements::buffer(&DeviceMemory(&self.device), &d, u),
-                ),
-                _ => continue,
-            };
-            let memory = allocate(
-                &self.device,
-                key,
-                needs,
-                matches!(r.desc, AnyDesc::Buffer(_)),
-            )?;
-            let object = RawObject::create(&self.device, key, &r.desc, usage, &memory, 0)?;
-            let new = TemporalObject {
-                desc: r.desc,
-                usage: r.usage,
-                object,
-                _memory: memory,
-            };
-            if let Some(old) = self.temporal.insert(key.clone(), new) {
-                // The object goes first, then (when `old` drops) its memory.
-                self.destroy_after_idle(vec![old.object])?;
-            }
-        }
-        Ok(())
     }
 
     /// Compiles `graph` (cached while its shape is unchanged) and records it into `cb`, which
@@ -780,127 +133,61 @@ impl Executor {
     ) -> Result<(Arc<Plan>, Vec<PassTiming>), ExecuteError> {
         let plan = self.compiler.compile(&graph, &DeviceMemory(&self.device))?;
         let slot_index = (self.frame % self.slots.len() as u64) as usize;
-        let set = self.transients_for(&plan, slot_index)?;
-        self.ensure_temporal(&plan)?;
+        let set = self
+            .objects
+            .transients_for(&self.device, &plan, slot_index, self.slots.len())?;
+        self.objects.ensure_temporal(&self.device, &plan)?;
         for pass in &plan.passes {
             match &graph.works[pass.id.0 as usize] {
                 Work::Compute(c) => {
-                    compute_pipeline(&self.device, &mut self.compute_pipelines, c.shader)?;
+                    self.pipelines.compute(&self.device, c.shader)?;
                 }
                 Work::Raster(r) => {
                     check_area(&plan, pass, r)?;
-                    graphics_pipeline(&self.device, &mut self.graphics_pipelines, &r.pipeline)?;
+                    self.pipelines.graphics(&self.device, &r.pipeline)?;
                 }
                 Work::Declared | Work::Transfer(_) | Work::Raw(_) => {}
             }
         }
 
-        let mut objects: Vec<Option<GpuResource>> = vec![None; plan.resources.len()];
-        for (id, o) in &self.transients[set].objects {
-            objects[id.0 as usize] = Some(o.0);
-        }
-        for r in &plan.resources {
-            let slot = &mut objects[r.id.0 as usize];
-            match &r.kind {
-                ResourceKind::Transient => {}
-                ResourceKind::Temporal(key) => {
-                    *slot = self
-                        .temporal
-                        .get(key)
-                        .filter(|t| t.desc == r.desc && t.usage == r.usage)
-                        .map(|t| t.object.0)
-                }
-                ResourceKind::Imported => {
-                    *slot = graph.externals[r.id.0 as usize].map(|e| match e {
-                        External::Image { image, view } => GpuResource::Image { image, view },
-                        External::Buffer(b) => GpuResource::Buffer(b),
-                    });
-                    if slot.is_none() && r.used {
-                        return Err(ExecuteError::MissingObject(r.name.clone()));
-                    }
-                }
-            }
-        }
+        let objects = self.objects.table(&plan, set, &graph.externals)?;
 
         let slot = &mut self.slots[slot_index];
-        if let Some(frame) = slot.unread.take() {
-            self.timings.extend(read_timings(&slot.timestamps, frame)?);
-        }
+        self.timings.extend(slot.timestamps.take()?);
         slot.descriptors.reset()?;
         if let Some(cb) = cb {
-            slot.timestamps.reset(cb);
+            slot.timestamps.pool.reset(cb);
         }
         let mut host_timings = Vec::new();
         let start = std::time::Instant::now();
         for (position, pass) in plan.passes.iter().enumerate() {
             // Serialized: a command buffer of its own for this pass.
-            let mut own = match cb {
-                Some(_) => None,
-                None => Some(self.device.begin_commands()?),
+            let (own, pass_cb) = match cb {
+                Some(cb) => (None, cb),
+                None => {
+                    let mut commands = self.device.begin_commands()?;
+                    let raw = commands.raw();
+                    (Some(commands), raw)
+                }
             };
-            let pass_cb = cb.or(own.as_mut().map(|c| c.raw())).unwrap_or_default();
-            let recorder = Recorder {
-                device: &self.device,
-                cb: pass_cb,
-                plan: &plan,
-                objects: &objects,
-            };
+            let recorder = Recorder::new(&self.device, pass_cb, &plan, &objects);
             recorder.barriers(&pass.barriers);
             if cb.is_some() {
-                slot.timestamps.begin(pass_cb, &pass.name)?;
+                slot.timestamps.pool.begin(pass_cb, &pass.name)?;
             }
             self.device.begin_label(pass_cb, &pass.name);
             let work = std::mem::replace(&mut graph.works[pass.id.0 as usize], Work::Declared);
-            let recorded = match work {
-                Work::Declared => Ok(()),
-                // The pipelines were created above; an error here still closes the scopes.
-                Work::Compute(c) => {
-                    compute_pipeline(&self.device, &mut self.compute_pipelines, c.shader)
-                        .and_then(|p| recorder.compute(pass, &c, p, &mut slot.descriptors))
-                }
-                Work::Raster(r) => {
-                    // Store ops follow from the plan: nothing for a read-only depth, don't-care
-                    // at a transient's last use, store otherwise.
-                    let attachment = |id: ResourceId| {
-                        let layout = pass
-                            .resources
-                            .iter()
-                            .find(|p| p.resource == id)
-                            .map_or(vk::ImageLayout::UNDEFINED, |p| p.info.layout);
-                        let last_use = plan
-                            .memory
-                            .placement(id)
-                            .is_some_and(|p| p.lifetime.1 == position);
-                        let store = if layout == vk::ImageLayout::DEPTH_STENCIL_READ_ONLY_OPTIMAL {
-                            vk::AttachmentStoreOp::NONE
-                        } else if last_use {
-                            vk::AttachmentStoreOp::DONT_CARE
-                        } else {
-                            vk::AttachmentStoreOp::STORE
-                        };
-                        (layout, store)
-                    };
-                    graphics_pipeline(&self.device, &mut self.graphics_pipelines, &r.pipeline)
-                        .and_then(|p| {
-                            recorder.raster(pass, &r, p, &mut slot.descriptors, attachment)
-                        })
-                }
-                Work::Transfer(op) => {
-                    recorder.transfer(op);
-                    Ok(())
-                }
-                Work::Raw(f) => {
-                    let mut ctx = RawContext {
-                        device: &self.device,
-                        cb: pass_cb,
-                        resources: &objects,
-                    };
-                    f(&mut ctx).map_err(ExecuteError::from)
-                }
-            };
+            // The pipelines were created above; an error here still closes the scopes.
+            let recorded = recorder.work(
+                pass,
+                position,
+                work,
+                &mut self.pipelines,
+                &mut slot.descriptors,
+            );
             self.device.end_label(pass_cb);
             if cb.is_some() {
-                slot.timestamps.end(pass_cb)?;
+                slot.timestamps.pool.end(pass_cb)?;
             }
             recorded?;
             if let Some(commands) = own {
@@ -916,24 +203,13 @@ impl Executor {
         }
         match cb {
             Some(cb) => {
-                Recorder {
-                    device: &self.device,
-                    cb,
-                    plan: &plan,
-                    objects: &objects,
-                }
-                .barriers(&plan.final_barriers);
-                slot.unread = Some(self.frame);
+                Recorder::new(&self.device, cb, &plan, &objects).barriers(&plan.final_barriers);
+                slot.timestamps.recorded(self.frame);
             }
             None => {
                 let mut commands = self.device.begin_commands()?;
-                Recorder {
-                    device: &self.device,
-                    cb: commands.raw(),
-                    plan: &plan,
-                    objects: &objects,
-                }
-                .barriers(&plan.final_barriers);
+                Recorder::new(&self.device, commands.raw(), &plan, &objects)
+                    .barriers(&plan.final_barriers);
                 self.device.submit(commands)?.wait()?;
             }
         }
@@ -945,60 +221,18 @@ impl Executor {
     /// Per-pass GPU times of every executed frame not reported yet, oldest first. Call only
     /// once those frames' submissions have completed.
     pub fn timings(&mut self) -> Result<Vec<PassTiming>, ExecuteError> {
-        let mut slots: Vec<&mut FrameSlot> = self
+        let mut unread: Vec<&mut SlotTimestamps> = self
             .slots
             .iter_mut()
-            .filter(|s| s.unread.is_some())
+            .map(|s| &mut s.timestamps)
+            .filter(|t| t.unread().is_some())
             .collect();
-        slots.sort_by_key(|s| s.unread);
-        for slot in slots {
-            if let Some(frame) = slot.unread.take() {
-                self.timings.extend(read_timings(&slot.timestamps, frame)?);
-            }
+        unread.sort_by_key(|t| t.unread());
+        for timestamps in unread {
+            self.timings.extend(timestamps.take()?);
         }
         Ok(std::mem::take(&mut self.timings))
     }
-}
-
-/// A raster pass's area ([`crate::RasterPass::area`]) must lie inside every attachment.
-fn check_area(plan: &Plan, pass: &PlannedPass, work: &RasterWork) -> Result<(), ExecuteError> {
-    let Some(area) = work.area else {
-        return Ok(());
-    };
-    let attachments = work.colors.iter().chain(work.depth.as_ref());
-    for a in attachments {
-        let extent = image_extent(plan, a.resource);
-        let (x, y) = (area.offset.x.max(0) as u32, area.offset.y.max(0) as u32);
-        let inside = area.offset.x >= 0
-            && area.offset.y >= 0
-            && u64::from(x) + u64::from(area.extent.width) <= u64::from(extent.width)
-            && u64::from(y) + u64::from(area.extent.height) <= u64::from(extent.height);
-        if !inside {
-            return Err(ExecuteError::RenderArea {
-                pass: pass.name.clone(),
-                x,
-                y,
-                width: area.extent.width,
-                height: area.extent.height,
-                attachment_width: extent.width,
-                attachment_height: extent.height,
-            });
-        }
-    }
-    Ok(())
-}
-
-fn read_timings(pool: &TimestampPool, frame: u64) -> Result<Vec<PassTiming>, ExecuteError> {
-    Ok(pool
-        .read()?
-        .into_iter()
-        .map(|t| PassTiming {
-            name: t.name,
-            begin_ns: t.begin_ns,
-            end_ns: t.end_ns,
-            frame,
-        })
-        .collect())
 }
 
 impl Drop for Executor {
@@ -1007,14 +241,6 @@ impl Drop for Executor {
         // caller made itself. If waiting fails the device is lost and nothing can still be
         // using the objects.
         let _ = self.device.wait_idle();
-        for set in self.transients.drain(..) {
-            for (_, o) in set.objects {
-                o.destroy(&self.device);
-            }
-            // The set's memory blocks are freed here, after the objects bound to them.
-        }
-        for (_, t) in self.temporal.drain() {
-            t.object.destroy(&self.device);
-        }
+        self.objects.destroy(&self.device);
     }
 }

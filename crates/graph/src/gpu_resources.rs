@@ -186,3 +186,17 @@ pub(crate) fn allocate(
     };
     MemoryBlock::new(device, name, requirements, MemoryLocation::GpuOnly, linear)
 }
+
+/// Waits for the device, then destroys `objects` (nothing to wait for when there are none).
+pub(crate) fn destroy_after_idle(
+    device: &Device,
+    objects: Vec<RawObject>,
+) -> Result<(), shine_gpu::Error> {
+    if !objects.is_empty() {
+        device.wait_idle()?;
+        for o in objects {
+            o.destroy(device);
+        }
+    }
+    Ok(())
+}

@@ -38,6 +38,7 @@
 //! assert_eq!(barrier.new_layout, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL);
 //! println!("{}", plan.dump().dot);
 //! ```
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 mod access;
 mod alias;
@@ -51,10 +52,15 @@ mod execute;
 mod gpu_resources;
 mod graph;
 mod handle;
+mod objects;
 mod pass;
+mod pipelines;
 mod plan;
+mod raw;
+mod record;
 mod resource;
 mod temporal;
+mod timing;
 mod work;
 
 pub use access::{AccessInfo, AnyAccess, BufferAccess, ImageAccess};
@@ -63,13 +69,15 @@ pub use barrier::{Barrier, Scope};
 pub use builders::{ComputePass, RasterPass};
 pub use compiler::Compiler;
 pub use dump::PlanDump;
-pub use error::GraphError;
-pub use execute::{ExecuteError, Executor, PassTiming, RawContext};
+pub use error::{ExecuteError, GraphError};
+pub use execute::Executor;
 pub use gpu_resources::GpuResource;
 pub use graph::{History, PassBuilder, RenderGraph};
 pub use handle::{Buffer, Handle, Image, ResourceId, ResourceType};
 pub use pass::{PassId, PassKind, UpdateRate};
 pub use plan::{PassResource, Plan, PlannedPass, PlannedResource, ResourceKind, Usage};
+pub use raw::RawContext;
 pub use resource::{AnyDesc, BufferDesc, BufferImport, ExternalState, ImageDesc, ImageImport};
 pub use shine_gpu::vk;
+pub use timing::PassTiming;
 pub use work::{ColorLoad, DepthLoad};

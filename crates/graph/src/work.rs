@@ -4,8 +4,8 @@ use std::fmt;
 
 use shine_gpu::{GraphicsPipelineDesc, ShaderDesc, vk};
 
-use crate::execute::RawContext;
 use crate::handle::ResourceId;
+use crate::raw::RawContext;
 
 /// What a shader binding points at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

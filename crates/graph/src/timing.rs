@@ -1,0 +1,67 @@
+//! GPU timing of passes: [`PassTiming`], and the timestamp scopes of one frame slot, which are
+//! read back only once the frame recorded into them has completed.
+
+use shine_gpu::{Device, TimestampPool};
+
+/// Timestamp scopes one frame may hold (one per pass).
+const SCOPES_PER_FRAME: u32 = 512;
+
+/// GPU time of one executed pass.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PassTiming {
+    /// The pass name.
+    pub name: String,
+    /// Start in ns, relative to the first pass of the frame.
+    pub begin_ns: f64,
+    /// End in ns, same origin.
+    pub end_ns: f64,
+    /// The frame number.
+    pub frame: u64,
+}
+
+/// The timestamp scopes of one frame slot and the frame they hold until it is read.
+pub(crate) struct SlotTimestamps {
+    /// One scope per pass of the frame recorded with this slot.
+    pub pool: TimestampPool,
+    /// The frame recorded with this slot whose timings were not read yet.
+    unread: Option<u64>,
+}
+
+impl SlotTimestamps {
+    /// Scopes for one frame, holding none yet.
+    pub fn new(device: &Device) -> Result<Self, shine_gpu::Error> {
+        Ok(Self {
+            pool: TimestampPool::new(device, SCOPES_PER_FRAME)?,
+            unread: None,
+        })
+    }
+
+    /// The scopes now hold `frame`'s passes, to be read by [`SlotTimestamps::take`].
+    pub fn recorded(&mut self, frame: u64) {
+        self.unread = Some(frame);
+    }
+
+    /// The frame whose timings wait to be read, if any.
+    pub fn unread(&self) -> Option<u64> {
+        self.unread
+    }
+
+    /// The pass timings of the unread frame (none when there is none). That frame must have
+    /// completed; it counts as read afterwards, even when reading fails.
+    pub fn take(&mut self) -> Result<Vec<PassTiming>, shine_gpu::Error> {
+        let Some(frame) = self.unread.take() else {
+            return Ok(Vec::new());
+        };
+        Ok(self
+            .pool
+            .read()?
+            .into_iter()
+            .map(|t| PassTiming {
+                name: t.name,
+                begin_ns: t.begin_ns,
+                end_ns: t.end_ns,
+                frame,
+            })
+            .collect())
+    }
+}
