@@ -19,12 +19,14 @@ pub mod glb_writer;
 mod load;
 pub mod proxies;
 mod scene;
+mod types;
 
 pub use error::{Error, Result};
 pub use load::{
     DEFAULT_SUN_DIRECTION, DEFAULT_SUN_LUX, DEFAULT_YFOV, SUPPORTED_EXTENSIONS, load, load_slice,
 };
-pub use scene::{
+pub use scene::Scene;
+pub use types::{
     Aabb, Camera, Instance, Light, LightKind, Material, Mesh, NO_TEXTURE, Node, Primitive,
-    Projection, Scene, Texture, Transform,
+    Projection, Texture, Transform,
 };

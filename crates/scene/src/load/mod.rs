@@ -37,8 +37,9 @@ use crate::animation::{Animation, Channel, Interpolation, Property};
 use crate::environment::{self, Environment};
 use crate::error::{Error, Result};
 use crate::proxies::{self, NodeProxies, ProxySource};
-use crate::scene::{
-    Aabb, Camera, Light, LightKind, Material, Mesh, NO_TEXTURE, Node, Primitive, Projection, Scene,
+use crate::scene::Scene;
+use crate::types::{
+    Aabb, Camera, Light, LightKind, Material, Mesh, NO_TEXTURE, Node, Primitive, Projection,
     Texture, Transform,
 };
 use accessor::Buffers;
