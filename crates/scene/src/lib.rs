@@ -9,6 +9,7 @@
 //!   GPU and refittable after animation.
 //! - [`proxies`]: proxy spheres for dynamic objects (paper 002).
 //! - [`animation`]: node animation evaluated at any time.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod animation;
 pub mod builtin;
