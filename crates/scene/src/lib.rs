@@ -1,6 +1,6 @@
 //! shine-scene: everything the engine needs to know about a scene, as plain data. No GPU.
 //!
-//! - [`load`] / [`load_slice`]: glTF 2.0 (`.gltf` + `.bin`, `.glb`, data URIs) into a [`Scene`]
+//! - [`load()`] / [`load_slice`]: glTF 2.0 (`.gltf` + `.bin`, `.glb`, data URIs) into a [`Scene`]
 //!   of flat arrays: meshes, instances, materials, RGBA8 textures, lights, cameras,
 //!   animations, environment, proxy spheres, and the warnings met on the way.
 //! - [`builtin`]: the procedural scenes `cornell-box`, `spheres` and `room`, written as GLB by

@@ -30,7 +30,7 @@ pub struct Scene {
     /// Decoded textures.
     pub textures: Vec<Texture>,
     /// Lights in world space at rest. Never empty when the scene has no environment: a default
-    /// sun is added (see [`crate::load`]).
+    /// sun is added (see [`crate::load()`]).
     pub lights: Vec<Light>,
     /// Cameras; never empty (a default camera framing the scene is added when needed). The
     /// first one is the one to render with.
