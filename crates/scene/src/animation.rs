@@ -6,9 +6,9 @@
 //! `CUBICSPLINE` evaluates the Hermite spline from the in/out tangents. Rotations are
 //! renormalised. Morph-target weights are not animated (the loader warns about them).
 
-use glam::{Mat4, Quat, Vec4};
+use glam::{Quat, Vec4};
 
-use crate::scene::{Scene, Transform};
+use crate::types::Transform;
 
 /// Which part of a node's transform a channel drives.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -150,45 +150,6 @@ impl Animation {
     /// Whether a channel of this animation drives `node`.
     pub fn targets(&self, node: usize) -> bool {
         self.channels.iter().any(|c| c.node == node)
-    }
-}
-
-impl Scene {
-    /// Local transforms of all nodes at time `t` with every animation applied (later
-    /// animations win where two drive the same property).
-    pub fn local_transforms_at(&self, t: f32) -> Vec<Transform> {
-        let mut locals: Vec<Transform> = self.nodes.iter().map(|n| n.transform).collect();
-        for a in &self.animations {
-            a.apply(t, &mut locals);
-        }
-        locals
-    }
-
-    /// World matrices of all nodes at time `t` with every animation applied.
-    pub fn world_transforms_at(&self, t: f32) -> Vec<Mat4> {
-        let locals: Vec<Mat4> = self
-            .local_transforms_at(t)
-            .iter()
-            .map(Transform::matrix)
-            .collect();
-        self.world_from_locals(&locals)
-    }
-
-    /// Whether `node` or one of its ancestors is driven by an animation.
-    pub fn is_animated(&self, node: usize) -> bool {
-        let mut n = Some(node);
-        let mut steps = 0;
-        while let Some(i) = n {
-            if self.animations.iter().any(|a| a.targets(i)) {
-                return true;
-            }
-            n = self.nodes.get(i).and_then(|x| x.parent);
-            steps += 1;
-            if steps > self.nodes.len() {
-                break;
-            }
-        }
-        false
     }
 }
 

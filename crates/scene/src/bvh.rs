@@ -11,7 +11,8 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3};
 
-use crate::scene::{Aabb, Instance, Scene};
+use crate::scene::Scene;
+use crate::types::{Aabb, Instance};
 
 const BINS: usize = 16;
 const MAX_LEAF: usize = 8;

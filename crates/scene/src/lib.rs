@@ -1,6 +1,6 @@
 //! shine-scene: everything the engine needs to know about a scene, as plain data. No GPU.
 //!
-//! - [`load`] / [`load_slice`]: glTF 2.0 (`.gltf` + `.bin`, `.glb`, data URIs) into a [`Scene`]
+//! - [`load()`] / [`load_slice`]: glTF 2.0 (`.gltf` + `.bin`, `.glb`, data URIs) into a [`Scene`]
 //!   of flat arrays: meshes, instances, materials, RGBA8 textures, lights, cameras,
 //!   animations, environment, proxy spheres, and the warnings met on the way.
 //! - [`builtin`]: the procedural scenes `cornell-box`, `spheres` and `room`, written as GLB by
@@ -9,6 +9,7 @@
 //!   GPU and refittable after animation.
 //! - [`proxies`]: proxy spheres for dynamic objects (paper 002).
 //! - [`animation`]: node animation evaluated at any time.
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod animation;
 pub mod builtin;
@@ -19,12 +20,14 @@ pub mod glb_writer;
 mod load;
 pub mod proxies;
 mod scene;
+mod types;
 
 pub use error::{Error, Result};
 pub use load::{
     DEFAULT_SUN_DIRECTION, DEFAULT_SUN_LUX, DEFAULT_YFOV, SUPPORTED_EXTENSIONS, load, load_slice,
 };
-pub use scene::{
+pub use scene::Scene;
+pub use types::{
     Aabb, Camera, Instance, Light, LightKind, Material, Mesh, NO_TEXTURE, Node, Primitive,
-    Projection, Scene, Texture, Transform,
+    Projection, Texture, Transform,
 };

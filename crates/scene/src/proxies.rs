@@ -13,10 +13,10 @@
 //! ([`crate::Scene::proxies_at`]).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3};
+use glam::Vec3;
 use serde_json::{Value, json};
 
-use crate::scene::{Mesh, Scene};
+use crate::types::Mesh;
 
 /// The key in a node's `extras` holding explicit proxies.
 pub const EXTRAS_KEY: &str = "shine_proxies";
@@ -294,28 +294,6 @@ pub fn from_json(v: &Value) -> Result<Vec<ProxySphere>, String> {
             }
         })
         .collect()
-}
-
-impl Scene {
-    /// All proxy spheres in world space for the given world matrices (e.g. from
-    /// [`Scene::world_transforms_at`]). Radii scale by the node's largest axis scale.
-    pub fn proxies_at(&self, world: &[Mat4]) -> Vec<ProxySphere> {
-        let mut out = Vec::new();
-        for p in &self.proxies {
-            let Some(w) = world.get(p.node) else { continue };
-            let scale = w
-                .x_axis
-                .truncate()
-                .length()
-                .max(w.y_axis.truncate().length())
-                .max(w.z_axis.truncate().length());
-            out.extend(p.spheres.iter().map(|s| ProxySphere {
-                center: w.transform_point3(Vec3::from(s.center)).to_array(),
-                radius: s.radius * scale,
-            }));
-        }
-        out
-    }
 }
 
 #[cfg(test)]

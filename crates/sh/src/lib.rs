@@ -56,6 +56,7 @@
 //! | 8 | 0.140 | 0.066 | 0.062 |
 
 #![deny(missing_docs)]
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod aaf;
 pub mod basis;

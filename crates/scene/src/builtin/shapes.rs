@@ -3,7 +3,7 @@
 use glam::{Mat4, Vec2, Vec3};
 
 use crate::load::{VertexData, tangents_for};
-use crate::scene::{Aabb, Mesh, Primitive};
+use crate::types::{Aabb, Mesh, Primitive};
 
 /// Indexed triangles with normals and UVs, before upload or export.
 #[derive(Clone, Debug, Default, PartialEq)]
