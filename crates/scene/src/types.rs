@@ -1,5 +1,5 @@
 //! The plain data a scene is made of: geometry, materials, textures, lights, cameras and the
-//! node hierarchy, in glTF conventions (DESIGN §6: right-handed, +Y up, metres,
+//! node hierarchy, in glTF conventions (docs/architecture.md, "Conventions": right-handed, +Y up, metres,
 //! KHR_lights_punctual units).
 //!
 //! A leaf module: it depends on no other module of the crate, so [`crate::animation`],
