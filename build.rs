@@ -28,7 +28,8 @@ fn main() {
         std::process::exit(1);
     };
     let path = PathBuf::from(out_dir).join("shaders.rs");
-    if let Err(error) = std::fs::write(&path, shader_build::generate_rust(&output.shaders)) {
+    if let Err(error) = std::fs::write(&path, shader_build::codegen::generate_rust(&output.shaders))
+    {
         eprintln!("error: cannot write {}: {error}", path.display());
         std::process::exit(1);
     }
