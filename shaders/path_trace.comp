@@ -24,19 +24,6 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-// Bindings 0-3 (materials, srgb_textures, linear_textures, texture_sampler): surface.glsl.
-// GpuScene::vertices: four vec4 per vertex, (position, material bits), (normal, 0), tangent,
-// (uv, 0, 0).
-layout(set = 0, binding = 4, std430) readonly buffer Vertices {
-    vec4 v[];
-} vertices;
-layout(set = 0, binding = 5, std430) readonly buffer Indices {
-    uint i[];
-} indices;
-layout(set = 0, binding = 6, std430) readonly buffer Lights {
-    Light l[];
-} lights;
-DEFINE_LOAD_LIGHT(lights)
 layout(set = 0, binding = 11, std430) buffer Accumulation {
     vec4 a[];
 } accumulation;
@@ -52,94 +39,13 @@ layout(push_constant) uniform Push {
     vec4 pad;
 } push;
 
-const uint PT_JITTER = 1u;
-const uint PT_EMISSIVE_LIGHTING = 2u;
-const uint PT_LAMBERT_ONLY = 4u;
-const float PT_FAR = 1e30;
-
-uint rng_state;
-
-// PCG hash (Jarzynski & Olano 2020).
-uint pcg(uint v) {
-    uint state = v * 747796405u + 2891336453u;
-    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
-float rand() {
-    rng_state = pcg(rng_state);
-    return float(rng_state >> 8) * (1.0 / 16777216.0);
-}
-
-struct Vertex {
-    vec3 position;
-    vec3 geometric_normal;
-    Surface s;
-};
+#define PATH_LIGHT_COUNT push.config.y
+#define PATH_FLAGS push.config.z
+#include "path.glsl"
 
 vec3 unproject(vec2 ndc, float z) {
     vec4 p = push.inv_view_proj * vec4(ndc, z, 1.0);
     return p.xyz / p.w;
-}
-
-// The surface at a hit, its geometric normal turned towards the ray's origin.
-Vertex shade(TraceHit hit, vec3 dir) {
-    uint i0 = indices.i[3u * hit.triangle];
-    uint i1 = indices.i[3u * hit.triangle + 1u];
-    uint i2 = indices.i[3u * hit.triangle + 2u];
-    vec3 b = vec3(1.0 - hit.u - hit.v, hit.u, hit.v);
-    Vertex x;
-    x.position = b.x * vertices.v[4u * i0].xyz + b.y * vertices.v[4u * i1].xyz + b.z * vertices.v[4u * i2].xyz;
-    vec3 n = b.x * vertices.v[4u * i0 + 1u].xyz + b.y * vertices.v[4u * i1 + 1u].xyz + b.z * vertices.v[4u * i2 + 1u].xyz;
-    vec4 t = b.x * vertices.v[4u * i0 + 2u] + b.y * vertices.v[4u * i1 + 2u] + b.z * vertices.v[4u * i2 + 2u];
-    vec2 uv = b.x * vertices.v[4u * i0 + 3u].xy + b.y * vertices.v[4u * i1 + 3u].xy + b.z * vertices.v[4u * i2 + 3u].xy;
-    uint material = floatBitsToUint(vertices.v[4u * i0].w);
-    vec3 ng = normalize(trace_geometric_normal(hit.leaf_triangle));
-    bool front = dot(ng, dir) < 0.0;
-    x.geometric_normal = front ? ng : -ng;
-    // Tangent w is ±1 at every vertex: keep the sign.
-    t.w = t.w < 0.0 ? -1.0 : 1.0;
-    x.s = surface(material, n, t, uv, front);
-    return x;
-}
-
-vec3 brdf(Vertex x, vec3 l, vec3 v) {
-    if ((push.config.z & PT_LAMBERT_ONLY) != 0u) {
-        return x.s.base_color / BRDF_PI;
-    }
-    return brdf_metallic_roughness(x.s.normal, l, v, x.s.base_color, x.s.metallic, x.s.roughness);
-}
-
-// Next-event estimation: every punctual light, shadowed by a ray through the BVH.
-vec3 punctual_lights(Vertex x, vec3 v) {
-    vec3 sum = vec3(0.0);
-    vec3 origin = trace_offset(x.position, x.geometric_normal);
-    for (uint i = 0u; i < push.config.y; ++i) {
-        Light light = load_light(i);
-        vec3 l;
-        vec3 irradiance;
-        float d;
-        if (light.kind == LIGHT_DIRECTIONAL) {
-            l = -light.direction;
-            irradiance = light.color * light.intensity;
-            d = PT_FAR;
-        } else {
-            vec3 to_light = light.position - x.position;
-            d = length(to_light);
-            l = to_light / max(d, 1e-6);
-            irradiance = light_intensity(light, -l) * light_range_window(light, d) / max(d * d, 1e-8);
-        }
-        float nl = dot(x.s.normal, l);
-        if (nl <= 0.0 || all(equal(irradiance, vec3(0.0)))) {
-            continue;
-        }
-        // The shadow ray stops just short of the light (the offset origin is a little closer).
-        if (trace_occluded(origin, l, 0.0, d * (1.0 - 1e-5))) {
-            continue;
-        }
-        sum += brdf(x, l, v) * irradiance * nl;
-    }
-    return sum;
 }
 
 void main() {

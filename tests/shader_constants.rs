@@ -40,7 +40,7 @@ fn path_trace_flags_match_the_shader() {
         ("PT_EMISSIVE_LIGHTING", FLAG_EMISSIVE_LIGHTING),
         ("PT_LAMBERT_ONLY", FLAG_LAMBERT_ONLY),
     ] {
-        assert_eq!(glsl_uint("path_trace.comp", name), rust, "{name}");
+        assert_eq!(glsl_uint("include/path.glsl", name), rust, "{name}");
     }
 }
 

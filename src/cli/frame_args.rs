@@ -22,7 +22,7 @@ pub struct SettingsArgs {
     #[arg(long)]
     time: Option<f32>,
     /// GI techniques: `hvl` (default), `igi`, `proxy`, `none`, combined with commas
-    /// (`hvl,proxy`); later `aaf`.
+    /// (`hvl,proxy`), `aaf`.
     #[arg(long)]
     gi: Option<String>,
     /// Tonemapping: none, aces, pbr-neutral.

@@ -2,6 +2,7 @@
 
 use crate::capture::image_io::ImageIoError;
 use crate::gpu_scene::SceneUploadError;
+use crate::passes::aaf::AafError;
 use crate::passes::brdf_tables::BrdfTablesError;
 use crate::passes::gi_add::GiAddError;
 use crate::passes::hvl::HvlError;
@@ -39,6 +40,9 @@ pub enum RenderError {
     /// The proxy passes refused their inputs or parameters.
     #[error(transparent)]
     Proxy(#[from] ProxyError),
+    /// The AAF passes refused their parameters.
+    #[error(transparent)]
+    Aaf(#[from] AafError),
     /// The BRDF SH tables could not be built or uploaded.
     #[error(transparent)]
     BrdfTables(#[from] BrdfTablesError),

@@ -7,6 +7,7 @@
 //! its passes, return its output image). A technique that was not prepared has no state to
 //! declare with. `Renderer::declare_frame` composes them in one place.
 
+pub mod aaf;
 pub mod error;
 pub mod hvl;
 pub mod igi;

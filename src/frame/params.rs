@@ -2,6 +2,7 @@
 //! own. [`FrameParams::from_settings`] is the one conversion from [`Settings`]; nothing below
 //! the frame reads the settings.
 
+use crate::passes::aaf::AafParams;
 use crate::passes::composite::{Component, CompositeParams};
 use crate::passes::direct::ShadowParams;
 use crate::passes::hvl::HvlParams;
@@ -35,6 +36,8 @@ pub struct FrameParams {
     pub igi: Option<IgiParams>,
     /// Sphere proxies (paper 002), when the frame has them.
     pub proxy: Option<ProxySetup>,
+    /// Axis-aligned filtering of path-traced indirect light (paper 004), when the frame has it.
+    pub aaf: Option<AafParams>,
     /// The joint bilateral upsample of the receiver-resolution light.
     pub upsample: UpsampleParams,
     /// Exposure and tonemap of the composite.
@@ -112,6 +115,20 @@ impl FrameParams {
                 },
                 indirect_expansion: p.indirect_expansion,
                 fit_count: p.fit_count,
+            }),
+            aaf: gi.contains(GiTechnique::Aaf).then(|| {
+                let a = &settings.aaf;
+                AafParams {
+                    first_samples: a.samples,
+                    mu: a.mu,
+                    omega_h: a.omega_h,
+                    spp_min: a.spp_min,
+                    spp_max: a.spp_max,
+                    bounces: a.bounces,
+                    adaptive: a.adaptive,
+                    filter: a.filter,
+                    ..AafParams::default()
+                }
             }),
             upsample: UpsampleParams {
                 depth_sigma: settings.upsample.depth_epsilon,

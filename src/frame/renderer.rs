@@ -3,6 +3,7 @@
 //! Each frame declares its passes (docs/frame.md) into a fresh graph; the executor compiles it
 //! (cached while the shape is unchanged), records it and times every pass.
 
+use super::aaf::{AafInputs, AafTechnique};
 use super::error::RenderError;
 use super::hvl::{HvlInputs, HvlTechnique};
 use super::igi::{IgiInputs, IgiTechnique};
@@ -91,6 +92,8 @@ pub struct Renderer {
     hvl: HvlTechnique,
     /// Instant GI (paper 000).
     igi: IgiTechnique,
+    /// Axis-aligned filtering of path-traced indirect light (paper 004).
+    aaf: AafTechnique,
     /// Readback buffers of [`Renderer::render`].
     readback: Option<Readback>,
 }
@@ -154,6 +157,7 @@ impl Renderer {
             shadows: None,
             hvl: HvlTechnique::new(device),
             igi: IgiTechnique::new(device),
+            aaf: AafTechnique,
             readback: None,
         })
     }
@@ -356,6 +360,7 @@ impl Renderer {
         let shadows = self.shadows.insert(shadows);
         let hvl = p.hvl.map(|h| self.hvl.prepare(rg, h)).transpose()?;
         let igi = p.igi.map(|i| self.igi.prepare(rg, i)).transpose()?;
+        let aaf = p.aaf.map(|a| self.aaf.prepare(a)).transpose()?;
         let proxy = p
             .proxy
             .as_ref()
@@ -446,8 +451,25 @@ impl Renderer {
             )?),
             _ => None,
         };
-        // `igi,proxy`: both full-resolution indirect terms summed.
-        let indirect = match (upsampled, igi_full) {
+        let aaf_full = match aaf {
+            Some(aaf) => Some(aaf.declare(
+                rg,
+                &AafInputs {
+                    gbuffer: &g,
+                    scene: &handles,
+                    bvh: &scene.bvh,
+                    light_count,
+                    bounds: scene.gpu.bounds,
+                    camera: &camera,
+                    texture_sampler: self.linear.raw(),
+                },
+            )?),
+            None => None,
+        };
+        // `igi,proxy` and `aaf,proxy`: both full-resolution indirect terms summed (settings
+        // allow at most one of hvl, igi and aaf).
+        let full = igi_full.or(aaf_full);
+        let indirect = match (upsampled, full) {
             (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
             (a, b) => a.or(b),
         };

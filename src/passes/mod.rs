@@ -2,6 +2,7 @@
 //! to a [`crate::graph::RenderGraph`] and returning its output handles, with a CPU reference of
 //! the same computation for its GPU test where one exists.
 
+pub mod aaf;
 pub mod brdf_tables;
 pub mod composite;
 pub mod direct;

@@ -13,6 +13,7 @@
 //! # Ok(()) }
 //! ```
 
+pub mod aaf;
 pub mod hvl;
 pub mod igi;
 pub mod proxy;

@@ -20,17 +20,6 @@ pub enum SettingsError {
     /// A named choice (tonemap operator, GI technique, …) that shine does not know.
     #[error(transparent)]
     UnknownName(#[from] UnknownChoice),
-    /// A GI technique that a later issue adds, not usable yet.
-    #[error(
-        "GI technique `{name}` is not implemented yet: available now are {available} \
-         (combine them with commas, e.g. `--gi hvl`)"
-    )]
-    GiNotImplemented {
-        /// The planned technique that was asked for.
-        name: String,
-        /// The techniques that work today.
-        available: String,
-    },
     /// A GI list that is malformed: empty entry, duplicate, or `none` combined with others.
     #[error("invalid GI technique list `{list}`: {reason}")]
     GiList {

@@ -17,12 +17,10 @@ crate::choice::named_choice! {
         /// Sphere proxies under the environment light (paper 002): proxy-shadowed environment
         /// plus proxy indirect light.
         Proxy = "proxy",
+        /// Axis-aligned filtering of path-traced indirect light (paper 004).
+        Aaf = "aaf",
     }
 }
-
-/// Techniques that later issues add: named so that asking for one says "not implemented yet"
-/// rather than "unknown".
-const PLANNED_GI: [&str; 1] = ["aaf"];
 
 /// The name of the empty technique list: direct light only.
 const NO_GI: &str = "none";
@@ -88,12 +86,6 @@ impl FromStr for GiTechniques {
             if name == NO_GI {
                 return Err(invalid("`none` cannot be combined with other techniques"));
             }
-            if PLANNED_GI.contains(&name) {
-                return Err(SettingsError::GiNotImplemented {
-                    name: name.to_owned(),
-                    available: available_gi(),
-                });
-            }
             let technique = name.parse::<GiTechnique>().map_err(|_| UnknownChoice {
                 what: "GI technique",
                 name: name.to_owned(),
@@ -108,18 +100,10 @@ impl FromStr for GiTechniques {
     }
 }
 
-/// The technique names usable today, `none` included.
-fn available_gi() -> String {
-    let mut names: Vec<&str> = GiTechnique::ALL.iter().map(|t| t.name()).collect();
-    names.push(NO_GI);
-    names.join(", ")
-}
-
-/// Every technique name shine knows, planned ones included.
+/// Every technique name, `none` included.
 fn known_gi() -> String {
     let mut names: Vec<&str> = GiTechnique::ALL.iter().map(|t| t.name()).collect();
     names.push(NO_GI);
-    names.extend(PLANNED_GI);
     names.join(", ")
 }
 

@@ -37,6 +37,7 @@ pub use validate::{EXTENT, FRAMES, TIME};
 use serde::{Deserialize, Serialize};
 
 use crate::capture::tonemap::Tonemap;
+use crate::passes::aaf::AafParams;
 use crate::passes::composite::Component;
 use crate::passes::hvl::{GatherPath, RadiusHeuristic};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
@@ -76,6 +77,51 @@ pub struct Settings {
     pub igi: IgiSettings,
     /// Sphere-proxy soft shadows and indirect light under the environment (paper 002).
     pub proxy: ProxySettings,
+    /// Axis-aligned filtering of path-traced indirect light (paper 004).
+    pub aaf: AafSettings,
+}
+
+/// `[aaf]`: axis-aligned filtering of path-traced indirect light (paper 004,
+/// `src/passes/aaf.rs`). Defaults are the paper's.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct AafSettings {
+    /// Stratified samples per pixel of the first pass. Range 1..=1024, default 16.
+    pub samples: u32,
+    /// Filter scale μ (eq. 15, 21): larger narrows the filter and samples more. Range
+    /// 0.01..=100.0, default 0.9.
+    pub mu: f32,
+    /// Bandlimit Ω_h of the receiver's transfer function (eq. 18). Range 0.1..=100.0,
+    /// default 2.8 (Lambert).
+    pub omega_h: f32,
+    /// Lower clamp of the samples per pixel. Range 16..=1024, default 16.
+    pub spp_min: u32,
+    /// Upper clamp of the samples per pixel before the factor μ (the paper's 100μ).
+    /// Range 16..=10000, default 100.
+    pub spp_max: u32,
+    /// Path vertices after the receiver (1: one-bounce indirect). Range 1..=8, default 1.
+    pub bounces: u32,
+    /// The adaptive second pass (eq. 21); off: uniform sampling at `samples`. Default true.
+    pub adaptive: bool,
+    /// The screen-space filter; off: the unfiltered Monte-Carlo mean. Default true.
+    pub filter: bool,
+}
+
+impl Default for AafSettings {
+    /// The defaults of the AAF passes ([`AafParams::default`]).
+    fn default() -> Self {
+        let p = AafParams::default();
+        Self {
+            samples: p.first_samples,
+            mu: p.mu,
+            omega_h: p.omega_h,
+            spp_min: p.spp_min,
+            spp_max: p.spp_max,
+            bounces: p.bounces,
+            adaptive: p.adaptive,
+            filter: p.filter,
+        }
+    }
 }
 
 /// `[proxy]`: sphere proxies under the environment light (paper 002).
@@ -246,6 +292,7 @@ impl Default for Settings {
             upsample: UpsampleSettings::default(),
             igi: IgiSettings::default(),
             proxy: ProxySettings::default(),
+            aaf: AafSettings::default(),
         }
     }
 }
@@ -520,12 +567,7 @@ mod tests {
     fn gi_errors_are_clear() {
         let unknown = "hvl,foo".parse::<GiTechniques>().unwrap_err().to_string();
         assert!(unknown.contains("`foo`"), "{unknown}");
-        assert!(unknown.contains("hvl, igi, proxy, none, aaf"), "{unknown}");
-        let planned = "hvl,aaf".parse::<GiTechniques>().unwrap_err().to_string();
-        assert!(
-            planned.contains("`aaf` is not implemented yet"),
-            "{planned}"
-        );
+        assert!(unknown.contains("hvl, igi, proxy, aaf, none"), "{unknown}");
         for bad in ["", "hvl,", "none,hvl", "hvl,hvl"] {
             let message = bad.parse::<GiTechniques>().unwrap_err().to_string();
             assert!(
@@ -533,13 +575,36 @@ mod tests {
                 "{bad}: {message}"
             );
         }
-        let in_file = Settings::from_toml_str("gi = \"aaf\"")
+        let both = Settings::from_toml_str("gi = \"hvl,aaf\"")
             .unwrap_err()
             .to_string();
-        assert!(
-            in_file.contains("`aaf` is not implemented yet"),
-            "{in_file}"
-        );
+        assert!(both.contains("choose one"), "{both}");
+    }
+
+    #[test]
+    fn aaf_settings_are_checked() {
+        let aaf = Settings::from_toml_str("gi = \"aaf,proxy\"\n[aaf]\nmu = 2.0").unwrap();
+        assert!(aaf.gi.contains(GiTechnique::Aaf));
+        assert_eq!(aaf.aaf.mu, 2.0);
+        type Edit = fn(&mut Settings);
+        let cases: [(&str, &str, Edit); 5] = [
+            ("aaf.mu", "0.0", |s| s.aaf.mu = 0.0),
+            ("aaf.mu", "-1.0", |s| s.aaf.mu = -1.0),
+            ("aaf.spp_min", "8", |s| s.aaf.spp_min = 8),
+            ("aaf.omega_h", "0.0", |s| s.aaf.omega_h = 0.0),
+            ("aaf.spp_max", "8", |s| {
+                s.aaf.spp_max = 8;
+            }),
+        ];
+        for (field, value, edit) in cases {
+            let mut settings = Settings::default();
+            edit(&mut settings);
+            let message = settings.validate().unwrap_err().to_string();
+            assert!(
+                message.contains(&format!("`{field}` = {value}")),
+                "{field}: {message}"
+            );
+        }
     }
 
     #[test]

@@ -7,7 +7,7 @@ use std::ops::RangeInclusive;
 use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
-use crate::passes::{hvl, igi, proxy, receivers, rsm, shadows, upsample};
+use crate::passes::{aaf, hvl, igi, proxy, receivers, rsm, shadows, upsample};
 
 /// Output sides in pixels.
 pub const EXTENT: RangeInclusive<u32> = 1..=16384;
@@ -120,6 +120,7 @@ impl Settings {
         )?;
         check("proxy.fit_count", self.proxy.fit_count, &proxy::FIT_COUNT)?;
         self.validate_igi()?;
+        self.validate_aaf()?;
         Ok(())
     }
 
@@ -153,13 +154,28 @@ impl Settings {
                 ),
             });
         }
-        if self.gi.contains(GiTechnique::Igi) && self.gi.contains(GiTechnique::Hvl) {
+        let bounces = [GiTechnique::Hvl, GiTechnique::Igi, GiTechnique::Aaf]
+            .iter()
+            .filter(|&&t| self.gi.contains(t))
+            .count();
+        if bounces > 1 {
             return Err(SettingsError::GiList {
                 list: self.gi.to_string(),
-                reason: "`igi` and `hvl` both compute the one-bounce indirect light of the \
-                         primary light: choose one",
+                reason: "`hvl`, `igi` and `aaf` each compute the indirect light of the punctual \
+                         lights: choose one",
             });
         }
         Ok(())
+    }
+
+    /// The `[aaf]` checks of [`Settings::validate`].
+    fn validate_aaf(&self) -> Result<(), SettingsError> {
+        let a = &self.aaf;
+        check("aaf.samples", a.samples, &aaf::FIRST_SAMPLES)?;
+        check("aaf.mu", a.mu, &aaf::MU_RANGE)?;
+        check("aaf.omega_h", a.omega_h, &aaf::OMEGA_H_RANGE)?;
+        check("aaf.spp_min", a.spp_min, &aaf::SPP_MIN)?;
+        check("aaf.spp_max", a.spp_max, &aaf::SPP_MAX)?;
+        check("aaf.bounces", a.bounces, &aaf::BOUNCES)
     }
 }

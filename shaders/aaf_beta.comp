@@ -1,0 +1,51 @@
+// AAF filter width and sampling rate per pixel (paper 004 eq. 15, 16, 21; src/passes/aaf.rs):
+// from the first pass's nearest and farthest reflector distances and the pixel's world-space
+// footprint d. z_min is clamped from below (a fraction of the scene's size) and z_max to at
+// least z_min; the sample count is clamped to [spp_min, spp_max]. A pixel whose first samples
+// hit nothing takes no filter (beta = 0) and no further samples; a background pixel neither.
+// CPU twin: shine::reference::aaf::beta_cpu.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "aaf.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 1, std430) readonly buffer Depths {
+    vec2 z[];
+} depths;
+// x: beta (world units), y: samples per pixel.
+layout(set = 0, binding = 2, std430) buffer Filter {
+    vec2 f[];
+} filter_widths;
+
+// shine::passes::aaf::BetaPush (48 bytes).
+layout(push_constant) uniform Push {
+    uvec2 extent;
+    // d = linear depth * footprint.x + footprint.y.
+    vec2 footprint;
+    // x: Omega_h, y: alpha, z: mu, w: gamma.
+    vec4 paper;
+    // x: lower clamp of z_min, y: spp_min, z: spp_max, w: unused.
+    vec4 clamps;
+} push;
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, push.extent))) {
+        return;
+    }
+    uint p = pixel.y * push.extent.x + pixel.x;
+    float depth = imageLoad(gb_position, ivec2(pixel)).w;
+    vec2 z = depths.z[p];
+    if (depth == 0.0 || z.y == 0.0) {
+        filter_widths.f[p] = vec2(0.0, depth == 0.0 ? 0.0 : push.clamps.y);
+        return;
+    }
+    float d = depth * push.footprint.x + push.footprint.y;
+    float z_min = max(z.x, push.clamps.x);
+    float z_max = max(z.y, z_min);
+    float omega_r = aaf_filter_bandwidth(push.paper.x, z_min, d, push.paper.y, push.paper.z);
+    float n = aaf_samples_per_pixel(push.paper.x, z_min, z_max, d, push.paper.y, push.paper.z, push.paper.w);
+    filter_widths.f[p] = vec2(aaf_filter_width(omega_r), clamp(ceil(n), push.clamps.y, push.clamps.z));
+}

@@ -1,0 +1,126 @@
+// AAF screen-space filter (paper 004 §5, src/passes/aaf.rs): a separable gaussian of the
+// per-pixel mean incident radiance, standard deviation beta (world units, the aaf_beta pass) of
+// the CENTRE pixel, over world-space distances between the pixels' positions. A neighbour
+// counts only when its shading normal is within the normal threshold of the centre's (paper
+// 004: 10 degrees) and it lies within `plane_tolerance` pixel footprints of the centre's tangent
+// plane, so no light leaks across surfaces. `x` filters rows into `filtered`; `y` filters
+// columns and multiplies by the receiver's diffuse weight kd (brdf_indirect_weights) into the
+// indirect image. With `enabled` = 0 the mean passes through unfiltered (uniform Monte Carlo).
+// CPU twin: shine::reference::aaf::filter_cpu.
+//! variant x AAF_X=1
+//! variant y AAF_Y=1
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "brdf.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 1, rgba16f) readonly uniform image2D gb_normal;
+layout(set = 0, binding = 2, std430) readonly buffer Filter {
+    vec2 f[];
+} filter_widths;
+#ifdef AAF_X
+// rgb: sum of the samples' radiance, a: samples.
+layout(set = 0, binding = 3, std430) readonly buffer Sums {
+    vec4 s[];
+} sums;
+layout(set = 0, binding = 4, std430) buffer Filtered {
+    vec4 m[];
+} filtered;
+#else
+layout(set = 0, binding = 3, std430) readonly buffer Filtered {
+    vec4 m[];
+} filtered;
+layout(set = 0, binding = 4, rgba8) readonly uniform image2D gb_albedo;
+layout(set = 0, binding = 5, rgba8) readonly uniform image2D gb_material;
+layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D indirect;
+#endif
+
+// shine::passes::aaf::FilterPush (48 bytes).
+layout(push_constant) uniform Push {
+    // xyz: camera position; w: cos of the normal threshold.
+    vec4 camera;
+    uvec2 extent;
+    // d = linear depth * footprint.x + footprint.y.
+    vec2 footprint;
+    // Neighbours at most this far from the centre's tangent plane, in pixel footprints.
+    float plane_tolerance;
+    // Largest filter radius in pixels.
+    uint max_radius;
+    // 1: filter; 0: pass the mean through.
+    uint enabled;
+    uint pad;
+} push;
+
+vec3 mean_at(uint q) {
+#ifdef AAF_X
+    vec4 s = sums.s[q];
+    return s.w > 0.0 ? s.rgb / s.w : vec3(0.0);
+#else
+    return filtered.m[q].rgb;
+#endif
+}
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, push.extent))) {
+        return;
+    }
+    uint p = pixel.y * push.extent.x + pixel.x;
+    ivec2 ixy = ivec2(pixel);
+    vec4 position = imageLoad(gb_position, ixy);
+    vec3 result = mean_at(p);
+    float beta = filter_widths.f[p].x;
+    vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
+    if (push.enabled != 0u && position.w > 0.0 && beta > 0.0) {
+        float d = position.w * push.footprint.x + push.footprint.y;
+        uint radius = min(push.max_radius, uint(ceil(2.0 * beta / d)));
+#ifdef AAF_X
+        ivec2 axis = ivec2(1, 0);
+        int limit = int(push.extent.x);
+        int coordinate = ixy.x;
+#else
+        ivec2 axis = ivec2(0, 1);
+        int limit = int(push.extent.y);
+        int coordinate = ixy.y;
+#endif
+        vec3 sum = vec3(0.0);
+        float weight = 0.0;
+        for (int k = -int(radius); k <= int(radius); ++k) {
+            int c = coordinate + k;
+            if (c < 0 || c >= limit) {
+                continue;
+            }
+            ivec2 q = ixy + axis * k;
+            vec4 xq = imageLoad(gb_position, q);
+            if (xq.w == 0.0) {
+                continue;
+            }
+            vec3 nq = normalize(imageLoad(gb_normal, q).xyz);
+            vec3 offset = xq.xyz - position.xyz;
+            if (dot(n, nq) < push.camera.w || abs(dot(n, offset)) > push.plane_tolerance * d) {
+                continue;
+            }
+            float w = exp(-dot(offset, offset) / (2.0 * beta * beta));
+            sum += w * mean_at(uint(q.y) * push.extent.x + uint(q.x));
+            weight += w;
+        }
+        result = weight > 0.0 ? sum / weight : result;
+    }
+#ifdef AAF_X
+    filtered.m[p] = vec4(result, 0.0);
+#else
+    vec3 out_radiance = vec3(0.0);
+    if (position.w > 0.0) {
+        vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
+        float metallic = imageLoad(gb_material, ixy).g;
+        vec3 v = normalize(push.camera.xyz - position.xyz);
+        vec3 kd;
+        vec3 ks;
+        brdf_indirect_weights(albedo, metallic, dot(n, v), kd, ks);
+        out_radiance = kd * result;
+    }
+    imageStore(indirect, ixy, vec4(out_radiance, 0.0));
+#endif
+}

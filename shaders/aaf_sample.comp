@@ -1,0 +1,146 @@
+// AAF sampling (paper 004 §5, src/passes/aaf.rs): Monte-Carlo estimate of the incident
+// indirect radiance at every G-buffer pixel, cosine-weighted about the shading normal, so the
+// mean of the samples is the irradiance over pi (the receiver's albedo is applied after the
+// filter). Each sample traces a ray through the BVH; where it hits, the radiance leaving the hit
+// towards the pixel is next-event estimation to the punctual lights (path.glsl), continued for
+// `bounces` - 1 further BRDF-sampled vertices. Misses, emission and the environment add
+// nothing (the raster GI convention: punctual lights only).
+//
+// `first`: `samples` stratified samples (a k x k grid of strata, k = floor(sqrt(samples)), the
+// rest uniform); writes the sums and the nearest/farthest hit distances (z_min, z_max; 0, 0
+// without a hit). `second`: the pixel's remaining samples up to the count of the aaf_beta pass
+// (eq. 21), added to the first pass's sums.
+//! variant first AAF_FIRST=1
+//! variant second AAF_SECOND=1
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
+#include "surface.glsl"
+#include "brdf.glsl"
+#define TRACE_NODES_BINDING 7
+#define TRACE_TRIANGLES_BINDING 8
+#include "trace.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+// shine::passes::aaf::SamplePush (32 bytes).
+layout(push_constant) uniform Push {
+    // x: width, y: height, z: light count, w: seed.
+    uvec4 frame;
+    // x: bounces B, y: samples of the first pass, z, w: unused.
+    uvec4 config;
+} push;
+
+#define PATH_LIGHT_COUNT push.frame.z
+#define PATH_FLAGS 0u
+#include "path.glsl"
+
+layout(set = 0, binding = 9, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 10, rgba16f) readonly uniform image2D gb_normal;
+layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_normal;
+// rgb: sum of the samples' radiance, a: samples taken.
+layout(set = 0, binding = 12, std430) buffer Sums {
+    vec4 s[];
+} sums;
+#ifdef AAF_FIRST
+// x: z_min, y: z_max of the pixel's hits.
+layout(set = 0, binding = 13, std430) buffer Depths {
+    vec2 z[];
+} depths;
+#else
+layout(set = 0, binding = 13, std430) readonly buffer FirstSums {
+    vec4 s[];
+} first_sums;
+// x: beta (world units), y: samples per pixel (eq. 21, clamped).
+layout(set = 0, binding = 14, std430) readonly buffer Filter {
+    vec2 f[];
+} filter_widths;
+#endif
+
+// Radiance arriving at the receiver along `dir` from the hit `hit`: NEE at the hit, then
+// bounces - 1 more BRDF-sampled vertices (as path_trace.comp's indirect paths).
+vec3 incident(vec3 dir, TraceHit hit, uint bounces) {
+    vec3 radiance = vec3(0.0);
+    vec3 throughput = vec3(1.0);
+    for (uint vertex = 1u; ; ++vertex) {
+        Vertex x = shade(hit, dir);
+        vec3 v = -dir;
+        radiance += throughput * punctual_lights(x, v);
+        if (vertex >= bounces) {
+            break;
+        }
+        vec3 xi = vec3(rand(), rand(), rand());
+        vec3 n = x.s.normal;
+        float p_specular = brdf_specular_probability(x.s.base_color, x.s.metallic);
+        vec3 l = brdf_sample(n, v, p_specular, x.s.roughness, xi);
+        float pdf = brdf_pdf(n, l, v, p_specular, x.s.roughness);
+        vec3 weight = pdf > 0.0 ? brdf(x, l, v) * max(dot(n, l), 0.0) / pdf : vec3(0.0);
+        if (dot(n, l) <= 0.0 || dot(x.geometric_normal, l) <= 0.0 || all(equal(weight, vec3(0.0)))) {
+            break;
+        }
+        throughput *= weight;
+        dir = l;
+        if (!trace_closest(trace_offset(x.position, x.geometric_normal), dir, 0.0, PT_FAR, hit)) {
+            break;
+        }
+    }
+    return radiance;
+}
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    uvec2 extent = push.frame.xy;
+    if (any(greaterThanEqual(pixel, extent))) {
+        return;
+    }
+    uint p = pixel.y * extent.x + pixel.x;
+    ivec2 ixy = ivec2(pixel);
+    vec4 position = imageLoad(gb_position, ixy);
+#ifdef AAF_FIRST
+    uint begin = 0u;
+    uint end = push.config.y;
+    vec4 sum = vec4(0.0);
+#else
+    vec4 sum = first_sums.s[p];
+    uint begin = uint(sum.w);
+    uint end = max(begin, uint(filter_widths.f[p].y));
+#endif
+    if (position.w == 0.0) {
+        sums.s[p] = vec4(0.0);
+#ifdef AAF_FIRST
+        depths.z[p] = vec2(0.0);
+#endif
+        return;
+    }
+    vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
+    vec3 ng = normalize(imageLoad(gb_geometric_normal, ixy).xyz);
+    vec3 origin = trace_offset(position.xyz, ng);
+    uint strata = uint(floor(sqrt(float(push.config.y))));
+    float z_min = PT_FAR;
+    float z_max = 0.0;
+    for (uint s = begin; s < end; ++s) {
+        rng_state = pcg(pcg(pcg(pixel.x ^ pcg(push.frame.w)) + pixel.y) + s);
+        vec2 xi = vec2(rand(), rand());
+#ifdef AAF_FIRST
+        if (s < strata * strata) {
+            xi = (vec2(float(s % strata), float(s / strata)) + xi) / float(strata);
+        }
+#endif
+        vec3 l = sample_cosine(n, xi);
+        sum.w += 1.0;
+        TraceHit hit;
+        if (dot(ng, l) <= 0.0 || !trace_closest(origin, l, 0.0, PT_FAR, hit)) {
+            continue;
+        }
+        z_min = min(z_min, hit.t);
+        z_max = max(z_max, hit.t);
+        vec3 radiance = incident(l, hit, push.config.x);
+        if (!any(isnan(radiance)) && !any(isinf(radiance))) {
+            sum.rgb += radiance;
+        }
+    }
+    sums.s[p] = sum;
+#ifdef AAF_FIRST
+    depths.z[p] = z_max > 0.0 ? vec2(z_min, z_max) : vec2(0.0);
+#endif
+}

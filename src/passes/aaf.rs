@@ -1,0 +1,383 @@
+//! Axis-aligned filtering of path-traced indirect light (paper 004): the `aaf_sample_first`,
+//! `aaf_beta`, `aaf_sample_second`, `aaf_filter_x` and `aaf_filter_y` passes.
+//!
+//! 1. **First pass** (`shaders/aaf_sample.comp`, variant `first`): at every G-buffer pixel,
+//!    [`AafParams::first_samples`] stratified, cosine-weighted rays about the shading normal
+//!    through the BVH; each hit's outgoing radiance is next-event estimation to the punctual
+//!    lights (one bounce; [`AafParams::bounces`] > 1 continues the path by BRDF sampling, as
+//!    the path tracer). The mean of the samples is the incident irradiance over π; the nearest
+//!    and farthest hit distances are `z_min`, `z_max`.
+//! 2. **Filter width and sampling rate** (`aaf_beta.comp`, GLSL twin of [`shine_sh::aaf`] in
+//!    `shaders/include/aaf.glsl`): `Ω_x^r = μ min(Ω_h/z_min, α/d)` (eq. 15), `β = 2/Ω_x^r`
+//!    (eq. 16), `n = γ (μ Ω_h d/z_min + α)² Ω_h² (1 + μ z_max/z_min)²` (eq. 21) clamped to
+//!    `[spp_min, spp_max·μ]`, with `d` the pixel's world-space footprint and `z_min` clamped
+//!    from below to [`AafParams::z_min_fraction`] of the scene's size.
+//! 3. **Second pass** (variant `second`): each pixel's remaining `n − first_samples` samples,
+//!    added to the first pass's sums.
+//! 4. **Filter** (`aaf_filter.comp`, variants `x` then `y`): a separable gaussian of the mean
+//!    incident radiance over world-space distances, standard deviation `β` of the centre pixel,
+//!    neighbours only within the normal threshold (paper: 10°) and near the centre's tangent
+//!    plane; then the receiver's diffuse weight `kd` (the albedo modulation after filtering).
+//!
+//! # Decisions and deviations from paper 004
+//!
+//! * Direct light stays the raster's; AAF computes the indirect term only, diffuse: the
+//!   receiver's `kd` (`brdf_indirect_weights`, as HVL and IGI) times the filtered irradiance
+//!   over π. Glossy receivers' specular indirect light is not computed yet (the paper's glossy
+//!   bandlimits are in shine-sh, unused here).
+//! * The filter's world-distance test (not in the paper, which tests normals only): a neighbour
+//!   farther than [`PLANE_TOLERANCE`] pixel footprints from the centre's tangent plane is left
+//!   out, so light does not leak between parallel surfaces at different depths.
+//! * The gaussian is cut at 2β or [`MAX_RADIUS`] pixels, whichever is smaller.
+//! * The emission of emissive surfaces and the environment light nothing (punctual lights only,
+//!   the convention of every raster GI technique).
+
+use std::ops::RangeInclusive;
+
+use crate::gpu_scene::bvh::TraceBuffers;
+use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::gbuffer::{GBuffer, SceneHandles, View};
+use crate::shaders;
+
+/// Ω_h of a Lambertian receiver (paper 004 eq. 18): the default bandlimit.
+pub const OMEGA_H: f32 = shine_sh::aaf::OMEGA_H_DIFFUSE;
+/// Bandlimits Ω_h the settings take.
+pub const OMEGA_H_RANGE: RangeInclusive<f32> = 0.1..=100.0;
+/// Filter scales μ the settings take (paper: 0.9; larger μ narrows the filter and samples more).
+pub const MU_RANGE: RangeInclusive<f32> = 0.01..=100.0;
+/// Samples of the first pass the settings take (paper: 16).
+pub const FIRST_SAMPLES: RangeInclusive<u32> = 1..=1024;
+/// The lower spp clamps the settings take: never below the paper's 16.
+pub const SPP_MIN: RangeInclusive<u32> = 16..=1024;
+/// The upper spp clamps (before the factor μ) the settings take (paper: 100).
+pub const SPP_MAX: RangeInclusive<u32> = 16..=10_000;
+/// Path vertices after the receiver (1: one-bounce indirect light).
+pub const BOUNCES: RangeInclusive<u32> = 1..=8;
+/// The lower clamps of z_min the settings take, as a fraction of the scene's bounding diagonal.
+pub const Z_MIN_FRACTION: RangeInclusive<f32> = 1e-4..=1.0;
+/// How far from the centre's tangent plane a neighbour may lie, in pixel footprints.
+pub const PLANE_TOLERANCE: f32 = 2.0;
+/// Largest filter radius in pixels (the gaussian is cut at 2β).
+pub const MAX_RADIUS: u32 = 32;
+
+/// Parameters of the AAF passes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AafParams {
+    /// Stratified samples of the first pass (paper: 16).
+    pub first_samples: u32,
+    /// Filter scale μ (eq. 15, 21; paper: 0.9).
+    pub mu: f32,
+    /// Bandlimit Ω_h of the receiver's transfer function (paper, diffuse: 2.8).
+    pub omega_h: f32,
+    /// α of `Ω_x^max = α/d` (paper: 0.3).
+    pub alpha: f32,
+    /// Importance-sampling factor γ of eq. 21 (paper, diffuse: 0.4).
+    pub gamma: f32,
+    /// Lower clamp of the per-pixel sample count.
+    pub spp_min: u32,
+    /// Upper clamp of the per-pixel sample count before the factor μ (paper: 100μ).
+    pub spp_max: u32,
+    /// Path vertices after the receiver (1: one bounce).
+    pub bounces: u32,
+    /// Lower clamp of z_min as a fraction of the scene's bounding diagonal (0.02).
+    pub z_min_fraction: f32,
+    /// Normal threshold of the filter in degrees (paper: 10°).
+    pub normal_threshold_degrees: f32,
+    /// Take the adaptive second pass (off: uniform sampling at `first_samples`).
+    pub adaptive: bool,
+    /// Filter (off: the unfiltered Monte-Carlo mean).
+    pub filter: bool,
+    /// Seed of the samples' random numbers.
+    pub seed: u32,
+}
+
+impl Default for AafParams {
+    /// Paper 004's values (§4.3, §6).
+    fn default() -> Self {
+        Self {
+            first_samples: 16,
+            mu: shine_sh::aaf::DEFAULT_MU,
+            omega_h: OMEGA_H,
+            alpha: shine_sh::aaf::DEFAULT_ALPHA,
+            gamma: shine_sh::aaf::DEFAULT_GAMMA,
+            spp_min: 16,
+            spp_max: 100,
+            bounces: 1,
+            z_min_fraction: 0.02,
+            normal_threshold_degrees: 10.0,
+            adaptive: true,
+            filter: true,
+            seed: 0,
+        }
+    }
+}
+
+/// What the AAF passes refuse.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AafError {
+    /// A parameter out of its range.
+    #[error("AAF parameter `{name}` = {value} is out of range: {expected}")]
+    OutOfRange {
+        /// Parameter name.
+        name: &'static str,
+        /// Value given.
+        value: f64,
+        /// The allowed range.
+        expected: String,
+    },
+}
+
+impl AafParams {
+    /// Checks every parameter against its range.
+    pub fn validate(&self) -> Result<(), AafError> {
+        fn check<T: PartialOrd + std::fmt::Debug + Into<f64> + Copy>(
+            name: &'static str,
+            value: T,
+            range: &RangeInclusive<T>,
+        ) -> Result<(), AafError> {
+            if range.contains(&value) {
+                Ok(())
+            } else {
+                Err(AafError::OutOfRange {
+                    name,
+                    value: value.into(),
+                    expected: format!("{range:?}"),
+                })
+            }
+        }
+        check("first_samples", self.first_samples, &FIRST_SAMPLES)?;
+        check("mu", self.mu, &MU_RANGE)?;
+        check("omega_h", self.omega_h, &OMEGA_H_RANGE)?;
+        check("alpha", self.alpha, &(1e-3..=1.0))?;
+        check("gamma", self.gamma, &(0.0..=10.0))?;
+        check("spp_min", self.spp_min, &SPP_MIN)?;
+        check("spp_max", self.spp_max, &SPP_MAX)?;
+        check("bounces", self.bounces, &BOUNCES)?;
+        check("z_min_fraction", self.z_min_fraction, &Z_MIN_FRACTION)?;
+        check(
+            "normal_threshold_degrees",
+            self.normal_threshold_degrees,
+            &(0.0..=180.0),
+        )
+    }
+
+    /// The upper clamp of the sample count, `spp_max · μ`, never below `spp_min`.
+    pub fn spp_upper(&self) -> f32 {
+        (self.spp_max as f32 * self.mu).max(self.spp_min as f32)
+    }
+}
+
+/// The world-space size `d` of a pixel at linear view depth `z` is `z · scale + bias`:
+/// `2 tan(fov/2) / H` and 0 for a perspective camera, 0 and `width / H` for an orthographic one.
+pub fn footprint(camera: &View, height: u32) -> [f32; 2] {
+    let h = height.max(1) as f32;
+    if camera.orthographic {
+        [0.0, camera.extent / h]
+    } else {
+        [2.0 * (0.5 * camera.extent).tan() / h, 0.0]
+    }
+}
+
+/// Push constants of `shaders/aaf_sample.comp` (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SamplePush {
+    /// Width, height, light count, seed.
+    pub frame: [u32; 4],
+    /// Bounces, samples of the first pass, unused, unused.
+    pub config: [u32; 4],
+}
+
+/// Push constants of `shaders/aaf_beta.comp` (48 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct BetaPush {
+    /// Image size.
+    pub extent: [u32; 2],
+    /// [`footprint`].
+    pub footprint: [f32; 2],
+    /// Ω_h, α, μ, γ.
+    pub paper: [f32; 4],
+    /// Lower clamp of z_min (world units), spp_min, spp_upper, unused.
+    pub clamps: [f32; 4],
+}
+
+/// Push constants of `shaders/aaf_filter.comp` (48 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct FilterPush {
+    /// xyz camera position, w cos of the normal threshold.
+    pub camera: [f32; 4],
+    /// Image size.
+    pub extent: [u32; 2],
+    /// [`footprint`].
+    pub footprint: [f32; 2],
+    /// [`PLANE_TOLERANCE`].
+    pub plane_tolerance: f32,
+    /// [`MAX_RADIUS`].
+    pub max_radius: u32,
+    /// 1: filter; 0: pass the mean through.
+    pub enabled: u32,
+    /// Padding.
+    pub pad: u32,
+}
+
+/// The scene as the AAF rays see it.
+#[derive(Debug, Clone, Copy)]
+pub struct AafScene<'a> {
+    /// The scene's buffers and textures.
+    pub handles: &'a SceneHandles,
+    /// Its BVH.
+    pub bvh: &'a TraceBuffers,
+    /// Lights in the light buffer.
+    pub light_count: u32,
+    /// Length of the scene's bounding-box diagonal (for the z_min clamp).
+    pub size: f32,
+    /// The sampler of the scene's textures.
+    pub texture_sampler: vk::Sampler,
+}
+
+/// The AAF passes' outputs.
+#[derive(Debug, Clone, Copy)]
+pub struct AafOutputs {
+    /// Indirect light (RGBA16F, full resolution): `kd` × filtered irradiance / π.
+    pub indirect: Handle<Image>,
+    /// Per pixel: rgb sum of the samples' radiance, a: samples taken (vec4).
+    pub sums: Handle<Buffer>,
+    /// Per pixel: z_min, z_max of the first pass (vec2).
+    pub depths: Handle<Buffer>,
+    /// Per pixel: β (world units), samples per pixel (vec2).
+    pub widths: Handle<Buffer>,
+}
+
+/// Adds the AAF passes over the G-buffer `g` seen from `camera`; returns the indirect light and
+/// the intermediate buffers (for tests and the study).
+pub fn aaf(
+    rg: &mut RenderGraph,
+    g: &GBuffer,
+    scene: &AafScene<'_>,
+    camera: &View,
+    params: &AafParams,
+) -> Result<AafOutputs, AafError> {
+    params.validate()?;
+    let [w, h] = g.extent;
+    let pixels = u64::from(w) * u64::from(h);
+    let sample_push = SamplePush {
+        frame: [w, h, scene.light_count, params.seed],
+        config: [params.bounces, params.first_samples, 0, 0],
+    };
+    let mut first = rg.create_buffer("aaf_sums_first", BufferDesc::new(pixels * 16));
+    let mut depths = rg.create_buffer("aaf_depths", BufferDesc::new(pixels * 8));
+    sample_pass(
+        rg,
+        "aaf_sample_first",
+        &shaders::AAF_SAMPLE_COMP_FIRST,
+        g,
+        scene,
+    )
+    .write("sums", &mut first)
+    .write("depths", &mut depths)
+    .push(&sample_push)
+    .dispatch([w, h, 1]);
+    let footprint = footprint(camera, h);
+    let mut widths = rg.create_buffer("aaf_widths", BufferDesc::new(pixels * 8));
+    rg.compute("aaf_beta", &shaders::AAF_BETA_COMP)
+        .read("gb_position", &g.position)
+        .read("depths", &depths)
+        .write("filter_widths", &mut widths)
+        .push(&BetaPush {
+            extent: g.extent,
+            footprint,
+            paper: [params.omega_h, params.alpha, params.mu, params.gamma],
+            clamps: [
+                params.z_min_fraction * scene.size,
+                params.spp_min as f32,
+                params.spp_upper(),
+                0.0,
+            ],
+        })
+        .dispatch([w, h, 1]);
+    let sums = if params.adaptive {
+        let mut second = rg.create_buffer("aaf_sums", BufferDesc::new(pixels * 16));
+        sample_pass(
+            rg,
+            "aaf_sample_second",
+            &shaders::AAF_SAMPLE_COMP_SECOND,
+            g,
+            scene,
+        )
+        .read("first_sums", &first)
+        .read("filter_widths", &widths)
+        .write("sums", &mut second)
+        .push(&sample_push)
+        .dispatch([w, h, 1]);
+        second
+    } else {
+        first
+    };
+    let filter_push = FilterPush {
+        camera: camera
+            .eye
+            .extend(params.normal_threshold_degrees.to_radians().cos())
+            .to_array(),
+        extent: g.extent,
+        footprint,
+        plane_tolerance: PLANE_TOLERANCE,
+        max_radius: MAX_RADIUS,
+        enabled: u32::from(params.filter),
+        pad: 0,
+    };
+    let mut rows = rg.create_buffer("aaf_rows", BufferDesc::new(pixels * 16));
+    rg.compute("aaf_filter_x", &shaders::AAF_FILTER_COMP_X)
+        .read("gb_position", &g.position)
+        .read("gb_normal", &g.normal)
+        .read("filter_widths", &widths)
+        .read("sums", &sums)
+        .write("filtered", &mut rows)
+        .push(&filter_push)
+        .dispatch([w, h, 1]);
+    let mut indirect = rg.create_image(
+        "aaf_indirect",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    rg.compute("aaf_filter_y", &shaders::AAF_FILTER_COMP_Y)
+        .read("gb_position", &g.position)
+        .read("gb_normal", &g.normal)
+        .read("filter_widths", &widths)
+        .read("filtered", &rows)
+        .read("gb_albedo", &g.albedo)
+        .read("gb_material", &g.material)
+        .write("indirect", &mut indirect)
+        .push(&filter_push)
+        .dispatch([w, h, 1]);
+    Ok(AafOutputs {
+        indirect,
+        sums,
+        depths,
+        widths,
+    })
+}
+
+/// A sampling pass with the scene, BVH and G-buffer bound.
+fn sample_pass<'a>(
+    rg: &'a mut RenderGraph,
+    name: &str,
+    shader: &'static crate::gpu::ShaderDesc,
+    g: &GBuffer,
+    scene: &AafScene<'_>,
+) -> crate::graph::ComputePass<'a> {
+    let mut pass = rg.compute(name, shader);
+    pass.read("materials", &scene.handles.materials)
+        .read("srgb_textures", &scene.handles.srgb_textures)
+        .read("linear_textures", &scene.handles.linear_textures)
+        .sampler("texture_sampler", scene.texture_sampler)
+        .read("vertices", &scene.handles.vertices)
+        .read("indices", &scene.handles.indices)
+        .read("lights", &scene.handles.lights)
+        .read("bvh_nodes", &scene.bvh.nodes)
+        .read("bvh_triangles", &scene.bvh.triangles)
+        .read("gb_position", &g.position)
+        .read("gb_normal", &g.normal)
+        .read("gb_geometric_normal", &g.geometric_normal);
+    pass
+}

@@ -1,0 +1,121 @@
+//! CPU twin of the AAF filter-width and filter passes (paper 004, `src/passes/aaf.rs`):
+//! [`beta_cpu`] is `aaf_beta.comp` through shine-sh's formulas, [`filter_cpu`] the two passes
+//! of `aaf_filter.comp` before the albedo modulation. `tests/aaf.rs` ties them to the GPU.
+
+use glam::{Vec3, Vec4};
+use shine_sh::ShError;
+use shine_sh::aaf::{PixelFootprint, filter_bandwidth, filter_width, samples_per_pixel};
+
+use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE};
+
+/// What `aaf_beta` writes for one pixel: `(β, samples)` from its linear depth (0 on
+/// background), its first-pass `(z_min, z_max)` (0, 0 without a hit), the [`footprint`]
+/// and the z_min clamp in world units.
+///
+/// [`footprint`]: crate::passes::aaf::footprint
+pub fn beta_cpu(
+    depth: f32,
+    z: [f32; 2],
+    footprint: [f32; 2],
+    z_min_clamp: f32,
+    params: &AafParams,
+) -> Result<[f32; 2], ShError> {
+    if depth == 0.0 {
+        return Ok([0.0, 0.0]);
+    }
+    if z[1] == 0.0 {
+        return Ok([0.0, params.spp_min as f32]);
+    }
+    let z_min = z[0].max(z_min_clamp);
+    let px = PixelFootprint {
+        z_min,
+        z_max: z[1].max(z_min),
+        pixel_size: depth * footprint[0] + footprint[1],
+    };
+    let omega_r = filter_bandwidth(params.omega_h, px, params.alpha, params.mu)?;
+    let n = samples_per_pixel(params.omega_h, px, params.alpha, params.mu, params.gamma)?;
+    Ok([
+        filter_width(omega_r)?,
+        n.ceil().clamp(params.spp_min as f32, params.spp_upper()),
+    ])
+}
+
+/// One pixel of the G-buffer as the filter sees it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FilterTexel {
+    /// xyz world position, w linear depth (0 on background).
+    pub position: Vec4,
+    /// Shading normal (normalised here).
+    pub normal: Vec3,
+    /// β of the pixel (world units; 0: no filter).
+    pub beta: f32,
+    /// The mean incident radiance to filter.
+    pub mean: Vec3,
+}
+
+/// The two passes of `aaf_filter.comp` (rows, then columns) over a `width`-wide image, before
+/// the albedo modulation: the filtered mean per pixel.
+pub fn filter_cpu(
+    texels: &[FilterTexel],
+    width: usize,
+    footprint: [f32; 2],
+    params: &AafParams,
+) -> Vec<Vec3> {
+    let rows = filter_axis(texels, width, footprint, params, [1, 0]);
+    let columns: Vec<FilterTexel> = texels
+        .iter()
+        .zip(&rows)
+        .map(|(t, m)| FilterTexel { mean: *m, ..*t })
+        .collect();
+    filter_axis(&columns, width, footprint, params, [0, 1])
+}
+
+/// One separable pass along `axis` ([1, 0]: rows, [0, 1]: columns).
+fn filter_axis(
+    texels: &[FilterTexel],
+    width: usize,
+    footprint: [f32; 2],
+    params: &AafParams,
+    axis: [i64; 2],
+) -> Vec<Vec3> {
+    let height = texels.len() / width.max(1);
+    let cos_threshold = params.normal_threshold_degrees.to_radians().cos();
+    (0..texels.len())
+        .map(|p| {
+            let centre = &texels[p];
+            let (x, y) = ((p % width) as i64, (p / width) as i64);
+            if !params.filter || centre.position.w == 0.0 || centre.beta <= 0.0 {
+                return centre.mean;
+            }
+            let n = centre.normal.normalize();
+            let d = centre.position.w * footprint[0] + footprint[1];
+            let radius = MAX_RADIUS.min((2.0 * centre.beta / d).ceil() as u32) as i64;
+            let mut sum = Vec3::ZERO;
+            let mut weight = 0.0f32;
+            for k in -radius..=radius {
+                let (qx, qy) = (x + axis[0] * k, y + axis[1] * k);
+                if qx < 0 || qy < 0 || qx >= width as i64 || qy >= height as i64 {
+                    continue;
+                }
+                let q = &texels[qy as usize * width + qx as usize];
+                if q.position.w == 0.0 {
+                    continue;
+                }
+                let offset = q.position.truncate() - centre.position.truncate();
+                if n.dot(q.normal.normalize()) < cos_threshold
+                    || n.dot(offset).abs() > PLANE_TOLERANCE * d
+                {
+                    continue;
+                }
+                let w = (-offset.length_squared() / (2.0 * centre.beta * centre.beta)).exp();
+                sum += w * q.mean;
+                weight += w;
+            }
+            if weight > 0.0 {
+                sum / weight
+            } else {
+                centre.mean
+            }
+        })
+        .collect()
+}
