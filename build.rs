@@ -11,7 +11,6 @@ use std::path::PathBuf;
 
 fn main() {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("shaders");
-    println!("cargo::rerun-if-changed=build/shader_build.rs");
     println!("cargo::rerun-if-changed={}", root.display());
     let output = match shader_build::build_all(&root) {
         Ok(output) => output,

@@ -1,4 +1,4 @@
-// World-space scene vertices (src/gpu_scene.rs) through a view: the G-buffer and the RSM.
+// World-space scene vertices (src/gpu_scene/mod.rs) through a view: the G-buffer and the RSM.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "view.glsl"

@@ -8,7 +8,7 @@ layout(set = 0, binding = 0, rgba16f) readonly uniform image2D first;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D second;
 layout(set = 0, binding = 2, rgba16f) uniform image2D sum;
 
-// shine::passes::proxy::AddPush
+// shine::passes::gi_add::AddPush
 layout(push_constant) uniform Push {
     uvec2 extent;
 } push;

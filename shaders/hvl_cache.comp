@@ -13,7 +13,7 @@
 //
 // `r1`: radius heuristic r1 (eq. 23) over the cell's neighbours (HvlGrid::neighbours); an HVL
 // without a usable neighbour falls back to r2. Both stages apply the user scale.
-// CPU twin: shine::hvl_reference::build_cache.
+// CPU twin: shine::reference::hvl::build_cache.
 //! variant build HVL_STAGE_BUILD=1
 //! variant r1 HVL_STAGE_R1=1
 #version 460

@@ -13,7 +13,7 @@
 // kd, ks: brdf_indirect_weights (Schlick F at n.v; ks over the tables' own dielectric F). Each
 // HVL's contribution is clamped
 // at 0 per channel (band-limited ringing must not go negative in the RGBA16F output; the
-// paper's sinc window is not applied). CPU twin: shine::hvl_reference.
+// paper's sinc window is not applied). CPU twin: shine::reference::hvl.
 //! variant full_c1 HVL_FULL=1 SH_BANDS=1
 //! variant full_c2 HVL_FULL=1 SH_BANDS=2
 //! variant full_c3 HVL_FULL=1 SH_BANDS=3
@@ -72,7 +72,7 @@ layout(set = 0, binding = 4, std430) readonly buffer Hvls {
 } hvls;
 
 #ifdef HVL_FULL
-// shine::passes::hvl::GatherBrdf::gpu_data: F of Lambert (albedo 1) then F of GGX at each
+// shine::passes::brdf_tables::GatherBrdf::gpu_data: F of Lambert (albedo 1) then F of GGX at each
 // roughness node, each 90 rows of SH_COEFFS floats (shine_sh::brdf_table layout)
 layout(set = 0, binding = 5, std430) readonly buffer Brdf {
     float f[];

@@ -23,7 +23,7 @@
 // O_log and V are rows of shine_sh::sphere_blocker::AlphaTable, smoothly clamped (§4.1).
 // A table is exactly 0 for alpha <= its support, so a proxy with r <= support |c - p| adds
 // nothing (the substitute sphere lies inside the original one, so its alpha is not larger):
-// the sphere of influence has radius r / support. CPU twin: shine::passes::proxy.
+// the sphere of influence has radius r / support. CPU twin: shine::reference::proxy::accumulate_cpu.
 //! variant splat_b3 SPLAT=1 SH_BANDS=3
 //! variant splat_b4 SPLAT=1 SH_BANDS=4
 //! variant splat_b5 SPLAT=1 SH_BANDS=5
@@ -91,6 +91,8 @@ void table_lookup(uint table, float alpha, out float zh[SH_BANDS]) {
 }
 
 #ifdef SPLAT
+// Words of a tile's proxy mask: shine::passes::proxy::TILE_WORDS.
+const uint TILE_WORDS = 64u;
 // shaders/proxy_tiles.comp: per 8x8 tile, 64 words; bit b of word w set when proxy 32 w + b
 // may touch the tile
 layout(set = 0, binding = 6, std430) readonly buffer TileMasks {
@@ -137,8 +139,8 @@ void main() {
             }
         }
 #ifdef SPLAT
-        for (uint w = 0u; w < 64u; ++w) {
-            uint bits = tile_masks.m[tile * 64u + w];
+        for (uint w = 0u; w < TILE_WORDS; ++w) {
+            uint bits = tile_masks.m[tile * TILE_WORDS + w];
             // (no findLSB: naga types its result as uint, glslang as int)
             for (uint b = 0u; bits != 0u; ++b, bits >>= 1u) {
                 if ((bits & 1u) == 0u) {

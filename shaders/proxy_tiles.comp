@@ -2,10 +2,14 @@
 // 8x8 tile of the receiver buffer. The tile's valid receivers give a world-space box; proxy i
 // is kept for the tile when its sphere of influence (centre c, radius r / support) meets the
 // box. Writes 64 words per tile (bit b of word w: proxy 32 w + b), read by the SPLAT variants
-// of shaders/proxy_accumulate.comp. CPU twin: shine::passes::proxy::tile_masks_cpu.
+// of shaders/proxy_accumulate.comp. Checked by tests/proxy.rs: splatted sums equal the
+// brute-force sums over every proxy.
 #version 460
 
 layout(local_size_x = 8, local_size_y = 8) in;
+
+// Words of a tile's proxy mask: shine::passes::proxy::TILE_WORDS.
+const uint TILE_WORDS = 64u;
 
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
 
@@ -44,8 +48,8 @@ void main() {
         }
     }
     bool any_valid = lo.x <= hi.x;
-    uint base = (t.y * tiles.x + t.x) * 64u;
-    for (uint w = 0u; w < 64u; ++w) {
+    uint base = (t.y * tiles.x + t.x) * TILE_WORDS;
+    for (uint w = 0u; w < TILE_WORDS; ++w) {
         uint word = 0u;
         for (uint b = 0u; b < 32u; ++b) {
             uint i = w * 32u + b;

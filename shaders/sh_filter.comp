@@ -1,6 +1,6 @@
 // sh_filter (paper 000 §3, steps 3-4): the discontinuity filter over each pixel's incident
 // radiance SH (variants o2, o3, o4) or, classic IGI (variant irr), over its irradiance and glossy
-// radiance; then the BRDF. CPU twin: shine::igi_reference::sh_filter.
+// radiance; then the BRDF. CPU twin: shine::reference::igi::sh_filter.
 //
 // Filter: the mean over a window of k n x k m pixels (k = filter_radius tiles of the n x m
 // pattern; x from p.x - floor(k n / 2), likewise y) of the pixels q with geometry
@@ -45,7 +45,7 @@ layout(set = 0, binding = 5, std430) readonly buffer VplSh {
 layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
 
 #ifdef IGI_GGX
-// shine::passes::hvl::GatherBrdf::gpu_data at SH_BANDS bands
+// shine::passes::brdf_tables::GatherBrdf::gpu_data at SH_BANDS bands
 layout(set = 0, binding = 7, std430) readonly buffer Brdf {
     float f[];
 } brdf;

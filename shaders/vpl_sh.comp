@@ -3,7 +3,7 @@
 // order = bands) or, for classic IGI (variant irr), reduced to the irradiance about the shading
 // normal and the glossy radiance about the reflected direction. Output: `vpl_sh`, per pixel
 // SH_OUT coefficients of rgb as two uints (packHalf2x16(r, g), packHalf2x16(b, 0)), row-major
-// pixels, coefficient-minor. CPU twin: shine::igi_reference::vpl_sh.
+// pixels, coefficient-minor. CPU twin: shine::reference::igi::vpl_sh.
 //
 // Pixel px uses set s = igi_set(px): the VPLs of global index i = s + k n m < M, k = 0, 1, ...,
 // VPL record igi_vpl_cell(i) of the HVL cache layout (shaders/include/hvl.glsl). The set holds

@@ -16,7 +16,7 @@ pub struct UnknownChoice {
 }
 
 /// Defines an enum of named choices whose names are the single source for TOML, the CLI
-/// ([`FromStr`], [`std::fmt::Display`]) and the error listing the known names.
+/// ([`FromStr`](std::str::FromStr), [`std::fmt::Display`]) and the error listing the known names.
 macro_rules! named_choice {
     (
         $(#[$meta:meta])*

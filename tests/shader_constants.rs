@@ -4,10 +4,12 @@
 use shine::capture::tonemap::Tonemap;
 use shine::passes::hvl::EMISSION_MAX_BANDS;
 use shine::passes::path_trace::{FLAG_EMISSIVE_LIGHTING, FLAG_JITTER, FLAG_LAMBERT_ONLY};
+use shine::passes::proxy::{MAX_PROXIES, TABLE_ENTRIES, TILE_WORDS};
+use shine_scene::{Light, LightKind, NO_TEXTURE};
 use std::path::Path;
 
-/// The value of the unsigned integer constant `name` in `shaders/<file>`, written either
-/// `const uint NAME = 4u;` or `#define NAME 4u` (or without the `u`).
+/// The value of the integer constant `name` in `shaders/<file>`, written
+/// `const uint NAME = 4u;`, `const int NAME = 4;` or `#define NAME 4u`, decimal or `0x` hex.
 fn glsl_uint(file: &str, name: &str) -> u32 {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("shaders")
@@ -19,6 +21,7 @@ fn glsl_uint(file: &str, name: &str) -> u32 {
         .find_map(|line| {
             let rest = line
                 .strip_prefix(&format!("const uint {name} ="))
+                .or_else(|| line.strip_prefix(&format!("const int {name} =")))
                 .or_else(|| line.strip_prefix(&format!("#define {name} ")))?;
             Some(
                 rest.trim()
@@ -28,9 +31,11 @@ fn glsl_uint(file: &str, name: &str) -> u32 {
             )
         })
         .unwrap_or_else(|| panic!("{name} is not defined in {}", path.display()));
-    value
-        .parse()
-        .unwrap_or_else(|_| panic!("{name} = `{value}` in {} is no integer", path.display()))
+    let parsed = match value.strip_prefix("0x") {
+        Some(hex) => u32::from_str_radix(hex, 16),
+        None => value.parse(),
+    };
+    parsed.unwrap_or_else(|_| panic!("{name} = `{value}` in {} is no integer", path.display()))
 }
 
 #[test]
@@ -65,4 +70,37 @@ fn hvl_emission_bands_match_the_shader() {
         glsl_uint("include/hvl.glsl", "HVL_EMISSION_MAX_BANDS") as usize,
         EMISSION_MAX_BANDS
     );
+}
+
+#[test]
+fn table_sizes_match_the_shaders() {
+    assert_eq!(
+        glsl_uint("include/brdf_table.glsl", "BRDF_TABLE_THETA_SAMPLES") as usize,
+        shine_sh::brdf_table::THETA_SAMPLES
+    );
+    assert_eq!(
+        glsl_uint("include/proxy_tables.glsl", "PROXY_TABLE_ENTRIES") as usize,
+        TABLE_ENTRIES
+    );
+    // The tile masks hold one bit per proxy.
+    assert_eq!(TILE_WORDS, MAX_PROXIES / 32);
+    for file in ["proxy_tiles.comp", "proxy_accumulate.comp"] {
+        assert_eq!(glsl_uint(file, "TILE_WORDS"), TILE_WORDS, "{file}");
+    }
+}
+
+#[test]
+fn scene_encodings_match_the_shaders() {
+    assert_eq!(glsl_uint("include/scene.glsl", "NO_TEXTURE"), NO_TEXTURE);
+    for (name, kind) in [
+        ("LIGHT_DIRECTIONAL", LightKind::Directional),
+        ("LIGHT_POINT", LightKind::Point),
+        ("LIGHT_SPOT", LightKind::Spot),
+    ] {
+        let light = Light {
+            kind: glsl_uint("include/scene.glsl", name),
+            ..<Light as bytemuck::Zeroable>::zeroed()
+        };
+        assert_eq!(light.light_kind(), Some(kind), "{name}");
+    }
 }

@@ -15,8 +15,9 @@ use common::{
 use shine::gpu::{Device, MemoryLocation};
 use shine::graph::vk::{self, AccessFlags2 as A, ImageLayout as L, PipelineStageFlags2 as S};
 use shine::graph::{Executor, ExternalState, Handle, Image, RenderGraph};
+use shine::passes::gbuffer::GBuffer;
 use shine::passes::receivers::{
-    GBuffer, Receivers, ReceiversPush, gather_texels, receiver_extent, receiver_samples, receivers,
+    Receivers, ReceiversPush, gather_texels, receiver_extent, receiver_samples, receivers,
 };
 use shine::passes::upsample::{
     UpsampleInputs, UpsampleParams, UpsamplePush, upsample, upsample_cpu,

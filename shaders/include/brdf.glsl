@@ -106,7 +106,7 @@ vec3 brdf_sample(vec3 n, vec3 v, float p_specular, float roughness, vec3 xi) {
 }
 
 // Diffuse and specular weights of the metallic-roughness material for indirect light (HVL and
-// IGI), shine::passes::hvl::indirect_weights:
+// IGI), shine::passes::brdf_tables::indirect_weights:
 // Schlick's Fresnel at the mirror direction (v . h = n . v), kd = (1 - F)(1 - metallic) albedo
 // (the direct pass's diffuse), ks = F.
 void brdf_indirect_weights(vec3 albedo, float metallic, float n_dot_v, out vec3 kd, out vec3 ks) {
@@ -115,7 +115,7 @@ void brdf_indirect_weights(vec3 albedo, float metallic, float n_dot_v, out vec3 
     kd = (1.0 - ks) * (1.0 - metallic) * albedo;
 }
 
-// shine::passes::hvl::table_fresnel_weight (an n.v approximation: the tables' Fresnel varies
+// shine::passes::brdf_tables::table_fresnel_weight (an n.v approximation: the tables' Fresnel varies
 // with each direction's v.h). Weight of the GGX tables' glossy row (they hold the exact dielectric Fresnel, eta = 1.5): the
 // material's Schlick F over the tables' F at the mirror direction (v . h = n . v), Schlick with
 // F0 = 0.04 standing for the latter: 1 for dielectrics, about albedo / 0.04 at normal view for

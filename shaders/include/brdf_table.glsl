@@ -1,4 +1,4 @@
-// Rows of the BRDF SH tables on the GPU (shine::passes::hvl::GatherBrdf::gpu_data): F of Lambert
+// Rows of the BRDF SH tables on the GPU (shine::passes::brdf_tables::GatherBrdf::gpu_data): F of Lambert
 // (albedo 1, table 0) then F of GGX at each roughness node (tables 1..), each 90 rows of
 // SH_COEFFS floats in the receiver frame (z = normal, omega_o in the xz half-plane), the
 // shine_sh::brdf_table layout. Used by hvl_gather.comp and sh_filter.comp.
@@ -22,7 +22,7 @@ void brdf_table_row(int table, float theta_o, out float f[SH_COEFFS]) {
     }
 }
 
-// shine::passes::hvl::GatherBrdf::glossy_f: the glossy row at `roughness`, blended linearly
+// shine::passes::brdf_tables::GatherBrdf::glossy_f: the glossy row at `roughness`, blended linearly
 // between the two tables around it (clamped to the nodes). nodes: roughness of the first table
 // and the step between tables; tables: number of glossy tables.
 void brdf_table_glossy_row(float roughness, vec2 nodes, uint tables, float theta_o, out float f[SH_COEFFS]) {

@@ -1,6 +1,6 @@
 // Harmonics Virtual Lights (paper 003): the HVL cache record and the zonal helpers the HVL
 // passes share. Include after sh.glsl (SH_BANDS defined). Every function mirrors a Rust
-// function named in its comment (shine::hvl_reference or shine-sh) with the same formula.
+// function named in its comment (shine::reference::hvl or shine-sh) with the same formula.
 #ifndef HVL_GLSL
 #define HVL_GLSL
 
@@ -31,7 +31,7 @@ float hvl_sphere_half_angle(float distance, float radius) {
     return asin(radius / distance);
 }
 
-// shine::hvl_reference::zh_eval: a ZH vector (about axis a) evaluated at direction b,
+// shine::reference::hvl::zh_eval: a ZH vector (about axis a) evaluated at direction b,
 // cos_angle = a . b: sum_l zh_l sqrt((2l+1)/(4 pi)) P_l(cos_angle), first `bands` bands.
 float hvl_zh_eval(float zh[8], int bands, float cos_angle) {
     float p[SH_BANDS + 1];
@@ -43,7 +43,7 @@ float hvl_zh_eval(float zh[8], int bands, float cos_angle) {
     return s;
 }
 
-// shine::hvl_reference::zh_dot: dot product of two ZH vectors rotated to axes at cos_angle,
+// shine::reference::hvl::zh_dot: dot product of two ZH vectors rotated to axes at cos_angle,
 // sum_l f_l g_l P_l(cos_angle) (the O(n) zonal path of paper 003 §6.3)
 float hvl_zh_dot(float f[SH_BANDS], float g[SH_BANDS], float cos_angle) {
     float p[SH_BANDS + 1];

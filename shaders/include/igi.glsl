@@ -1,5 +1,5 @@
 // Instant GI with SH-filtered incident radiance (paper 000): the per-VPL and per-pixel formulas
-// shared by vpl_sh.comp and sh_filter.comp. CPU twin: shine::igi_reference (same names without
+// shared by vpl_sh.comp and sh_filter.comp. CPU twin: shine::reference::igi (same names without
 // the igi_ prefix); tests/igi.rs compares the passes built on them with it.
 //
 // Needs SH_BANDS and sh.glsl (included here).

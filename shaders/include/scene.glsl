@@ -1,4 +1,4 @@
-// Scene data as uploaded by src/gpu_scene.rs: materials and lights (std430 mirrors of
+// Scene data as uploaded by src/gpu_scene/mod.rs: materials and lights (std430 mirrors of
 // shine_scene::Material, 80 bytes, and shine_scene::Light, 64 bytes).
 #ifndef SCENE_GLSL
 #define SCENE_GLSL

@@ -1,6 +1,6 @@
 //! The HVL technique (paper 003) as the frame uses it: the BRDF SH tables it keeps on the
 //! device, and the passes it adds to a frame (`hvl_cache` over the primary light's RSM, then
-//! `hvl_gather` at every receiver; `src/passes/hvl.rs`).
+//! `hvl_gather` at every receiver; `src/passes/hvl/mod.rs`).
 
 use glam::Vec3;
 use shine_gpu::Device;

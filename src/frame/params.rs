@@ -4,17 +4,12 @@
 
 use crate::passes::aaf::AafParams;
 use crate::passes::composite::{Component, CompositeParams};
-use crate::passes::direct::ShadowParams;
+use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParams};
 use crate::passes::hvl::HvlParams;
 use crate::passes::igi::IgiParams;
 use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
 use crate::passes::upsample::UpsampleParams;
 use crate::settings::{GiTechnique, Settings};
-
-/// Shadow-map depth bias in NDC depth units, on top of the raster slope bias.
-pub const SHADOW_DEPTH_BIAS: f32 = 1e-4;
-/// Receiver offset along its normal in shadow-map texels (removes acne at grazing angles).
-pub const SHADOW_NORMAL_OFFSET: f32 = 1.5;
 
 /// Everything a frame needs to know, resolved from the settings: a technique is in the frame
 /// exactly when its parameters are present.

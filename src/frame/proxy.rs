@@ -18,7 +18,9 @@ use super::error::RenderError;
 use super::params::ProxySetup;
 use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::environment_sh::EnvironmentSh;
-use crate::passes::proxy::{self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyTables};
+use crate::passes::proxy::{
+    self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyParams, ProxyTables,
+};
 use crate::passes::receivers::Receivers;
 
 /// One node's proxies as set up from the scene.
@@ -36,12 +38,20 @@ pub struct ProxyTechnique {
     device: Device,
     sources: Vec<ProxySource>,
     environment: Option<Environment>,
-    /// Proxies for one `fit_count`: (fit_count, count, buffer).
-    proxies: Option<(u32, u32, Buffer)>,
+    /// The proxies for one `fit_count`.
+    proxies: Option<ProxyBuffer>,
     /// Environment SH per band count.
     environments: Vec<(u32, Buffer)>,
     /// Tables per (bands, η shadow, η indirect).
     tables: Vec<(TableKey, ProxyTables, Buffer)>,
+}
+
+/// The world-space proxies on the device for one `fit_count`.
+struct ProxyBuffer {
+    fit_count: u32,
+    /// Proxies in the buffer (0: it holds one zero record).
+    count: u32,
+    buffer: Buffer,
 }
 
 /// The α tables' cache key: bands and the bits of both expansion factors.
@@ -49,7 +59,7 @@ type TableKey = (u32, u32, u32);
 
 /// A proxy frame ready to be declared: the GPU data of its setup imported into the graph.
 pub struct PreparedProxy<'a> {
-    setup: ProxySetup,
+    params: ProxyParams,
     inputs: ProxyInputs,
     tables: &'a ProxyTables,
 }
@@ -89,7 +99,7 @@ impl ProxyTechnique {
     }
 
     /// The world-space proxies for `fit_count` (0: the scene's own).
-    pub fn proxies(&self, fit_count: u32) -> Vec<GpuProxy> {
+    fn proxies(&self, fit_count: u32) -> Vec<GpuProxy> {
         let mut out = Vec::new();
         for s in &self.sources {
             let fitted;
@@ -100,19 +110,9 @@ impl ProxyTechnique {
                 }
                 _ => &s.spheres,
             };
-            let w = s.world;
-            let scale = w
-                .x_axis
-                .truncate()
-                .length()
-                .max(w.y_axis.truncate().length())
-                .max(w.z_axis.truncate().length());
             out.extend(spheres.iter().map(|sp| {
-                GpuProxy::new(
-                    w.transform_point3(Vec3::from(sp.center)),
-                    sp.radius * scale,
-                    s.albedo,
-                )
+                let world = sp.transformed(&s.world);
+                GpuProxy::new(Vec3::from(world.center), world.radius, s.albedo)
             }));
         }
         out
@@ -160,14 +160,14 @@ impl ProxyTechnique {
             }
         };
         let proxies = match self.proxies.take() {
-            Some(cached) if cached.0 == setup.fit_count => cached,
+            Some(cached) if cached.fit_count == setup.fit_count => cached,
             _ => self.upload_proxies(setup.fit_count)?,
         };
-        let (_, count, proxy_buffer) = self.proxies.insert(proxies);
+        let proxies = self.proxies.insert(proxies);
         let (_, tables, table_buffer) = &self.tables[table_index];
         let inputs = ProxyInputs {
-            proxies: rg.import_gpu_buffer(proxy_buffer, BUFFER_READ, BUFFER_READ),
-            count: *count,
+            proxies: rg.import_gpu_buffer(&proxies.buffer, BUFFER_READ, BUFFER_READ),
+            count: proxies.count,
             tables: rg.import_gpu_buffer(table_buffer, BUFFER_READ, BUFFER_READ),
             environment: rg.import_gpu_buffer(
                 &self.environments[environment_index].1,
@@ -176,16 +176,14 @@ impl ProxyTechnique {
             ),
         };
         Ok(PreparedProxy {
-            setup: *setup,
+            params: setup.pass,
             inputs,
             tables,
         })
     }
-}
 
-impl ProxyTechnique {
-    /// The proxies for `fit_count` on the device: `(fit_count, count, buffer)`.
-    fn upload_proxies(&self, fit_count: u32) -> Result<(u32, u32, Buffer), RenderError> {
+    /// The proxies for `fit_count` on the device.
+    fn upload_proxies(&self, fit_count: u32) -> Result<ProxyBuffer, RenderError> {
         let list = self.proxies(fit_count);
         let count = u32::try_from(list.len())
             .ok()
@@ -199,7 +197,11 @@ impl ProxyTechnique {
         };
         let buffer =
             Buffer::storage_with_data(&self.device, "proxies", bytemuck::cast_slice(&data))?;
-        Ok((fit_count, count, buffer))
+        Ok(ProxyBuffer {
+            fit_count,
+            count,
+            buffer,
+        })
     }
 }
 
@@ -211,7 +213,7 @@ impl PreparedProxy<'_> {
         rg: &mut RenderGraph,
         receivers: &Receivers,
     ) -> Result<Handle<Image>, RenderError> {
-        let params = &self.setup.pass;
+        let params = &self.params;
         let sums = proxy::proxy_accumulate(rg, receivers, &self.inputs, self.tables, params)?;
         let out = proxy::proxy_shade(rg, receivers, &sums, &self.inputs, self.tables, params)?;
         Ok(out.radiance)

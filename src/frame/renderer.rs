@@ -76,7 +76,7 @@ pub struct HostTarget {
 }
 
 /// Renders scenes on a [`Device`]: the scene's resources, the techniques' persistent state, and
-/// the composition of every frame's passes ([`Renderer::declare_frame`]).
+/// the composition of every frame's passes (`Renderer::declare_frame`).
 pub struct Renderer {
     device: Device,
     executor: Executor,

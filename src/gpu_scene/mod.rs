@@ -15,13 +15,10 @@ pub mod environment_sh;
 use glam::{Mat3, Mat4, Vec3};
 use shine_gpu::{Buffer, BufferDesc, Device, Image, ImageDesc, MemoryLocation, vk};
 use shine_graph::ExternalState;
-use shine_scene::{Light, LightKind, Material, Scene};
+use shine_scene::{Light, LightKind, Material, NO_TEXTURE, Scene};
 
 /// Edge of every layer of the texture arrays, in texels.
 pub const TEXTURE_SIZE: u32 = 256;
-
-/// Marks "no texture" in [`GpuMaterial`] (as in shine-scene).
-pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// Persistent buffers the frame reads (scene, BVH, tables, shadow records): read by any stage,
 /// before and after the frame.

@@ -30,7 +30,8 @@ pub fn glossy_roughness_step() -> f32 {
 }
 
 /// The two glossy tables around `roughness` and the weight of the second: `(k, k + 1, t)`,
-/// clamped to the nodes (the GLSL twin is `glossy_rows` in `shaders/hvl_gather.comp`).
+/// clamped to the nodes (the GLSL twin is `brdf_table_glossy_row` in
+/// `shaders/include/brdf_table.glsl`).
 pub fn glossy_blend(roughness: f32) -> (u32, u32, f32) {
     let x = ((roughness - GLOSSY_ROUGHNESS_MIN) / glossy_roughness_step())
         .clamp(0.0, (GLOSSY_TABLES - 1) as f32);

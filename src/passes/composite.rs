@@ -27,6 +27,16 @@ pub struct CompositeParams {
     pub tonemap: Tonemap,
 }
 
+impl Default for CompositeParams {
+    /// Exposure 1 and the Khronos PBR Neutral curve.
+    fn default() -> Self {
+        Self {
+            exposure: 1.0,
+            tonemap: Tonemap::PbrNeutral,
+        }
+    }
+}
+
 crate::choice::named_choice! {
     /// Which part of the radiance the frame shows (image tests compare each against the
     /// path-traced reference, `crate::reference`): what the composite sums.

@@ -23,6 +23,11 @@ pub struct DirectConstants {
     pub shadow: [f32; 4],
 }
 
+/// Shadow-map depth bias in NDC depth units, on top of the raster slope bias.
+pub const SHADOW_DEPTH_BIAS: f32 = 1e-4;
+/// Receiver offset along its normal in shadow-map texels (removes acne at grazing angles).
+pub const SHADOW_NORMAL_OFFSET: f32 = 1.5;
+
 /// Shadow filtering parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowParams {

@@ -133,7 +133,7 @@ pub struct IgiParams {
     pub glossy: Glossy,
     /// d_min of the 1/d² clamp in metres (0..=10).
     pub clamp_distance: f32,
-    /// Relative depth tolerance of the filter (> 0).
+    /// Relative depth tolerance of the filter, in [`DEPTH_TOLERANCE`].
     pub depth_tolerance: f32,
     /// Cosine threshold of the geometric-normal test (−1..=1).
     pub normal_threshold: f32,

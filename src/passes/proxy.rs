@@ -3,11 +3,11 @@
 //!
 //! * [`proxy_accumulate`] sums, at every receiver, the rotated log-occlusion ZH vectors of the
 //!   proxies (eq. 4, 8) and their indirect shading `I_i · H(N_p)` with the summed solid angle
-//!   `ω_p` (eq. 12–15): the `proxy_occlusion` and the accumulation half of
-//!   `proxy_indirect`, in one tiled compute "splat" (docs/frame.md, "Proxy GI", says why).
-//! * [`proxy_shade`] exponentiates the sum (OL, PS or HYB), shades the
-//!   environment through the occlusion (eq. 10), normalises the indirect sum (eq. 12) and
-//!   writes the outgoing diffuse radiance at receiver resolution (`proxy_gi`).
+//!   `ω_p` (eq. 12–15), occlusion and indirect light in one tiled compute "splat"
+//!   (docs/frame.md, "Proxy GI", says why).
+//! * [`proxy_shade`] exponentiates the sum (OL, PS or HYB), shades the environment through the
+//!   occlusion (eq. 10), normalises the indirect sum (eq. 12) and writes the outgoing diffuse
+//!   radiance at receiver resolution (`proxy_gi`).
 //!
 //! Every formula comes from shine-sh ([`shine_sh::sphere_blocker`], [`shine_sh::exp_log`],
 //! [`shine_sh::proxy_indirect`]) on the CPU and from `shaders/include/sh.glsl` on the GPU;
@@ -23,7 +23,7 @@
 //!   `r / α_0`: slightly larger than `η r` (17.0 r for η = 15 with 256 rows) because the
 //!   smooth ramp starts one row below `1/η`. Splatting with that radius loses nothing: splat
 //!   and brute force agree exactly.
-//! * **Self-shadowing** ([`self_shadow_substitute`]) replaces the proxy for both the shadow and
+//! * **Self-shadowing** ([`shine_sh::sphere_blocker::self_shadow_substitute`]) replaces the proxy for both the shadow and
 //!   the indirect accumulation, so a receiver on a proxied object neither shadows nor lights
 //!   itself through its own proxy.
 //! * **Indirect light** is order 3 (the D(θ) fit of eq. 15): `I_i = (ρ_i/π) κ_i V_i`, with the
@@ -41,7 +41,7 @@ use crate::gpu_scene::environment_sh::ORDERS;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
 
-pub use super::receivers::Receivers;
+use super::receivers::Receivers;
 
 crate::choice::named_choice! {
     /// The SH exponential of the accumulated log-occlusion (paper 002 eq. 4, Ren et al. 2006).
@@ -64,6 +64,9 @@ pub const MAX_PROXIES: u32 = 2048;
 pub fn paper_expansion(bands: u32) -> f32 {
     if bands <= 3 { 10.0 } else { 15.0 }
 }
+
+/// Default SH order of the occlusion and environment: paper 002's shadow order.
+pub const DEFAULT_ORDER: u32 = 4;
 
 /// Radius expansion factors η of the spheres of influence (§4.1: 10 at order 3, 15 above).
 pub const EXPANSION: std::ops::RangeInclusive<f32> = 2.0..=100.0;
@@ -370,7 +373,9 @@ pub struct ProxyInputs {
     pub count: u32,
     /// [`ProxyTables::gpu_data`] at the parameters' band count.
     pub tables: Handle<Buffer>,
-    /// [`EnvironmentSh::gpu_data`](crate::gpu_scene::environment_sh::EnvironmentSh::gpu_data) at the parameters' band count.
+    /// [`EnvironmentSh::gpu_data`] at the parameters' band count.
+    ///
+    /// [`EnvironmentSh::gpu_data`]: crate::gpu_scene::environment_sh::EnvironmentSh::gpu_data
     pub environment: Handle<Buffer>,
 }
 

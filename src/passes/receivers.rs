@@ -7,18 +7,29 @@
 //! block's first sample when the whole block is background. A size not divisible by s gives
 //! `ceil(W/s)×ceil(H/s)` receivers whose right and bottom blocks are clipped to the image.
 
-pub use super::gbuffer::GBuffer;
+use super::gbuffer::GBuffer;
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
 
 /// Receiver scales s the passes accept: 1/1, 1/2 and 1/4 of the resolution (paper 002 §4.2).
 pub const SCALES: [u32; 3] = [1, 2, 4];
 
+/// [`SCALES`] in words: `1, 2 or 4`.
+pub fn scale_list() -> String {
+    match SCALES.split_last() {
+        Some((last, rest)) if !rest.is_empty() => {
+            let rest: Vec<String> = rest.iter().map(u32::to_string).collect();
+            format!("{} or {last}", rest.join(", "))
+        }
+        _ => SCALES.map(|s| s.to_string()).join(", "),
+    }
+}
+
 /// Bad input to the `receivers` or `upsample` pass.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
 pub enum ReceiverError {
     /// The scale is not one of [`SCALES`].
-    #[error("receiver scale {0} is not supported: use 1, 2 or 4")]
+    #[error("receiver scale {0} is not supported: use {scales}", scales = scale_list())]
     Scale(u32),
     /// An extent has a zero side.
     #[error("image extent {0:?} is empty: both sides must be at least 1")]

@@ -9,6 +9,9 @@ use super::gbuffer::{SceneHandles, View, scene_pipeline};
 use crate::gpu::vk;
 use crate::shaders;
 
+/// Default RSM side: 512² texels serve 400 HVLs with room to spare.
+pub const DEFAULT_SIZE: u32 = 512;
+
 /// RSM sides S in texels (S×S per primary light).
 pub const SIZE: std::ops::RangeInclusive<u32> = 16..=4096;
 

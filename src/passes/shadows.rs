@@ -24,6 +24,12 @@ use shine_scene::LightKind;
 /// Shadow-map tile sides in texels (`shadow.size`).
 pub const TILE_SIZE: std::ops::RangeInclusive<u32> = 64..=16384;
 
+/// Default shadow-map tile side in texels.
+pub const DEFAULT_TILE_SIZE: u32 = 2048;
+
+/// Default PCF radius in texels (a 3×3 kernel).
+pub const DEFAULT_FILTER_RADIUS: f32 = 1.5;
+
 /// Percentage-closer filter radii in texels (`shadow.filter_radius`; 0: one hard tap).
 pub const FILTER_RADIUS: std::ops::RangeInclusive<f32> = 0.0..=16.0;
 

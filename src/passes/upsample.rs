@@ -24,7 +24,8 @@
 //! Background pixels (`w == 0`) get 0. With s = 1 the output is an exact copy of the radiance.
 
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
-use crate::passes::receivers::{GBuffer, ReceiverError, Receivers, receiver_extent};
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::receivers::{ReceiverError, Receivers, receiver_extent};
 use crate::shaders;
 
 /// The paper's normal-weight exponent n in `w^N = (N_p · N_i)^n` (eq. 11, paper 002).

@@ -44,7 +44,8 @@ pub struct ReceiverSample {
     pub metallic: f32,
 }
 
-/// CPU twin of `proxy_accumulate` at one receiver: the [`sums_stride`] floats it writes. Every
+/// CPU twin of `proxy_accumulate` at one receiver: the
+/// [`sums_stride`](crate::passes::proxy::sums_stride) floats it writes. Every
 /// proxy is visited (the splat only skips proxies whose contribution is exactly 0). `exp` is
 /// the SH machinery of the parameters' band count.
 pub fn accumulate_cpu(

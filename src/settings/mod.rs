@@ -38,11 +38,12 @@ use serde::{Deserialize, Serialize};
 
 use crate::capture::tonemap::Tonemap;
 use crate::passes::aaf::AafParams;
-use crate::passes::composite::Component;
-use crate::passes::hvl::{GatherPath, RadiusHeuristic};
+use crate::passes::composite::{Component, CompositeParams};
+use crate::passes::hvl::{GatherPath, HvlParams, RadiusHeuristic};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
-use crate::passes::proxy::{ExpMethod, INDIRECT_BANDS, paper_expansion};
+use crate::passes::proxy::{DEFAULT_ORDER, ExpMethod, INDIRECT_BANDS, paper_expansion};
 use crate::passes::upsample::{DEPTH_SIGMA, NORMAL_POWER_N};
+use crate::passes::{rsm, shadows};
 
 /// Everything that decides what a frame computes and how it is written.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -300,7 +301,7 @@ impl Default for Settings {
 impl Default for ProxySettings {
     fn default() -> Self {
         Self {
-            sh_order: 4,
+            sh_order: DEFAULT_ORDER,
             expansion: 0.0,
             indirect_expansion: paper_expansion(INDIRECT_BANDS as u32),
             exp: ExpMethod::Hyb,
@@ -312,40 +313,46 @@ impl Default for ProxySettings {
 }
 
 impl Default for OutputSettings {
+    /// The composite's defaults ([`CompositeParams::default`]), the full radiance.
     fn default() -> Self {
+        let c = CompositeParams::default();
         Self {
-            tonemap: Tonemap::PbrNeutral,
-            exposure: 1.0,
+            tonemap: c.tonemap,
+            exposure: c.exposure,
             component: Component::Full,
         }
     }
 }
 
 impl Default for HvlSettings {
+    /// The defaults of the HVL passes ([`HvlParams::default`]).
     fn default() -> Self {
+        let h = HvlParams::default();
         Self {
-            count: 400,
-            radius: RadiusHeuristic::R2,
-            radius_scale: 1.5,
-            convolution_bands: 5,
-            emission_bands: 3,
-            visibility: false,
-            gather: GatherPath::Full,
+            count: h.count,
+            radius: h.radius,
+            radius_scale: h.radius_scale,
+            convolution_bands: h.conv_bands,
+            emission_bands: h.emission_bands,
+            visibility: h.visibility,
+            gather: h.path,
         }
     }
 }
 
 impl Default for RsmSettings {
     fn default() -> Self {
-        Self { size: 512 }
+        Self {
+            size: rsm::DEFAULT_SIZE,
+        }
     }
 }
 
 impl Default for ShadowSettings {
     fn default() -> Self {
         Self {
-            size: 2048,
-            filter_radius: 1.5,
+            size: shadows::DEFAULT_TILE_SIZE,
+            filter_radius: shadows::DEFAULT_FILTER_RADIUS,
         }
     }
 }

@@ -48,7 +48,7 @@ impl Settings {
             return Err(SettingsError::OutOfRange {
                 field: "receiver_scale",
                 value: self.receiver_scale.to_string(),
-                allowed: format!("one of {:?}", receivers::SCALES),
+                allowed: receivers::scale_list(),
             });
         }
         check("output.exposure", self.output.exposure, &tonemap::EXPOSURE)?;

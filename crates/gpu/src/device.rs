@@ -6,18 +6,15 @@
 use crate::error::{Error, Result, VkContext};
 use crate::features::{FeatureStatus, Support};
 use crate::instance::{
-    InstanceGuard, OwnedGuard, choose, create_instance, destroy_owned, list_adapters,
-    messenger_info, physical_name,
+    Adapter, InstanceGuard, Owned, OwnedGuard, VALIDATION_LAYER, choose, create_instance,
+    destroy_owned, list_adapters, messenger_info, physical_name,
 };
 use crate::retire::Tracker;
 use crate::validation::{MessageCounts, MessageLog, Validation};
 use ash::vk;
 use gpu_allocator::vulkan::{Allocator, AllocatorCreateDesc};
-use std::ffi::CStr;
 use std::mem::ManuallyDrop;
 use std::sync::{Arc, Mutex, MutexGuard};
-
-pub(crate) const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
 
 /// How to create a headless device.
 #[derive(Clone, Debug, Default)]
@@ -101,12 +98,6 @@ pub(crate) struct Inner {
     log: Arc<MessageLog>,
 }
 
-/// Objects shine created and must destroy (absent for a wrapped host device).
-pub(crate) struct Owned {
-    pub(crate) debug_instance:
-        Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
-}
-
 /// The engine's handle to a Vulkan device. Clone freely.
 #[derive(Clone)]
 pub struct Device {
@@ -119,19 +110,6 @@ impl std::fmt::Debug for Device {
             .field("name", &self.inner.info.name)
             .finish_non_exhaustive()
     }
-}
-
-/// A physical device as listed by [`Device::enumerate`].
-#[derive(Clone, Debug)]
-pub struct Adapter {
-    /// Index used by `SHINE_DEVICE=<index>`.
-    pub index: usize,
-    /// Device name.
-    pub name: String,
-    /// Device type.
-    pub device_type: vk::PhysicalDeviceType,
-    /// Requirements it does not meet (empty when usable).
-    pub missing: Vec<String>,
 }
 
 impl Device {

@@ -3,12 +3,35 @@
 //!
 //! [`Device`]: crate::Device
 
-use crate::device::{Adapter, Owned, VALIDATION_LAYER};
 use crate::error::{Error, Result};
 use crate::features::Support;
 use crate::validation::{self, MessageLog};
 use ash::vk;
+use std::ffi::CStr;
 
+/// The Khronos validation layer's name.
+pub(crate) const VALIDATION_LAYER: &CStr = c"VK_LAYER_KHRONOS_validation";
+
+/// A physical device as listed by [`Device::enumerate`](crate::Device::enumerate).
+#[derive(Clone, Debug)]
+pub struct Adapter {
+    /// Index used by `SHINE_DEVICE=<index>`.
+    pub index: usize,
+    /// Device name.
+    pub name: String,
+    /// Device type.
+    pub device_type: vk::PhysicalDeviceType,
+    /// Requirements it does not meet (empty when usable).
+    pub missing: Vec<String>,
+}
+
+/// Objects shine created and must destroy (absent for a wrapped host device).
+pub(crate) struct Owned {
+    pub(crate) debug_instance:
+        Option<(ash::ext::debug_utils::Instance, vk::DebugUtilsMessengerEXT)>,
+}
+
+/// The debug-utils messenger that counts validation messages into `log`.
 pub(crate) fn messenger_info(log: &MessageLog) -> vk::DebugUtilsMessengerCreateInfoEXT<'static> {
     vk::DebugUtilsMessengerCreateInfoEXT::default()
         .message_severity(validation::severities())
@@ -17,6 +40,7 @@ pub(crate) fn messenger_info(log: &MessageLog) -> vk::DebugUtilsMessengerCreateI
         .user_data(log as *const MessageLog as *mut std::ffi::c_void)
 }
 
+/// A Vulkan 1.3 instance, with the validation layer and debug utils when asked for.
 pub(crate) fn create_instance(
     entry: &ash::Entry,
     validation: bool,
@@ -61,6 +85,7 @@ pub(crate) fn create_instance(
     })
 }
 
+/// The device name a physical device reports.
 pub(crate) fn physical_name(instance: &ash::Instance, physical: vk::PhysicalDevice) -> String {
     // SAFETY: the physical device belongs to the instance.
     let properties = unsafe { instance.get_physical_device_properties(physical) };
@@ -70,6 +95,7 @@ pub(crate) fn physical_name(instance: &ash::Instance, physical: vk::PhysicalDevi
     )
 }
 
+/// Every physical device with what it lacks of shine's requirements.
 pub(crate) fn list_adapters(
     instance: &ash::Instance,
 ) -> Result<Vec<(Adapter, vk::PhysicalDevice)>> {
@@ -96,7 +122,8 @@ pub(crate) fn list_adapters(
         .collect())
 }
 
-pub(crate) fn type_rank(t: vk::PhysicalDeviceType) -> u32 {
+/// Preference of a device type: discrete before integrated before virtual before CPU.
+fn type_rank(t: vk::PhysicalDeviceType) -> u32 {
     match t {
         vk::PhysicalDeviceType::DISCRETE_GPU => 0,
         vk::PhysicalDeviceType::INTEGRATED_GPU => 1,
@@ -106,6 +133,8 @@ pub(crate) fn type_rank(t: vk::PhysicalDeviceType) -> u32 {
     }
 }
 
+/// The adapter `selector` names (`SHINE_DEVICE`: an index or a name substring), or the
+/// most preferred usable one.
 pub(crate) fn choose<'a>(
     adapters: &'a [(Adapter, vk::PhysicalDevice)],
     selector: Option<&str>,
@@ -156,6 +185,7 @@ pub(crate) fn choose<'a>(
     }
 }
 
+/// Destroys the messenger and the instance shine created.
 pub(crate) fn destroy_owned(instance: &ash::Instance, owned: Owned) {
     if let Some((loader, messenger)) = owned.debug_instance {
         // SAFETY: created by shine on this instance.

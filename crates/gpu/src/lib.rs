@@ -27,9 +27,10 @@ pub use ash;
 pub use ash::vk;
 pub use commands::{Commands, SCOPES_PER_RECORDING, Submission};
 pub use descriptors::{Descriptor, DescriptorArena};
-pub use device::{Adapter, Device, DeviceDesc, DeviceInfo, RawDevice};
+pub use device::{Device, DeviceDesc, DeviceInfo, RawDevice};
 pub use error::{Error, Result};
 pub use features::{FeatureStatus, REQUIREMENTS, Requirements};
+pub use instance::Adapter;
 pub use memory::{
     Buffer, BufferDesc, Image, ImageDesc, MemoryBlock, MemoryLocation, Sampler, format_aspect,
     format_texel_size,

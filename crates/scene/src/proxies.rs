@@ -13,7 +13,7 @@
 //! ([`crate::Scene::proxies_at`]).
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use serde_json::{Value, json};
 
 use crate::types::Mesh;
@@ -35,6 +35,23 @@ pub struct ProxySphere {
     pub center: [f32; 3],
     /// Radius.
     pub radius: f32,
+}
+
+impl ProxySphere {
+    /// The sphere carried by the node matrix `world`: its centre transformed, its radius scaled
+    /// by the matrix's largest axis scale (so it still bounds what it stood for).
+    pub fn transformed(&self, world: &Mat4) -> ProxySphere {
+        let scale = world
+            .x_axis
+            .truncate()
+            .length()
+            .max(world.y_axis.truncate().length())
+            .max(world.z_axis.truncate().length());
+        ProxySphere {
+            center: world.transform_point3(Vec3::from(self.center)).to_array(),
+            radius: self.radius * scale,
+        }
+    }
 }
 
 /// How well a set of spheres stands for a mesh surface, measured on area-weighted surface

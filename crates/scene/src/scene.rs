@@ -217,16 +217,7 @@ impl Scene {
         let mut out = Vec::new();
         for p in &self.proxies {
             let Some(w) = world.get(p.node) else { continue };
-            let scale = w
-                .x_axis
-                .truncate()
-                .length()
-                .max(w.y_axis.truncate().length())
-                .max(w.z_axis.truncate().length());
-            out.extend(p.spheres.iter().map(|s| ProxySphere {
-                center: w.transform_point3(Vec3::from(s.center)).to_array(),
-                radius: s.radius * scale,
-            }));
+            out.extend(p.spheres.iter().map(|s| s.transformed(w)));
         }
         out
     }

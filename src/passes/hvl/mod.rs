@@ -5,7 +5,7 @@
 //!   (eq. 23) or r2 (eq. 24–26) times a user scale, and the sender's SH emission (eq. 20).
 //! * [`hvl_gather`] sums, at every receiver, the outgoing radiance towards the camera due to
 //!   every HVL (eq. 1, 3, 19–22): the full O(n²) SH path with the receiver's BRDF SH tables
-//!   (Lambert + glossy tables over roughness, [`GatherBrdf`](crate::passes::brdf_tables::GatherBrdf)) or the O(n) zonal path (Lambert
+//!   (Lambert + glossy tables over roughness, [`GatherBrdf`]) or the O(n) zonal path (Lambert
 //!   only, §6.3).
 //!
 //! The CPU twin of both passes is [`crate::reference::hvl`]; docs/frame.md, section "Indirect
@@ -36,9 +36,8 @@
 //! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
 //!   never makes `indirect` negative; the paper's sinc window (§4.2) is not applied.
 //! * **Receiver BRDF.** `kd` times Lambert and `ks` times GGX (its tables hold the dielectric
-//!   Fresnel of η = 1.5; [`table_fresnel_weight`](crate::passes::brdf_tables::table_fresnel_weight) swaps it for the material's, approximately,
-//!   at n·v) at the
-//!   receiver's roughness, with the weights of [`indirect_weights`](crate::passes::brdf_tables::indirect_weights): the paper
+//!   Fresnel of η = 1.5; [`table_fresnel_weight`] swaps it for the material's, approximately,
+//!   at n·v) at the receiver's roughness, with the weights of [`indirect_weights`]: the paper
 //!   tabulates one table per material; we tabulate [`GLOSSY_TABLES`] roughness nodes
 //!   ([`glossy_roughness`]) and interpolate the two tables around the receiver's roughness
 //!   linearly, which serves every material of every scene with one buffer. Rougher than the
@@ -56,6 +55,11 @@
 //! lobes; zonal, Lambert only: 5.8% at 3, 0.8% at 9); with the exact Lambert emission as
 //! reference the total is 31–33% with 3 emission bands (the band-limited `F'·Y` overshoots
 //! near the sender's normal, the paper's choice) and 27% with 5.
+//!
+//! [`GatherBrdf`]: crate::passes::brdf_tables::GatherBrdf
+//! [`table_fresnel_weight`]: crate::passes::brdf_tables::table_fresnel_weight
+//! [`indirect_weights`]: crate::passes::brdf_tables::indirect_weights
+//! [`glossy_roughness`]: crate::passes::brdf_tables::glossy_roughness
 
 use std::ops::RangeInclusive;
 
@@ -136,7 +140,8 @@ pub struct GatherPush {
     pub hvl_count: u32,
     /// Bands of the HVL emission reconstructed (1–5).
     pub emission_bands: u32,
-    /// Roughness of the first glossy table and the step between tables ([`glossy_roughness`]).
+    /// Roughness of the first glossy table and the step between tables
+    /// ([`glossy_roughness`](crate::passes::brdf_tables::glossy_roughness)).
     pub roughness_nodes: [f32; 2],
     /// Number of glossy tables ([`GLOSSY_TABLES`]).
     pub glossy_tables: u32,
@@ -172,7 +177,7 @@ pub struct HvlParams {
     pub count: u32,
     /// Radius heuristic.
     pub radius: RadiusHeuristic,
-    /// User scale of the radii, 1–2 in the paper (accepted: 0.1–4).
+    /// User scale k of the radii, in [`RADIUS_SCALE`] (paper 003 §5.3: 1–2).
     pub radius_scale: f32,
     /// SH bands of the convolution at the receiver (1–10 in the paper).
     pub conv_bands: u32,
@@ -183,6 +188,22 @@ pub struct HvlParams {
     /// Shadow rays from each receiver to each HVL through the scene's BVH (not in paper 003,
     /// whose HVLs are unshadowed).
     pub visibility: bool,
+}
+
+impl Default for HvlParams {
+    /// Paper 003's choices: 400 HVLs (fig. 10), r2 radii scaled by 1.5 (§5.3: 1–2), 5
+    /// convolution and 3 emission bands, the full path, unshadowed.
+    fn default() -> Self {
+        Self {
+            count: 400,
+            radius: RadiusHeuristic::R2,
+            radius_scale: 1.5,
+            conv_bands: 5,
+            emission_bands: 3,
+            path: GatherPath::Full,
+            visibility: false,
+        }
+    }
 }
 
 /// Errors of the HVL passes: parameters out of range or inconsistent inputs.
@@ -234,8 +255,8 @@ pub enum HvlError {
     /// HVL visibility was asked for without the scene's BVH.
     #[error("HVL visibility needs the scene's BVH buffers")]
     NoBvh,
-    /// Building the BRDF SH tables failed.
-    #[error("BRDF SH table: {0}")]
+    /// An SH computation of the CPU twin failed (a band count outside shine-sh's range).
+    #[error("HVL SH: {0}")]
     Sh(#[from] shine_sh::ShError),
 }
 
