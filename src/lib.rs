@@ -16,6 +16,7 @@ pub mod passes;
 pub mod profile;
 pub mod reference;
 pub mod settings;
+pub mod study;
 
 pub use frame::RenderError;
 pub use frame::renderer::{FrameImage, HostTarget, Renderer};

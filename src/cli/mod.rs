@@ -7,6 +7,7 @@ mod profile;
 mod reference;
 mod render;
 mod scene;
+mod study;
 
 use clap::{Parser, Subcommand};
 
@@ -35,6 +36,8 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Built-in scenes: list them or export one as .glb.
     Scene(scene::SceneArgs),
+    /// Quality studies: error against samples per pixel (`study aaf`: paper 004's Fig. 10).
+    Study(study::StudyArgs),
 }
 
 /// Runs the chosen subcommand.
@@ -46,5 +49,6 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Reference(args) => reference::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Scene(args) => scene::run(&args),
+        Command::Study(args) => study::run(&args),
     }
 }

@@ -1,0 +1,158 @@
+//! `shine study`: quality studies. `shine study aaf SCENE` measures how many samples AAF
+//! (paper 004) saves at equal error: the error-vs-spp curves of its Fig. 10 against a
+//! high-sample truth, the equal-error speedup, the filter's share of the frame, and plots
+//! (`shine::study::aaf`; the numbers measured so far are in docs/quality.md).
+
+use super::CliError;
+use super::frame_args::{EnvironmentArgs, load_scene};
+use shine::gpu::{Device, DeviceDesc};
+use shine::study::aaf::AafStudyConfig;
+use shine::study::report::StudyFormat;
+use shine::study::{Progress, aaf};
+use std::path::PathBuf;
+
+/// Arguments of `shine study`.
+#[derive(clap::Args, Debug)]
+pub struct StudyArgs {
+    #[command(subcommand)]
+    study: Study,
+}
+
+#[derive(clap::Subcommand, Debug)]
+enum Study {
+    /// AAF (paper 004): error against spp of uniform Monte Carlo, filtered uniform Monte Carlo
+    /// and AAF at several μ; the samples and time uniform sampling needs for AAF's error.
+    Aaf(AafStudyArgs),
+}
+
+/// Arguments of `shine study aaf`.
+#[derive(clap::Args, Debug)]
+pub struct AafStudyArgs {
+    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room).
+    scene: String,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 128)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 128)]
+    height: u32,
+    /// Output folder for error.png, spp.png, beta.png, truth.png, aaf.png and uniform.png
+    /// (default: out/study-aaf-SCENE).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Report format on stdout: table or json.
+    #[arg(long, default_value = "table")]
+    format: String,
+    /// Samples per pixel of the truth (uniform Monte Carlo of the same quantity).
+    #[arg(long, default_value_t = 2048)]
+    truth_spp: u32,
+    /// Samples per pixel of one truth render (one seed); --truth-spp is a multiple of it.
+    #[arg(long, default_value_t = 128)]
+    truth_chunk: u32,
+    /// The uniform curves' spp levels, increasing, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4, 8, 16, 32, 64, 128, 256])]
+    spp: Vec<u32>,
+    /// AAF's μ values (the AAF curve), comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [0.25, 0.5, 0.9, 2.0, 4.0, 8.0])]
+    mu: Vec<f32>,
+    /// The μ of the equal-error comparison (paper: 0.9).
+    #[arg(long, default_value_t = shine_sh::aaf::DEFAULT_MU)]
+    equal_error_mu: f32,
+    /// Renders per curve point, each with its own seed (errors averaged, times the least).
+    #[arg(long, default_value_t = 1)]
+    repeats: u32,
+    /// Samples per pixel of the path-traced indirect light AAF is also compared with; 0 skips
+    /// it.
+    #[arg(long, default_value_t = 256)]
+    path_tracer_spp: u32,
+    /// The first seed (every render takes the next).
+    #[arg(long, default_value_t = 1)]
+    seed: u32,
+    /// Scene time in seconds (animations).
+    #[arg(long, default_value_t = 0.0)]
+    time: f32,
+    #[command(flatten)]
+    environment: EnvironmentArgs,
+}
+
+/// Runs the chosen study.
+pub fn run(args: &StudyArgs) -> Result<(), CliError> {
+    match &args.study {
+        Study::Aaf(args) => run_aaf(args),
+    }
+}
+
+/// The default output folder of a scene argument: `out/study-aaf-NAME`, NAME the built-in's
+/// name or the file's stem.
+fn default_out(scene: &str) -> PathBuf {
+    let name = match scene.strip_prefix("builtin:") {
+        Some(name) => name.to_owned(),
+        None => PathBuf::from(scene)
+            .file_stem()
+            .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned()),
+    };
+    PathBuf::from("out").join(format!("study-aaf-{name}"))
+}
+
+fn run_aaf(args: &AafStudyArgs) -> Result<(), CliError> {
+    let format: StudyFormat = args.format.parse()?;
+    let config = AafStudyConfig {
+        extent: [args.width, args.height],
+        time: args.time,
+        truth_spp: args.truth_spp,
+        truth_chunk: args.truth_chunk,
+        uniform_spp: args.spp.clone(),
+        mus: args.mu.clone(),
+        mu: args.equal_error_mu,
+        repeats: args.repeats,
+        path_tracer_spp: args.path_tracer_spp,
+        seed: args.seed,
+        ..AafStudyConfig::default()
+    };
+    // Refuse bad numbers before loading anything.
+    config.validate()?;
+    let out = args.out.clone().unwrap_or_else(|| default_out(&args.scene));
+    let scene = load_scene(&args.scene, &args.environment)?;
+    let device = Device::new(&DeviceDesc::from_env())?;
+    let mut bars = Bars::default();
+    let mut study = aaf::run(&device, &scene, &args.scene, &config, &mut bars)?;
+    study.write_outputs(&out)?;
+    println!("{}", study.report.format(format)?);
+    Ok(())
+}
+
+/// Progress bars on stderr, one per stage (hidden when stderr is not a terminal).
+#[derive(Default)]
+struct Bars {
+    bar: Option<indicatif::ProgressBar>,
+}
+
+impl Progress for Bars {
+    fn stage(&mut self, name: &str, total: u64) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+        let bar = indicatif::ProgressBar::new(total);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{prefix:>12} {bar:40} {pos}/{len} {msg}, {elapsed} elapsed, {eta} left",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_prefix(name.to_owned());
+        self.bar = Some(bar);
+    }
+
+    fn advance(&mut self, steps: u64, message: &str) {
+        if let Some(bar) = &self.bar {
+            bar.set_message(message.to_owned());
+            bar.inc(steps);
+        }
+    }
+
+    fn finish(&mut self) {
+        if let Some(bar) = self.bar.take() {
+            bar.finish_and_clear();
+        }
+    }
+}
