@@ -6,6 +6,7 @@
 // CPU twin: shine::reference::aaf::beta_cpu.
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#include "brdf.glsl"
 #include "aaf.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -4,14 +4,15 @@
 // counts only when its shading normal is within the normal threshold of the centre's (paper
 // 004: 10 degrees) and it lies within `plane_tolerance` pixel footprints of the centre's tangent
 // plane, so no light leaks across surfaces. `x` filters rows into `filtered`; `y` filters
-// columns and multiplies by the receiver's diffuse weight kd (brdf_indirect_weights) into the
-// indirect image. With `enabled` = 0 the mean passes through unfiltered (uniform Monte Carlo).
+// columns and multiplies by the receiver's demodulation weight w (aaf.glsl) into the indirect
+// image. With `enabled` = 0 the mean passes through unfiltered (uniform Monte Carlo).
 // CPU twin: shine::reference::aaf::filter_cpu.
 //! variant x AAF_X=1
 //! variant y AAF_Y=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "brdf.glsl"
+#include "aaf.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -116,10 +117,7 @@ void main() {
         vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
         float metallic = imageLoad(gb_material, ixy).g;
         vec3 v = normalize(push.camera.xyz - position.xyz);
-        vec3 kd;
-        vec3 ks;
-        brdf_indirect_weights(albedo, metallic, dot(n, v), kd, ks);
-        out_radiance = kd * result;
+        out_radiance = aaf_demodulation(albedo, metallic, dot(n, v)) * result;
     }
     imageStore(indirect, ixy, vec4(out_radiance, 0.0));
 #endif

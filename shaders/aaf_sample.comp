@@ -1,10 +1,12 @@
-// AAF sampling (paper 004 §5, src/passes/aaf.rs): Monte-Carlo estimate of the incident
-// indirect radiance at every G-buffer pixel, cosine-weighted about the shading normal, so the
-// mean of the samples is the irradiance over pi (the receiver's albedo is applied after the
-// filter). Each sample traces a ray through the BVH; where it hits, the radiance leaving the hit
-// towards the pixel is next-event estimation to the punctual lights (path.glsl), continued for
-// `bounces` - 1 further BRDF-sampled vertices. Misses, emission and the environment add
-// nothing (the raster GI convention: punctual lights only).
+// AAF sampling (paper 004 §5, src/passes/aaf.rs): Monte-Carlo estimate of the indirect light
+// leaving every G-buffer pixel towards the camera, with directions cosine-weighted about the
+// shading normal: a sample carrying radiance L from direction l adds pi f(l, v) L / w, f the
+// receiver's metallic-roughness BRDF and w its demodulation weight (aaf.glsl; for a Lambertian
+// receiver the mean is the irradiance over pi, the quantity paper 004 filters). Each sample
+// traces a ray through the BVH; where it hits, the radiance leaving the hit towards the pixel is
+// next-event estimation to the punctual lights (path.glsl), continued for `bounces` - 1 further
+// BRDF-sampled vertices. Misses, emission and the environment add nothing (the raster GI
+// convention: punctual lights only).
 //
 // `first`: `samples` stratified samples (a k x k grid of strata, k = floor(sqrt(samples)), the
 // rest uniform); writes the sums and the nearest/farthest hit distances (z_min, z_max; 0, 0
@@ -20,15 +22,18 @@
 #define TRACE_NODES_BINDING 7
 #define TRACE_TRIANGLES_BINDING 8
 #include "trace.glsl"
+#include "aaf.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-// shine::passes::aaf::SamplePush (32 bytes).
+// shine::passes::aaf::SamplePush (48 bytes).
 layout(push_constant) uniform Push {
     // x: width, y: height, z: light count, w: seed.
     uvec4 frame;
     // x: bounces B, y: samples of the first pass, z, w: unused.
     uvec4 config;
+    // xyz: camera position, w: unused.
+    vec4 camera;
 } push;
 
 #define PATH_LIGHT_COUNT push.frame.z
@@ -38,6 +43,8 @@ layout(push_constant) uniform Push {
 layout(set = 0, binding = 9, rgba32f) readonly uniform image2D gb_position;
 layout(set = 0, binding = 10, rgba16f) readonly uniform image2D gb_normal;
 layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_normal;
+layout(set = 0, binding = 15, rgba8) readonly uniform image2D gb_albedo;
+layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
 // rgb: sum of the samples' radiance, a: samples taken.
 layout(set = 0, binding = 12, std430) buffer Sums {
     vec4 s[];
@@ -115,6 +122,10 @@ void main() {
     vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
     vec3 ng = normalize(imageLoad(gb_geometric_normal, ixy).xyz);
     vec3 origin = trace_offset(position.xyz, ng);
+    vec3 v = normalize(push.camera.xyz - position.xyz);
+    vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
+    vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
+    vec3 w = aaf_demodulation(albedo, roughness_metallic.y, dot(n, v));
     uint strata = uint(floor(sqrt(float(push.config.y))));
     float z_min = PT_FAR;
     float z_max = 0.0;
@@ -134,7 +145,8 @@ void main() {
         }
         z_min = min(z_min, hit.t);
         z_max = max(z_max, hit.t);
-        vec3 radiance = incident(l, hit, push.config.x);
+        vec3 f = brdf_metallic_roughness(n, l, v, albedo, roughness_metallic.y, roughness_metallic.x);
+        vec3 radiance = incident(l, hit, push.config.x) * BRDF_PI * f / w;
         if (!any(isnan(radiance)) && !any(isinf(radiance))) {
             sum.rgb += radiance;
         }

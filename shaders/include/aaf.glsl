@@ -1,6 +1,7 @@
 // Paper 004's filter width and sampling rate per pixel: the GLSL twin of shine_sh::aaf (tied by
 // tests/aaf.rs through the aaf_beta pass). z_min, z_max: nearest and farthest reflector seen
-// from the pixel; d: world-space size of the pixel at the receiver (A_p = d^2).
+// from the pixel; d: world-space size of the pixel at the receiver (A_p = d^2). The includer
+// includes brdf.glsl first.
 #ifndef AAF_GLSL
 #define AAF_GLSL
 
@@ -19,6 +20,18 @@ float aaf_samples_per_pixel(float omega_h, float z_min, float z_max, float d, fl
     float a = mu * omega_h * d / z_min + alpha;
     float b = 1.0 + mu * z_max / z_min;
     return gamma * a * a * omega_h * omega_h * b * b;
+}
+
+// The receiver's demodulation weight w = kd + ks (brdf_indirect_weights at n.v, never below
+// 1e-3): the samples store the BRDF-weighted radiance over w, the filter smooths that, and the
+// result is multiplied by w again (paper 004 filters irradiance before albedo modulation; w
+// extends it to the specular part of the metallic-roughness BRDF).
+// CPU twin: shine::reference::aaf::demodulation.
+vec3 aaf_demodulation(vec3 albedo, float metallic, float n_dot_v) {
+    vec3 kd;
+    vec3 ks;
+    brdf_indirect_weights(albedo, metallic, n_dot_v, kd, ks);
+    return max(kd + ks, vec3(1e-3));
 }
 
 #endif

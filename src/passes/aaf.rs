@@ -3,10 +3,12 @@
 //!
 //! 1. **First pass** (`shaders/aaf_sample.comp`, variant `first`): at every G-buffer pixel,
 //!    [`AafParams::first_samples`] stratified, cosine-weighted rays about the shading normal
-//!    through the BVH; each hit's outgoing radiance is next-event estimation to the punctual
-//!    lights (one bounce; [`AafParams::bounces`] > 1 continues the path by BRDF sampling, as
-//!    the path tracer). The mean of the samples is the incident irradiance over π; the nearest
-//!    and farthest hit distances are `z_min`, `z_max`.
+//!    through the BVH; each hit's outgoing radiance `L` is next-event estimation to the
+//!    punctual lights (one bounce; [`AafParams::bounces`] > 1 continues the path by BRDF
+//!    sampling, as the path tracer). A sample adds `π f(l, v) L / w`: `f` the receiver's BRDF,
+//!    `w = kd + ks` its demodulation weight, so that for a Lambertian receiver the mean is the
+//!    irradiance over π, the quantity the paper filters. The nearest and farthest hit
+//!    distances are `z_min`, `z_max`.
 //! 2. **Filter width and sampling rate** (`aaf_beta.comp`, GLSL twin of [`shine_sh::aaf`] in
 //!    `shaders/include/aaf.glsl`): `Ω_x^r = μ min(Ω_h/z_min, α/d)` (eq. 15), `β = 2/Ω_x^r`
 //!    (eq. 16), `n = γ (μ Ω_h d/z_min + α)² Ω_h² (1 + μ z_max/z_min)²` (eq. 21) clamped to
@@ -17,14 +19,17 @@
 //! 4. **Filter** (`aaf_filter.comp`, variants `x` then `y`): a separable gaussian of the mean
 //!    incident radiance over world-space distances, standard deviation `β` of the centre pixel,
 //!    neighbours only within the normal threshold (paper: 10°) and near the centre's tangent
-//!    plane; then the receiver's diffuse weight `kd` (the albedo modulation after filtering).
+//!    plane; then the receiver's weight `w` (the albedo modulation after filtering).
 //!
 //! # Decisions and deviations from paper 004
 //!
-//! * Direct light stays the raster's; AAF computes the indirect term only, diffuse: the
-//!   receiver's `kd` (`brdf_indirect_weights`, as HVL and IGI) times the filtered irradiance
-//!   over π. Glossy receivers' specular indirect light is not computed yet (the paper's glossy
-//!   bandlimits are in shine-sh, unused here).
+//! * Direct light stays the raster's; AAF computes the indirect term only. The receiver's whole
+//!   metallic-roughness BRDF weights the samples (with cosine-weighted directions), demodulated
+//!   by `w = kd + ks` (`brdf_indirect_weights`, as HVL and IGI) so the filter smooths what is
+//!   smooth: without the specular part the cornell box lost 16% of its indirect energy against
+//!   the path tracer (rough dielectrics, F0 = 0.04). Every receiver takes the diffuse bandlimit
+//!   Ω_h (the paper's glossy bandlimits are in shine-sh, unused yet): sharp lobes are blurred
+//!   and noisy under cosine sampling.
 //! * The filter's world-distance test (not in the paper, which tests normals only): a neighbour
 //!   farther than [`PLANE_TOLERANCE`] pixel footprints from the centre's tangent plane is left
 //!   out, so light does not leak between parallel surfaces at different depths.
@@ -178,7 +183,7 @@ pub fn footprint(camera: &View, height: u32) -> [f32; 2] {
     }
 }
 
-/// Push constants of `shaders/aaf_sample.comp` (32 bytes).
+/// Push constants of `shaders/aaf_sample.comp` (48 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SamplePush {
@@ -186,6 +191,8 @@ pub struct SamplePush {
     pub frame: [u32; 4],
     /// Bounces, samples of the first pass, unused, unused.
     pub config: [u32; 4],
+    /// xyz camera position, w unused.
+    pub camera: [f32; 4],
 }
 
 /// Push constants of `shaders/aaf_beta.comp` (48 bytes).
@@ -265,6 +272,7 @@ pub fn aaf(
     let sample_push = SamplePush {
         frame: [w, h, scene.light_count, params.seed],
         config: [params.bounces, params.first_samples, 0, 0],
+        camera: camera.eye.extend(0.0).to_array(),
     };
     let mut first = rg.create_buffer("aaf_sums_first", BufferDesc::new(pixels * 16));
     let mut depths = rg.create_buffer("aaf_depths", BufferDesc::new(pixels * 8));
@@ -279,24 +287,7 @@ pub fn aaf(
     .write("depths", &mut depths)
     .push(&sample_push)
     .dispatch([w, h, 1]);
-    let footprint = footprint(camera, h);
-    let mut widths = rg.create_buffer("aaf_widths", BufferDesc::new(pixels * 8));
-    rg.compute("aaf_beta", &shaders::AAF_BETA_COMP)
-        .read("gb_position", &g.position)
-        .read("depths", &depths)
-        .write("filter_widths", &mut widths)
-        .push(&BetaPush {
-            extent: g.extent,
-            footprint,
-            paper: [params.omega_h, params.alpha, params.mu, params.gamma],
-            clamps: [
-                params.z_min_fraction * scene.size,
-                params.spp_min as f32,
-                params.spp_upper(),
-                0.0,
-            ],
-        })
-        .dispatch([w, h, 1]);
+    let widths = aaf_beta(rg, g, &depths, camera, scene.size, params)?;
     let sums = if params.adaptive {
         let mut second = rg.create_buffer("aaf_sums", BufferDesc::new(pixels * 16));
         sample_pass(
@@ -315,26 +306,87 @@ pub fn aaf(
     } else {
         first
     };
-    let filter_push = FilterPush {
+    let indirect = aaf_filter(rg, g, &sums, &widths, camera, params)?;
+    Ok(AafOutputs {
+        indirect,
+        sums,
+        depths,
+        widths,
+    })
+}
+
+/// Adds `aaf_beta`: per pixel of `g`, β (world units) and the sample count (eq. 15, 16, 21)
+/// from the first pass's `depths` (vec2 z_min, z_max per pixel); z_min is clamped to
+/// `z_min_fraction × scene_size`. Returns the widths buffer (vec2 per pixel).
+pub fn aaf_beta(
+    rg: &mut RenderGraph,
+    g: &GBuffer,
+    depths: &Handle<Buffer>,
+    camera: &View,
+    scene_size: f32,
+    params: &AafParams,
+) -> Result<Handle<Buffer>, AafError> {
+    params.validate()?;
+    let [w, h] = g.extent;
+    let mut widths = rg.create_buffer(
+        "aaf_widths",
+        BufferDesc::new(u64::from(w) * u64::from(h) * 8),
+    );
+    rg.compute("aaf_beta", &shaders::AAF_BETA_COMP)
+        .read("gb_position", &g.position)
+        .read("depths", depths)
+        .write("filter_widths", &mut widths)
+        .push(&BetaPush {
+            extent: g.extent,
+            footprint: footprint(camera, h),
+            paper: [params.omega_h, params.alpha, params.mu, params.gamma],
+            clamps: [
+                params.z_min_fraction * scene_size,
+                params.spp_min as f32,
+                params.spp_upper(),
+                0.0,
+            ],
+        })
+        .dispatch([w, h, 1]);
+    Ok(widths)
+}
+
+/// Adds `aaf_filter_x` and `aaf_filter_y`: the separable filter of the mean of `sums` (vec4
+/// per pixel: rgb sum, count) with the widths of [`aaf_beta`], then the receivers' `kd`.
+/// Returns the indirect light (RGBA16F).
+pub fn aaf_filter(
+    rg: &mut RenderGraph,
+    g: &GBuffer,
+    sums: &Handle<Buffer>,
+    widths: &Handle<Buffer>,
+    camera: &View,
+    params: &AafParams,
+) -> Result<Handle<Image>, AafError> {
+    params.validate()?;
+    let [w, h] = g.extent;
+    let push = FilterPush {
         camera: camera
             .eye
             .extend(params.normal_threshold_degrees.to_radians().cos())
             .to_array(),
         extent: g.extent,
-        footprint,
+        footprint: footprint(camera, h),
         plane_tolerance: PLANE_TOLERANCE,
         max_radius: MAX_RADIUS,
         enabled: u32::from(params.filter),
         pad: 0,
     };
-    let mut rows = rg.create_buffer("aaf_rows", BufferDesc::new(pixels * 16));
+    let mut rows = rg.create_buffer(
+        "aaf_rows",
+        BufferDesc::new(u64::from(w) * u64::from(h) * 16),
+    );
     rg.compute("aaf_filter_x", &shaders::AAF_FILTER_COMP_X)
         .read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
-        .read("filter_widths", &widths)
-        .read("sums", &sums)
+        .read("filter_widths", widths)
+        .read("sums", sums)
         .write("filtered", &mut rows)
-        .push(&filter_push)
+        .push(&push)
         .dispatch([w, h, 1]);
     let mut indirect = rg.create_image(
         "aaf_indirect",
@@ -343,19 +395,14 @@ pub fn aaf(
     rg.compute("aaf_filter_y", &shaders::AAF_FILTER_COMP_Y)
         .read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
-        .read("filter_widths", &widths)
+        .read("filter_widths", widths)
         .read("filtered", &rows)
         .read("gb_albedo", &g.albedo)
         .read("gb_material", &g.material)
         .write("indirect", &mut indirect)
-        .push(&filter_push)
+        .push(&push)
         .dispatch([w, h, 1]);
-    Ok(AafOutputs {
-        indirect,
-        sums,
-        depths,
-        widths,
-    })
+    Ok(indirect)
 }
 
 /// A sampling pass with the scene, BVH and G-buffer bound.
@@ -378,6 +425,8 @@ fn sample_pass<'a>(
         .read("bvh_triangles", &scene.bvh.triangles)
         .read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
-        .read("gb_geometric_normal", &g.geometric_normal);
+        .read("gb_geometric_normal", &g.geometric_normal)
+        .read("gb_albedo", &g.albedo)
+        .read("gb_material", &g.material);
     pass
 }

@@ -7,6 +7,7 @@ use shine_sh::ShError;
 use shine_sh::aaf::{PixelFootprint, filter_bandwidth, filter_width, samples_per_pixel};
 
 use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE};
+use crate::passes::brdf_tables::indirect_weights;
 
 /// What `aaf_beta` writes for one pixel: `(β, samples)` from its linear depth (0 on
 /// background), its first-pass `(z_min, z_max)` (0, 0 without a hit), the [`footprint`]
@@ -38,6 +39,14 @@ pub fn beta_cpu(
         filter_width(omega_r)?,
         n.ceil().clamp(params.spp_min as f32, params.spp_upper()),
     ])
+}
+
+/// The receiver's demodulation weight `w = kd + ks` (`aaf_demodulation` of
+/// `shaders/include/aaf.glsl`), never below 1e-3: the filter's output is `w` times the filtered
+/// mean.
+pub fn demodulation(albedo: Vec3, metallic: f32, n_dot_v: f32) -> Vec3 {
+    let (kd, ks) = indirect_weights(albedo, metallic, n_dot_v);
+    (kd + ks).max(Vec3::splat(1e-3))
 }
 
 /// One pixel of the G-buffer as the filter sees it.
