@@ -1,7 +1,8 @@
 // AAF filter width and sampling rate per pixel (paper 004 eq. 15, 16, 21; src/passes/aaf.rs):
 // from the first pass's nearest and farthest reflector distances and the pixel's world-space
 // footprint d. z_min is clamped from below (a fraction of the scene's size) and z_max to at
-// least z_min; the sample count is clamped to [spp_min, spp_max]. A pixel whose first samples
+// least z_min; the sample count is clamped to [spp_min, spp_max]. Omega_h is the receiver's:
+// the diffuse bandlimit blended towards its GGX lobe's Blinn-Phong bandlimit by metallic. A pixel whose first samples
 // hit nothing takes no filter (beta = 0) and no further samples; a background pixel neither.
 // CPU twin: shine::reference::aaf::beta_cpu.
 #version 460
@@ -16,6 +17,7 @@ layout(set = 0, binding = 1, std430) readonly buffer Depths {
     vec2 z[];
 } depths;
 // x: beta (world units), y: samples per pixel.
+layout(set = 0, binding = 3, rgba8) readonly uniform image2D gb_material;
 layout(set = 0, binding = 2, std430) buffer Filter {
     vec2 f[];
 } filter_widths;
@@ -46,7 +48,9 @@ void main() {
     float d = depth * push.footprint.x + push.footprint.y;
     float z_min = max(z.x, push.clamps.x);
     float z_max = max(z.y, z_min);
-    float omega_r = aaf_filter_bandwidth(push.paper.x, z_min, d, push.paper.y, push.paper.z);
-    float n = aaf_samples_per_pixel(push.paper.x, z_min, z_max, d, push.paper.y, push.paper.z, push.paper.w);
+    vec2 roughness_metallic = imageLoad(gb_material, ivec2(pixel)).rg;
+    float omega_h = aaf_receiver_bandlimit(push.paper.x, roughness_metallic.x, roughness_metallic.y);
+    float omega_r = aaf_filter_bandwidth(omega_h, z_min, d, push.paper.y, push.paper.z);
+    float n = aaf_samples_per_pixel(omega_h, z_min, z_max, d, push.paper.y, push.paper.z, push.paper.w);
     filter_widths.f[p] = vec2(aaf_filter_width(omega_r), clamp(ceil(n), push.clamps.y, push.clamps.z));
 }

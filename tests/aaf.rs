@@ -111,12 +111,13 @@ fn synthetic() -> Synthetic {
             s.normal.push(q16(normal));
             s.albedo
                 .push(q8(Vec4::new(0.2 + 0.6 * u, 0.5, 0.8 - 0.5 * v, 1.0)));
-            s.material.push(q8(Vec4::new(
-                0.5,
-                if i % 7 == 2 { 1.0 } else { 0.0 },
-                0.0,
-                0.0,
-            )));
+            let metallic = match i % 7 {
+                2 => 1.0,
+                5 => 0.5,
+                _ => 0.0,
+            };
+            s.material
+                .push(q8(Vec4::new(0.2 + 0.6 * v, metallic, 0.0, 0.0)));
         }
     }
     s
@@ -234,7 +235,16 @@ fn beta_spp_and_filter_match_the_cpu_twin() {
     let clamp = params.z_min_fraction * SCENE_SIZE;
     let (mut filtered_pixels, mut clamped_spp) = (0, 0);
     for (p, got) in gpu.widths.iter().enumerate() {
-        let want = beta_cpu(s.position[p].w, s.depths[p], footprint, clamp, &params).expect("beta");
+        let material = [s.material[p].x, s.material[p].y];
+        let want = beta_cpu(
+            s.position[p].w,
+            s.depths[p],
+            material,
+            footprint,
+            clamp,
+            &params,
+        )
+        .expect("beta");
         let beta_error = (got[0] - want[0]).abs() / want[0].max(1e-6);
         assert!(beta_error < 1e-4, "pixel {p}: β {} vs {}", got[0], want[0]);
         // ceil() of eq. 21 in f32 against f64 may differ by one sample at an integer.

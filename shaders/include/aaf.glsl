@@ -5,6 +5,20 @@
 #ifndef AAF_GLSL
 #define AAF_GLSL
 
+// shine_sh::aaf::blinn_phong_exponent: m = 2 / alpha^2 - 2 of GGX alpha = roughness^2
+// (Walter et al. 2007), clamped to the fit's range [0, 50] of eq. 24.
+float aaf_blinn_phong_exponent(float roughness) {
+    float alpha = max(roughness * roughness, 1e-3);
+    return clamp(2.0 / (alpha * alpha) - 2.0, 0.0, 50.0);
+}
+
+// shine_sh::aaf::receiver_bandlimit: the diffuse Omega_h blended by metallic towards the
+// Blinn-Phong bandlimit 3.6 + 0.084 m (eq. 24, paper 004), never below Omega_h.
+float aaf_receiver_bandlimit(float omega_h, float roughness, float metallic) {
+    float glossy = 3.6 + 0.084 * aaf_blinn_phong_exponent(roughness);
+    return omega_h + (max(glossy, omega_h) - omega_h) * clamp(metallic, 0.0, 1.0);
+}
+
 // eq. 15, paper 004: Omega_x^r = mu min(Omega_h / z_min, alpha / d).
 float aaf_filter_bandwidth(float omega_h, float z_min, float d, float alpha, float mu) {
     return mu * min(omega_h / z_min, alpha / d);

@@ -13,7 +13,10 @@
 //!    `shaders/include/aaf.glsl`): `Ω_x^r = μ min(Ω_h/z_min, α/d)` (eq. 15), `β = 2/Ω_x^r`
 //!    (eq. 16), `n = γ (μ Ω_h d/z_min + α)² Ω_h² (1 + μ z_max/z_min)²` (eq. 21) clamped to
 //!    `[spp_min, spp_max·μ]`, with `d` the pixel's world-space footprint and `z_min` clamped
-//!    from below to [`AafParams::z_min_fraction`] of the scene's size.
+//!    from below to [`AafParams::z_min_fraction`] of the scene's size. Ω_h is the receiver's
+//!    ([`shine_sh::aaf::receiver_bandlimit`]): [`AafParams::omega_h`] for dielectrics, blended
+//!    by `metallic` towards the appendix's Blinn-Phong bandlimit `3.6 + 0.084 m` (eq. 24) with
+//!    `m = 2/α² − 2` from the GGX roughness (Walter et al. 2007), `m ≤ 50` (the fit's range).
 //! 3. **Second pass** (variant `second`): each pixel's remaining `n − first_samples` samples,
 //!    added to the first pass's sums.
 //! 4. **Filter** (`aaf_filter.comp`, variants `x` then `y`): a separable gaussian of the mean
@@ -27,9 +30,8 @@
 //!   metallic-roughness BRDF weights the samples (with cosine-weighted directions), demodulated
 //!   by `w = kd + ks` (`brdf_indirect_weights`, as HVL and IGI) so the filter smooths what is
 //!   smooth: without the specular part the cornell box lost 16% of its indirect energy against
-//!   the path tracer (rough dielectrics, F0 = 0.04). Every receiver takes the diffuse bandlimit
-//!   Ω_h (the paper's glossy bandlimits are in shine-sh, unused yet): sharp lobes are blurred
-//!   and noisy under cosine sampling.
+//!   the path tracer (rough dielectrics, F0 = 0.04). Sharp metallic lobes are sampled with
+//!   cosine-weighted directions (noisy) and filtered with their glossy β.
 //! * The filter's world-distance test (not in the paper, which tests normals only): a neighbour
 //!   farther than [`PLANE_TOLERANCE`] pixel footprints from the centre's tangent plane is left
 //!   out, so light does not leak between parallel surfaces at different depths.
@@ -334,6 +336,7 @@ pub fn aaf_beta(
     );
     rg.compute("aaf_beta", &shaders::AAF_BETA_COMP)
         .read("gb_position", &g.position)
+        .read("gb_material", &g.material)
         .read("depths", depths)
         .write("filter_widths", &mut widths)
         .push(&BetaPush {

@@ -4,19 +4,22 @@
 
 use glam::{Vec3, Vec4};
 use shine_sh::ShError;
-use shine_sh::aaf::{PixelFootprint, filter_bandwidth, filter_width, samples_per_pixel};
+use shine_sh::aaf::{
+    PixelFootprint, filter_bandwidth, filter_width, receiver_bandlimit, samples_per_pixel,
+};
 
 use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE};
 use crate::passes::brdf_tables::indirect_weights;
 
 /// What `aaf_beta` writes for one pixel: `(β, samples)` from its linear depth (0 on
-/// background), its first-pass `(z_min, z_max)` (0, 0 without a hit), the [`footprint`]
-/// and the z_min clamp in world units.
+/// background), its first-pass `(z_min, z_max)` (0, 0 without a hit), its roughness and
+/// metallic, the [`footprint`] and the z_min clamp in world units.
 ///
 /// [`footprint`]: crate::passes::aaf::footprint
 pub fn beta_cpu(
     depth: f32,
     z: [f32; 2],
+    roughness_metallic: [f32; 2],
     footprint: [f32; 2],
     z_min_clamp: f32,
     params: &AafParams,
@@ -33,8 +36,10 @@ pub fn beta_cpu(
         z_max: z[1].max(z_min),
         pixel_size: depth * footprint[0] + footprint[1],
     };
-    let omega_r = filter_bandwidth(params.omega_h, px, params.alpha, params.mu)?;
-    let n = samples_per_pixel(params.omega_h, px, params.alpha, params.mu, params.gamma)?;
+    let [roughness, metallic] = roughness_metallic;
+    let omega_h = receiver_bandlimit(params.omega_h, roughness, metallic);
+    let omega_r = filter_bandwidth(omega_h, px, params.alpha, params.mu)?;
+    let n = samples_per_pixel(omega_h, px, params.alpha, params.mu, params.gamma)?;
     Ok([
         filter_width(omega_r)?,
         n.ceil().clamp(params.spp_min as f32, params.spp_upper()),

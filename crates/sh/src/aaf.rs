@@ -45,6 +45,29 @@ pub fn transfer_bandlimit(t: Transfer) -> f32 {
     }
 }
 
+/// Largest Blinn-Phong exponent of the appendix's fit (eq. 24 is fitted for 4 < m < 50).
+pub const BLINN_PHONG_EXPONENT_MAX: f32 = 50.0;
+
+/// The Blinn-Phong exponent with the same lobe width as GGX of perceptual `roughness`
+/// (α = roughness²): `m = 2/α² − 2` (Walter et al. 2007, §5.2), clamped to
+/// `[0, BLINN_PHONG_EXPONENT_MAX]`.
+pub fn blinn_phong_exponent(roughness: f32) -> f32 {
+    let alpha = (roughness * roughness).max(1e-3);
+    (2.0 / (alpha * alpha) - 2.0).clamp(0.0, BLINN_PHONG_EXPONENT_MAX)
+}
+
+/// Ω_h of a metallic-roughness receiver: the diffuse bandlimit `omega_h` blended by `metallic`
+/// towards the Blinn-Phong bandlimit (eq. 24) of its GGX lobe ([`blinn_phong_exponent`]),
+/// never below `omega_h`. Dielectrics keep the diffuse bandlimit (their specular lobe carries a
+/// few percent of the energy); metals take the glossy one.
+pub fn receiver_bandlimit(omega_h: f32, roughness: f32, metallic: f32) -> f32 {
+    let glossy = transfer_bandlimit(Transfer::BlinnPhong {
+        exponent: blinn_phong_exponent(roughness),
+    });
+    let m = metallic.clamp(0.0, 1.0);
+    omega_h + (glossy.max(omega_h) - omega_h) * m
+}
+
 /// Per-pixel inputs of the AAF formulas.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PixelFootprint {
@@ -136,6 +159,22 @@ mod tests {
         assert_eq!(transfer_bandlimit(Transfer::Diffuse), 2.8);
         assert!((transfer_bandlimit(Transfer::BlinnPhong { exponent: 10.0 }) - 4.44).abs() < 1e-5);
         assert!((transfer_bandlimit(Transfer::Phong { exponent: 10.0 }) - 5.77).abs() < 1e-5);
+    }
+
+    #[test]
+    fn receiver_bandlimits_blend_from_diffuse_to_glossy() {
+        // GGX roughness 1 is a Blinn-Phong exponent 0; sharp lobes clamp at the fit's 50.
+        assert_eq!(blinn_phong_exponent(1.0), 0.0);
+        assert_eq!(blinn_phong_exponent(0.1), BLINN_PHONG_EXPONENT_MAX);
+        let alpha: f32 = 0.5 * 0.5;
+        assert!((blinn_phong_exponent(0.5) - (2.0 / (alpha * alpha) - 2.0)).abs() < 1e-4);
+        // Dielectrics keep Ω_h; metals take 3.6 + 0.084 m; half-metals lie between.
+        assert_eq!(receiver_bandlimit(2.8, 0.3, 0.0), 2.8);
+        let glossy = 3.6 + 0.084 * blinn_phong_exponent(0.3);
+        assert!((receiver_bandlimit(2.8, 0.3, 1.0) - glossy).abs() < 1e-5);
+        assert!((receiver_bandlimit(2.8, 0.3, 0.5) - 0.5 * (2.8 + glossy)).abs() < 1e-5);
+        // A rough metal's Blinn-Phong bandlimit (3.6) is above the diffuse one: never below.
+        assert!(receiver_bandlimit(2.8, 1.0, 1.0) >= 2.8);
     }
 
     #[test]
