@@ -123,6 +123,7 @@ fn tiny_aaf_study_reports_every_number_and_writes_the_pictures() {
         Some(5)
     );
     assert!(report["bars"]["sample_speedup_met"].is_boolean());
+    assert!(report["equal_error"]["reliable"].is_boolean());
     assert!(report["bars"]["overhead_share_met"].is_boolean());
     for field in [
         "aaf_relative_rmse",
@@ -141,6 +142,8 @@ fn tiny_aaf_study_reports_every_number_and_writes_the_pictures() {
         ("error.png", None),
         ("spp.png", Some((32, 40))),
         ("beta.png", Some((32, 40))),
+        ("aaf_error.png", Some((32, 40))),
+        ("filter_bias.png", Some((32, 40))),
         ("truth.png", Some((32, 32))),
         ("aaf.png", Some((32, 32))),
         ("uniform.png", Some((32, 32))),

@@ -20,12 +20,12 @@ use std::path::{Path, PathBuf};
 use shine_gpu::Device;
 use shine_scene::Scene;
 
-use super::metrics::{self, ImageError, TruthAccumulator};
+use super::metrics::{self, TruthAccumulator};
 use super::plot::{self, Curve};
 use super::report::{
     AafStudyReport, AgainstPathTracer, Bars, CurvePoint, Curves, EqualError, Maps, Truth,
 };
-use super::runner::{AAF_PASSES, AafFrame, AafRunner};
+use super::runner::{AAF_PASSES, AafFrame, AafRunner, Bench, Measured, Target};
 use super::{Progress, StudyError};
 use crate::passes::aaf::{self, AafParams};
 use crate::reference::{self, ReferenceParams};
@@ -34,6 +34,12 @@ use crate::reference::{self, ReferenceParams};
 pub const SAMPLE_SPEEDUP_BAR: f64 = 5.0;
 /// The bar on the filtering's share of AAF's frame.
 pub const OVERHEAD_SHARE_BAR: f64 = 0.15;
+/// aaf_error.png and filter_bias.png show signed errors relative to the truth's mean from
+/// minus this (blue) to plus this (red).
+pub const SIGNED_ERROR_RANGE: f32 = 1.0;
+/// The equal-error numbers are reliable when the truth's own noise (its MSE τ²) is at most this
+/// share of AAF's MSE (τ at most half AAF's RMSE).
+pub const RELIABLE_NOISE_SHARE: f64 = 0.25;
 /// Largest image side the study takes.
 pub const MAX_EXTENT: u32 = reference::MAX_EXTENT;
 
@@ -152,79 +158,8 @@ pub struct AafStudy {
     uniform: Vec<[f32; 3]>,
     mask: Vec<bool>,
     beta_px: Vec<f32>,
-}
-
-/// A curve point's renders, before the report's definitions are applied.
-struct Measured {
-    spp: f64,
-    error: ImageError,
-    time_ms: f64,
-    last: AafFrame,
-}
-
-/// The truth a render is measured against.
-struct Target<'a> {
-    truth: &'a [[f32; 3]],
-    mask: &'a [bool],
-    mean: f64,
-}
-
-/// The runner with the study's seed sequence: every render gets the next seed.
-struct Bench {
-    runner: AafRunner,
-    seed: u32,
-    repeats: u32,
-}
-
-impl Bench {
-    /// Renders `params` with the next seed.
-    fn render(&mut self, params: AafParams) -> Result<AafFrame, StudyError> {
-        self.seed = self.seed.wrapping_add(1);
-        self.runner.render(&AafParams {
-            seed: self.seed,
-            ..params
-        })
-    }
-
-    /// Renders `params` `repeats` times: the mean MSE, energy ratio and spp, and the least
-    /// `time` over the renders.
-    fn measure(
-        &mut self,
-        params: AafParams,
-        target: &Target<'_>,
-        time: &dyn Fn(&AafFrame) -> f64,
-        what: &str,
-        progress: &mut dyn Progress,
-    ) -> Result<Measured, StudyError> {
-        let (mut mse, mut energy, mut spp, mut time_ms) = (0.0, 0.0, 0.0, f64::INFINITY);
-        let mut last = None;
-        for _ in 0..self.repeats {
-            let frame = self.render(params)?;
-            let error = metrics::image_error(&frame.indirect, target.truth, target.mask)
-                .ok_or_else(|| {
-                    StudyError::NothingToMeasure("the truth is black on every pixel".into())
-                })?;
-            mse += error.mse;
-            energy += error.energy_ratio;
-            spp += metrics::mean_samples(&frame.samples, target.mask);
-            time_ms = time_ms.min(time(&frame));
-            last = Some(frame);
-            progress.advance(1, what);
-        }
-        let last = last.ok_or_else(|| StudyError::Invalid("no render".into()))?;
-        let r = f64::from(self.repeats);
-        let mse = mse / r;
-        Ok(Measured {
-            spp: spp / r,
-            error: ImageError {
-                mse,
-                relative_rmse: mse.sqrt() / target.mean,
-                energy_ratio: energy / r,
-            },
-            time_ms,
-            last,
-        })
-    }
+    /// Uniform filtered at the most spp: the filter's bias with little noise left.
+    filtered_most: Vec<[f32; 3]>,
 }
 
 /// Renders the study's images of `scene` on `device` and measures them.
@@ -307,6 +242,7 @@ pub fn run(
         uniform_images.push((n, m.last.indirect));
     }
     let mut filtered = Vec::new();
+    let mut filtered_most = Vec::new();
     for &n in &config.uniform_spp {
         let what = format!("uniform filtered {n} spp");
         let m = bench.measure(
@@ -317,6 +253,7 @@ pub fn run(
             progress,
         )?;
         filtered.push(point(&m, None));
+        filtered_most = m.last.indirect;
     }
     let mut aaf_points = Vec::new();
     let mut at_mu = None;
@@ -345,6 +282,7 @@ pub fn run(
     let overhead_share = share(&["aaf_beta", "aaf_filter_x", "aaf_filter_y"]);
     let sample_speedup = crossing.map(|c| c.spp / at_mu.spp);
     let equal_error = EqualError {
+        reliable: noise_mse.is_some_and(|t| t <= RELIABLE_NOISE_SHARE * at_mu.error.mse),
         mu: config.mu,
         aaf_spp: at_mu.spp,
         aaf_relative_rmse: at_mu.error.relative_rmse,
@@ -456,6 +394,7 @@ pub fn run(
             beta_values.iter().sum::<f32>() / beta_values.len().max(1) as f32,
             beta_max,
         ],
+        signed_error_range: SIGNED_ERROR_RANGE,
         exposure: (0.3 / truth_mean) as f32,
         uniform_image_spp,
     };
@@ -490,11 +429,13 @@ pub fn run(
         uniform: uniform_image,
         mask,
         beta_px,
+        filtered_most,
     })
 }
 
 impl AafStudy {
-    /// Writes error.png, spp.png, beta.png, truth.png, aaf.png and uniform.png into `dir`
+    /// Writes error.png, spp.png, beta.png, aaf_error.png, filter_bias.png, truth.png, aaf.png
+    /// and uniform.png into `dir`
     /// (created if missing), each atomically; records them and the plot's axes in the report.
     pub fn write_outputs(&mut self, dir: &Path) -> Result<(), StudyError> {
         std::fs::create_dir_all(dir)
@@ -531,7 +472,11 @@ impl AafStudy {
             "{}: error vs samples ({}×{})",
             r.scene, extent[0], extent[1]
         );
-        let plot = plot::error_plot(&path, &title, &curves, crossing, [800, 560])?;
+        let marks = plot::Marks {
+            crossing,
+            floor: r.truth.noise_relative_rmse,
+        };
+        let plot = plot::error_plot(&path, &title, &curves, marks, [800, 560])?;
         files.push(path);
         let path = dir.join("spp.png");
         plot::write_map(
@@ -551,6 +496,24 @@ impl AafStudy {
             [0.0, r.maps.beta_ramp_max_px],
         )?;
         files.push(path);
+        // Signed errors per pixel, relative to the truth's mean.
+        let signed = |image: &[[f32; 3]]| -> Vec<f32> {
+            let mean = r.truth.mean as f32;
+            image
+                .iter()
+                .zip(&self.truth)
+                .map(|(x, t)| (0..3).map(|c| x[c] - t[c]).sum::<f32>() / (3.0 * mean))
+                .collect()
+        };
+        let range = r.maps.signed_error_range;
+        for (name, image) in [
+            ("aaf_error.png", &self.aaf.indirect),
+            ("filter_bias.png", &self.filtered_most),
+        ] {
+            let path = dir.join(name);
+            plot::write_signed_map(&path, extent, &signed(image), &self.mask, range)?;
+            files.push(path);
+        }
         for (name, image) in [
             ("truth.png", &self.truth),
             ("aaf.png", &self.aaf.indirect),

@@ -128,18 +128,33 @@ fn tick(v: f64) -> String {
     }
 }
 
-/// Draws the curves on log-log axes, marks `crossing` (spp, error) if given, and writes the plot
-/// to `path` (PNG, `size` pixels).
+/// What the error plot marks besides its curves.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Marks {
+    /// The equal-error construction: AAF's error and the uniform spp that reaches it.
+    pub crossing: Option<(f64, f64)>,
+    /// The truth's own noise (relative RMSE): a horizontal line every error sits above.
+    pub floor: Option<f64>,
+}
+
+/// Draws the curves on log-log axes with the `marks`, and writes the plot to `path` (PNG,
+/// `size` pixels).
 pub fn error_plot(
     path: &Path,
     title: &str,
     curves: &[Curve],
-    crossing: Option<(f64, f64)>,
+    marks: Marks,
     size: [u32; 2],
 ) -> Result<ErrorPlot, StudyError> {
     let all = || curves.iter().flat_map(|c| c.points.iter().copied());
+    let crossing = marks.crossing;
     let spp_axis = log_range(all().map(|p| p.0).chain(crossing.map(|c| c.0)));
-    let error_axis = log_range(all().map(|p| p.1).chain(crossing.map(|c| c.1)));
+    let error_axis = log_range(
+        all()
+            .map(|p| p.1)
+            .chain(crossing.map(|c| c.1))
+            .chain(marks.floor),
+    );
     let font = font();
     let plot = ErrorPlot {
         spp_axis,
@@ -148,7 +163,7 @@ pub fn error_plot(
     };
     let [w, h] = size;
     let mut rgb = vec![255u8; w as usize * h as usize * 3];
-    draw_error_plot(&mut rgb, size, title, curves, crossing, &plot)
+    draw_error_plot(&mut rgb, size, title, curves, marks, &plot)
         .map_err(|e| StudyError::Plot(format!("{}: {e}", path.display())))?;
     let texels = rgb
         .chunks_exact(3)
@@ -171,7 +186,7 @@ fn draw_error_plot(
     [w, h]: [u32; 2],
     title: &str,
     curves: &[Curve],
-    crossing: Option<(f64, f64)>,
+    marks: Marks,
     plot: &ErrorPlot,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let labels = plot.font.is_some();
@@ -224,7 +239,16 @@ fn draw_error_plot(
                 .map(|p| Circle::new(*p, 3, colour.filled())),
         )?;
     }
-    if let Some((n, e)) = crossing {
+    if let Some(floor) = marks.floor {
+        let grey = RGBColor(160, 160, 160);
+        let series = chart.draw_series(LineSeries::new(vec![(x0, floor), (x1, floor)], grey))?;
+        if labels {
+            series
+                .label("truth's own noise")
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        }
+    }
+    if let Some((n, e)) = marks.crossing {
         // The equal-error construction: AAF's error across to the uniform curve, down to its spp.
         let grey = RGBColor(96, 96, 96);
         chart.draw_series(LineSeries::new(vec![(x0, e), (n, e), (n, y0)], grey))?;
@@ -283,9 +307,8 @@ pub fn write_map(
     mask: &[bool],
     range: [f32; 2],
 ) -> Result<(), StudyError> {
-    let [w, h] = extent;
     let span = (range[1] - range[0]).max(f32::MIN_POSITIVE);
-    let mut texels: Vec<[u8; 4]> = values
+    let texels = values
         .iter()
         .zip(mask)
         .map(|(v, m)| {
@@ -296,12 +319,59 @@ pub fn write_map(
             }
         })
         .collect();
+    write_with_bar(path, extent, texels, ramp)
+}
+
+/// A diverging ramp: blue at −1, white at 0, red at +1 (clamped).
+pub fn diverging(t: f32) -> [u8; 4] {
+    let t = if t.is_finite() {
+        t.clamp(-1.0, 1.0)
+    } else {
+        0.0
+    };
+    let (far, f) = if t < 0.0 {
+        ([33.0, 102.0, 172.0], -t)
+    } else {
+        ([178.0, 24.0, 43.0], t)
+    };
+    let c = |k: usize| (255.0 + f * (far[k] - 255.0)).round().clamp(0.0, 255.0) as u8;
+    [c(0), c(1), c(2), 255]
+}
+
+/// Writes signed `values` on the diverging ramp from `−range` to `+range`, the pixels where
+/// `mask` is false black, with the ramp as a bar under the map.
+pub fn write_signed_map(
+    path: &Path,
+    extent: [u32; 2],
+    values: &[f32],
+    mask: &[bool],
+    range: f32,
+) -> Result<(), StudyError> {
+    let scale = range.max(f32::MIN_POSITIVE);
+    let texels = values.iter().zip(mask).map(|(v, m)| {
+        if *m {
+            diverging(v / scale)
+        } else {
+            [0, 0, 0, 255]
+        }
+    });
+    let bar = |t: f32| diverging(2.0 * t - 1.0);
+    write_with_bar(path, extent, texels.collect(), bar)
+}
+
+/// Writes `texels` (row-major, `extent`) with a bar of `bar(0 … 1)` under them.
+fn write_with_bar(
+    path: &Path,
+    [w, h]: [u32; 2],
+    mut texels: Vec<[u8; 4]>,
+    bar: impl Fn(f32) -> [u8; 4],
+) -> Result<(), StudyError> {
     for row in 0..BAR_ROWS {
         texels.extend((0..w).map(|x| {
             if row < 2 {
                 [0, 0, 0, 255]
             } else {
-                ramp(x as f32 / (w.max(2) - 1) as f32)
+                bar(x as f32 / (w.max(2) - 1) as f32)
             }
         }));
     }
@@ -349,6 +419,9 @@ mod tests {
         assert_eq!(ramp(2.0), ramp(1.0));
         assert_eq!(ramp(f32::NAN), ramp(0.0));
         assert_eq!(ramp(0.5), [33, 144, 141, 255]);
+        assert_eq!(diverging(0.0), [255, 255, 255, 255]);
+        assert_eq!(diverging(-3.0), [33, 102, 172, 255]);
+        assert_eq!(diverging(1.0), [178, 24, 43, 255]);
     }
 
     #[test]

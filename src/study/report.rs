@@ -92,6 +92,9 @@ pub struct AgainstPathTracer {
 /// The equal-error comparison at the study's μ.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct EqualError {
+    /// Whether the truth's own noise is small against AAF's error (its MSE at most a quarter of
+    /// AAF's): if not, every error is mostly the truth's noise and these numbers mean little.
+    pub reliable: bool,
     /// AAF's μ.
     pub mu: f32,
     /// AAF's average spp.
@@ -149,6 +152,10 @@ pub struct Maps {
     pub beta_ramp_max_px: f32,
     /// Mean and largest β over non-background pixels, in pixels.
     pub beta_px_mean_max: [f32; 2],
+    /// aaf_error.png (AAF at the study's μ) and filter_bias.png (uniform filtered at the most
+    /// spp): per pixel, the mean over channels of (image − truth) / the truth's mean, on a
+    /// blue–white–red ramp from −this to +this.
+    pub signed_error_range: f32,
     /// The factor the tonemapped images' radiance was scaled by.
     pub exposure: f32,
     /// The uniform spp shown in uniform.png (the measured level nearest AAF's average spp).
@@ -250,6 +257,15 @@ impl AafStudyReport {
                 ""
             }
         );
+        if !e.reliable {
+            let _ = writeln!(
+                s,
+                "WARNING: the truth's own noise ({} relative RMSE) is not small against AAF's error: \
+                 the equal-error numbers below are not reliable (more --truth-spp, or a scene \
+                 with less variance)",
+                opt(t.noise_relative_rmse, 3)
+            );
+        }
         let _ = writeln!(
             s,
             "speedup: {}× in samples, {}× in time (AAF {:.1} ms, uniform {} ms)",

@@ -8,7 +8,8 @@ use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
 use shine_graph::{Executor, ExternalState};
 use shine_scene::Scene;
 
-use super::StudyError;
+use super::metrics::{self, ImageError};
+use super::{Progress, StudyError};
 use crate::frame::RenderError;
 use crate::gpu_scene::bvh::GpuBvh;
 use crate::gpu_scene::{BUFFER_READ, GpuScene};
@@ -228,6 +229,89 @@ impl AafRunner {
             beta: widths.iter().map(|f| f[0]).collect(),
             passes,
             wall_ms: start.elapsed().as_secs_f64() * 1e3,
+        })
+    }
+}
+
+/// A curve point's renders, before the report's definitions are applied.
+pub(super) struct Measured {
+    /// Average samples per non-background pixel.
+    pub spp: f64,
+    /// The error against the truth (MSE and energy averaged over the renders).
+    pub error: ImageError,
+    /// The least time over the renders, ms.
+    pub time_ms: f64,
+    /// The last render.
+    pub last: AafFrame,
+}
+
+/// The truth a render is measured against.
+pub(super) struct Target<'a> {
+    /// The truth image.
+    pub truth: &'a [[f32; 3]],
+    /// Non-background pixels.
+    pub mask: &'a [bool],
+    /// The truth's mean over the mask and channels.
+    pub mean: f64,
+}
+
+/// The runner with the study's seed sequence: every render gets the next seed.
+pub(super) struct Bench {
+    /// The renderer.
+    pub runner: AafRunner,
+    /// The last seed used.
+    pub seed: u32,
+    /// Renders per measurement.
+    pub repeats: u32,
+}
+
+impl Bench {
+    /// Renders `params` with the next seed.
+    pub fn render(&mut self, params: AafParams) -> Result<AafFrame, StudyError> {
+        self.seed = self.seed.wrapping_add(1);
+        self.runner.render(&AafParams {
+            seed: self.seed,
+            ..params
+        })
+    }
+
+    /// Renders `params` `repeats` times: the mean MSE, energy ratio and spp, and the least
+    /// `time` over the renders.
+    pub fn measure(
+        &mut self,
+        params: AafParams,
+        target: &Target<'_>,
+        time: &dyn Fn(&AafFrame) -> f64,
+        what: &str,
+        progress: &mut dyn Progress,
+    ) -> Result<Measured, StudyError> {
+        let (mut mse, mut energy, mut spp, mut time_ms) = (0.0, 0.0, 0.0, f64::INFINITY);
+        let mut last = None;
+        for _ in 0..self.repeats {
+            let frame = self.render(params)?;
+            let error = metrics::image_error(&frame.indirect, target.truth, target.mask)
+                .ok_or_else(|| {
+                    StudyError::NothingToMeasure("the truth is black on every pixel".into())
+                })?;
+            mse += error.mse;
+            energy += error.energy_ratio;
+            spp += metrics::mean_samples(&frame.samples, target.mask);
+            time_ms = time_ms.min(time(&frame));
+            last = Some(frame);
+            progress.advance(1, what);
+        }
+        let last = last.ok_or_else(|| StudyError::Invalid("no render".into()))?;
+        let r = f64::from(self.repeats);
+        let mse = mse / r;
+        Ok(Measured {
+            spp: spp / r,
+            error: ImageError {
+                mse,
+                relative_rmse: mse.sqrt() / target.mean,
+                energy_ratio: energy / r,
+            },
+            time_ms,
+            last,
         })
     }
 }
