@@ -25,6 +25,8 @@ pub struct FrameParams {
     pub shadow_size: u32,
     /// How the direct pass filters and biases its shadow lookups.
     pub shadow: ShadowParams,
+    /// Trilinear texture filtering over the mip chains (off: level 0 only).
+    pub mipmaps: bool,
     /// Harmonics Virtual Lights (paper 003), when the frame has them.
     pub hvl: Option<HvlParams>,
     /// Instant GI (paper 000), when the frame has it.
@@ -72,6 +74,7 @@ impl FrameParams {
                 bias: SHADOW_DEPTH_BIAS,
                 normal_offset: SHADOW_NORMAL_OFFSET,
             },
+            mipmaps: settings.texture.mipmaps,
             hvl: gi.contains(GiTechnique::Hvl).then_some(HvlParams {
                 count: h.count,
                 radius: h.radius,

@@ -42,6 +42,28 @@ fn sampler(
     )
 }
 
+/// Anisotropy of the scene textures' sampler where the device allows it.
+const TEXTURE_ANISOTROPY: f32 = 16.0;
+
+/// The scene textures' sampler: trilinear over the mip chain, repeating, anisotropic up to
+/// [`TEXTURE_ANISOTROPY`] where the device has it enabled.
+fn texture_sampler(device: &Device) -> Result<Sampler, shine_gpu::Error> {
+    let anisotropy = TEXTURE_ANISOTROPY.min(device.info().max_anisotropy);
+    Sampler::new(
+        device,
+        &vk::SamplerCreateInfo::default()
+            .mag_filter(vk::Filter::LINEAR)
+            .min_filter(vk::Filter::LINEAR)
+            .mipmap_mode(vk::SamplerMipmapMode::LINEAR)
+            .address_mode_u(vk::SamplerAddressMode::REPEAT)
+            .address_mode_v(vk::SamplerAddressMode::REPEAT)
+            .address_mode_w(vk::SamplerAddressMode::REPEAT)
+            .anisotropy_enable(anisotropy > 1.0)
+            .max_anisotropy(anisotropy.max(1.0))
+            .max_lod(vk::LOD_CLAMP_NONE),
+    )
+}
+
 /// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
 const FRAMES_IN_FLIGHT: usize = 2;
 
@@ -80,7 +102,10 @@ pub struct HostTarget {
 pub struct Renderer {
     device: Device,
     executor: Executor,
-    linear: Sampler,
+    /// Trilinear, repeating: the scene textures' sampler.
+    textures: Sampler,
+    /// Bilinear on level 0, repeating: the scene textures' sampler without mipmaps.
+    textures_level0: Sampler,
     nearest: Sampler,
     /// Linear, repeating in u and clamped in v: the environment texture's sampler.
     environment_sampler: Sampler,
@@ -145,7 +170,8 @@ impl Renderer {
         Ok(Self {
             device: device.clone(),
             executor: Executor::new(device, FRAMES_IN_FLIGHT)?,
-            linear: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::REPEAT)?,
+            textures: texture_sampler(device)?,
+            textures_level0: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::REPEAT)?,
             nearest: sampler(
                 device,
                 vk::Filter::NEAREST,
@@ -368,9 +394,14 @@ impl Renderer {
             .transpose()?;
 
         let handles = SceneHandles::import(rg, &scene.gpu);
+        let textures = if p.mipmaps {
+            self.textures.raw()
+        } else {
+            self.textures_level0.raw()
+        };
         let [width, height] = p.extent;
         let camera = gbuffer::camera_view(&scene.gpu, width, height);
-        let g = gbuffer::gbuffer(rg, &handles, &camera, p.extent, self.linear.raw());
+        let g = gbuffer::gbuffer(rg, &handles, &camera, p.extent, textures);
         let light_count = u32::try_from(scene.gpu.light_list.len())
             .map_err(|_| RenderError::Invalid("too many lights".into()))?;
         let atlas = shadows.declare(rg, &handles);
@@ -397,14 +428,9 @@ impl Renderer {
             .primary_light()
             .and_then(|i| Some((i as u32, gbuffer::light_view(&scene.gpu, i)?)));
         let rsm = match primary {
-            Some((light, view)) if hvl.is_some() || igi.is_some() => Some(rsm::rsm(
-                rg,
-                &handles,
-                view,
-                light,
-                p.rsm_size,
-                self.linear.raw(),
-            )),
+            Some((light, view)) if hvl.is_some() || igi.is_some() => {
+                Some(rsm::rsm(rg, &handles, view, light, p.rsm_size, textures))
+            }
             _ => None,
         };
         // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
@@ -461,7 +487,7 @@ impl Renderer {
                     light_count,
                     bounds: scene.gpu.bounds,
                     camera: &camera,
-                    texture_sampler: self.linear.raw(),
+                    texture_sampler: textures,
                 },
             )?),
             None => None,

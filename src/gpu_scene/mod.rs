@@ -20,6 +20,10 @@ use shine_scene::{Light, LightKind, Material, NO_TEXTURE, Scene};
 /// Edge of every layer of the texture arrays, in texels.
 pub const TEXTURE_SIZE: u32 = 256;
 
+/// Mip levels of the texture arrays: the full chain down to 1×1, built by linear blits at
+/// upload (the raster passes sample them trilinearly; ray hits read level 0).
+pub const TEXTURE_MIP_LEVELS: u32 = TEXTURE_SIZE.ilog2() + 1;
+
 /// Persistent buffers the frame reads (scene, BVH, tables, shadow records): read by any stage,
 /// before and after the frame.
 pub const BUFFER_READ: ExternalState = ExternalState::new(
@@ -310,8 +314,10 @@ fn texture_array(
             name,
             extent: [TEXTURE_SIZE, TEXTURE_SIZE],
             format,
-            usage: vk::ImageUsageFlags::SAMPLED | vk::ImageUsageFlags::TRANSFER_DST,
-            mip_levels: 1,
+            usage: vk::ImageUsageFlags::SAMPLED
+                | vk::ImageUsageFlags::TRANSFER_DST
+                | vk::ImageUsageFlags::TRANSFER_SRC,
+            mip_levels: TEXTURE_MIP_LEVELS,
             array_layers: layer_count,
             // The shaders declare `texture2DArray`, also for a single layer.
             array_view: true,

@@ -72,6 +72,8 @@ pub struct Settings {
     pub rsm: RsmSettings,
     /// Shadow maps of the direct light.
     pub shadow: ShadowSettings,
+    /// Texture filtering of the raster passes.
+    pub texture: TextureSettings,
     /// Joint bilateral upsampling of the receiver-resolution GI (paper 002 eq. 11).
     pub upsample: UpsampleSettings,
     /// Instant GI with SH-filtered incoming radiance (paper 000).
@@ -199,6 +201,22 @@ pub struct RsmSettings {
     pub size: u32,
 }
 
+/// `[texture]`: how the raster passes filter the scene's textures.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TextureSettings {
+    /// Trilinear filtering over the mip chains built at upload (false: the full-resolution
+    /// level only, point-exact against the path tracer, which reads level 0 at each hit).
+    /// Default true.
+    pub mipmaps: bool,
+}
+
+impl Default for TextureSettings {
+    fn default() -> Self {
+        Self { mipmaps: true }
+    }
+}
+
 /// `[shadow]`: shadow maps of the direct light.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -290,6 +308,7 @@ impl Default for Settings {
             hvl: HvlSettings::default(),
             rsm: RsmSettings::default(),
             shadow: ShadowSettings::default(),
+            texture: TextureSettings::default(),
             upsample: UpsampleSettings::default(),
             igi: IgiSettings::default(),
             proxy: ProxySettings::default(),

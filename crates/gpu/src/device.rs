@@ -80,6 +80,10 @@ pub struct DeviceInfo {
     pub validation: bool,
     /// Feature report: required and optional features and whether present.
     pub features: Vec<FeatureStatus>,
+    /// Largest sampler anisotropy usable: the device's limit where shine enabled
+    /// `samplerAnisotropy`, 1 (none) without it or on a host's device, whose enabled features
+    /// shine does not know.
+    pub max_anisotropy: f32,
 }
 
 pub(crate) struct Inner {
@@ -360,6 +364,13 @@ impl Device {
             subgroup_size: subgroup.subgroup_size,
             validation: parts.validation,
             features: support.report(),
+            max_anisotropy: if owned.is_some()
+                && support.enabled_core().sampler_anisotropy == vk::TRUE
+            {
+                properties.limits.max_sampler_anisotropy
+            } else {
+                1.0
+            },
         };
         let debug_utils = parts
             .debug_utils

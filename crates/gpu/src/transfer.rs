@@ -24,6 +24,18 @@ const COPY_READ: (vk::PipelineStageFlags2, vk::AccessFlags2) = (
     vk::PipelineStageFlags2::COPY,
     vk::AccessFlags2::TRANSFER_READ,
 );
+/// A copy's or a blit's write (mip levels are written by both).
+const TRANSFER_WRITE: (vk::PipelineStageFlags2, vk::AccessFlags2) = (
+    vk::PipelineStageFlags2::from_raw(
+        vk::PipelineStageFlags2::COPY.as_raw() | vk::PipelineStageFlags2::BLIT.as_raw(),
+    ),
+    vk::AccessFlags2::TRANSFER_WRITE,
+);
+/// A blit's read.
+const BLIT_READ: (vk::PipelineStageFlags2, vk::AccessFlags2) = (
+    vk::PipelineStageFlags2::BLIT,
+    vk::AccessFlags2::TRANSFER_READ,
+);
 /// The host reading a readback.
 const HOST_READ: (vk::PipelineStageFlags2, vk::AccessFlags2) =
     (vk::PipelineStageFlags2::HOST, vk::AccessFlags2::HOST_READ);
@@ -118,8 +130,10 @@ impl Device {
             .ok_or_else(|| Error::InvalidUsage("readback memory is not host-visible".into()))
     }
 
-    /// Uploads mip 0 of every layer of `image` from tightly packed texels (layer after layer)
-    /// and leaves the image in `final_layout` (it needs `TRANSFER_DST`).
+    /// Uploads mip 0 of every layer of `image` from tightly packed texels (layer after layer),
+    /// fills every further mip level by linear blits from the one above (a box filter of each
+    /// 2×2 block; the image then needs `TRANSFER_SRC` too), and leaves the image in
+    /// `final_layout` (it needs `TRANSFER_DST`).
     pub fn upload_image(
         &self,
         image: &Image,
@@ -145,9 +159,9 @@ impl Device {
                     vk::ImageLayout::TRANSFER_DST_OPTIMAL,
                 ),
                 ANY_ACCESS,
-                COPY_WRITE,
+                TRANSFER_WRITE,
             );
-            let mut region = [copy_region(image)];
+            let mut region = [copy_region(image, 0)];
             region[0].image_subresource.layer_count = range.layer_count;
             let raw = cmd.device().raw().clone();
             let cb = cmd.raw();
@@ -161,11 +175,74 @@ impl Device {
                     &region,
                 )
             };
+            // Level l is written by a blit from level l - 1, which is first made a source.
+            let level_size = |l: u32| level_extent(image, l).map(|side| side as i32);
+            for level in 1..range.level_count {
+                let source = vk::ImageSubresourceRange {
+                    base_mip_level: level - 1,
+                    level_count: 1,
+                    ..range
+                };
+                cmd.image_barrier(
+                    image.raw(),
+                    source,
+                    (
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                    ),
+                    TRANSFER_WRITE,
+                    BLIT_READ,
+                );
+                let layers = |mip_level| vk::ImageSubresourceLayers {
+                    aspect_mask: range.aspect_mask,
+                    mip_level,
+                    base_array_layer: 0,
+                    layer_count: range.layer_count,
+                };
+                let [sw, sh] = level_size(level - 1);
+                let [dw, dh] = level_size(level);
+                let blit = [vk::ImageBlit {
+                    src_subresource: layers(level - 1),
+                    src_offsets: [vk::Offset3D::default(), vk::Offset3D { x: sw, y: sh, z: 1 }],
+                    dst_subresource: layers(level),
+                    dst_offsets: [vk::Offset3D::default(), vk::Offset3D { x: dw, y: dh, z: 1 }],
+                }];
+                // SAFETY: level - 1 is a transfer source, level a transfer destination, and
+                // both regions lie inside their levels.
+                unsafe {
+                    raw.cmd_blit_image(
+                        cb,
+                        image.raw(),
+                        vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
+                        image.raw(),
+                        vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                        &blit,
+                        vk::Filter::LINEAR,
+                    )
+                };
+            }
+            let last = range.level_count - 1;
+            if last > 0 {
+                cmd.image_barrier(
+                    image.raw(),
+                    vk::ImageSubresourceRange {
+                        level_count: last,
+                        ..range
+                    },
+                    (vk::ImageLayout::TRANSFER_SRC_OPTIMAL, final_layout),
+                    BLIT_READ,
+                    ANY_ACCESS,
+                );
+            }
             cmd.image_barrier(
                 image.raw(),
-                range,
+                vk::ImageSubresourceRange {
+                    base_mip_level: last,
+                    level_count: 1,
+                    ..range
+                },
                 (vk::ImageLayout::TRANSFER_DST_OPTIMAL, final_layout),
-                COPY_WRITE,
+                TRANSFER_WRITE,
                 ANY_ACCESS,
             );
             Ok(())
@@ -176,7 +253,24 @@ impl Device {
     /// Reads mip 0, layer 0 of `image`, currently in `layout` (it needs `TRANSFER_SRC`), as
     /// tightly packed texels; the image is returned to `layout`.
     pub fn read_image(&self, image: &Image, layout: vk::ImageLayout) -> Result<Vec<u8>> {
-        let bytes = image_bytes(image)?;
+        self.read_image_level(image, layout, 0)
+    }
+
+    /// Reads mip `level`, layer 0 of `image` as [`Device::read_image`] reads mip 0.
+    pub fn read_image_level(
+        &self,
+        image: &Image,
+        layout: vk::ImageLayout,
+        level: u32,
+    ) -> Result<Vec<u8>> {
+        let levels = image.full_range().level_count;
+        if level >= levels {
+            return Err(Error::InvalidUsage(format!(
+                "image `{}` has {levels} mip levels, level {level} asked for",
+                image.name()
+            )));
+        }
+        let bytes = level_bytes(image, level)?;
         let staging = self.staging(
             "staging image readback",
             bytes,
@@ -192,7 +286,7 @@ impl Device {
                 ANY_ACCESS,
                 COPY_READ,
             );
-            let region = [copy_region(image)];
+            let region = [copy_region(image, level)];
             let raw = cmd.device().raw().clone();
             let cb = cmd.raw();
             // SAFETY: the image is in TRANSFER_SRC_OPTIMAL and the region lies inside both.
@@ -227,7 +321,24 @@ impl Device {
     }
 }
 
+/// Width and height of mip `level` of `image`.
+fn level_extent(image: &Image, level: u32) -> [u32; 2] {
+    image.extent().map(|side| (side >> level).max(1))
+}
+
+/// Bytes of one layer of mip `level` of `image`, tightly packed.
+fn level_bytes(image: &Image, level: u32) -> Result<u64> {
+    let [w, h] = level_extent(image, level);
+    Ok(u64::from(w) * u64::from(h) * texel_bytes(image)?)
+}
+
+/// Bytes of one layer of mip 0 of `image`, tightly packed.
 fn image_bytes(image: &Image) -> Result<u64> {
+    level_bytes(image, 0)
+}
+
+/// Bytes of one texel of `image`'s format, or an error for formats transfers do not handle.
+fn texel_bytes(image: &Image) -> Result<u64> {
     let texel = format_texel_size(image.format()).ok_or_else(|| {
         Error::InvalidUsage(format!(
             "image `{}`: transfers of {:?} are not supported",
@@ -235,12 +346,11 @@ fn image_bytes(image: &Image) -> Result<u64> {
             image.format()
         ))
     })?;
-    let [w, h] = image.extent();
-    Ok(u64::from(w) * u64::from(h) * u64::from(texel))
+    Ok(u64::from(texel))
 }
 
-fn copy_region(image: &Image) -> vk::BufferImageCopy {
-    let [width, height] = image.extent();
+fn copy_region(image: &Image, level: u32) -> vk::BufferImageCopy {
+    let [width, height] = level_extent(image, level);
     let range = image.full_range();
     vk::BufferImageCopy {
         buffer_offset: 0,
@@ -248,7 +358,7 @@ fn copy_region(image: &Image) -> vk::BufferImageCopy {
         buffer_image_height: 0,
         image_subresource: vk::ImageSubresourceLayers {
             aspect_mask: range.aspect_mask,
-            mip_level: 0,
+            mip_level: level,
             base_array_layer: 0,
             layer_count: 1,
         },
