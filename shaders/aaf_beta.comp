@@ -1,9 +1,11 @@
 // AAF filter width and sampling rate per pixel (paper 004 eq. 15, 16, 21; src/passes/aaf.rs):
 // from the first pass's nearest and farthest reflector distances and the pixel's world-space
 // footprint d. z_min is clamped from below (a fraction of the scene's size) and z_max to at
-// least z_min; the sample count is clamped to [spp_min, spp_max]. Omega_h is the receiver's:
-// the diffuse bandlimit blended towards its GGX lobe's Blinn-Phong bandlimit by metallic. A pixel whose first samples
-// hit nothing takes no filter (beta = 0) and no further samples; a background pixel neither.
+// least z_min; the sample count is clamped to [spp_min, spp_max]. A pixel whose first rays all
+// escaped takes its reflectors at the scene's size (z_min = z_max = S): the widest filter the
+// formulas give inside the scene, and the fewest samples; a background pixel gets neither.
+// Omega_h is the receiver's: the diffuse bandlimit blended towards its GGX lobe's Blinn-Phong
+// bandlimit by metallic.
 // CPU twin: shine::reference::aaf::beta_cpu.
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -29,7 +31,7 @@ layout(push_constant) uniform Push {
     vec2 footprint;
     // x: Omega_h, y: alpha, z: mu, w: gamma.
     vec4 paper;
-    // x: lower clamp of z_min, y: spp_min, z: spp_max, w: unused.
+    // x: lower clamp of z_min, y: spp_min, z: spp_max, w: the scene's size S.
     vec4 clamps;
 } push;
 
@@ -41,9 +43,12 @@ void main() {
     uint p = pixel.y * push.extent.x + pixel.x;
     float depth = imageLoad(gb_position, ivec2(pixel)).w;
     vec2 z = depths.z[p];
-    if (depth == 0.0 || z.y == 0.0) {
-        filter_widths.f[p] = vec2(0.0, depth == 0.0 ? 0.0 : push.clamps.y);
+    if (depth == 0.0) {
+        filter_widths.f[p] = vec2(0.0);
         return;
+    }
+    if (z.y == 0.0) {
+        z = vec2(push.clamps.w);
     }
     float d = depth * push.footprint.x + push.footprint.y;
     float z_min = max(z.x, push.clamps.x);

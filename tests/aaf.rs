@@ -22,7 +22,7 @@ use shine_scene::Scene;
 
 const EXTENT: [u32; 2] = [24, 16];
 const EYE: Vec3 = Vec3::new(0.0, 1.0, 3.0);
-/// The scene's bounding diagonal the z_min clamp is a fraction of.
+/// The scene's size S (the z_min clamp is a fraction of it).
 const SCENE_SIZE: f32 = 6.0;
 
 /// The perspective camera the synthetic G-buffer is seen from (only its footprint and
@@ -232,7 +232,6 @@ fn beta_spp_and_filter_match_the_cpu_twin() {
     let gpu = run_gpu(&device, &s, &params);
     assert_clean(&device);
     let footprint = aaf::footprint(&camera(), EXTENT[1]);
-    let clamp = params.z_min_fraction * SCENE_SIZE;
     let (mut filtered_pixels, mut clamped_spp) = (0, 0);
     for (p, got) in gpu.widths.iter().enumerate() {
         let material = [s.material[p].x, s.material[p].y];
@@ -241,7 +240,7 @@ fn beta_spp_and_filter_match_the_cpu_twin() {
             s.depths[p],
             material,
             footprint,
-            clamp,
+            SCENE_SIZE,
             &params,
         )
         .expect("beta");

@@ -31,7 +31,7 @@ pub struct AafInputs<'a> {
     pub bvh: &'a GpuBvh,
     /// Lights in the scene's light buffer.
     pub light_count: u32,
-    /// The scene's bounds (the z_min clamp is a fraction of their diagonal).
+    /// The scene's bounds ([`aaf::scene_size`]).
     pub bounds: (Vec3, Vec3),
     /// The camera's view (pixel footprints, view direction).
     pub camera: &'a View,
@@ -59,7 +59,7 @@ impl PreparedAaf {
             handles: inputs.scene,
             bvh: &bvh,
             light_count: inputs.light_count,
-            size: (inputs.bounds.1 - inputs.bounds.0).length(),
+            size: aaf::scene_size(inputs.bounds),
             texture_sampler: inputs.texture_sampler,
         };
         Ok(aaf::aaf(rg, inputs.gbuffer, &scene, inputs.camera, &self.params)?.indirect)

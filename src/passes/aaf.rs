@@ -13,7 +13,8 @@
 //!    `shaders/include/aaf.glsl`): `Ω_x^r = μ min(Ω_h/z_min, α/d)` (eq. 15), `β = 2/Ω_x^r`
 //!    (eq. 16), `n = γ (μ Ω_h d/z_min + α)² Ω_h² (1 + μ z_max/z_min)²` (eq. 21) clamped to
 //!    `[spp_min, spp_max·μ]`, with `d` the pixel's world-space footprint and `z_min` clamped
-//!    from below to [`AafParams::z_min_fraction`] of the scene's size. Ω_h is the receiver's
+//!    from below to [`AafParams::z_min_fraction`] of the scene's largest side ([`scene_size`]);
+//!    a pixel whose first rays all escaped takes `z_min = z_max =` that size. Ω_h is the receiver's
 //!    ([`shine_sh::aaf::receiver_bandlimit`]): [`AafParams::omega_h`] for dielectrics, blended
 //!    by `metallic` towards the appendix's Blinn-Phong bandlimit `3.6 + 0.084 m` (eq. 24) with
 //!    `m = 2/α² − 2` from the GGX roughness (Walter et al. 2007), `m ≤ 50` (the fit's range).
@@ -60,7 +61,7 @@ pub const SPP_MIN: RangeInclusive<u32> = 16..=1024;
 pub const SPP_MAX: RangeInclusive<u32> = 16..=10_000;
 /// Path vertices after the receiver (1: one-bounce indirect light).
 pub const BOUNCES: RangeInclusive<u32> = 1..=8;
-/// The lower clamps of z_min the settings take, as a fraction of the scene's bounding diagonal.
+/// The lower clamps of z_min the settings take, as a fraction of the scene's [`scene_size`].
 pub const Z_MIN_FRACTION: RangeInclusive<f32> = 1e-4..=1.0;
 /// How far from the centre's tangent plane a neighbour may lie, in pixel footprints.
 pub const PLANE_TOLERANCE: f32 = 2.0;
@@ -86,7 +87,7 @@ pub struct AafParams {
     pub spp_max: u32,
     /// Path vertices after the receiver (1: one bounce).
     pub bounces: u32,
-    /// Lower clamp of z_min as a fraction of the scene's bounding diagonal (0.02).
+    /// Lower clamp of z_min as a fraction of the scene's [`scene_size`] (paper: about 2%).
     pub z_min_fraction: f32,
     /// Normal threshold of the filter in degrees (paper: 10°).
     pub normal_threshold_degrees: f32,
@@ -185,6 +186,12 @@ pub fn footprint(camera: &View, height: u32) -> [f32; 2] {
     }
 }
 
+/// The scene's size S for AAF: its bounds' largest side (paper 004 §5: z_min is clamped to
+/// "about 2% of maximum scene dimension").
+pub fn scene_size(bounds: (glam::Vec3, glam::Vec3)) -> f32 {
+    (bounds.1 - bounds.0).max_element()
+}
+
 /// Push constants of `shaders/aaf_sample.comp` (48 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -207,7 +214,7 @@ pub struct BetaPush {
     pub footprint: [f32; 2],
     /// Ω_h, α, μ, γ.
     pub paper: [f32; 4],
-    /// Lower clamp of z_min (world units), spp_min, spp_upper, unused.
+    /// Lower clamp of z_min (world units), spp_min, spp_upper, the scene's size.
     pub clamps: [f32; 4],
 }
 
@@ -240,7 +247,8 @@ pub struct AafScene<'a> {
     pub bvh: &'a TraceBuffers,
     /// Lights in the light buffer.
     pub light_count: u32,
-    /// Length of the scene's bounding-box diagonal (for the z_min clamp).
+    /// [`scene_size`] of the scene's bounds (the z_min clamp, and the reflector distance of a
+    /// pixel whose first rays all escaped).
     pub size: f32,
     /// The sampler of the scene's textures.
     pub texture_sampler: vk::Sampler,
@@ -347,7 +355,7 @@ pub fn aaf_beta(
                 params.z_min_fraction * scene_size,
                 params.spp_min as f32,
                 params.spp_upper(),
-                0.0,
+                scene_size,
             ],
         })
         .dispatch([w, h, 1]);

@@ -12,8 +12,9 @@ use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE};
 use crate::passes::brdf_tables::indirect_weights;
 
 /// What `aaf_beta` writes for one pixel: `(β, samples)` from its linear depth (0 on
-/// background), its first-pass `(z_min, z_max)` (0, 0 without a hit), its roughness and
-/// metallic, the [`footprint`] and the z_min clamp in world units.
+/// background), its first-pass `(z_min, z_max)` (0, 0 without a hit: the scene's size is taken
+/// for both), its roughness and metallic, the [`footprint`] and the scene's size
+/// ([`scene_size`](crate::passes::aaf::scene_size)).
 ///
 /// [`footprint`]: crate::passes::aaf::footprint
 pub fn beta_cpu(
@@ -21,16 +22,14 @@ pub fn beta_cpu(
     z: [f32; 2],
     roughness_metallic: [f32; 2],
     footprint: [f32; 2],
-    z_min_clamp: f32,
+    scene_size: f32,
     params: &AafParams,
 ) -> Result<[f32; 2], ShError> {
     if depth == 0.0 {
         return Ok([0.0, 0.0]);
     }
-    if z[1] == 0.0 {
-        return Ok([0.0, params.spp_min as f32]);
-    }
-    let z_min = z[0].max(z_min_clamp);
+    let z = if z[1] == 0.0 { [scene_size; 2] } else { z };
+    let z_min = z[0].max(params.z_min_fraction * scene_size);
     let px = PixelFootprint {
         z_min,
         z_max: z[1].max(z_min),

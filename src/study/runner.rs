@@ -170,7 +170,7 @@ impl AafRunner {
             handles: &handles,
             bvh: &bvh,
             light_count,
-            size: (self.scene.bounds.1 - self.scene.bounds.0).length(),
+            size: aaf::scene_size(self.scene.bounds),
             texture_sampler: self.sampler.raw(),
         };
         let out = aaf::aaf(&mut rg, &g, &scene, &self.camera, params).map_err(RenderError::from)?;
