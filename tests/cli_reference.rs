@@ -1,37 +1,9 @@
 //! `shine reference` and `shine compare` as a user runs them, including bad input (exit
 //! status 1, a message, no panic).
 
-use std::path::PathBuf;
-use std::process::{Command, Output};
+mod common;
 
-fn shine(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_shine"))
-        .args(args)
-        .output()
-        .expect("run shine")
-}
-
-fn scratch(test: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(test);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("scratch dir");
-    dir
-}
-
-fn text(out: &Output) -> String {
-    format!(
-        "{}\n{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    )
-}
-
-fn fails_cleanly(out: &Output, needle: &str) {
-    let all = text(out);
-    assert_eq!(out.status.code(), Some(1), "{all}");
-    assert!(all.contains(needle), "expected `{needle}` in:\n{all}");
-    assert!(!all.contains("panicked"), "{all}");
-}
+use common::cli::{fails_cleanly, scratch, shine, text};
 
 #[test]
 fn reference_then_compare_reports_metrics() {

@@ -2,6 +2,8 @@
 //! small resources and dispatches several tests share. (Each test crate uses a subset.)
 #![allow(dead_code)]
 
+pub mod cli;
+
 use glam::Vec4;
 use shine::gpu::{
     Buffer, BufferDesc, ComputePipeline, Descriptor, Device, DeviceDesc, MemoryLocation,
