@@ -124,35 +124,14 @@ impl Default for AafParams {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AafError {
     /// A parameter out of its range.
-    #[error("AAF parameter `{name}` = {value} is out of range: {expected}")]
-    OutOfRange {
-        /// Parameter name.
-        name: &'static str,
-        /// Value given.
-        value: f64,
-        /// The allowed range.
-        expected: String,
-    },
+    #[error("AAF {0}")]
+    OutOfRange(#[from] super::OutOfRange),
 }
 
 impl AafParams {
     /// Checks every parameter against its range.
     pub fn validate(&self) -> Result<(), AafError> {
-        fn check<T: PartialOrd + std::fmt::Debug + Into<f64> + Copy>(
-            name: &'static str,
-            value: T,
-            range: &RangeInclusive<T>,
-        ) -> Result<(), AafError> {
-            if range.contains(&value) {
-                Ok(())
-            } else {
-                Err(AafError::OutOfRange {
-                    name,
-                    value: value.into(),
-                    expected: format!("{range:?}"),
-                })
-            }
-        }
+        use super::check_range as check;
         check("first_samples", self.first_samples, &FIRST_SAMPLES)?;
         check("mu", self.mu, &MU_RANGE)?;
         check("omega_h", self.omega_h, &OMEGA_H_RANGE)?;
@@ -166,7 +145,8 @@ impl AafParams {
             "normal_threshold_degrees",
             self.normal_threshold_degrees,
             &(0.0..=180.0),
-        )
+        )?;
+        Ok(())
     }
 
     /// The upper clamp of the sample count, `spp_max · μ`, never below `spp_min`.

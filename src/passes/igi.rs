@@ -201,15 +201,8 @@ pub struct FilterPush {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum IgiError {
     /// A parameter out of its range.
-    #[error("IGI parameter `{name}` = {value} is out of range: {expected}")]
-    OutOfRange {
-        /// Parameter name.
-        name: &'static str,
-        /// Value given.
-        value: f64,
-        /// Expected range in words.
-        expected: String,
-    },
+    #[error("IGI {0}")]
+    OutOfRange(#[from] super::OutOfRange),
     /// The per-pixel SH buffer would exceed one storage buffer.
     #[error(
         "IGI per-pixel radiance of {width}×{height} pixels × {coefficients} coefficients needs {bytes} bytes, more than the {MAX_STORAGE_BUFFER} bytes of one storage buffer: lower igi.sh_order or the resolution"
@@ -232,21 +225,7 @@ pub enum IgiError {
 impl IgiParams {
     /// Checks every parameter (ranges as documented on the fields).
     pub fn validate(&self) -> Result<(), IgiError> {
-        fn check<T: PartialOrd + std::fmt::Debug + Into<f64> + Copy>(
-            name: &'static str,
-            value: T,
-            range: &RangeInclusive<T>,
-        ) -> Result<(), IgiError> {
-            if range.contains(&value) {
-                Ok(())
-            } else {
-                Err(IgiError::OutOfRange {
-                    name,
-                    value: value.into(),
-                    expected: format!("{range:?}"),
-                })
-            }
-        }
+        use super::check_range as check;
         let [n, m] = self.pattern;
         check("n", n, &PATTERN)?;
         check("m", m, &PATTERN)?;
@@ -255,7 +234,8 @@ impl IgiParams {
         check("filter_radius", self.filter_radius, &FILTER_RADIUS)?;
         check("clamp_distance", self.clamp_distance, &CLAMP_DISTANCE)?;
         check("depth_tolerance", self.depth_tolerance, &DEPTH_TOLERANCE)?;
-        check("normal_threshold", self.normal_threshold, &NORMAL_THRESHOLD)
+        check("normal_threshold", self.normal_threshold, &NORMAL_THRESHOLD)?;
+        Ok(())
     }
 
     /// Coefficients stored per pixel: order² (SH) or 2 (irradiance and glossy radiance).
@@ -358,11 +338,11 @@ pub fn vpl_sh(
     let bytes = params.sh_bytes(g.extent)?;
     let need = hvl::cache_bytes(params.vpl_count);
     if vpls.desc().size < need {
-        return Err(IgiError::OutOfRange {
+        return Err(IgiError::OutOfRange(super::OutOfRange {
             name: "vpls buffer bytes",
             value: vpls.desc().size as f64,
             expected: "at least vpl_count × 80 bytes".to_owned(),
-        });
+        }));
     }
     let shader = shader("vpl_sh.comp", params, false)?;
     let mut sh = rg.create_buffer("vpl_sh", BufferDesc::new(bytes));
@@ -404,11 +384,11 @@ pub fn sh_filter(
     params.validate()?;
     let bytes = params.sh_bytes(g.extent)?;
     if sh.desc().size < bytes {
-        return Err(IgiError::OutOfRange {
+        return Err(IgiError::OutOfRange(super::OutOfRange {
             name: "vpl_sh buffer bytes",
             value: sh.desc().size as f64,
             expected: "W × H × coefficients × 8 bytes".to_owned(),
-        });
+        }));
     }
     let shader = shader("sh_filter.comp", params, true)?;
     let brdf = match (params.needs_brdf_tables(), brdf) {
@@ -417,12 +397,12 @@ pub fn sh_filter(
             Some(b)
         }
         (true, _) => {
-            return Err(IgiError::OutOfRange {
+            return Err(IgiError::OutOfRange(super::OutOfRange {
                 name: "brdf tables bytes",
                 value: brdf.map_or(0.0, |b| b.desc().size as f64),
                 expected: "GatherBrdf::gpu_data at sh_order bands (the GGX path needs them)"
                     .to_owned(),
-            });
+            }));
         }
     };
     let [w, h] = g.extent;
@@ -482,11 +462,13 @@ fn shader(
     params: &IgiParams,
     filter: bool,
 ) -> Result<&'static crate::gpu::ShaderDesc, IgiError> {
-    shaders::get(&format!("{file}:{}", params.variant(filter))).ok_or(IgiError::OutOfRange {
-        name: "sh_order",
-        value: f64::from(params.sh_order),
-        expected: format!("a compiled variant: SH order {SH_ORDERS:?}"),
-    })
+    shaders::get(&format!("{file}:{}", params.variant(filter))).ok_or(IgiError::OutOfRange(
+        super::OutOfRange {
+            name: "sh_order",
+            value: f64::from(params.sh_order),
+            expected: format!("a compiled variant: SH order {SH_ORDERS:?}"),
+        },
+    ))
 }
 
 #[cfg(test)]

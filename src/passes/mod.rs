@@ -16,3 +16,33 @@ pub mod receivers;
 pub mod rsm;
 pub mod shadows;
 pub mod upsample;
+
+/// A pass parameter outside its range: the name, the value and the range in words.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("parameter `{name}` = {value} is out of range: {expected}")]
+pub struct OutOfRange {
+    /// Parameter name.
+    pub name: &'static str,
+    /// Value given.
+    pub value: f64,
+    /// The allowed range (`Debug` of the range constant: `1..=8`, `0.0..=10.0`).
+    pub expected: String,
+}
+
+/// Checks `value` against the named range constant `range` (NaN is outside every range): the
+/// one check of the passes' parameter validation.
+pub fn check_range<T: PartialOrd + std::fmt::Debug + Into<f64> + Copy>(
+    name: &'static str,
+    value: T,
+    range: &std::ops::RangeInclusive<T>,
+) -> Result<(), OutOfRange> {
+    if range.contains(&value) {
+        Ok(())
+    } else {
+        Err(OutOfRange {
+            name,
+            value: value.into(),
+            expected: format!("{range:?}"),
+        })
+    }
+}
