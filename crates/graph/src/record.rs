@@ -267,34 +267,34 @@ impl<'a> Recorder<'a> {
         };
         // Checked against every attachment before recording began (`check_area`).
         let area = work.area.unwrap_or(whole);
+        // One attachment of this pass: its view, the plan's layout and store op, its load op.
+        let attachment = |resource, load, clear| {
+            let (layout, store) = attachment_ops(self.plan, pass, position, resource);
+            vk::RenderingAttachmentInfo::default()
+                .image_view(self.image(resource).1)
+                .image_layout(layout)
+                .load_op(load)
+                .store_op(store)
+                .clear_value(clear)
+        };
         let colors: Vec<vk::RenderingAttachmentInfo<'_>> = work
             .colors
             .iter()
             .map(|a| {
-                let (layout, store) = attachment_ops(self.plan, pass, position, a.resource);
-                vk::RenderingAttachmentInfo::default()
-                    .image_view(self.image(a.resource).1)
-                    .image_layout(layout)
-                    .load_op(a.load)
-                    .store_op(store)
-                    .clear_value(vk::ClearValue {
-                        color: vk::ClearColorValue { float32: a.clear },
-                    })
+                let clear = vk::ClearValue {
+                    color: vk::ClearColorValue { float32: a.clear },
+                };
+                attachment(a.resource, a.load, clear)
             })
             .collect();
         let depth = work.depth.map(|a| {
-            let (layout, store) = attachment_ops(self.plan, pass, position, a.resource);
-            vk::RenderingAttachmentInfo::default()
-                .image_view(self.image(a.resource).1)
-                .image_layout(layout)
-                .load_op(a.load)
-                .store_op(store)
-                .clear_value(vk::ClearValue {
-                    depth_stencil: vk::ClearDepthStencilValue {
-                        depth: a.clear[0],
-                        stencil: 0,
-                    },
-                })
+            let clear = vk::ClearValue {
+                depth_stencil: vk::ClearDepthStencilValue {
+                    depth: a.clear[0],
+                    stencil: 0,
+                },
+            };
+            attachment(a.resource, a.load, clear)
         });
         let mut rendering = vk::RenderingInfo::default()
             .render_area(area)
