@@ -21,6 +21,8 @@
 #include "brdf.glsl"
 #define TRACE_NODES_BINDING 7
 #define TRACE_TRIANGLES_BINDING 8
+#define TRACE_TOP_BINDING 17
+#define TRACE_INSTANCES_BINDING 18
 #include "trace.glsl"
 #include "aaf.glsl"
 

@@ -85,6 +85,8 @@ layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
 #ifdef HVL_VISIBILITY
 #define TRACE_NODES_BINDING 7
 #define TRACE_TRIANGLES_BINDING 8
+#define TRACE_TOP_BINDING 9
+#define TRACE_INSTANCES_BINDING 10
 #include "trace.glsl"
 
 // The HVL centre lies on its sender's surface: the shadow ray aims at it lifted along the

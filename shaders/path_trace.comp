@@ -17,6 +17,8 @@
 #include "brdf.glsl"
 #define TRACE_NODES_BINDING 7
 #define TRACE_TRIANGLES_BINDING 8
+#define TRACE_TOP_BINDING 12
+#define TRACE_INSTANCES_BINDING 13
 #include "trace.glsl"
 #define ENVIRONMENT_BINDING 9
 #define ENVIRONMENT_SAMPLER_BINDING 10

@@ -19,6 +19,8 @@
 #include "hvl.glsl"
 #define TRACE_NODES_BINDING 6
 #define TRACE_TRIANGLES_BINDING 7
+#define TRACE_TOP_BINDING 8
+#define TRACE_INSTANCES_BINDING 9
 #include "trace.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;

@@ -20,6 +20,7 @@ pub mod study;
 
 pub use frame::RenderError;
 pub use frame::renderer::{FrameImage, HostTarget, Renderer};
+pub use gpu_scene::{CameraPose, FrameUpdate};
 pub use settings::Settings;
 
 /// Every shader of the engine, compiled to SPIR-V 1.5 and reflected by naga at build time.

@@ -297,6 +297,11 @@ fn decode_rgba16f(bytes: &[u8]) -> Vec<Vec4> {
     halves.chunks_exact(4).map(Vec4::from_slice).collect()
 }
 
+/// The one-level world-space BVH of `scene` at rest.
+fn world_bvh(scene: &shine_scene::Scene) -> shine_scene::bvh::Bvh {
+    shine_scene::bvh::Bvh::from_scene(scene, &scene.rest_world_transforms())
+}
+
 /// Runs the gather alone on `hvls` (uploaded) and returns `indirect`; `bvh` answers the
 /// shadow rays of `params.visibility`.
 fn gpu_gather(
@@ -602,7 +607,7 @@ fn gather_visibility_matches_the_cpu_shadow_rays() {
         Vec3::new(51.0, 51.0, 50.0),
         Vec3::new(50.0, 51.0, 50.0),
     ]]);
-    let far_bvh = GpuBvh::upload(&device, &far, 0.0).unwrap();
+    let far_bvh = GpuBvh::from_world(&device, &world_bvh(&far)).unwrap();
     let clear = gpu_gather(
         &device,
         &receivers,
@@ -620,7 +625,8 @@ fn gather_visibility_matches_the_cpu_shadow_rays() {
         Vec3::new(3.0, 0.1, -3.0),
         Vec3::new(-3.0, 0.1, -3.0),
     ]]);
-    let slab_bvh = GpuBvh::upload(&device, &slab, 0.0).unwrap();
+    let slab_cpu = world_bvh(&slab);
+    let slab_bvh = GpuBvh::from_world(&device, &slab_cpu).unwrap();
     let gpu = gpu_gather(
         &device,
         &receivers,
@@ -638,7 +644,7 @@ fn gather_visibility_matches_the_cpu_shadow_rays() {
             t_min: 0.0,
             t_max: d.length(),
         };
-        slab_bvh.bvh.intersect(&ray).is_none()
+        slab_cpu.intersect(&ray).is_none()
     };
     let cpu =
         reference::gather(&receivers, &hvls, &brdf, CAMERA, &shadowed, Some(&visible)).unwrap();

@@ -16,7 +16,6 @@ use shine::capture::image_compare::compare;
 use shine::capture::image_io::HdrImage;
 use shine::frame::renderer::Renderer;
 use shine::gpu::Device;
-use shine::gpu_scene::bvh::TraceBuffers;
 use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, RenderGraph};
 use shine::passes::brdf_tables::GatherBrdf;
@@ -240,29 +239,7 @@ fn run_gpu(
         std::mem::size_of_val(vpls) as u64,
         Some(bytemuck::cast_slice(vpls)),
     );
-    let triangles: Vec<shine::gpu_scene::bvh::GpuBvhTriangle> = bvh
-        .triangles
-        .iter()
-        .map(|t| shine::gpu_scene::bvh::GpuBvhTriangle {
-            v0: t.v0,
-            index: t.triangle,
-            v1: t.v1,
-            v2: t.v2,
-            ..Default::default()
-        })
-        .collect();
-    let nodes = transfer_storage(
-        device,
-        "bvh nodes",
-        std::mem::size_of_val(bvh.nodes.as_slice()) as u64,
-        Some(bytemuck::cast_slice(&bvh.nodes)),
-    );
-    let tris = transfer_storage(
-        device,
-        "bvh triangles",
-        std::mem::size_of_val(triangles.as_slice()) as u64,
-        Some(bytemuck::cast_slice(&triangles)),
-    );
+    let gpu_bvh = shine::gpu_scene::bvh::GpuBvh::from_world(device, bvh).expect("bvh");
     let sh_bytes = params.sh_bytes(e).expect("size");
     let field_buffer = field.map(|f| {
         let words: Vec<u32> = f.iter().flat_map(|c| pack(c)).collect();
@@ -308,10 +285,7 @@ fn run_gpu(
         None => {
             let lights =
                 rg.import_gpu_buffer(&vpl_buffer, uploaded_state(), ExternalState::UNDEFINED);
-            let trace = TraceBuffers {
-                nodes: rg.import_gpu_buffer(&nodes, uploaded_state(), ExternalState::UNDEFINED),
-                triangles: rg.import_gpu_buffer(&tris, uploaded_state(), ExternalState::UNDEFINED),
-            };
+            let trace = gpu_bvh.import(&mut rg, uploaded_state());
             let sh = igi::vpl_sh(&mut rg, &gb, &lights, &trace, CAMERA, params).expect("vpl_sh");
             let mut out =
                 rg.import_gpu_buffer(&sh_readback, ExternalState::UNDEFINED, read_by_copy());

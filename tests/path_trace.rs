@@ -5,8 +5,10 @@ mod common;
 
 use glam::{Mat4, Quat, Vec3};
 use shine::capture::image_compare::rmse;
-use shine::gpu::{ComputePipeline, Descriptor, vk};
-use shine::gpu_scene::bvh::GpuBvh;
+use shine::gpu::vk;
+use shine::gpu_scene::bvh::world_bvh;
+use shine::gpu_scene::{FrameUpdate, GpuScene};
+use shine::graph::{Executor, ExternalState};
 use shine::reference::{PathTracer, ReferenceImages, ReferenceParams, render_reference};
 use shine_scene::bvh::Ray;
 use shine_scene::environment::Environment;
@@ -257,7 +259,7 @@ fn diffuse_plane_under_a_point_light_matches_analytic_irradiance() {
     // The camera ray of every pixel centre, as the tracer builds it.
     let view_proj = {
         let gpu = shine::gpu_scene::GpuScene::upload(&device, &scene, 0.0).expect("upload");
-        shine::passes::gbuffer::camera_view(&gpu, size, size).view_proj()
+        shine::passes::gbuffer::camera_view(&gpu.state, size, size).view_proj()
     };
     let inverse = view_proj.inverse();
     for y in 0..size {
@@ -288,17 +290,46 @@ fn diffuse_plane_under_a_point_light_matches_analytic_irradiance() {
     common::assert_clean(&device);
 }
 
-/// trace.glsl's closest hit and occlusion equal shine-scene's `Bvh::intersect` on the Cornell
-/// box for rays from inside and outside it.
+/// trace.glsl's closest hit and occlusion through the two-level BVH equal shine-scene's
+/// one-level world-space `Bvh::intersect` on the Cornell box for rays from inside and outside
+/// it, at rest and with every instance moved by a host update (rotated, scaled unevenly,
+/// translated: the top level and the rays' trip into mesh space are both exercised).
 #[test]
 fn gpu_traversal_hits_equal_cpu_bvh_hits() {
     let device = common::device();
     let scene = Scene::builtin("cornell-box").expect("scene");
-    let bvh = GpuBvh::upload(&device, &scene, 0.0).expect("bvh");
-    let (lo, hi) = {
-        let b = scene.bounds(&scene.rest_world_transforms());
-        (b.min, b.max)
-    };
+    let mut gpu = GpuScene::upload(&device, &scene, 0.0).expect("upload");
+    check_traversal(&device, &mut gpu);
+    let nodes = gpu
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(i, r)| {
+            let k = i as f32;
+            let transform = Transform {
+                translation: Vec3::new(0.05 * k, -0.03 * k, 0.02),
+                rotation: Quat::from_axis_angle(
+                    Vec3::new(1.0, 2.0, 0.5).normalize(),
+                    0.1 + 0.07 * k,
+                ),
+                scale: Vec3::new(1.0, 0.9, 1.1),
+            };
+            (r.node as usize, transform)
+        })
+        .collect();
+    gpu.update(&FrameUpdate {
+        nodes,
+        ..FrameUpdate::at(0.0)
+    })
+    .expect("update");
+    check_traversal(&device, &mut gpu);
+    common::assert_clean(&device);
+}
+
+/// Traces 4096 pseudo-random rays through `gpu`'s BVH on the GPU and on the CPU.
+fn check_traversal(device: &shine::gpu::Device, gpu: &mut GpuScene) {
+    let (cpu_bvh, flat_index) = world_bvh(gpu.rig(), &gpu.state.world).expect("cpu bvh");
+    let (lo, hi) = gpu.state.bounds;
     // Deterministic pseudo-random rays: origins in the box grown by 20 %, directions anywhere.
     let mut state = 12345u32;
     let mut rand = move || {
@@ -318,45 +349,48 @@ fn gpu_traversal_hits_equal_cpu_bvh_hits() {
         let t_max = if i % 4 == 0 { 0.3 } else { 1e30 };
         rays.push([o.x, o.y, o.z, 0.0]);
         rays.push([d.x, d.y, d.z, t_max]);
-        cpu.push(bvh.bvh.intersect(&Ray {
+        cpu.push(cpu_bvh.intersect(&Ray {
             origin: o,
             dir: d,
             t_min: 0.0,
             t_max,
         }));
     }
-    let pipeline =
-        ComputePipeline::new(&device, &shine::shaders::TESTS_TRACE_RAYS_COMP).expect("pipeline");
-    let ray_buffer = common::storage_with(&device, "rays", bytemuck::cast_slice(&rays));
+    let ray_buffer = common::storage_with(device, "rays", bytemuck::cast_slice(&rays));
     let hits = common::buffer(
-        &device,
+        device,
         "hits",
         (count * 32) as u64,
         vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
     );
-    let push = [count as u32, 0, 0, 0];
+    let mut executor = Executor::new(device, 1).expect("executor");
+    let mut rg = executor.begin_frame();
+    let handles = gpu.declare(&mut rg).expect("declare");
+    let rays_handle = rg.import_gpu_buffer(
+        &ray_buffer,
+        common::uploaded_state(),
+        common::uploaded_state(),
+    );
+    let mut hits_handle =
+        rg.import_gpu_buffer(&hits, ExternalState::UNDEFINED, common::read_by_copy());
+    let mut pass = rg.compute("trace_rays", &shine::shaders::TESTS_TRACE_RAYS_COMP);
+    handles.trace.bind(&mut pass);
+    pass.read("rays", &rays_handle)
+        .write("hits", &mut hits_handle)
+        .push(&[count as u32, 0, 0, 0])
+        .dispatch([count as u32, 1, 1]);
+    let mut commands = device.begin_commands().expect("commands");
+    executor.execute(commands.raw(), rg).expect("execute");
     device
-        .run_once(|cmd| {
-            cmd.begin_scope("trace_rays")?;
-            cmd.bind_compute(
-                &pipeline,
-                &[
-                    ("bvh_nodes", Descriptor::from(&bvh.nodes)),
-                    ("bvh_triangles", Descriptor::from(&bvh.triangles)),
-                    ("rays", Descriptor::from(&ray_buffer)),
-                    ("hits", Descriptor::from(&hits)),
-                ],
-            )?;
-            cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&push))?;
-            cmd.dispatch_threads(&pipeline, [count as u32, 1, 1]);
-            cmd.end_scope()
-        })
-        .expect("dispatch");
-    let gpu: Vec<[f32; 4]> =
+        .submit(commands)
+        .expect("submit")
+        .wait()
+        .expect("wait");
+    let gpu_hits: Vec<[f32; 4]> =
         bytemuck::cast_slice(&device.read_buffer(&hits).expect("readback")).to_vec();
     let (mut hit_count, mut ties) = (0, 0);
     for (i, expected) in cpu.iter().enumerate() {
-        let (h, occluded) = (gpu[2 * i], gpu[2 * i + 1][0] > 0.5);
+        let (h, occluded) = (gpu_hits[2 * i], gpu_hits[2 * i + 1][0] > 0.5);
         match expected {
             None => {
                 assert!(h[0] < 0.0, "ray {i}: GPU hit {h:?}, CPU none");
@@ -371,7 +405,7 @@ fn gpu_traversal_hits_equal_cpu_bvh_hits() {
                     h[0],
                     hit.t
                 );
-                let flat = bvh.flat_index[hit.triangle];
+                let flat = flat_index[hit.triangle];
                 if h[3].to_bits() != flat {
                     // Two triangles at the same t (a shared edge): either is the closest hit.
                     ties += 1;
@@ -386,7 +420,6 @@ fn gpu_traversal_hits_equal_cpu_bvh_hits() {
     }
     assert!(hit_count > count / 3, "only {hit_count} hits");
     assert!(ties <= count / 100, "{ties} hits on a different triangle");
-    common::assert_clean(&device);
 }
 
 /// The Monte-Carlo error falls as 1/√spp: two independent estimates (different seeds) of the

@@ -59,7 +59,7 @@ Vertex shade(TraceHit hit, vec3 dir) {
     vec4 t = b.x * vertices.v[4u * i0 + 2u] + b.y * vertices.v[4u * i1 + 2u] + b.z * vertices.v[4u * i2 + 2u];
     vec2 uv = b.x * vertices.v[4u * i0 + 3u].xy + b.y * vertices.v[4u * i1 + 3u].xy + b.z * vertices.v[4u * i2 + 3u].xy;
     uint material = floatBitsToUint(vertices.v[4u * i0].w);
-    vec3 ng = normalize(trace_geometric_normal(hit.leaf_triangle));
+    vec3 ng = normalize(hit.normal);
     bool front = dot(ng, dir) < 0.0;
     x.geometric_normal = front ? ng : -ng;
     // Tangent w is ±1 at every vertex: keep the sign.

@@ -1,21 +1,28 @@
-// Ray traversal of the scene BVH (src/gpu_scene/bvh.rs): closest hit and occlusion (any hit) with a
-// fixed-size stack. Any compute pass can include it; before the #include define the binding
-// numbers of the two buffers it declares (set 0, names fixed so the graph binds them by name):
+// Ray traversal of the scene's two-level BVH (src/gpu_scene/bvh.rs): closest hit and occlusion
+// (any hit) with fixed-size stacks. Any compute pass can include it; before the #include define
+// the binding numbers of the four buffers it declares (set 0, names fixed so the graph binds
+// them by name):
 //
-//     #define TRACE_NODES_BINDING 7       // `bvh_nodes`: GpuBvh::nodes
-//     #define TRACE_TRIANGLES_BINDING 8   // `bvh_triangles`: GpuBvh::triangles
+//     #define TRACE_NODES_BINDING 7       // `bvh_nodes`: bottom-level nodes
+//     #define TRACE_TRIANGLES_BINDING 8   // `bvh_triangles`: bottom-level triangles
+//     #define TRACE_TOP_BINDING 9         // `bvh_top`: top-level nodes
+//     #define TRACE_INSTANCES_BINDING 10  // `bvh_instances`: top-level instance records
 //     #include "trace.glsl"
 //
 // Layout: a node is two vec4, (min, bits of left_or_first) and (max, bits of count) —
-// shine_scene::bvh::BvhNode; a leaf has count > 0 and holds triangles left_or_first ..
-// left_or_first + count; an interior node's left child is the next node, its right child
-// left_or_first. A triangle is three vec4, (v0, bits of its index in the flattened scene index
-// buffer), (v1, 0), (v2, 0) — GpuBvhTriangle. Both faces of every triangle are hit.
+// shine_scene::bvh::BvhNode; a leaf has count > 0 and holds items left_or_first ..
+// left_or_first + count (triangles in a bottom level, instances in the top level); an interior
+// node's left child is the next node, its right child left_or_first. A triangle is three vec4,
+// (v0, bits of its index within its mesh), (v1, 0), (v2, 0) — GpuBvhTriangle, mesh space. An
+// instance is four vec4: rows 0–2 of its world-to-mesh matrix, then (bits of its bottom-level
+// root, bits of its first flattened triangle, 0, 0) — TraceInstance. Rays enter a bottom level
+// transformed but not renormalised, so hit distances are world distances. Both faces of every
+// triangle are hit.
 #ifndef TRACE_GLSL
 #define TRACE_GLSL
 
-#if !defined(TRACE_NODES_BINDING) || !defined(TRACE_TRIANGLES_BINDING)
-#error "define TRACE_NODES_BINDING and TRACE_TRIANGLES_BINDING before including trace.glsl"
+#if !defined(TRACE_NODES_BINDING) || !defined(TRACE_TRIANGLES_BINDING) || !defined(TRACE_TOP_BINDING) || !defined(TRACE_INSTANCES_BINDING)
+#error "define TRACE_NODES_BINDING, TRACE_TRIANGLES_BINDING, TRACE_TOP_BINDING and TRACE_INSTANCES_BINDING before including trace.glsl"
 #endif
 
 layout(set = 0, binding = TRACE_NODES_BINDING, std430) readonly buffer BvhNodes {
@@ -24,10 +31,18 @@ layout(set = 0, binding = TRACE_NODES_BINDING, std430) readonly buffer BvhNodes 
 layout(set = 0, binding = TRACE_TRIANGLES_BINDING, std430) readonly buffer BvhTriangles {
     vec4 t[];
 } bvh_triangles;
+layout(set = 0, binding = TRACE_TOP_BINDING, std430) readonly buffer BvhTop {
+    vec4 n[];
+} bvh_top;
+layout(set = 0, binding = TRACE_INSTANCES_BINDING, std430) readonly buffer BvhInstances {
+    vec4 i[];
+} bvh_instances;
 
 // Deeper than any binned-SAH tree over a storage buffer's worth of triangles needs (the far
 // child is pushed, so the stack holds at most one entry per level).
 const uint TRACE_STACK_SIZE = 48u;
+// The same for the top level (over instances).
+const uint TRACE_TOP_STACK_SIZE = 32u;
 
 struct TraceHit {
     // Ray parameter (in units of the direction's length).
@@ -37,14 +52,12 @@ struct TraceHit {
     float v;
     // Index of the triangle in the flattened index buffer (vertices indices[3 * triangle + k]).
     uint triangle;
-    // Index of the triangle in bvh_triangles (leaf order).
-    uint leaf_triangle;
+    // World-space geometric normal (unnormalised; front face counter-clockwise).
+    vec3 normal;
 };
 
-// Slab test; returns the entry distance or -1 on a miss.
-float trace_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
-    vec3 lo = bvh_nodes.n[2u * node].xyz;
-    vec3 hi = bvh_nodes.n[2u * node + 1u].xyz;
+// Slab test of the box (lo, hi); returns the entry distance or -1 on a miss.
+float trace_slab(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
     vec3 t0 = (lo - origin) * inv_dir;
     vec3 t1 = (hi - origin) * inv_dir;
     vec3 a = min(t0, t1);
@@ -52,6 +65,16 @@ float trace_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) 
     float near = max(max(max(a.x, a.y), a.z), t_min);
     float far = min(min(min(b.x, b.y), b.z), t_max);
     return near <= far ? near : -1.0;
+}
+
+// Slab test of a bottom-level node.
+float trace_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
+    return trace_slab(bvh_nodes.n[2u * node].xyz, bvh_nodes.n[2u * node + 1u].xyz, origin, inv_dir, t_min, t_max);
+}
+
+// Slab test of a top-level node.
+float trace_top_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
+    return trace_slab(bvh_top.n[2u * node].xyz, bvh_top.n[2u * node + 1u].xyz, origin, inv_dir, t_min, t_max);
 }
 
 // Möller–Trumbore (both faces), as shine_scene::bvh::intersect_triangle: (t, u, v) when the
@@ -88,21 +111,18 @@ vec3 trace_inverse(vec3 dir) {
     return 1.0 / safe;
 }
 
-// Traverses the BVH; with `any_hit` returns at the first hit found (occlusion), otherwise
-// keeps the closest.
-bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hit, out TraceHit hit) {
-    hit.t = t_max;
-    hit.u = 0.0;
-    hit.v = 0.0;
-    hit.triangle = 0xffffffffu;
-    hit.leaf_triangle = 0xffffffffu;
+// Traverses one bottom level from `root` with a mesh-space ray; on a hit closer than hit.t
+// updates hit.t/u/v, sets `leaf` to the triangle's index in bvh_triangles and returns true.
+// With `any_hit` returns at the first hit found.
+bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit, out uint leaf) {
+    leaf = 0xffffffffu;
     vec3 inv_dir = trace_inverse(dir);
-    if (trace_box(0u, origin, inv_dir, t_min, t_max) < 0.0) {
+    if (trace_box(root, origin, inv_dir, t_min, hit.t) < 0.0) {
         return false;
     }
     uint stack[TRACE_STACK_SIZE];
     uint sp = 0u;
-    uint node = 0u;
+    uint node = root;
     bool found = false;
     while (true) {
         vec4 lo = bvh_nodes.n[2u * node];
@@ -116,15 +136,12 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
                     hit.t = tuv.x;
                     hit.u = tuv.y;
                     hit.v = tuv.z;
-                    hit.leaf_triangle = i;
+                    leaf = i;
                     found = true;
                     if (any_hit) {
-                        break;
+                        return true;
                     }
                 }
-            }
-            if (found && any_hit) {
-                break;
             }
         } else {
             uint left = node + 1u;
@@ -155,8 +172,90 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
         sp -= 1u;
         node = stack[sp];
     }
-    if (found) {
-        hit.triangle = floatBitsToUint(bvh_triangles.t[3u * hit.leaf_triangle].w);
+    return found;
+}
+
+// Tests a ray against top-level instance `k` (its bottom level in mesh space).
+bool trace_instance(uint k, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit) {
+    vec4 r0 = bvh_instances.i[4u * k];
+    vec4 r1 = bvh_instances.i[4u * k + 1u];
+    vec4 r2 = bvh_instances.i[4u * k + 2u];
+    vec4 info = bvh_instances.i[4u * k + 3u];
+    vec4 o = vec4(origin, 1.0);
+    vec3 mesh_origin = vec3(dot(r0, o), dot(r1, o), dot(r2, o));
+    vec3 mesh_dir = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
+    uint leaf;
+    if (!trace_bottom(floatBitsToUint(info.x), mesh_origin, mesh_dir, t_min, any_hit, hit, leaf)) {
+        return false;
+    }
+    vec3 a = bvh_triangles.t[3u * leaf].xyz;
+    vec3 b = bvh_triangles.t[3u * leaf + 1u].xyz;
+    vec3 c = bvh_triangles.t[3u * leaf + 2u].xyz;
+    // Normals move with the inverse transpose: the transpose of world-to-mesh.
+    vec3 n = cross(b - a, c - a);
+    hit.normal = r0.xyz * n.x + r1.xyz * n.y + r2.xyz * n.z;
+    hit.triangle = floatBitsToUint(info.y) + floatBitsToUint(bvh_triangles.t[3u * leaf].w);
+    return true;
+}
+
+// Traverses the top level, each instance's bottom level in turn; with `any_hit` returns at
+// the first hit found (occlusion), otherwise keeps the closest.
+bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hit, out TraceHit hit) {
+    hit.t = t_max;
+    hit.u = 0.0;
+    hit.v = 0.0;
+    hit.triangle = 0xffffffffu;
+    hit.normal = vec3(0.0);
+    vec3 inv_dir = trace_inverse(dir);
+    if (trace_top_box(0u, origin, inv_dir, t_min, t_max) < 0.0) {
+        return false;
+    }
+    uint stack[TRACE_TOP_STACK_SIZE];
+    uint sp = 0u;
+    uint node = 0u;
+    bool found = false;
+    while (true) {
+        vec4 lo = bvh_top.n[2u * node];
+        vec4 hi = bvh_top.n[2u * node + 1u];
+        uint count = floatBitsToUint(hi.w);
+        uint first = floatBitsToUint(lo.w);
+        if (count > 0u) {
+            for (uint k = first; k < first + count; ++k) {
+                if (trace_instance(k, origin, dir, t_min, any_hit, hit)) {
+                    found = true;
+                    if (any_hit) {
+                        return true;
+                    }
+                }
+            }
+        } else {
+            uint left = node + 1u;
+            uint right = first;
+            float tl = trace_top_box(left, origin, inv_dir, t_min, hit.t);
+            float tr = trace_top_box(right, origin, inv_dir, t_min, hit.t);
+            if (tl >= 0.0 && tr >= 0.0) {
+                bool left_first = tl <= tr;
+                if (sp < TRACE_TOP_STACK_SIZE) {
+                    stack[sp] = left_first ? right : left;
+                    sp += 1u;
+                }
+                node = left_first ? left : right;
+                continue;
+            }
+            if (tl >= 0.0) {
+                node = left;
+                continue;
+            }
+            if (tr >= 0.0) {
+                node = right;
+                continue;
+            }
+        }
+        if (sp == 0u) {
+            break;
+        }
+        sp -= 1u;
+        node = stack[sp];
     }
     return found;
 }
@@ -170,15 +269,6 @@ bool trace_closest(vec3 origin, vec3 dir, float t_min, float t_max, out TraceHit
 bool trace_occluded(vec3 origin, vec3 dir, float t_min, float t_max) {
     TraceHit hit;
     return trace_traverse(origin, dir, t_min, t_max, true, hit);
-}
-
-// Geometric normal (unnormalised, by winding: front face is counter-clockwise) of a BVH
-// triangle, by its leaf index.
-vec3 trace_geometric_normal(uint leaf_triangle) {
-    vec3 a = bvh_triangles.t[3u * leaf_triangle].xyz;
-    vec3 b = bvh_triangles.t[3u * leaf_triangle + 1u].xyz;
-    vec3 c = bvh_triangles.t[3u * leaf_triangle + 2u].xyz;
-    return cross(b - a, c - a);
 }
 
 // A ray origin moved off a surface at p along its unit geometric normal n (towards the side

@@ -3,6 +3,8 @@
 #extension GL_GOOGLE_include_directive : require
 #define TRACE_NODES_BINDING 0
 #define TRACE_TRIANGLES_BINDING 1
+#define TRACE_TOP_BINDING 4
+#define TRACE_INSTANCES_BINDING 5
 #include "trace.glsl"
 
 layout(local_size_x = 64) in;

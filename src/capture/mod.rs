@@ -3,4 +3,5 @@
 
 pub mod image_compare;
 pub mod image_io;
+pub mod sequence;
 pub mod tonemap;

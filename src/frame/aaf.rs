@@ -7,10 +7,10 @@ use shine_graph::{Handle, Image, RenderGraph};
 
 use super::error::RenderError;
 use crate::gpu::vk;
-use crate::gpu_scene::BUFFER_READ;
-use crate::gpu_scene::bvh::GpuBvh;
+use crate::gpu_scene::SceneHandles;
+use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::aaf::{self, AafParams, AafScene};
-use crate::passes::gbuffer::{GBuffer, SceneHandles, View};
+use crate::passes::gbuffer::{GBuffer, View};
 
 /// The AAF technique.
 #[derive(Debug, Default)]
@@ -28,7 +28,7 @@ pub struct AafInputs<'a> {
     /// The scene's buffers and textures (the rays' hits are shaded from them).
     pub scene: &'a SceneHandles,
     /// The scene's BVH.
-    pub bvh: &'a GpuBvh,
+    pub bvh: &'a TraceBuffers,
     /// Lights in the scene's light buffer.
     pub light_count: u32,
     /// The scene's bounds ([`aaf::scene_size`]).
@@ -54,10 +54,9 @@ impl PreparedAaf {
         rg: &mut RenderGraph,
         inputs: &AafInputs<'_>,
     ) -> Result<Handle<Image>, RenderError> {
-        let bvh = inputs.bvh.import(rg, BUFFER_READ);
         let scene = AafScene {
             handles: inputs.scene,
-            bvh: &bvh,
+            bvh: inputs.bvh,
             light_count: inputs.light_count,
             size: aaf::scene_size(inputs.bounds),
             texture_sampler: inputs.texture_sampler,

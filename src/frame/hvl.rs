@@ -8,7 +8,7 @@ use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
 use crate::gpu_scene::BUFFER_READ;
-use crate::gpu_scene::bvh::GpuBvh;
+use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::hvl::{self, HvlParams};
 use crate::passes::receivers::Receivers;
@@ -32,8 +32,8 @@ pub struct HvlInputs<'a> {
     pub receivers: &'a Receivers,
     /// The primary light's RSM the HVLs are cut from.
     pub rsm: &'a Rsm,
-    /// The scene's BVH (imported only with `hvl.visibility`).
-    pub bvh: &'a GpuBvh,
+    /// The scene's BVH this frame (read only with `hvl.visibility`).
+    pub bvh: &'a TraceBuffers,
     /// The camera position (the gather's view direction).
     pub camera: Vec3,
 }
@@ -71,16 +71,13 @@ impl PreparedHvl {
         inputs: &HvlInputs<'_>,
     ) -> Result<Handle<Image>, RenderError> {
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &self.params)?;
-        let bvh = self
-            .params
-            .visibility
-            .then(|| inputs.bvh.import(rg, BUFFER_READ));
+        let bvh = self.params.visibility.then_some(inputs.bvh);
         Ok(hvl::hvl_gather(
             rg,
             inputs.receivers,
             &hvls,
             &self.brdf,
-            bvh.as_ref(),
+            bvh,
             inputs.camera,
             &self.params,
         )?)

@@ -8,7 +8,7 @@ use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
 use crate::gpu_scene::BUFFER_READ;
-use crate::gpu_scene::bvh::GpuBvh;
+use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::igi::{self, IgiParams};
@@ -34,7 +34,7 @@ pub struct IgiInputs<'a> {
     /// The primary light's RSM the VPLs are cut from.
     pub rsm: &'a Rsm,
     /// The scene's BVH for the VPL shadow rays.
-    pub bvh: &'a GpuBvh,
+    pub bvh: &'a TraceBuffers,
     /// The camera position.
     pub camera: Vec3,
 }
@@ -72,12 +72,11 @@ impl PreparedIgi {
         rg: &mut RenderGraph,
         inputs: &IgiInputs<'_>,
     ) -> Result<Handle<Image>, RenderError> {
-        let trace = inputs.bvh.import(rg, BUFFER_READ);
         Ok(igi::igi(
             rg,
             inputs.gbuffer,
             inputs.rsm,
-            &trace,
+            inputs.bvh,
             self.brdf.as_ref(),
             inputs.camera,
             &self.params,

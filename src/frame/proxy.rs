@@ -1,14 +1,14 @@
 //! The proxy technique (paper 002) as the frame uses it: the scene's proxy spheres and
 //! environment on the GPU, and the passes it adds to a frame (`src/passes/proxy.rs`).
 //!
-//! The proxies are taken at the scene time given to [`crate::Renderer::set_scene`]
-//! (`Scene::world_transforms_at`), with the albedo of their node's first material. With the
+//! The proxies follow their nodes every frame (placed by the frame's node world matrices,
+//! uploaded through a staging ring), with the albedo of their node's first material. With the
 //! setting `proxy.fit_count = k > 0`, every node that has proxies gets `k` spheres fitted to its
 //! mesh instead ([`shine_scene::proxies::fit`]): the built-in `spheres` scene has 4 proxied
 //! objects, so `k` = 2, 8, 32 gives 8, 32, 128 proxies (the profiling cases of issue 8).
 
 use glam::{Mat4, Vec3};
-use shine_gpu::{Buffer, Device};
+use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
 use shine_graph::{Handle, Image, RenderGraph};
 use shine_scene::environment::Environment;
 use shine_scene::proxies::{self, ProxySphere};
@@ -16,8 +16,9 @@ use shine_scene::{Mesh, Scene};
 
 use super::error::RenderError;
 use super::params::ProxySetup;
-use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::environment_sh::EnvironmentSh;
+use crate::gpu_scene::upload_ring::UploadRing;
+use crate::gpu_scene::{BUFFER_READ, FRAMES_IN_FLIGHT};
 use crate::passes::proxy::{
     self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyParams, ProxyTables,
 };
@@ -26,7 +27,7 @@ use crate::passes::receivers::Receivers;
 /// One node's proxies as set up from the scene.
 #[derive(Debug, Clone)]
 struct ProxySource {
-    world: Mat4,
+    node: usize,
     spheres: Vec<ProxySphere>,
     mesh: Option<Mesh>,
     albedo: Vec3,
@@ -44,11 +45,16 @@ pub struct ProxyTechnique {
     environments: Vec<(u32, Buffer)>,
     /// Tables per (bands, η shadow, η indirect).
     tables: Vec<(TableKey, ProxyTables, Buffer)>,
+    /// Staging of the per-frame proxy uploads.
+    ring: UploadRing,
 }
 
-/// The world-space proxies on the device for one `fit_count`.
+/// The proxies of one `fit_count`: in their nodes' space, and their device buffer, rewritten
+/// in world space every frame.
 struct ProxyBuffer {
     fit_count: u32,
+    /// (node, sphere in the node's space, albedo) of every proxy.
+    local: Vec<(usize, ProxySphere, Vec3)>,
     /// Proxies in the buffer (0: it holds one zero record).
     count: u32,
     buffer: Buffer,
@@ -65,9 +71,8 @@ pub struct PreparedProxy<'a> {
 }
 
 impl ProxyTechnique {
-    /// The proxies and environment of `scene` at time `t`; nothing is uploaded yet.
-    pub fn new(device: &Device, scene: &Scene, t: f32) -> Self {
-        let world = scene.world_transforms_at(t);
+    /// The proxies and environment of `scene`; nothing is uploaded yet.
+    pub fn new(device: &Device, scene: &Scene) -> Self {
         let sources = scene
             .proxies
             .iter()
@@ -81,7 +86,7 @@ impl ProxyTechnique {
                     .map(|m| Vec3::new(m.base_color[0], m.base_color[1], m.base_color[2]))
                     .unwrap_or(Vec3::splat(0.5));
                 Some(ProxySource {
-                    world: *world.get(p.node)?,
+                    node: p.node,
                     spheres: p.spheres.clone(),
                     mesh,
                     albedo,
@@ -95,11 +100,12 @@ impl ProxyTechnique {
             proxies: None,
             environments: Vec::new(),
             tables: Vec::new(),
+            ring: UploadRing::new(device, FRAMES_IN_FLIGHT),
         }
     }
 
-    /// The world-space proxies for `fit_count` (0: the scene's own).
-    fn proxies(&self, fit_count: u32) -> Vec<GpuProxy> {
+    /// The proxies for `fit_count` (0: the scene's own) in their nodes' space.
+    fn local_proxies(&self, fit_count: u32) -> Vec<(usize, ProxySphere, Vec3)> {
         let mut out = Vec::new();
         for s in &self.sources {
             let fitted;
@@ -110,19 +116,18 @@ impl ProxyTechnique {
                 }
                 _ => &s.spheres,
             };
-            out.extend(spheres.iter().map(|sp| {
-                let world = sp.transformed(&s.world);
-                GpuProxy::new(Vec3::from(world.center), world.radius, s.albedo)
-            }));
+            out.extend(spheres.iter().map(|sp| (s.node, *sp, s.albedo)));
         }
         out
     }
 
-    /// Uploads what `setup` needs (once per distinct setup) and imports it into `rg`.
+    /// Uploads what `setup` needs (tables once per distinct setup; the proxies, placed by
+    /// the frame's node matrices `world`, every frame) and imports it into `rg`.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
         setup: &ProxySetup,
+        world: &[Mat4],
     ) -> Result<PreparedProxy<'_>, RenderError> {
         let bands = setup.pass.bands;
         let environment = self.environment.as_ref().ok_or(ProxyError::NoEnvironment)?;
@@ -163,10 +168,24 @@ impl ProxyTechnique {
             Some(cached) if cached.fit_count == setup.fit_count => cached,
             _ => self.upload_proxies(setup.fit_count)?,
         };
+        let placed: Vec<GpuProxy> = proxies
+            .local
+            .iter()
+            .map(|(node, sphere, albedo)| {
+                let w = sphere.transformed(world.get(*node).unwrap_or(&Mat4::IDENTITY));
+                GpuProxy::new(Vec3::from(w.center), w.radius, *albedo)
+            })
+            .collect();
         let proxies = self.proxies.insert(proxies);
+        let proxy_handle = self.ring.upload(
+            rg,
+            "proxies",
+            &proxies.buffer,
+            bytemuck::cast_slice(&placed),
+        )?;
         let (_, tables, table_buffer) = &self.tables[table_index];
         let inputs = ProxyInputs {
-            proxies: rg.import_gpu_buffer(&proxies.buffer, BUFFER_READ, BUFFER_READ),
+            proxies: proxy_handle,
             count: proxies.count,
             tables: rg.import_gpu_buffer(table_buffer, BUFFER_READ, BUFFER_READ),
             environment: rg.import_gpu_buffer(
@@ -182,23 +201,27 @@ impl ProxyTechnique {
         })
     }
 
-    /// The proxies for `fit_count` on the device.
+    /// The proxies for `fit_count` and a device buffer for them.
     fn upload_proxies(&self, fit_count: u32) -> Result<ProxyBuffer, RenderError> {
-        let list = self.proxies(fit_count);
-        let count = u32::try_from(list.len())
+        let local = self.local_proxies(fit_count);
+        let count = u32::try_from(local.len())
             .ok()
             .filter(|&c| c <= MAX_PROXIES)
-            .ok_or(ProxyError::TooMany(list.len()))?;
+            .ok_or(ProxyError::TooMany(local.len()))?;
         // A storage buffer cannot be empty: one zero record stands for "no proxy".
-        let data = if list.is_empty() {
-            vec![GpuProxy::new(Vec3::ZERO, 0.0, Vec3::ZERO)]
-        } else {
-            list
-        };
-        let buffer =
-            Buffer::storage_with_data(&self.device, "proxies", bytemuck::cast_slice(&data))?;
+        let buffer = Buffer::with_data(
+            &self.device,
+            &BufferDesc {
+                name: "proxies",
+                size: (local.len().max(1) * std::mem::size_of::<GpuProxy>()) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                location: MemoryLocation::GpuOnly,
+            },
+            bytemuck::bytes_of(&GpuProxy::new(Vec3::ZERO, 0.0, Vec3::ZERO)),
+        )?;
         Ok(ProxyBuffer {
             fit_count,
+            local,
             count,
             buffer,
         })

@@ -11,10 +11,9 @@ use super::params::FrameParams;
 use super::proxy::ProxyTechnique;
 use super::shadows::ShadowState;
 use crate::capture::image_io::{HdrImage, LdrImage};
-use crate::gpu_scene::bvh::GpuBvh;
-use crate::gpu_scene::{GpuScene, SAMPLED_READ};
+use crate::gpu_scene::{FRAMES_IN_FLIGHT, FrameUpdate, GpuScene, SAMPLED_READ};
 use crate::passes::composite::{self, Component, CompositeOutputs};
-use crate::passes::gbuffer::{self, SceneHandles};
+use crate::passes::gbuffer;
 use crate::passes::gi_add::gi_add;
 use crate::passes::{direct, receivers, rsm, upsample};
 use crate::profile::report::PassClock;
@@ -63,9 +62,6 @@ fn texture_sampler(device: &Device) -> Result<Sampler, shine_gpu::Error> {
             .max_lod(vk::LOD_CLAMP_NONE),
     )
 }
-
-/// Frames the executor lets run ahead (transient sets and timestamp pools rotate over them).
-const FRAMES_IN_FLIGHT: usize = 2;
 
 /// A rendered frame read back to the CPU.
 #[derive(Clone, Debug)]
@@ -126,9 +122,8 @@ pub struct Renderer {
 
 /// A scene on the device: what every frame of it reads.
 struct SceneState {
+    /// Geometry, materials, textures, the two-level BVH and the current frame's state.
     gpu: GpuScene,
-    /// The BVH for rays (path tracer, HVL visibility, IGI's VPL shadow rays).
-    bvh: GpuBvh,
     /// The environment baked for the background (black without one).
     environment: shine_gpu::Image,
     /// Sphere proxies under the environment (paper 002): scene-bound state.
@@ -189,24 +184,35 @@ impl Renderer {
         })
     }
 
-    /// Uploads `scene` as it is at time `t` (seconds). Replacing a scene first waits for the
-    /// queue to go idle: frames a host recorded with [`Renderer::record`] may still read the
-    /// old one, and shine cannot see host submissions.
+    /// Uploads the static data of `scene` (meshes, materials, textures, the BVH's bottom
+    /// levels) and poses it at time `t` (seconds); later frames change only what
+    /// [`Renderer::update`] sends. Replacing a scene first waits for the queue to go idle:
+    /// frames a host recorded with [`Renderer::record`] may still read the old one, and shine
+    /// cannot see host submissions.
     pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
         let state = SceneState {
             gpu: GpuScene::upload(&self.device, scene, t)?,
-            bvh: GpuBvh::upload(&self.device, scene, t)?,
             environment: crate::gpu_scene::environment::upload(
                 &self.device,
                 scene.environment.as_ref(),
             )?,
-            proxy: ProxyTechnique::new(&self.device, scene, t),
+            proxy: ProxyTechnique::new(&self.device, scene),
         };
         if self.scene.is_some() {
             self.device.wait_idle()?;
         }
         self.scene = Some(state);
         self.shadows = None;
+        Ok(())
+    }
+
+    /// Sets what the next frames show: scene time (animation), camera, node transforms,
+    /// lights, jitter. CPU work only; the next frame uploads the result through its own
+    /// `update …` passes, without waiting for the GPU. A bad update is refused (nothing
+    /// changes).
+    pub fn update(&mut self, update: &FrameUpdate) -> Result<(), RenderError> {
+        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        scene.gpu.update(update)?;
         Ok(())
     }
 
@@ -250,14 +256,16 @@ impl Renderer {
         Ok(image)
     }
 
-    /// Renders `count` frames without reading them back (profiling); returns the pass timings
-    /// of every frame, from GPU timestamps or, with [`PassClock::Host`], from the host clock
-    /// around each pass submitted alone.
+    /// Renders `count` frames without reading them back (profiling), frame `k` after
+    /// [`Renderer::update`] with `update(k)` (the update path, as a host drives it); returns
+    /// the pass timings of every frame, from GPU timestamps or, with [`PassClock::Host`], from
+    /// the host clock around each pass submitted alone.
     pub fn render_timed(
         &mut self,
         settings: &Settings,
         count: u32,
         clock: PassClock,
+        update: &dyn Fn(u32) -> FrameUpdate,
     ) -> Result<Vec<PassTiming>, RenderError> {
         settings.validate()?;
         // The frame's outputs must reach something outside the graph, or every pass is culled:
@@ -265,7 +273,8 @@ impl Renderer {
         let sink = self.sink(settings)?;
         let params = FrameParams::from_settings(settings);
         let mut timings = Vec::new();
-        for _ in 0..count {
+        for k in 0..count {
+            self.update(&update(k))?;
             let mut rg = self.executor.begin_frame();
             let frame = self.declare_frame(&mut rg, &params)?;
             let mut out = rg.import_gpu_image(
@@ -377,10 +386,12 @@ impl Renderer {
         p: &FrameParams,
     ) -> Result<CompositeOutputs, RenderError> {
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        let handles = scene.gpu.declare(rg)?;
+        let frame = &scene.gpu.state;
         let shadows = ShadowState::prepare(
             &self.device,
             self.shadows.take(),
-            &scene.gpu,
+            frame,
             p.shadow_size,
             p.shadow.pcf_radius,
         )?;
@@ -391,21 +402,20 @@ impl Renderer {
         let proxy = p
             .proxy
             .as_ref()
-            .map(|setup| scene.proxy.prepare(rg, setup))
+            .map(|setup| scene.proxy.prepare(rg, setup, &frame.world))
             .transpose()?;
 
-        let handles = SceneHandles::import(rg, &scene.gpu);
         let textures = if p.mipmaps {
             self.textures.raw()
         } else {
             self.textures_level0.raw()
         };
         let [width, height] = p.extent;
-        let camera = gbuffer::camera_view(&scene.gpu, width, height);
+        let camera = gbuffer::camera_view(frame, width, height);
         let g = gbuffer::gbuffer(rg, &handles, &camera, p.extent, textures);
-        let light_count = u32::try_from(scene.gpu.light_list.len())
+        let light_count = u32::try_from(frame.lights.len())
             .map_err(|_| RenderError::Invalid("too many lights".into()))?;
-        let atlas = shadows.declare(rg, &handles);
+        let atlas = shadows.declare(rg, &handles)?;
         let background = direct::Background {
             environment: rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ),
             sampler: self.environment_sampler.raw(),
@@ -427,7 +437,7 @@ impl Renderer {
         let primary = scene
             .gpu
             .primary_light()
-            .and_then(|i| Some((i as u32, gbuffer::light_view(&scene.gpu, i)?)));
+            .and_then(|i| Some((i as u32, gbuffer::light_view(frame, i)?)));
         let rsm = match primary {
             Some((light, view)) if hvl.is_some() || igi.is_some() => {
                 Some(rsm::rsm(rg, &handles, view, light, p.rsm_size, textures))
@@ -447,7 +457,7 @@ impl Renderer {
                 &HvlInputs {
                     receivers,
                     rsm,
-                    bvh: &scene.bvh,
+                    bvh: &handles.trace,
                     camera: camera.eye,
                 },
             )?),
@@ -472,7 +482,7 @@ impl Renderer {
                 &IgiInputs {
                     gbuffer: &g,
                     rsm,
-                    bvh: &scene.bvh,
+                    bvh: &handles.trace,
                     camera: camera.eye,
                 },
             )?),
@@ -484,9 +494,9 @@ impl Renderer {
                 &AafInputs {
                     gbuffer: &g,
                     scene: &handles,
-                    bvh: &scene.bvh,
+                    bvh: &handles.trace,
                     light_count,
-                    bounds: scene.gpu.bounds,
+                    bounds: frame.bounds,
                     camera: &camera,
                     // Ray hits read level 0 (no derivatives there, and lavapipe's
                     // anisotropic path is ~300× slower for explicit-LOD lookups).

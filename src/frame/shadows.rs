@@ -1,42 +1,46 @@
-//! The shadow atlas's persistent state: the layout of the current scene's shadow tiles and
-//! its records on the device, kept while the scene and the tile size are unchanged.
+//! The shadow atlas's persistent state: the device buffers of the shadow records, kept while
+//! the scene and the tile size are unchanged, and rewritten every frame (lights move) through
+//! a staging ring.
 
 use shine_gpu::{Buffer, Device};
 use shine_graph::RenderGraph;
 
 use super::error::RenderError;
-use crate::gpu_scene::{BUFFER_READ, GpuScene};
-use crate::passes::gbuffer::SceneHandles;
+use crate::gpu_scene::upload_ring::UploadRing;
+use crate::gpu_scene::{FRAMES_IN_FLIGHT, FrameState, SceneHandles};
 use crate::passes::shadows::{self, ShadowAtlas, ShadowLayout};
 
-/// The atlas layout for one `(tile size, PCF radius)` and its GPU records.
+/// The atlas layout of the current frame for one `(tile size, PCF radius)` and the record
+/// buffers on the device.
 pub struct ShadowState {
     key: (u32, u32),
     layout: ShadowLayout,
     views: Buffer,
     lights: Buffer,
+    ring: UploadRing,
 }
 
 impl ShadowState {
-    /// The state for `scene` with tiles of `size` texels and a PCF kernel of `pcf_radius`:
-    /// `cached` when it matches, a new layout otherwise (after the queue idles, since frames a
-    /// host recorded may still read the old records and shine cannot see host submissions).
+    /// The state for `frame` with tiles of `size` texels and a PCF kernel of `pcf_radius`:
+    /// the layout is made anew (lights move), the buffers are `cached`'s when the key
+    /// matches, new ones otherwise (after the queue idles, since frames a host recorded may
+    /// still read the old records and shine cannot see host submissions).
     pub fn prepare(
         device: &Device,
         cached: Option<Self>,
-        scene: &GpuScene,
+        frame: &FrameState,
         size: u32,
         pcf_radius: u32,
     ) -> Result<Self, RenderError> {
         let key = (size, pcf_radius);
+        let max_dimension = device.limits().max_image_dimension2_d;
+        let layout = ShadowLayout::new(frame, size, pcf_radius, max_dimension)?;
         if let Some(state) = cached {
             if state.key == key {
-                return Ok(state);
+                return Ok(Self { layout, ..state });
             }
             device.wait_idle()?;
         }
-        let max_dimension = device.limits().max_image_dimension2_d;
-        let layout = ShadowLayout::new(scene, size, pcf_radius, max_dimension)?;
         let views = Buffer::storage_with_data(
             device,
             "shadow views",
@@ -52,6 +56,7 @@ impl ShadowState {
             layout,
             views,
             lights,
+            ring: UploadRing::new(device, FRAMES_IN_FLIGHT),
         })
     }
 
@@ -60,10 +65,30 @@ impl ShadowState {
         self.layout.warning.as_deref()
     }
 
-    /// Imports the records and adds the atlas's raster passes.
-    pub fn declare(&self, rg: &mut RenderGraph, scene: &SceneHandles) -> ShadowAtlas {
-        let views = rg.import_gpu_buffer(&self.views, BUFFER_READ, BUFFER_READ);
-        let lights = rg.import_gpu_buffer(&self.lights, BUFFER_READ, BUFFER_READ);
-        shadows::shadow_atlas(rg, scene, &self.layout, views, lights)
+    /// Uploads this frame's records and adds the atlas's raster passes.
+    pub fn declare(
+        &mut self,
+        rg: &mut RenderGraph,
+        scene: &SceneHandles,
+    ) -> Result<ShadowAtlas, RenderError> {
+        let views = self.ring.upload(
+            rg,
+            "shadow views",
+            &self.views,
+            bytemuck::cast_slice(&self.layout.view_records()),
+        )?;
+        let lights = self.ring.upload(
+            rg,
+            "shadow lights",
+            &self.lights,
+            bytemuck::cast_slice(&self.layout.light_records()),
+        )?;
+        Ok(shadows::shadow_atlas(
+            rg,
+            scene,
+            &self.layout,
+            views,
+            lights,
+        ))
     }
 }

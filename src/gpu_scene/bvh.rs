@@ -1,38 +1,58 @@
-//! The scene's BVH on the GPU, for ray traversal in compute shaders (`shaders/include/trace.glsl`).
+//! The scene's two-level BVH on the GPU, for ray traversal in compute shaders
+//! (`shaders/include/trace.glsl`).
 //!
-//! Built with shine-scene's binned-SAH [`Bvh`] from the same world transforms as
-//! [`crate::gpu_scene::GpuScene::upload`]; the nodes are uploaded as they are ([`BvhNode`],
-//! 32 bytes) and every triangle as a [`GpuBvhTriangle`] (48 bytes) whose `index` is its
-//! triangle index in the flattened index buffer of [`crate::gpu_scene::GpuScene`]
-//! (`indices[3 * index + k]` are its vertices), so a hit is shaded with the interpolated
-//! vertex attributes and the material of the raster passes.
+//! - **Bottom levels**: one binned-SAH [`Bvh`] per mesh, over its triangles in mesh space,
+//!   built once when the scene is uploaded ([`BottomLevels::build`]); all of them live in one
+//!   node buffer and one triangle buffer (absolute indices, so traversal needs no offsets). A
+//!   triangle carries its index within its mesh (primitives concatenated in order).
+//! - **Top level**: a binned-SAH tree over the instances' world boxes, rebuilt on the CPU
+//!   every frame ([`TopLevel::build`]; tens to hundreds of boxes: microseconds, see
+//!   docs/performance.md) and uploaded with the frame. An instance record holds the
+//!   world-to-mesh transform (the ray is moved into mesh space, not renormalised, so hit
+//!   distances stay world distances), its bottom level's root, and the index of its first
+//!   triangle in the flattened scene index buffer of [`crate::gpu_scene::GpuScene`], so a hit
+//!   is shaded with the interpolated world-space vertices and the material of the raster
+//!   passes.
 
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
-use shine_scene::Scene;
-use shine_scene::bvh::{Bvh, BvhNode};
+use shine_scene::bvh::{Bvh, BvhNode, BvhTriangle, build_over_boxes};
+use shine_scene::{Aabb, Scene};
 
 use crate::gpu_scene::SceneUploadError;
 use crate::graph::{ExternalState, Handle, RenderGraph};
 
-/// A [`GpuBvh`]'s buffers imported into a frame graph, bound by the names `trace.glsl`
-/// declares (`bvh_nodes`, `bvh_triangles`).
+/// The BVH buffers imported into a frame graph, bound by the names `trace.glsl` declares.
 #[derive(Debug, Clone, Copy)]
 pub struct TraceBuffers {
-    /// `bvh_nodes`.
+    /// `bvh_nodes`: the bottom levels' nodes.
     pub nodes: Handle<crate::graph::Buffer>,
-    /// `bvh_triangles`.
+    /// `bvh_triangles`: the bottom levels' triangles.
     pub triangles: Handle<crate::graph::Buffer>,
+    /// `bvh_top`: the top level's nodes.
+    pub top: Handle<crate::graph::Buffer>,
+    /// `bvh_instances`: the top level's instance records.
+    pub instances: Handle<crate::graph::Buffer>,
 }
 
-/// A BVH triangle as `trace.glsl` reads it (48 bytes): world-space vertices and the
-/// triangle's index in the flattened scene index buffer.
+impl TraceBuffers {
+    /// Binds the four buffers to `pass` by the names `trace.glsl` declares.
+    pub fn bind(&self, pass: &mut crate::graph::ComputePass<'_>) {
+        pass.read("bvh_nodes", &self.nodes)
+            .read("bvh_triangles", &self.triangles)
+            .read("bvh_top", &self.top)
+            .read("bvh_instances", &self.instances);
+    }
+}
+
+/// A bottom-level triangle as `trace.glsl` reads it (48 bytes): mesh-space vertices and the
+/// triangle's index within its mesh.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuBvhTriangle {
-    /// First vertex (world space).
+    /// First vertex (mesh space).
     pub v0: [f32; 3],
-    /// Triangle index in the flattened index buffer (vertices `3 * index .. 3 * index + 3`).
+    /// Triangle index within the mesh; the instance's `triangle_base` is added at a hit.
     pub index: u32,
     /// Second vertex.
     pub v1: [f32; 3],
@@ -44,47 +64,191 @@ pub struct GpuBvhTriangle {
     pub _pad1: u32,
 }
 
-/// The BVH of a scene at one instant, on the GPU.
-pub struct GpuBvh {
-    /// Nodes ([`BvhNode`], root first, depth-first order: left child = node + 1).
-    pub nodes: Buffer,
-    /// Triangles in leaf order ([`GpuBvhTriangle`]).
-    pub triangles: Buffer,
-    /// Number of nodes.
-    pub node_count: u32,
-    /// Number of triangles.
-    pub triangle_count: u32,
-    /// The CPU BVH the buffers were made from (tests compare GPU hits against it).
-    pub bvh: Bvh,
-    /// For every triangle of `bvh.triangles`, its index in the flattened index buffer.
-    pub flat_index: Vec<u32>,
+/// A top-level instance record as `trace.glsl` reads it (64 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct TraceInstance {
+    /// Rows 0–2 of the world-to-mesh matrix (an affine 3×4).
+    pub world_to_mesh: [[f32; 4]; 3],
+    /// Root node of the instance's bottom level in `bvh_nodes`.
+    pub root: u32,
+    /// Flattened index of the instance's first triangle.
+    pub triangle_base: u32,
+    /// Padding.
+    pub _pad: [u32; 2],
 }
 
-impl GpuBvh {
-    /// Imports both buffers into `rg`, read-only, in `state` before and after the frame.
-    pub fn import(&self, rg: &mut RenderGraph, state: ExternalState) -> TraceBuffers {
-        TraceBuffers {
-            nodes: rg.import_gpu_buffer(&self.nodes, state, state),
-            triangles: rg.import_gpu_buffer(&self.triangles, state, state),
+/// One instance as the top level is built from it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TopInstance {
+    /// Mesh-to-world matrix.
+    pub world: Mat4,
+    /// Bottom-level root ([`BottomLevels::roots`]).
+    pub root: u32,
+    /// Bounds of the bottom level in mesh space ([`BottomLevels::bounds`]).
+    pub bounds: Aabb,
+    /// Flattened index of the instance's first triangle.
+    pub triangle_base: u32,
+}
+
+/// Every mesh's bottom level, concatenated (CPU side).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct BottomLevels {
+    /// Nodes of all bottom levels (absolute child and triangle indices).
+    pub nodes: Vec<BvhNode>,
+    /// Triangles of all bottom levels, in leaf order.
+    pub triangles: Vec<GpuBvhTriangle>,
+    /// Per mesh: its root node, `u32::MAX` for a mesh without triangles.
+    pub roots: Vec<u32>,
+    /// Per mesh: the bounds of its triangles in mesh space.
+    pub bounds: Vec<Aabb>,
+}
+
+impl BottomLevels {
+    /// One bottom level per mesh of `scene`, over its primitives in mesh space.
+    pub fn build(scene: &Scene) -> Self {
+        let mut out = Self::default();
+        for mesh in &scene.meshes {
+            let mut soup = Vec::new();
+            for (p, primitive) in mesh.primitives.iter().enumerate() {
+                let get = |i: u32| {
+                    primitive
+                        .positions
+                        .get(i as usize)
+                        .copied()
+                        .unwrap_or_default()
+                        .to_array()
+                };
+                for (t, tri) in primitive.indices.chunks_exact(3).enumerate() {
+                    soup.push(BvhTriangle {
+                        v0: get(tri[0]),
+                        instance: 0,
+                        v1: get(tri[1]),
+                        primitive: p as u32,
+                        v2: get(tri[2]),
+                        triangle: t as u32,
+                    });
+                }
+            }
+            // Index of a primitive's first triangle within the mesh.
+            let starts: Vec<u32> = mesh
+                .primitives
+                .iter()
+                .scan(0u32, |next, p| {
+                    let start = *next;
+                    *next += p.triangle_count() as u32;
+                    Some(start)
+                })
+                .collect();
+            let (root, bounds) = out.append(&Bvh::build(soup), |t| {
+                starts.get(t.primitive as usize).copied().unwrap_or(0) + t.triangle
+            });
+            out.roots.push(root);
+            out.bounds.push(bounds);
         }
+        out
     }
 
-    /// Builds the BVH of `scene` at time `t` (seconds, animations applied) and uploads it.
-    pub fn upload(device: &Device, scene: &Scene, t: f32) -> Result<Self, SceneUploadError> {
-        let world = scene.world_transforms_at(t);
-        let (bvh, flat_index) = build(scene, &world)?;
-        let gpu_triangles: Vec<GpuBvhTriangle> = bvh
-            .triangles
-            .iter()
-            .zip(&flat_index)
-            .map(|(t, &index)| GpuBvhTriangle {
+    /// Appends `bvh` with each triangle's index given by `index`; returns its root
+    /// (`u32::MAX` when empty) and bounds.
+    pub fn append(&mut self, bvh: &Bvh, index: impl Fn(&BvhTriangle) -> u32) -> (u32, Aabb) {
+        let Some(root) = bvh.nodes.first() else {
+            return (u32::MAX, Aabb::EMPTY);
+        };
+        let node_base = self.nodes.len() as u32;
+        let triangle_base = self.triangles.len() as u32;
+        self.nodes.extend(bvh.nodes.iter().map(|n| BvhNode {
+            left_or_first: n.left_or_first
+                + if n.count == 0 {
+                    node_base
+                } else {
+                    triangle_base
+                },
+            ..*n
+        }));
+        self.triangles
+            .extend(bvh.triangles.iter().map(|t| GpuBvhTriangle {
                 v0: t.v0,
-                index,
+                index: index(t),
                 v1: t.v1,
                 v2: t.v2,
                 ..GpuBvhTriangle::default()
+            }));
+        let bounds = Aabb {
+            min: Vec3::from(root.min),
+            max: Vec3::from(root.max),
+        };
+        (node_base, bounds)
+    }
+}
+
+/// The top level of one frame (CPU side).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TopLevel {
+    /// Nodes; a leaf's `left_or_first .. + count` index `instances`.
+    pub nodes: Vec<BvhNode>,
+    /// Instance records in leaf order.
+    pub instances: Vec<TraceInstance>,
+}
+
+impl TopLevel {
+    /// The top level over `instances` (those without triangles are left out).
+    pub fn build(instances: &[TopInstance]) -> Self {
+        let live: Vec<&TopInstance> = instances
+            .iter()
+            .filter(|i| i.root != u32::MAX && !i.bounds.is_empty())
+            .collect();
+        let boxes: Vec<Aabb> = live
+            .iter()
+            .map(|i| i.bounds.transformed(&i.world))
+            .collect();
+        let (nodes, order) = build_over_boxes(&boxes);
+        let instances = order
+            .iter()
+            .filter_map(|&k| live.get(k as usize))
+            .map(|i| {
+                let inverse = i.world.inverse();
+                TraceInstance {
+                    world_to_mesh: [
+                        inverse.row(0).to_array(),
+                        inverse.row(1).to_array(),
+                        inverse.row(2).to_array(),
+                    ],
+                    root: i.root,
+                    triangle_base: i.triangle_base,
+                    _pad: [0; 2],
+                }
             })
             .collect();
+        Self { nodes, instances }
+    }
+}
+
+/// The two levels on the GPU: the bottom levels, uploaded once, and the top level's buffers,
+/// sized for every instance and rewritten every frame.
+pub struct GpuBvh {
+    /// Bottom-level nodes ([`BvhNode`], 32 bytes each).
+    pub nodes: Buffer,
+    /// Bottom-level triangles ([`GpuBvhTriangle`]).
+    pub triangles: Buffer,
+    /// Top-level nodes (room for `2n - 1` nodes of `n` instances).
+    pub top: Buffer,
+    /// Top-level instance records ([`TraceInstance`]).
+    pub instances: Buffer,
+    /// The bottom levels on the CPU (their roots and bounds place instances in the top level).
+    pub bottom: BottomLevels,
+}
+
+impl GpuBvh {
+    /// Uploads `bottom` and allocates top-level buffers for up to `instance_count` instances.
+    pub fn new(
+        device: &Device,
+        bottom: BottomLevels,
+        instance_count: usize,
+    ) -> Result<Self, SceneUploadError> {
+        if bottom.triangles.is_empty() {
+            return Err(SceneUploadError::Empty);
+        }
         let storage = |name, data: &[u8]| {
             Buffer::with_data(
                 device,
@@ -97,23 +261,63 @@ impl GpuBvh {
                 data,
             )
         };
-        let too_large = |what: &str| SceneUploadError::TooLarge(format!("over 4G BVH {what}"));
+        let dynamic = |name, size: usize| {
+            Buffer::new(
+                device,
+                &BufferDesc {
+                    name,
+                    size: size.max(16) as u64,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
+        };
+        let n = instance_count.max(1);
         Ok(Self {
-            nodes: storage("bvh nodes", bytemuck::cast_slice(&bvh.nodes))?,
-            triangles: storage("bvh triangles", bytemuck::cast_slice(&gpu_triangles))?,
-            node_count: u32::try_from(bvh.nodes.len()).map_err(|_| too_large("nodes"))?,
-            triangle_count: u32::try_from(gpu_triangles.len())
-                .map_err(|_| too_large("triangles"))?,
-            bvh,
-            flat_index,
+            nodes: storage("bvh nodes", bytemuck::cast_slice(&bottom.nodes))?,
+            triangles: storage("bvh triangles", bytemuck::cast_slice(&bottom.triangles))?,
+            top: dynamic("bvh top", (2 * n - 1) * std::mem::size_of::<BvhNode>())?,
+            instances: dynamic("bvh instances", n * std::mem::size_of::<TraceInstance>())?,
+            bottom,
         })
+    }
+
+    /// A BVH over a world-space triangle soup (tests and tools): one identity instance whose
+    /// triangles keep `bvh`'s `triangle` field as their flattened index, with its top level
+    /// already uploaded. Import it with [`GpuBvh::import`].
+    pub fn from_world(device: &Device, bvh: &Bvh) -> Result<Self, SceneUploadError> {
+        let mut bottom = BottomLevels::default();
+        let (root, bounds) = bottom.append(bvh, |t| t.triangle);
+        let top = TopLevel::build(&[TopInstance {
+            world: Mat4::IDENTITY,
+            root,
+            bounds,
+            triangle_base: 0,
+        }]);
+        let gpu = Self::new(device, bottom, 1)?;
+        device.upload_buffer(&gpu.top, 0, bytemuck::cast_slice(&top.nodes))?;
+        device.upload_buffer(&gpu.instances, 0, bytemuck::cast_slice(&top.instances))?;
+        Ok(gpu)
+    }
+
+    /// Imports all four buffers into `rg`, read-only, in `state` before and after the frame
+    /// (for a BVH whose top level is already on the device, e.g. [`GpuBvh::from_world`]).
+    pub fn import(&self, rg: &mut RenderGraph, state: ExternalState) -> TraceBuffers {
+        TraceBuffers {
+            nodes: rg.import_gpu_buffer(&self.nodes, state, state),
+            triangles: rg.import_gpu_buffer(&self.triangles, state, state),
+            top: rg.import_gpu_buffer(&self.top, state, state),
+            instances: rg.import_gpu_buffer(&self.instances, state, state),
+        }
     }
 }
 
-/// Builds the BVH for `world` and maps every BVH triangle to its index in the flattened
-/// index buffer (instances in [`Scene::instances`] order, then primitives, then triangles:
-/// the order in which `GpuScene::upload` concatenates them).
-fn build(scene: &Scene, world: &[Mat4]) -> Result<(Bvh, Vec<u32>), SceneUploadError> {
+/// A one-level world-space BVH of `scene` placed with `world`, and for every triangle of it
+/// its index in the flattened index buffer (instances in [`Scene::instances`] order, then
+/// primitives, then triangles: the order `GpuScene` concatenates them). The CPU reference the
+/// two-level GPU traversal is tested against.
+pub fn world_bvh(scene: &Scene, world: &[Mat4]) -> Result<(Bvh, Vec<u32>), SceneUploadError> {
     let bvh = Bvh::from_scene(scene, world);
     if bvh.triangles.is_empty() {
         return Err(SceneUploadError::Empty);
@@ -150,3 +354,4 @@ fn build(scene: &Scene, world: &[Mat4]) -> Result<(Bvh, Vec<u32>), SceneUploadEr
 /// `BvhNode` as `trace.glsl` reads it: two vec4 (min, left_or_first bits; max, count bits).
 const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuBvhTriangle>() == 48);
+const _: () = assert!(std::mem::size_of::<TraceInstance>() == 64);

@@ -1,21 +1,31 @@
-//! A shine-scene [`Scene`] uploaded for rendering: one world-space vertex and index buffer for
-//! the whole scene (so every raster view is a single draw), the materials, two texture arrays
-//! and the lights.
+//! A shine-scene [`Scene`] living on the GPU across frames.
 //!
-//! Decisions (first frame): geometry is flattened into world space on the CPU at a time `t`
-//! (re-uploaded when the scene moves), textures are resized to one square size per array so
-//! that they index a `texture2DArray` (lavapipe indexes arrays of textures only by constants),
-//! colour textures live in an sRGB array and data textures (normal, metallic-roughness) in a
-//! linear one.
+//! [`GpuScene::new`] uploads what never changes once: the flattened mesh-space vertices and
+//! the index buffer of the whole scene (so every raster view is a single draw), the
+//! materials, the texture arrays and the bottom levels of the BVH. [`GpuScene::update`]
+//! evaluates a [`FrameUpdate`] on the CPU (animation, host overrides: a [`FrameState`]);
+//! [`GpuScene::declare`] then records the frame's `update …` passes — the instance records,
+//! lights and top-level BVH copied from a staging ring ([`upload_ring`]), the world vertices
+//! rewritten by a compute pass — and returns the handles every later pass reads
+//! ([`SceneHandles`]). Nothing on the frame path waits for the queue.
 
 pub mod bvh;
 pub mod environment;
 pub mod environment_sh;
+pub mod frame_update;
+pub mod geometry;
+mod textures;
+pub mod upload_ring;
 
-use glam::{Mat3, Mat4, Vec3};
-use shine_gpu::{Buffer, BufferDesc, Device, Image, ImageDesc, MemoryLocation, vk};
-use shine_graph::ExternalState;
-use shine_scene::{Light, LightKind, Material, NO_TEXTURE, Scene};
+use glam::Mat4;
+use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, vk};
+use shine_graph::{ExternalState, Handle, RenderGraph};
+use shine_scene::{Light, LightKind, Material, Scene};
+
+use bvh::{BottomLevels, GpuBvh, TopInstance, TopLevel, TraceBuffers};
+pub use frame_update::{CameraPose, FrameState, FrameUpdate};
+use geometry::{DeformInstance, Geometry, InstanceRange};
+use upload_ring::UploadRing;
 
 /// Edge of every layer of the texture arrays, in texels.
 pub const TEXTURE_SIZE: u32 = 256;
@@ -39,20 +49,20 @@ pub const SAMPLED_READ: ExternalState = ExternalState::new(
     vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
 );
 
-/// One vertex of the flattened scene, in world space (64 bytes; locations 0–4 of the raster
-/// shaders).
+/// One vertex of the flattened scene (64 bytes; locations 0–4 of the raster shaders): in mesh
+/// space as uploaded, in world space after the `update vertices` pass.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct Vertex {
-    /// World position (location 0).
+    /// Position (location 0).
     pub position: [f32; 3],
     /// Index into the materials buffer (location 1).
     pub material: u32,
-    /// World normal (location 2).
+    /// Normal (location 2).
     pub normal: [f32; 3],
-    /// Padding.
-    pub _pad0: f32,
-    /// World tangent, w = bitangent sign (location 3).
+    /// Index of the instance the vertex belongs to (in [`GpuScene::instances`]).
+    pub instance: u32,
+    /// Tangent, w = bitangent sign (location 3).
     pub tangent: [f32; 4],
     /// Texture coordinate 0 (location 4).
     pub uv: [f32; 2],
@@ -64,7 +74,7 @@ pub struct Vertex {
 /// layers of the sRGB (base colour, emissive) and linear (metallic-roughness, normal) arrays.
 pub type GpuMaterial = Material;
 
-/// What went wrong while preparing a scene for the GPU.
+/// What went wrong while preparing a scene for the GPU or updating it.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneUploadError {
     /// The scene has no triangles to draw.
@@ -76,81 +86,76 @@ pub enum SceneUploadError {
     /// The scene is too large for 32-bit indices or one storage buffer.
     #[error("the scene is too large: {0}")]
     TooLarge(String),
+    /// A frame update names something the scene lacks or holds non-finite numbers.
+    #[error("frame update: {0}")]
+    Update(String),
 }
 
-/// The scene on the GPU at one instant.
+/// Frames the renderer lets run ahead of the GPU: the executor's transient resources and the
+/// scene's staging ring rotate over this many slots.
+pub const FRAMES_IN_FLIGHT: usize = 2;
+
+/// The scene's resources imported into one frame graph, after its `update …` passes.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneHandles {
+    /// World-space vertices ([`Vertex`]), written by `update vertices`.
+    pub vertices: Handle<shine_graph::Buffer>,
+    /// Index buffer.
+    pub indices: Handle<shine_graph::Buffer>,
+    /// Materials.
+    pub materials: Handle<shine_graph::Buffer>,
+    /// Lights of this frame.
+    pub lights: Handle<shine_graph::Buffer>,
+    /// sRGB texture array.
+    pub srgb_textures: Handle<shine_graph::Image>,
+    /// Linear texture array.
+    pub linear_textures: Handle<shine_graph::Image>,
+    /// The two-level BVH of this frame.
+    pub trace: TraceBuffers,
+    /// Index count of the single draw.
+    pub index_count: u32,
+}
+
+/// The scene on the GPU: static data uploaded once, per-frame data from the last update.
 pub struct GpuScene {
-    /// World-space vertices ([`Vertex`]).
+    /// Mesh-space vertices ([`Vertex`]), uploaded once.
+    pub source_vertices: Buffer,
+    /// World-space vertices ([`Vertex`]), rewritten every frame.
     pub vertices: Buffer,
-    /// Triangle-list indices (u32).
+    /// Triangle-list indices (u32), shared by both vertex buffers.
     pub indices: Buffer,
     /// Number of indices.
     pub index_count: u32,
+    /// Number of vertices.
+    pub vertex_count: u32,
     /// Materials ([`GpuMaterial`], 80 bytes each).
     pub materials: Buffer,
     /// sRGB colour textures, one per layer.
     pub srgb_textures: Image,
     /// Linear data textures, one per layer.
     pub linear_textures: Image,
-    /// Lights at this instant ([`Light`], 64 bytes each).
+    /// Lights of the current frame ([`Light`], 64 bytes each).
     pub lights: Buffer,
-    /// The same lights on the CPU (shadow and RSM views are built from them).
-    pub light_list: Vec<Light>,
-    /// World-space bounds of the geometry.
-    pub bounds: (Vec3, Vec3),
-    /// Camera-to-world matrix of the scene's first camera at this instant.
-    pub camera_world: Mat4,
-    /// The first camera's projection.
-    pub projection: shine_scene::Projection,
+    /// The two-level BVH (bottom levels static, top level per frame).
+    pub bvh: GpuBvh,
+    /// Per instance: where its vertices and triangles lie.
+    pub instances: Vec<InstanceRange>,
+    /// The scene at the last update.
+    pub state: FrameState,
+    /// Per instance: [`DeformInstance`] records of the current frame.
+    deform_instances: Buffer,
+    /// The scene's CPU data that frames are evaluated from (textures dropped).
+    rig: Scene,
+    /// Staging buffers of the per-frame uploads.
+    ring: UploadRing,
 }
 
 impl GpuScene {
-    /// Flattens `scene` at time `t` (seconds, animations applied) and uploads it.
-    pub fn upload(device: &Device, scene: &Scene, t: f32) -> Result<Self, SceneUploadError> {
-        let world = scene.world_transforms_at(t);
-        let mut vertices = Vec::new();
-        let mut indices: Vec<u32> = Vec::new();
-        let (mut lo, mut hi) = (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN));
-        for instance in scene.instances(&world) {
-            let model = Mat4::from_cols_array_2d(&instance.world);
-            let normal_matrix = Mat3::from_mat4(model).inverse().transpose();
-            let Some(mesh) = scene.meshes.get(instance.mesh as usize) else {
-                continue;
-            };
-            for primitive in &mesh.primitives {
-                let base = u32::try_from(vertices.len())
-                    .map_err(|_| SceneUploadError::TooLarge("over 4G vertices".into()))?;
-                for (i, p) in primitive.positions.iter().enumerate() {
-                    let position = model.transform_point3(*p);
-                    lo = lo.min(position);
-                    hi = hi.max(position);
-                    let normal = primitive
-                        .normals
-                        .get(i)
-                        .map_or(Vec3::Y, |n| (normal_matrix * *n).normalize_or(Vec3::Y));
-                    let tangent = primitive.tangents.get(i).map_or([1.0, 0.0, 0.0, 1.0], |t| {
-                        let v = model.transform_vector3(t.truncate()).normalize_or(Vec3::X);
-                        [v.x, v.y, v.z, t.w]
-                    });
-                    vertices.push(Vertex {
-                        position: position.to_array(),
-                        material: primitive.material,
-                        normal: normal.to_array(),
-                        tangent,
-                        uv: primitive.uvs.get(i).map_or([0.0; 2], |uv| uv.to_array()),
-                        ..Vertex::default()
-                    });
-                }
-                indices.extend(primitive.indices.iter().map(|i| base + i));
-            }
-        }
-        if indices.is_empty() {
-            return Err(SceneUploadError::Empty);
-        }
-        let index_count = u32::try_from(indices.len())
-            .map_err(|_| SceneUploadError::TooLarge("over 4G indices".into()))?;
-
-        let (materials, srgb_layers, linear_layers) = remap_textures(scene);
+    /// Uploads the static data of `scene`, posed at time 0 until the first
+    /// [`GpuScene::update`].
+    pub fn new(device: &Device, scene: &Scene) -> Result<Self, SceneUploadError> {
+        let geometry = Geometry::flatten(scene)?;
+        let (materials, srgb_layers, linear_layers) = textures::remap_textures(scene);
         let storage = |name, data: &[u8], usage| {
             Buffer::with_data(
                 device,
@@ -163,59 +168,192 @@ impl GpuScene {
                 data,
             )
         };
-        let light_list = scene.lights_at(&world);
-        let lights_bytes: &[u8] = if light_list.is_empty() {
-            &[0; 64]
-        } else {
-            bytemuck::cast_slice(&light_list)
+        let dynamic = |name, size: usize, usage| {
+            Buffer::new(
+                device,
+                &BufferDesc {
+                    name,
+                    size: size.max(16) as u64,
+                    usage: usage | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
         };
-        let camera_world = scene.camera_world(0, &world).unwrap_or(Mat4::IDENTITY);
-        let projection = scene.cameras.first().map(|c| c.projection).unwrap_or(
-            shine_scene::Projection::Perspective {
-                yfov: 0.8,
-                aspect_ratio: None,
-                znear: 0.05,
-                zfar: None,
-            },
-        );
+        let vertex_bytes = std::mem::size_of_val(geometry.source.as_slice());
+        let instance_count = geometry.instances.len();
+        let bottom = BottomLevels::build(scene);
+        let rig = Scene {
+            textures: Vec::new(),
+            ..scene.clone()
+        };
+        let state = FrameState::evaluate(&rig, &FrameUpdate::default());
         Ok(Self {
-            vertices: storage(
+            source_vertices: storage(
+                "scene source vertices",
+                bytemuck::cast_slice(&geometry.source),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+            vertices: dynamic(
                 "scene vertices",
-                bytemuck::cast_slice(&vertices),
+                vertex_bytes,
                 vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
             )?,
             indices: storage(
                 "scene indices",
-                bytemuck::cast_slice(&indices),
+                bytemuck::cast_slice(&geometry.indices),
                 vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
             )?,
-            index_count,
+            index_count: geometry.indices.len() as u32,
+            vertex_count: geometry.source.len() as u32,
             materials: storage(
                 "scene materials",
                 bytemuck::cast_slice(&materials),
                 vk::BufferUsageFlags::STORAGE_BUFFER,
             )?,
-            srgb_textures: texture_array(
+            srgb_textures: textures::texture_array(
                 device,
                 "srgb textures",
                 vk::Format::R8G8B8A8_SRGB,
                 &srgb_layers,
             )?,
-            linear_textures: texture_array(
+            linear_textures: textures::texture_array(
                 device,
                 "linear textures",
                 vk::Format::R8G8B8A8_UNORM,
                 &linear_layers,
             )?,
-            lights: storage(
+            lights: dynamic(
                 "scene lights",
-                lights_bytes,
+                scene.lights.len().max(1) * std::mem::size_of::<Light>(),
                 vk::BufferUsageFlags::STORAGE_BUFFER,
             )?,
-            light_list,
-            bounds: (lo, hi),
-            camera_world,
-            projection,
+            bvh: GpuBvh::new(device, bottom, instance_count)?,
+            deform_instances: dynamic(
+                "deform instances",
+                instance_count * std::mem::size_of::<DeformInstance>(),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+            instances: geometry.instances,
+            state,
+            rig,
+            ring: UploadRing::new(device, FRAMES_IN_FLIGHT),
+        })
+    }
+
+    /// Uploads `scene` and poses it at time `t` (a cold start).
+    pub fn upload(device: &Device, scene: &Scene, t: f32) -> Result<Self, SceneUploadError> {
+        let mut gpu = Self::new(device, scene)?;
+        gpu.update(&FrameUpdate::at(t))?;
+        Ok(gpu)
+    }
+
+    /// Evaluates `update` for the next frame (CPU only: the GPU is written when the frame is
+    /// declared). A bad update is refused and the previous state kept.
+    pub fn update(&mut self, update: &FrameUpdate) -> Result<(), SceneUploadError> {
+        update
+            .validate(&self.rig)
+            .map_err(SceneUploadError::Update)?;
+        self.state = FrameState::evaluate(&self.rig, update);
+        Ok(())
+    }
+
+    /// The scene's CPU data (without textures), as frames are evaluated from it.
+    pub fn rig(&self) -> &Scene {
+        &self.rig
+    }
+
+    /// Mesh-to-world matrix of every instance in the current frame.
+    pub fn instance_matrices(&self) -> Vec<Mat4> {
+        self.instances
+            .iter()
+            .map(|r| {
+                self.state
+                    .world
+                    .get(r.node as usize)
+                    .copied()
+                    .unwrap_or(Mat4::IDENTITY)
+            })
+            .collect()
+    }
+
+    /// Records this frame's `update …` passes (instance records, lights and top-level BVH
+    /// copied from the staging ring; the world vertices rewritten) and imports everything the
+    /// frame reads.
+    pub fn declare(&mut self, rg: &mut RenderGraph) -> Result<SceneHandles, SceneUploadError> {
+        let matrices = self.instance_matrices();
+        let records: Vec<DeformInstance> = matrices.iter().map(DeformInstance::rigid).collect();
+        let top = TopLevel::build(
+            &self
+                .instances
+                .iter()
+                .zip(&matrices)
+                .map(|(r, world)| TopInstance {
+                    world: *world,
+                    root: self
+                        .bvh
+                        .bottom
+                        .roots
+                        .get(r.mesh as usize)
+                        .copied()
+                        .unwrap_or(u32::MAX),
+                    bounds: self
+                        .bvh
+                        .bottom
+                        .bounds
+                        .get(r.mesh as usize)
+                        .copied()
+                        .unwrap_or(shine_scene::Aabb::EMPTY),
+                    triangle_base: r.first_triangle,
+                })
+                .collect::<Vec<_>>(),
+        );
+        let deform = self.ring.upload(
+            rg,
+            "instances",
+            &self.deform_instances,
+            bytemuck::cast_slice(&records),
+        )?;
+        let lights = self.ring.upload(
+            rg,
+            "lights",
+            &self.lights,
+            bytemuck::cast_slice(&self.state.lights),
+        )?;
+        let top_nodes = self.ring.upload(
+            rg,
+            "bvh top",
+            &self.bvh.top,
+            bytemuck::cast_slice(&top.nodes),
+        )?;
+        let top_instances = self.ring.upload(
+            rg,
+            "bvh instances",
+            &self.bvh.instances,
+            bytemuck::cast_slice(&top.instances),
+        )?;
+        let source = rg.import_gpu_buffer(&self.source_vertices, BUFFER_READ, BUFFER_READ);
+        let mut vertices = rg.import_gpu_buffer(&self.vertices, BUFFER_READ, BUFFER_READ);
+        crate::passes::update_vertices::update_vertices(
+            rg,
+            &source,
+            &deform,
+            &mut vertices,
+            self.vertex_count,
+        );
+        Ok(SceneHandles {
+            vertices,
+            indices: rg.import_gpu_buffer(&self.indices, BUFFER_READ, BUFFER_READ),
+            materials: rg.import_gpu_buffer(&self.materials, BUFFER_READ, BUFFER_READ),
+            lights,
+            srgb_textures: rg.import_gpu_image(&self.srgb_textures, SAMPLED_READ, SAMPLED_READ),
+            linear_textures: rg.import_gpu_image(&self.linear_textures, SAMPLED_READ, SAMPLED_READ),
+            trace: TraceBuffers {
+                nodes: rg.import_gpu_buffer(&self.bvh.nodes, BUFFER_READ, BUFFER_READ),
+                triangles: rg.import_gpu_buffer(&self.bvh.triangles, BUFFER_READ, BUFFER_READ),
+                top: top_nodes,
+                instances: top_instances,
+            },
+            index_count: self.index_count,
         })
     }
 
@@ -223,106 +361,10 @@ impl GpuScene {
     /// directional light, else the first light.
     pub fn primary_light(&self) -> Option<usize> {
         let kind = |l: &Light| l.light_kind();
-        self.light_list
+        self.state
+            .lights
             .iter()
             .position(|l| matches!(kind(l), Some(LightKind::Spot | LightKind::Directional)))
-            .or_else(|| (!self.light_list.is_empty()).then_some(0))
+            .or_else(|| (!self.state.lights.is_empty()).then_some(0))
     }
-}
-
-/// Remaps texture indices to layers of the sRGB and linear arrays, and resizes every used
-/// texture to [`TEXTURE_SIZE`]².
-fn remap_textures(scene: &Scene) -> (Vec<GpuMaterial>, Vec<Vec<u8>>, Vec<Vec<u8>>) {
-    let mut srgb: Vec<(u32, Vec<u8>)> = Vec::new();
-    let mut linear: Vec<(u32, Vec<u8>)> = Vec::new();
-    let mut layer = |index: u32, into_srgb: bool| -> u32 {
-        let Some(texture) = scene.textures.get(index as usize) else {
-            return NO_TEXTURE;
-        };
-        let list = if into_srgb { &mut srgb } else { &mut linear };
-        if let Some(found) = list.iter().position(|(i, _)| *i == index) {
-            return found as u32;
-        }
-        list.push((index, resize(texture)));
-        (list.len() - 1) as u32
-    };
-    let materials = scene
-        .materials
-        .iter()
-        .map(|m| GpuMaterial {
-            base_color_texture: layer(m.base_color_texture, true),
-            emissive_texture: layer(m.emissive_texture, true),
-            metallic_roughness_texture: layer(m.metallic_roughness_texture, false),
-            normal_texture: layer(m.normal_texture, false),
-            ..*m
-        })
-        .collect::<Vec<_>>();
-    let materials = if materials.is_empty() {
-        vec![GpuMaterial {
-            base_color: [0.8, 0.8, 0.8, 1.0],
-            roughness: 1.0,
-            base_color_texture: NO_TEXTURE,
-            emissive_texture: NO_TEXTURE,
-            metallic_roughness_texture: NO_TEXTURE,
-            normal_texture: NO_TEXTURE,
-            ..bytemuck::Zeroable::zeroed()
-        }]
-    } else {
-        materials
-    };
-    let strip = |v: Vec<(u32, Vec<u8>)>| v.into_iter().map(|(_, t)| t).collect();
-    (materials, strip(srgb), strip(linear))
-}
-
-fn resize(texture: &shine_scene::Texture) -> Vec<u8> {
-    let image = image::RgbaImage::from_raw(texture.width, texture.height, texture.rgba8.clone());
-    match image {
-        Some(img) if texture.width == TEXTURE_SIZE && texture.height == TEXTURE_SIZE => {
-            img.into_raw()
-        }
-        Some(img) => image::imageops::resize(
-            &img,
-            TEXTURE_SIZE,
-            TEXTURE_SIZE,
-            image::imageops::FilterType::Triangle,
-        )
-        .into_raw(),
-        // A texture whose bytes do not match its size reads as white (shine-scene validates
-        // sizes, so this is defensive).
-        None => vec![255; (TEXTURE_SIZE * TEXTURE_SIZE * 4) as usize],
-    }
-}
-
-fn texture_array(
-    device: &Device,
-    name: &str,
-    format: vk::Format,
-    layers: &[Vec<u8>],
-) -> Result<Image, shine_gpu::Error> {
-    // A scene without textures still binds a (white) layer: the shaders read it only through
-    // a texture index, which is NO_TEXTURE then.
-    let layer_bytes = (TEXTURE_SIZE * TEXTURE_SIZE * 4) as usize;
-    let data = if layers.is_empty() {
-        vec![255u8; layer_bytes]
-    } else {
-        layers.concat()
-    };
-    let layer_count = (data.len() / layer_bytes) as u32;
-    let image = Image::new(
-        device,
-        &ImageDesc {
-            name,
-            extent: [TEXTURE_SIZE, TEXTURE_SIZE],
-            format,
-            usage: vk::ImageUsageFlags::SAMPLED
-                | vk::ImageUsageFlags::TRANSFER_DST
-                | vk::ImageUsageFlags::TRANSFER_SRC,
-            mip_levels: TEXTURE_MIP_LEVELS,
-            array_layers: layer_count,
-            // The shaders declare `texture2DArray`, also for a single layer.
-            array_view: true,
-        },
-    )?;
-    device.upload_image(&image, &data, vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL)?;
-    Ok(image)
 }

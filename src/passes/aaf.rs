@@ -42,9 +42,10 @@
 
 use std::ops::RangeInclusive;
 
+use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
-use crate::passes::gbuffer::{GBuffer, SceneHandles, View};
+use crate::passes::gbuffer::{GBuffer, View};
 use crate::shaders;
 
 /// Ω_h of a Lambertian receiver (paper 004 eq. 18): the default bandlimit.
@@ -412,12 +413,11 @@ fn sample_pass<'a>(
         .read("vertices", &scene.handles.vertices)
         .read("indices", &scene.handles.indices)
         .read("lights", &scene.handles.lights)
-        .read("bvh_nodes", &scene.bvh.nodes)
-        .read("bvh_triangles", &scene.bvh.triangles)
         .read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
         .read("gb_geometric_normal", &g.geometric_normal)
         .read("gb_albedo", &g.albedo)
         .read("gb_material", &g.material);
+    scene.bvh.bind(&mut pass);
     pass
 }

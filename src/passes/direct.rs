@@ -2,8 +2,9 @@
 //! tiles of the shadow atlas ([`super::shadows`]) with a PCF kernel, plus emission; the
 //! environment behind the scene (docs/frame.md).
 
-use super::gbuffer::{GBuffer, SceneHandles, View};
+use super::gbuffer::{GBuffer, View};
 use super::shadows::ShadowAtlas;
+use crate::gpu_scene::SceneHandles;
 use crate::shaders;
 use shine_gpu::vk;
 use shine_graph::{Handle, Image, ImageDesc, RenderGraph};

@@ -1,7 +1,7 @@
 //! `gbuffer`: the scene rasterised from the camera into the G-buffer; the camera and light
 //! views and the scene raster pipeline every raster pass shares (shadows, RSM).
 
-use crate::gpu_scene::{GpuScene, Vertex};
+use crate::gpu_scene::{FrameState, SceneHandles, Vertex};
 use crate::shaders;
 use glam::{Mat4, Vec3};
 use shine_gpu::{Blend, DepthState, GraphicsPipelineDesc, VertexBufferLayout, vk};
@@ -87,12 +87,21 @@ pub(crate) fn flip_y(mut proj: Mat4) -> Mat4 {
     proj
 }
 
-/// The camera view for a `width`×`height` image.
-pub fn camera_view(scene: &GpuScene, width: u32, height: u32) -> View {
+/// The camera view of `frame` for a `width`×`height` image, its projection offset by the
+/// frame's sub-pixel jitter.
+pub fn camera_view(frame: &FrameState, width: u32, height: u32) -> View {
     let aspect = width as f32 / height.max(1) as f32;
-    let view = scene.camera_world.inverse();
-    let eye = scene.camera_world.transform_point3(Vec3::ZERO);
-    match scene.projection {
+    let view = frame.camera_world.inverse();
+    let eye = frame.camera_world.transform_point3(Vec3::ZERO);
+    // A shift by (jx, jy) pixels is 2j / size in clip space (Vulkan clip y points down, as
+    // image rows do).
+    let [jx, jy] = frame.jitter;
+    let jitter = Mat4::from_translation(Vec3::new(
+        2.0 * jx / width.max(1) as f32,
+        2.0 * jy / height.max(1) as f32,
+        0.0,
+    ));
+    let mut view = match frame.projection {
         shine_scene::Projection::Perspective {
             yfov, znear, zfar, ..
         } => View {
@@ -121,15 +130,17 @@ pub fn camera_view(scene: &GpuScene, width: u32, height: u32) -> View {
             orthographic: true,
             extent: 2.0 * ymag,
         },
-    }
+    };
+    view.proj = jitter * view.proj;
+    view
 }
 
 /// The primary light's view (the RSM and shadow map): a perspective frustum along a spot
 /// light's axis covering its outer cone, an orthographic box around the scene for a
 /// directional light, or a frustum from a point light towards the scene's centre.
-pub fn light_view(scene: &GpuScene, light_index: usize) -> Option<View> {
-    let light = scene.light_list.get(light_index)?;
-    let (lo, hi) = scene.bounds;
+pub fn light_view(frame: &FrameState, light_index: usize) -> Option<View> {
+    let light = frame.lights.get(light_index)?;
+    let (lo, hi) = frame.bounds;
     let center = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
     let up_for = |dir: Vec3| if dir.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
@@ -196,45 +207,6 @@ pub struct GBuffer {
     pub depth: Handle<Image>,
     /// Width and height.
     pub extent: [u32; 2],
-}
-
-/// Scene resources imported into a frame graph.
-#[derive(Clone, Copy, Debug)]
-pub struct SceneHandles {
-    /// Vertex buffer.
-    pub vertices: Handle<shine_graph::Buffer>,
-    /// Index buffer.
-    pub indices: Handle<shine_graph::Buffer>,
-    /// Materials.
-    pub materials: Handle<shine_graph::Buffer>,
-    /// Lights.
-    pub lights: Handle<shine_graph::Buffer>,
-    /// sRGB texture array.
-    pub srgb_textures: Handle<Image>,
-    /// Linear texture array.
-    pub linear_textures: Handle<Image>,
-    /// Index count of the single draw.
-    pub index_count: u32,
-}
-
-impl SceneHandles {
-    /// Imports the persistent buffers and texture arrays of `scene` into `rg` (read-only).
-    pub fn import(rg: &mut RenderGraph, scene: &GpuScene) -> Self {
-        use crate::gpu_scene::{BUFFER_READ, SAMPLED_READ};
-        Self {
-            vertices: rg.import_gpu_buffer(&scene.vertices, BUFFER_READ, BUFFER_READ),
-            indices: rg.import_gpu_buffer(&scene.indices, BUFFER_READ, BUFFER_READ),
-            materials: rg.import_gpu_buffer(&scene.materials, BUFFER_READ, BUFFER_READ),
-            lights: rg.import_gpu_buffer(&scene.lights, BUFFER_READ, BUFFER_READ),
-            srgb_textures: rg.import_gpu_image(&scene.srgb_textures, SAMPLED_READ, SAMPLED_READ),
-            linear_textures: rg.import_gpu_image(
-                &scene.linear_textures,
-                SAMPLED_READ,
-                SAMPLED_READ,
-            ),
-            index_count: scene.index_count,
-        }
-    }
 }
 
 /// The pipeline of every scene raster pass: the flattened scene's vertices through

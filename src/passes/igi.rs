@@ -361,9 +361,8 @@ pub fn vpl_sh(
         pass.read("gb_normal", &g.normal)
             .read("gb_material", &g.material);
     }
+    bvh.bind(&mut pass);
     pass.read("vpls", vpls)
-        .read("bvh_nodes", &bvh.nodes)
-        .read("bvh_triangles", &bvh.triangles)
         .write("vpl_sh", &mut sh)
         .push(&push)
         .dispatch([g.extent[0], g.extent[1], 1]);

@@ -15,6 +15,7 @@ pub mod proxy;
 pub mod receivers;
 pub mod rsm;
 pub mod shadows;
+pub mod update_vertices;
 pub mod upsample;
 
 /// A pass parameter outside its range: the name, the value and the range in words.

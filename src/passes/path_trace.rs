@@ -6,8 +6,8 @@
 //! readback ([`crate::reference`]). Each sample's random numbers are seeded from (pixel,
 //! sample index, seed): runs are deterministic and disjoint sample ranges independent.
 
+use crate::gpu_scene::SceneHandles;
 use crate::graph::{Buffer, Handle, Image, RenderGraph, vk};
-use crate::passes::gbuffer::SceneHandles;
 use crate::shaders;
 use glam::Mat4;
 
@@ -59,23 +59,13 @@ pub struct PathTraceParams {
     pub samples: u32,
 }
 
-/// The BVH and environment bindings of the tracer (src/gpu_scene/bvh.rs, src/gpu_scene/environment.rs).
-#[derive(Debug)]
-pub struct TraceHandles {
-    /// `bvh_nodes`.
-    pub nodes: Handle<Buffer>,
-    /// `bvh_triangles`.
-    pub triangles: Handle<Buffer>,
-    /// `environment` (RGBA32F equirectangular).
-    pub environment: Handle<Image>,
-}
-
 /// Adds one progressive `path_trace` dispatch accumulating into `accumulation` (at least
-/// `ACCUMULATION_PLANES × width × height × 16` bytes).
+/// `ACCUMULATION_PLANES × width × height × 16` bytes), tracing the scene's BVH and lit by
+/// `environment` (RGBA32F equirectangular, src/gpu_scene/environment.rs) on escape.
 pub fn path_trace(
     rg: &mut RenderGraph,
     scene: &SceneHandles,
-    trace: &TraceHandles,
+    environment: &Handle<Image>,
     accumulation: &mut Handle<Buffer>,
     params: &PathTraceParams,
     texture_sampler: vk::Sampler,
@@ -93,17 +83,16 @@ pub fn path_trace(
         ],
         pad: [0.0; 4],
     };
-    rg.compute("path_trace", &shaders::PATH_TRACE_COMP)
-        .read("materials", &scene.materials)
+    let mut pass = rg.compute("path_trace", &shaders::PATH_TRACE_COMP);
+    scene.trace.bind(&mut pass);
+    pass.read("materials", &scene.materials)
         .read("srgb_textures", &scene.srgb_textures)
         .read("linear_textures", &scene.linear_textures)
         .sampler("texture_sampler", texture_sampler)
         .read("vertices", &scene.vertices)
         .read("indices", &scene.indices)
         .read("lights", &scene.lights)
-        .read("bvh_nodes", &trace.nodes)
-        .read("bvh_triangles", &trace.triangles)
-        .read("environment", &trace.environment)
+        .read("environment", environment)
         .sampler("environment_sampler", environment_sampler)
         .write("accumulation", accumulation)
         .push(&constants)

@@ -5,8 +5,9 @@
 use glam::Vec3;
 use shine_graph::{ColorLoad, DepthLoad, Handle, Image, ImageDesc, RenderGraph};
 
-use super::gbuffer::{SceneHandles, View, scene_pipeline};
+use super::gbuffer::{View, scene_pipeline};
 use crate::gpu::vk;
+use crate::gpu_scene::SceneHandles;
 use crate::shaders;
 
 /// Default RSM side: 512² texels serve 400 HVLs with room to spare.

@@ -14,8 +14,8 @@
 //!   of the tile), so the PCF kernel of a receiver whose major axis picked the face stays on the
 //!   face's valid depth.
 
-use super::gbuffer::{SceneHandles, View, flip_y, light_view, scene_pipeline};
-use crate::gpu_scene::GpuScene;
+use super::gbuffer::{View, flip_y, light_view, scene_pipeline};
+use crate::gpu_scene::{FrameState, SceneHandles};
 use glam::{Mat4, Vec3};
 use shine_gpu::{GraphicsPipelineDesc, vk};
 use shine_graph::{DepthLoad, Handle, Image, ImageDesc, RenderGraph};
@@ -103,11 +103,11 @@ pub struct ShadowLayoutError {
 }
 
 impl ShadowLayout {
-    /// The views of every light of `scene` in tiles of `tile` texels (smaller if the atlas
+    /// The views of every light of `frame` in tiles of `tile` texels (smaller if the atlas
     /// would exceed `max_dimension`), with a margin of `pcf_radius` + 2 texels around each
     /// cube face.
     pub fn new(
-        scene: &GpuScene,
+        frame: &FrameState,
         tile: u32,
         pcf_radius: u32,
         max_dimension: u32,
@@ -119,7 +119,7 @@ impl ShadowLayout {
             Some(_) => 1,
             None => 0,
         };
-        let total: u32 = scene.light_list.iter().map(|l| count(l.light_kind())).sum();
+        let total: u32 = frame.lights.iter().map(|l| count(l.light_kind())).sum();
         let n = total.max(1);
         let columns = (f64::from(n).sqrt().ceil()) as u32;
         let rows = n.div_ceil(columns);
@@ -137,20 +137,20 @@ impl ShadowLayout {
         let margin = ((pcf_radius + 2) as f32).min(side as f32 / 4.0);
         let tan_half = side as f32 / (side as f32 - 2.0 * margin);
         let mut views = Vec::with_capacity(total as usize);
-        let mut lights = Vec::with_capacity(scene.light_list.len());
-        for (i, light) in scene.light_list.iter().enumerate() {
+        let mut lights = Vec::with_capacity(frame.lights.len());
+        for (i, light) in frame.lights.iter().enumerate() {
             let first_view = views.len() as u32;
             let index = i as u32;
             match light.light_kind() {
                 Some(LightKind::Point) => {
                     for (axis, up, face) in CUBE_FACES {
                         let eye = Vec3::from(light.position);
-                        let view = cube_face(scene, eye, axis, up, tan_half);
+                        let view = cube_face(frame, eye, axis, up, tan_half);
                         views.push((index, format!("shadow light {i} {face}"), view));
                     }
                 }
                 Some(_) => {
-                    if let Some(view) = light_view(scene, i) {
+                    if let Some(view) = light_view(frame, i) {
                         views.push((index, format!("shadow light {i}"), view));
                     }
                 }
@@ -235,8 +235,8 @@ impl ShadowLayout {
 
 /// One cube face of a point light at `eye` looking along `axis`: a square frustum whose
 /// half-angle tangent is `tan_half` (1 = exactly 90°), reaching past the scene's far side.
-fn cube_face(scene: &GpuScene, eye: Vec3, axis: Vec3, up: Vec3, tan_half: f32) -> View {
-    let (lo, hi) = scene.bounds;
+fn cube_face(frame: &FrameState, eye: Vec3, axis: Vec3, up: Vec3, tan_half: f32) -> View {
+    let (lo, hi) = frame.bounds;
     let center = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);
     let far = (eye - center).length() + radius * 2.0;

@@ -20,10 +20,9 @@ pub mod proxy;
 
 use crate::capture::image_io::HdrImage;
 use crate::frame::RenderError;
-use crate::gpu_scene::GpuScene;
-use crate::gpu_scene::bvh::GpuBvh;
-use crate::passes::gbuffer::{self, SceneHandles};
-use crate::passes::path_trace::{self, PathTraceParams, TraceHandles};
+use crate::gpu_scene::{FrameUpdate, GpuScene};
+use crate::passes::gbuffer;
+use crate::passes::path_trace::{self, PathTraceParams};
 use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, Sampler, vk};
 use shine_graph::{Executor, ExternalState};
 use shine_scene::Scene;
@@ -116,12 +115,12 @@ pub struct ReferenceImages {
     pub samples: u32,
 }
 
-/// A progressive path tracer of one scene at one instant.
+/// A progressive path tracer of one scene at one instant ([`PathTracer::update`] moves it
+/// to another and restarts the accumulation).
 pub struct PathTracer {
     device: Device,
     executor: Executor,
     scene: GpuScene,
-    bvh: GpuBvh,
     environment: Image,
     texture_sampler: Sampler,
     environment_sampler: Sampler,
@@ -141,7 +140,6 @@ impl PathTracer {
     ) -> Result<Self, RenderError> {
         params.validate()?;
         let gpu_scene = GpuScene::upload(device, scene, t)?;
-        let bvh = GpuBvh::upload(device, scene, t)?;
         let environment =
             crate::gpu_scene::environment::upload(device, scene.environment.as_ref())?;
         let sampler = |u, v| {
@@ -174,7 +172,6 @@ impl PathTracer {
             device: device.clone(),
             executor: Executor::new(device, 1)?,
             scene: gpu_scene,
-            bvh,
             environment,
             texture_sampler: sampler(
                 vk::SamplerAddressMode::REPEAT,
@@ -188,6 +185,15 @@ impl PathTracer {
             params: *params,
             samples: 0,
         })
+    }
+
+    /// Moves the scene to the instant `update` describes (the update path of the renderer:
+    /// static data stays, the frame's state is uploaded by the next dispatch) and restarts
+    /// the accumulation.
+    pub fn update(&mut self, update: &FrameUpdate) -> Result<(), RenderError> {
+        self.scene.update(update)?;
+        self.samples = 0;
+        Ok(())
     }
 
     /// Samples per pixel accumulated so far.
@@ -218,27 +224,23 @@ impl PathTracer {
     }
 
     fn dispatch(&mut self, samples: u32) -> Result<(), RenderError> {
-        let scene = &self.scene;
-        let (read, sampled) = (
-            crate::gpu_scene::BUFFER_READ,
-            crate::gpu_scene::SAMPLED_READ,
-        );
+        let sampled = crate::gpu_scene::SAMPLED_READ;
         let accumulated = ExternalState::new(
             vk::PipelineStageFlags2::ALL_COMMANDS,
             vk::AccessFlags2::MEMORY_READ | vk::AccessFlags2::MEMORY_WRITE,
             vk::ImageLayout::UNDEFINED,
         );
         let mut rg = self.executor.begin_frame();
-        let handles = SceneHandles::import(&mut rg, scene);
-        let trace = TraceHandles {
-            nodes: rg.import_gpu_buffer(&self.bvh.nodes, read, read),
-            triangles: rg.import_gpu_buffer(&self.bvh.triangles, read, read),
-            environment: rg.import_gpu_image(&self.environment, sampled, sampled),
-        };
+        let handles = self.scene.declare(&mut rg)?;
+        let frame = &self.scene.state;
+        let environment = rg.import_gpu_image(&self.environment, sampled, sampled);
         let mut accumulation = rg.import_gpu_buffer(&self.accumulation, accumulated, accumulated);
-        let light_count = u32::try_from(scene.light_list.len())
+        if self.samples == 0 {
+            rg.fill_buffer("clear accumulation", &mut accumulation, 0);
+        }
+        let light_count = u32::try_from(frame.lights.len())
             .map_err(|_| RenderError::Invalid("too many lights".into()))?;
-        let camera = gbuffer::camera_view(scene, self.params.width, self.params.height);
+        let camera = gbuffer::camera_view(frame, self.params.width, self.params.height);
         let params = PathTraceParams {
             extent: [self.params.width, self.params.height],
             view_proj: camera.view_proj(),
@@ -252,7 +254,7 @@ impl PathTracer {
         path_trace::path_trace(
             &mut rg,
             &handles,
-            &trace,
+            &environment,
             &mut accumulation,
             &params,
             self.texture_sampler.raw(),
@@ -295,9 +297,9 @@ impl PathTracer {
         })
     }
 
-    /// The BVH the tracer uses (tests compare its GPU traversal with the CPU one).
-    pub fn bvh(&self) -> &GpuBvh {
-        &self.bvh
+    /// The scene the tracer renders.
+    pub fn scene(&self) -> &GpuScene {
+        &self.scene
     }
 }
 

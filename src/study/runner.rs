@@ -11,10 +11,9 @@ use shine_scene::Scene;
 use super::metrics::{self, ImageError};
 use super::{Progress, StudyError};
 use crate::frame::RenderError;
-use crate::gpu_scene::bvh::GpuBvh;
-use crate::gpu_scene::{BUFFER_READ, GpuScene};
+use crate::gpu_scene::GpuScene;
 use crate::passes::aaf::{self, AafParams, AafScene};
-use crate::passes::gbuffer::{self, SceneHandles, View};
+use crate::passes::gbuffer::{self, View};
 
 /// The names of the AAF passes, in frame order (their host times make AAF's frame).
 pub const AAF_PASSES: [&str; 5] = [
@@ -70,7 +69,6 @@ pub struct AafRunner {
     device: Device,
     executor: Executor,
     scene: GpuScene,
-    bvh: GpuBvh,
     sampler: Sampler,
     extent: [u32; 2],
     camera: View,
@@ -88,7 +86,6 @@ impl AafRunner {
         extent: [u32; 2],
     ) -> Result<Self, StudyError> {
         let gpu = GpuScene::upload(device, scene, t).map_err(RenderError::from)?;
-        let bvh = GpuBvh::upload(device, scene, t).map_err(RenderError::from)?;
         let sampler = Sampler::new(
             device,
             &vk::SamplerCreateInfo::default()
@@ -119,12 +116,11 @@ impl AafRunner {
             widths: buffer("study widths", 8)?,
             position: buffer("study position", 16)?,
         };
-        let camera = gbuffer::camera_view(&gpu, extent[0], extent[1]);
+        let camera = gbuffer::camera_view(&gpu.state, extent[0], extent[1]);
         Ok(Self {
             device: device.clone(),
             executor: Executor::new(device, 1).map_err(RenderError::from)?,
             scene: gpu,
-            bvh,
             sampler,
             extent,
             camera,
@@ -155,7 +151,7 @@ impl AafRunner {
         let start = Instant::now();
         let [w, h] = self.extent;
         let mut rg = self.executor.begin_frame();
-        let handles = SceneHandles::import(&mut rg, &self.scene);
+        let handles = self.scene.declare(&mut rg).map_err(RenderError::from)?;
         let g = gbuffer::gbuffer(
             &mut rg,
             &handles,
@@ -163,14 +159,13 @@ impl AafRunner {
             self.extent,
             self.sampler.raw(),
         );
-        let light_count = u32::try_from(self.scene.light_list.len())
+        let light_count = u32::try_from(self.scene.state.lights.len())
             .map_err(|_| StudyError::Invalid("too many lights".into()))?;
-        let bvh = self.bvh.import(&mut rg, BUFFER_READ);
         let scene = AafScene {
             handles: &handles,
-            bvh: &bvh,
+            bvh: &handles.trace,
             light_count,
-            size: aaf::scene_size(self.scene.bounds),
+            size: aaf::scene_size(self.scene.state.bounds),
             texture_sampler: self.sampler.raw(),
         };
         let out = aaf::aaf(&mut rg, &g, &scene, &self.camera, params).map_err(RenderError::from)?;

@@ -218,8 +218,7 @@ impl Bvh {
                 }
             })
             .collect();
-        let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
-        let nodes = build_subtree(&mut items, 0, threads);
+        let nodes = build_items(&mut items);
         let triangles = items
             .iter()
             .filter_map(|item| triangles.get(item.index as usize).copied())
@@ -408,6 +407,32 @@ impl Bvh {
         }
         max
     }
+}
+
+/// A binned-SAH hierarchy over boxes (e.g. the world bounds of instances, for a two-level
+/// BVH's top level): the nodes, whose leaves index `order`, and `order`, the box indices in
+/// leaf order. Empty for no boxes.
+pub fn build_over_boxes(boxes: &[Aabb]) -> (Vec<BvhNode>, Vec<u32>) {
+    let mut items: Vec<Item> = boxes
+        .iter()
+        .enumerate()
+        .map(|(i, b)| Item {
+            bounds: *b,
+            centroid: b.center(),
+            index: i as u32,
+        })
+        .collect();
+    if items.is_empty() {
+        return (Vec::new(), Vec::new());
+    }
+    let nodes = build_items(&mut items);
+    (nodes, items.iter().map(|item| item.index).collect())
+}
+
+/// Builds the nodes over `items` (non-empty), on as many threads as the machine has.
+fn build_items(items: &mut [Item]) -> Vec<BvhNode> {
+    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+    build_subtree(items, 0, threads)
 }
 
 /// Subtrees smaller than this are not worth a thread.

@@ -555,8 +555,7 @@ pub fn hvl_gather(
         pass.read("brdf", brdf);
     }
     if let Some(b) = bvh {
-        pass.read("bvh_nodes", &b.nodes)
-            .read("bvh_triangles", &b.triangles);
+        b.bind(&mut pass);
     }
     pass.write("indirect", &mut indirect)
         .push(&push)

@@ -1,0 +1,83 @@
+//! Per-frame uploads without waiting: a ring of host-visible staging buffers, one set per
+//! frame in flight, copied into device buffers by `update …` transfer passes recorded into
+//! the frame's own command buffer.
+//!
+//! Frame `f` writes the staging buffers of slot `f mod slots`. The executor lets at most
+//! `slots` frames run ahead of the GPU (a host recording with [`crate::Renderer::record`]
+//! promises the same), so when frame `f` is declared, frame `f - slots`, the last reader of
+//! that slot, has completed. Staging buffers are created on first use with the size of their
+//! destination and then reused, so a steady stream of frames allocates nothing.
+
+use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_graph::{ExternalState, Handle, RenderGraph};
+
+use super::BUFFER_READ;
+
+/// A ring of staging buffers for the device buffers a frame rewrites.
+pub struct UploadRing {
+    device: Device,
+    /// Per slot: (name, staging buffer).
+    slots: Vec<Vec<(String, Buffer)>>,
+}
+
+impl UploadRing {
+    /// A ring for `frames_in_flight` frames (at least one slot).
+    pub fn new(device: &Device, frames_in_flight: usize) -> Self {
+        Self {
+            device: device.clone(),
+            slots: (0..frames_in_flight.max(1)).map(|_| Vec::new()).collect(),
+        }
+    }
+
+    /// Writes `data` into this frame's staging buffer `name` and adds a transfer pass
+    /// `update <name>` copying it into `dst` (a persistent device buffer with `TRANSFER_DST`,
+    /// read by any stage before and after the frame). Returns `dst`'s handle after the copy:
+    /// readers must use it, so the graph orders them after the update.
+    pub fn upload(
+        &mut self,
+        rg: &mut RenderGraph,
+        name: &str,
+        dst: &Buffer,
+        data: &[u8],
+    ) -> Result<Handle<crate::graph::Buffer>, shine_gpu::Error> {
+        if data.len() as u64 > dst.size() {
+            return Err(shine_gpu::Error::InvalidUsage(format!(
+                "upload `{name}`: {} bytes do not fit its {}-byte buffer",
+                data.len(),
+                dst.size()
+            )));
+        }
+        let slot_count = self.slots.len() as u64;
+        let slot = &mut self.slots[(rg.frame() % slot_count) as usize];
+        let index = match slot.iter().position(|(n, _)| n == name) {
+            Some(i) if slot[i].1.size() == dst.size() => i,
+            found => {
+                // A destination of a new size (a new scene): the old staging buffer's last
+                // reader finished (see the module docs), so it can go.
+                if let Some(i) = found {
+                    slot.swap_remove(i);
+                }
+                let staging = Buffer::new(
+                    &self.device,
+                    &BufferDesc {
+                        name: &format!("staging {name}"),
+                        size: dst.size(),
+                        usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                        location: MemoryLocation::CpuToGpu,
+                    },
+                )?;
+                slot.push((name.to_owned(), staging));
+                slot.len() - 1
+            }
+        };
+        let staging = &mut slot[index].1;
+        let mapped = staging.mapped_mut().ok_or_else(|| {
+            shine_gpu::Error::InvalidUsage(format!("staging buffer `{name}` is not host-visible"))
+        })?;
+        mapped[..data.len()].copy_from_slice(data);
+        let src = rg.import_gpu_buffer(staging, ExternalState::UNDEFINED, ExternalState::UNDEFINED);
+        let mut handle = rg.import_gpu_buffer(dst, BUFFER_READ, BUFFER_READ);
+        rg.copy_buffer(&format!("update {name}"), &src, &mut handle);
+        Ok(handle)
+    }
+}
