@@ -193,10 +193,13 @@ impl GpuScene {
                 bytemuck::cast_slice(&geometry.source),
                 vk::BufferUsageFlags::STORAGE_BUFFER,
             )?,
+            // TRANSFER_SRC: hosts and tests may copy the frame's vertices out.
             vertices: dynamic(
                 "scene vertices",
                 vertex_bytes,
-                vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
+                vk::BufferUsageFlags::VERTEX_BUFFER
+                    | vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC,
             )?,
             indices: storage(
                 "scene indices",

@@ -464,9 +464,31 @@ impl Device {
         let _ = unsafe { debug.set_debug_utils_object_name(&info) };
     }
 
+    /// Device memory held by shine's allocator right now (buffers, images, the render
+    /// graph's heaps): what a long run must keep flat.
+    pub fn memory_usage(&self) -> MemoryUsage {
+        let report = self.allocator().generate_report();
+        MemoryUsage {
+            allocated_bytes: report.total_allocated_bytes,
+            capacity_bytes: report.total_capacity_bytes,
+            allocations: report.allocations.len(),
+        }
+    }
+
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
         lock(&self.inner.allocator)
     }
+}
+
+/// A snapshot of the device memory shine holds ([`Device::memory_usage`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemoryUsage {
+    /// Bytes in live allocations.
+    pub allocated_bytes: u64,
+    /// Bytes of the memory blocks they are carved from (allocated or free).
+    pub capacity_bytes: u64,
+    /// Number of live allocations.
+    pub allocations: usize,
 }
 
 struct Parts {

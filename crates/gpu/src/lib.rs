@@ -27,7 +27,7 @@ pub use ash;
 pub use ash::vk;
 pub use commands::{Commands, SCOPES_PER_RECORDING, Submission};
 pub use descriptors::{Descriptor, DescriptorArena};
-pub use device::{Device, DeviceDesc, DeviceInfo, RawDevice};
+pub use device::{Device, DeviceDesc, DeviceInfo, MemoryUsage, RawDevice};
 pub use error::{Error, Result};
 pub use features::{FeatureStatus, REQUIREMENTS, Requirements};
 pub use instance::Adapter;

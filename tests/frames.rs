@@ -1,0 +1,217 @@
+//! Frames that move (issue 15): the update path (one upload, then `Renderer::update` per
+//! frame) against cold starts, the `update vertices` pass against its CPU twin, and device
+//! memory over a long run.
+
+mod common;
+
+use glam::{Mat3, Mat4, Vec3};
+use shine::capture::image_io::HdrImage;
+use shine::gpu_scene::geometry::Geometry;
+use shine::gpu_scene::{FrameUpdate, GpuScene, Vertex};
+use shine::graph::{Executor, ExternalState};
+use shine::reference::{PathTracer, ReferenceParams};
+use shine::{Renderer, Settings};
+use shine_scene::Scene;
+
+/// A small frame with `gi` (and nothing else changed from the defaults).
+fn settings(gi: &str) -> Settings {
+    let mut s = Settings {
+        width: 32,
+        height: 32,
+        ..Settings::default()
+    };
+    s.set("gi", gi).expect("gi");
+    s.set("shadow.size", "128").expect("shadow size");
+    s
+}
+
+/// RMS of `a - b` over the mean of `b` (all channels).
+fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
+    let (mut se, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    for (x, y) in a.texels.iter().zip(&b.texels) {
+        for c in 0..3 {
+            se += f64::from(x[c] - y[c]).powi(2);
+            sum += f64::from(y[c]);
+            n += 1;
+        }
+    }
+    (se / n as f64).sqrt() / (sum / n as f64).max(1e-12)
+}
+
+/// Frame k of a sequence (scene uploaded once, then updated) equals a cold render of the scene
+/// at the same time, in every GI mode, within 1e-4 of the mean.
+#[test]
+fn sequence_frames_equal_cold_renders() {
+    let device = common::device();
+    let scene = Scene::builtin("spheres").expect("scene");
+    let times = [0.0, 1.1];
+    let mut live = Renderer::new(&device).expect("renderer");
+    let mut cold = Renderer::new(&device).expect("renderer");
+    for gi in [
+        "none",
+        "hvl",
+        "igi",
+        "proxy",
+        "aaf",
+        "hvl,proxy",
+        "igi,proxy",
+    ] {
+        let settings = settings(gi);
+        live.set_scene(&scene, times[0]).expect("scene");
+        for &t in &times {
+            live.update(&FrameUpdate::at(t)).expect("update");
+            let frame = live.render(&settings).expect("render");
+            cold.set_scene(&scene, t).expect("scene");
+            let expected = cold.render(&settings).expect("render");
+            let e = relative_rmse(&frame.hdr, &expected.hdr);
+            assert!(e <= 1e-4, "gi {gi}, t {t}: relative RMSE {e:e}");
+        }
+    }
+    // The frames differ from each other: the scene does move (the sky lights it only
+    // through a GI technique: no punctual light).
+    live.set_scene(&scene, 0.0).expect("scene");
+    let first = live.render(&settings("proxy")).expect("render");
+    live.update(&FrameUpdate::at(1.1)).expect("update");
+    let later = live.render(&settings("proxy")).expect("render");
+    let moved = relative_rmse(&later.hdr, &first.hdr);
+    assert!(moved > 1e-2, "nothing moved: {moved:e}");
+    common::assert_clean(&device);
+}
+
+/// The path tracer moved to another instant by an update matches one started cold there.
+#[test]
+fn path_tracer_update_matches_cold_start() {
+    let device = common::device();
+    let scene = Scene::builtin("spheres").expect("scene");
+    let params = ReferenceParams {
+        width: 24,
+        height: 24,
+        ..ReferenceParams::default()
+    };
+    let mut moved = PathTracer::new(&device, &scene, 0.0, &params).expect("tracer");
+    moved.accumulate(2).expect("accumulate");
+    moved.update(&FrameUpdate::at(0.9)).expect("update");
+    moved.accumulate(4).expect("accumulate");
+    let mut cold = PathTracer::new(&device, &scene, 0.9, &params).expect("tracer");
+    cold.accumulate(4).expect("accumulate");
+    let (a, b) = (moved.read().expect("read"), cold.read().expect("read"));
+    assert_eq!(a.samples, 4);
+    let e = relative_rmse(&a.full, &b.full);
+    assert!(e <= 1e-4, "relative RMSE {e:e}");
+    common::assert_clean(&device);
+}
+
+/// `update vertices` writes what the CPU computes: every mesh-space vertex moved by its
+/// instance's world matrix (normals by the inverse transpose, renormalised).
+#[test]
+fn update_vertices_matches_the_cpu() {
+    let device = common::device();
+    let scene = Scene::builtin("spheres").expect("scene");
+    let mut gpu = GpuScene::upload(&device, &scene, 0.7).expect("upload");
+    let mut executor = Executor::new(&device, 1).expect("executor");
+    let mut rg = executor.begin_frame();
+    let handles = gpu.declare(&mut rg).expect("declare");
+    let readback = common::buffer(
+        &device,
+        "vertices readback",
+        gpu.vertices.size(),
+        shine::gpu::vk::BufferUsageFlags::TRANSFER_DST
+            | shine::gpu::vk::BufferUsageFlags::TRANSFER_SRC,
+    );
+    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, common::read_by_copy());
+    rg.copy_buffer("read vertices", &handles.vertices, &mut out);
+    let mut commands = device.begin_commands().expect("commands");
+    executor.execute(commands.raw(), rg).expect("execute");
+    device
+        .submit(commands)
+        .expect("submit")
+        .wait()
+        .expect("wait");
+    let bytes = device.read_buffer(&readback).expect("read");
+    let got: &[Vertex] = bytemuck::cast_slice(&bytes);
+    let source = Geometry::flatten(&scene).expect("flatten").source;
+    let matrices = gpu.instance_matrices();
+    let mut moved = 0;
+    for (i, (s, g)) in source.iter().zip(got).enumerate() {
+        let m: Mat4 = matrices[s.instance as usize];
+        let p = m.transform_point3(Vec3::from(s.position));
+        let n = (Mat3::from_mat4(m).inverse().transpose() * Vec3::from(s.normal)).normalize();
+        let tolerance = 1e-5 * (1.0 + p.abs().max_element());
+        assert!(
+            (Vec3::from(g.position) - p).abs().max_element() <= tolerance,
+            "vertex {i}: {:?} vs {p}",
+            g.position
+        );
+        assert!(
+            (Vec3::from(g.normal) - n).abs().max_element() <= 1e-5,
+            "vertex {i}: normal"
+        );
+        assert_eq!((g.material, g.uv), (s.material, s.uv), "vertex {i}");
+        moved += usize::from(Vec3::from(s.position).distance(p) > 1e-3);
+    }
+    assert!(moved > 0, "no vertex moved");
+    common::assert_clean(&device);
+}
+
+/// Device memory stays flat over a long animated run, and the validation layer stays silent.
+#[test]
+fn a_long_run_keeps_device_memory_flat() {
+    let device = common::device();
+    let scene = Scene::builtin("spheres").expect("scene");
+    let settings = {
+        let mut s = settings("hvl,proxy");
+        s.width = 16;
+        s.height = 16;
+        s
+    };
+    let mut renderer = Renderer::new(&device).expect("renderer");
+    renderer.set_scene(&scene, 0.0).expect("scene");
+    let mut at = Vec::new();
+    for k in 0..120u32 {
+        renderer
+            .update(&FrameUpdate::at(k as f32 / 30.0))
+            .expect("update");
+        renderer.render(&settings).expect("render");
+        if k == 9 || k == 119 {
+            at.push(device.memory_usage());
+        }
+    }
+    println!("device memory at frames 10 and 120: {at:?}");
+    assert_eq!(at[0].allocated_bytes, at[1].allocated_bytes, "{at:?}");
+    assert_eq!(at[0].allocations, at[1].allocations, "{at:?}");
+    common::assert_clean(&device);
+}
+
+/// A bad update is refused with a clear message and changes nothing.
+#[test]
+fn bad_updates_are_refused() {
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let mut renderer = Renderer::new(&device).expect("renderer");
+    renderer.set_scene(&scene, 0.0).expect("scene");
+    let before = renderer.render(&settings("none")).expect("render");
+    let bad = [
+        (FrameUpdate::at(f32::NAN), "not finite"),
+        (
+            FrameUpdate {
+                nodes: vec![(9999, shine_scene::Transform::default())],
+                ..FrameUpdate::default()
+            },
+            "node 9999 does not exist",
+        ),
+        (
+            FrameUpdate {
+                lights: vec![(77, scene.lights[0])],
+                ..FrameUpdate::default()
+            },
+            "light 77 does not exist",
+        ),
+    ];
+    for (update, message) in bad {
+        let err = renderer.update(&update).expect_err("refused").to_string();
+        assert!(err.contains(message), "{err}");
+    }
+    let after = renderer.render(&settings("none")).expect("render");
+    assert_eq!(after.hdr, before.hdr);
+    common::assert_clean(&device);
+}
