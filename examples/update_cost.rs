@@ -1,0 +1,72 @@
+//! The CPU side of a frame update, measured: evaluating a [`FrameUpdate`] (animation, world
+//! matrices, lights, bounds) on the built-in scenes, and rebuilding the top-level BVH over
+//! 10 to 10 000 instances (the scenes have tens; the larger counts show where a GPU build
+//! would start to pay). Numbers go to docs/performance.md.
+//!
+//! ```text
+//! cargo run --release --example update_cost
+//! ```
+
+use std::time::Instant;
+
+use glam::{Mat4, Quat, Vec3};
+use shine::gpu_scene::bvh::{TopInstance, TopLevel};
+use shine::gpu_scene::{FrameState, FrameUpdate};
+use shine_scene::{Aabb, Scene};
+
+/// Median over `runs` of `f`'s wall time, in microseconds.
+fn median_us(runs: usize, mut f: impl FnMut()) -> f64 {
+    let mut times: Vec<f64> = (0..runs)
+        .map(|_| {
+            let start = Instant::now();
+            f();
+            start.elapsed().as_secs_f64() * 1e6
+        })
+        .collect();
+    times.sort_by(f64::total_cmp);
+    times[times.len() / 2]
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    println!("FrameState::evaluate (CPU), median of 200:");
+    for name in shine_scene::builtin::names() {
+        let scene = Scene::builtin(name)?;
+        let mut k = 0u32;
+        let us = median_us(200, || {
+            k += 1;
+            std::hint::black_box(FrameState::evaluate(
+                &scene,
+                &FrameUpdate::at(k as f32 / 60.0),
+            ));
+        });
+        println!("  {name:<12} {:>4} nodes  {us:>8.1} µs", scene.nodes.len());
+    }
+    println!("TopLevel::build (CPU, binned SAH over instance boxes), median of 50:");
+    let unit = Aabb {
+        min: Vec3::splat(-0.5),
+        max: Vec3::splat(0.5),
+    };
+    for n in [10usize, 100, 1000, 10_000] {
+        let side = (n as f32).cbrt().ceil() as usize;
+        let instances: Vec<TopInstance> = (0..n)
+            .map(|i| {
+                let p = Vec3::new(
+                    (i % side) as f32,
+                    ((i / side) % side) as f32,
+                    (i / (side * side)) as f32,
+                ) * 2.0;
+                TopInstance {
+                    world: Mat4::from_rotation_translation(Quat::from_rotation_y(i as f32), p),
+                    root: 0,
+                    bounds: unit,
+                    triangle_base: 0,
+                }
+            })
+            .collect();
+        let us = median_us(50, || {
+            std::hint::black_box(TopLevel::build(&instances));
+        });
+        println!("  {n:>6} instances  {us:>9.1} µs");
+    }
+    Ok(())
+}
