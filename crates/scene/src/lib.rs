@@ -18,6 +18,7 @@ pub mod environment;
 mod error;
 pub mod glb_writer;
 mod load;
+mod pose;
 pub mod proxies;
 mod scene;
 mod types;
@@ -26,8 +27,9 @@ pub use error::{Error, Result};
 pub use load::{
     DEFAULT_SUN_DIRECTION, DEFAULT_SUN_LUX, DEFAULT_YFOV, SUPPORTED_EXTENSIONS, load, load_slice,
 };
+pub use pose::{DeformedVertices, Pose, skin_matrix};
 pub use scene::Scene;
 pub use types::{
-    Aabb, Camera, Instance, Light, LightKind, Material, Mesh, NO_TEXTURE, Node, Primitive,
-    Projection, Texture, Transform,
+    Aabb, Camera, Instance, Light, LightKind, Material, Mesh, MorphTarget, NO_SKIN, NO_TEXTURE,
+    Node, Primitive, Projection, Skin, Texture, Transform,
 };

@@ -89,6 +89,7 @@ fn plan<'d>(
         meshes.push(Mesh {
             name: mesh_name,
             primitives: Vec::new(),
+            weights: Vec::new(),
         });
     }
     (meshes, jobs)

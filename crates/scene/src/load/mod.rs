@@ -108,7 +108,7 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
         textures: textures.into_textures(),
         ..Scene::default()
     };
-    scene.animations = animations::load_animations(&mut ctx, &buffers, doc)?;
+    scene.animations = animations::load_animations(&ctx, &buffers, doc)?;
     let world = scene.rest_world_transforms();
     lights::load_lights(&mut ctx, doc, &mut scene, &world)?;
     cameras::load_cameras(&ctx, doc, &mut scene, &world)?;

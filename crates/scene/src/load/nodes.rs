@@ -62,6 +62,8 @@ fn load_node(ctx: &mut Ctx, node: &gltf::Node<'_>) -> Result<Node> {
         mesh: node.mesh().map(|m| m.index()),
         camera: None,
         lights: Vec::new(),
+        skin: None,
+        weights: None,
     })
 }
 

@@ -295,5 +295,8 @@ fn finish(v: VertexData, tangents: Vec<Vec4>, material: u32) -> Primitive {
         indices: v.indices,
         material,
         bounds,
+        joints: Vec::new(),
+        weights: Vec::new(),
+        targets: Vec::new(),
     }
 }
