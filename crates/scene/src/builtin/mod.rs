@@ -16,6 +16,7 @@ mod room;
 pub mod shapes;
 mod spheres;
 mod textures;
+mod tracks;
 
 use std::io::Write;
 use std::path::Path;
