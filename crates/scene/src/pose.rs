@@ -15,7 +15,7 @@
 use glam::{Mat3, Mat4, Vec3, Vec4};
 
 use crate::scene::Scene;
-use crate::types::{Aabb, Instance, Mesh, NO_SKIN};
+use crate::types::{Aabb, Instance, NO_SKIN};
 
 /// The time-dependent state of a scene at one instant.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -39,17 +39,6 @@ pub struct DeformedVertices {
     pub normals: Vec<Vec3>,
     /// World tangents: unit `xyz`, handedness `w` kept from the primitive.
     pub tangents: Vec<Vec4>,
-}
-
-impl Mesh {
-    /// Number of morph targets (the most over its primitives, which glTF requires equal).
-    pub fn target_count(&self) -> usize {
-        self.primitives
-            .iter()
-            .map(|p| p.targets.len())
-            .max()
-            .unwrap_or(0)
-    }
 }
 
 impl Scene {

@@ -217,7 +217,16 @@ pub struct Mesh {
 }
 
 impl Mesh {
-    /// Bounds of all primitives in mesh space.
+    /// Number of morph targets (the most over its primitives, which glTF requires equal).
+    pub fn target_count(&self) -> usize {
+        self.primitives
+            .iter()
+            .map(|p| p.targets.len())
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Bounds of all primitives in mesh space (base shapes, bind pose).
     pub fn bounds(&self) -> Aabb {
         self.primitives
             .iter()
