@@ -351,3 +351,43 @@ fn deformation_morphs_then_skins() {
     let own = s.pose(s.world_transforms_at(1.0), s.weights_at(1.0));
     assert_eq!(own, pose);
 }
+
+#[test]
+fn short_joints_and_normalized_byte_weights_are_read_and_renormalised() {
+    let mut j = common::gltf_json(&common::skinned_bar(|_| {}));
+    // JOINTS_0 as unsigned shorts, WEIGHTS_0 as normalized bytes that do not sum to 255.
+    let mut data = Vec::new();
+    for _ in 0..12 {
+        for v in [0u16, 1, 0, 0] {
+            data.extend(v.to_le_bytes());
+        }
+    }
+    for ring in 0..3 {
+        for _ in 0..4 {
+            data.extend(match ring {
+                0 => [200u8, 0, 0, 0],
+                1 => [100, 100, 0, 0],
+                _ => [0, 51, 0, 0],
+            });
+        }
+    }
+    j["buffers"].as_array_mut().unwrap().push(
+        json!({"byteLength": data.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&data))}),
+    );
+    let views = j["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 1, "byteOffset": 0, "byteLength": 96}));
+    views.push(json!({"buffer": 1, "byteOffset": 96, "byteLength": 48}));
+    let (jv, wv) = (views.len() - 2, views.len() - 1);
+    let accessors = j["accessors"].as_array_mut().unwrap();
+    accessors.push(json!({"bufferView": jv, "componentType": 5123, "count": 12, "type": "VEC4"}));
+    accessors.push(json!({"bufferView": wv, "componentType": 5121, "normalized": true, "count": 12, "type": "VEC4"}));
+    let n = accessors.len();
+    j["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = json!(n - 2);
+    j["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = json!(n - 1);
+    let s = load_slice(j.to_string().as_bytes(), None, "short.gltf").unwrap();
+    let p = &s.meshes[0].primitives[0];
+    assert_eq!(p.joints, vec![[0, 1, 0, 0]; 12]);
+    assert_eq!(p.weights[0], glam::Vec4::new(1.0, 0.0, 0.0, 0.0));
+    assert_eq!(p.weights[4], glam::Vec4::new(0.5, 0.5, 0.0, 0.0));
+    assert_eq!(p.weights[8], glam::Vec4::new(0.0, 1.0, 0.0, 0.0));
+}
