@@ -1,10 +1,11 @@
-//! Node animations (glTF translation / rotation / scale channels) evaluated at any time.
+//! Node animations (glTF translation / rotation / scale / morph weight channels) evaluated at
+//! any time.
 //!
 //! Sampling follows glTF 2.0 §3.11: before the first key the first value holds, after the last
 //! key the last value holds (no looping: wrap `t` yourself with [`Animation::duration`]);
 //! `STEP` holds the previous key, `LINEAR` lerps (rotations slerp along the shortest arc) and
 //! `CUBICSPLINE` evaluates the Hermite spline from the in/out tangents. Rotations are
-//! renormalised. Morph-target weights are not animated (the loader warns about them).
+//! renormalised. Morph weights are sampled component by component like translations.
 
 use glam::{Quat, Vec4};
 
@@ -19,6 +20,8 @@ pub enum Property {
     Rotation,
     /// Scale (xyz).
     Scale,
+    /// Morph target weights of the node's mesh (one per target).
+    Weights,
 }
 
 /// How values between keys are computed.
@@ -43,28 +46,43 @@ pub struct Channel {
     pub interpolation: Interpolation,
     /// Key times in seconds, strictly increasing, at least one.
     pub times: Vec<f32>,
-    /// Key values (xyz in `xyz` for translation and scale, xyzw for rotation). For
-    /// `CubicSpline`, three per key: in-tangent, value, out-tangent.
-    pub values: Vec<Vec4>,
+    /// Components per value: 3 for translation and scale, 4 for rotation (xyzw), the number
+    /// of morph targets for weights.
+    pub width: usize,
+    /// Key values, `width` floats each, flat. For `CubicSpline`, three values per key:
+    /// in-tangent, value, out-tangent.
+    pub values: Vec<f32>,
 }
 
 impl Channel {
-    /// The channel's value at time `t` (seconds).
-    pub fn sample(&self, t: f32) -> Vec4 {
+    /// Value `i` (in units of `width` floats); zeros past the end.
+    fn value(&self, i: usize, out: &mut [f32]) {
+        let start = i * self.width;
+        let src = self
+            .values
+            .get(start..start + self.width)
+            .unwrap_or_default();
+        out.fill(0.0);
+        for (o, s) in out.iter_mut().zip(src) {
+            *o = *s;
+        }
+    }
+
+    /// Writes the channel's value at time `t` (seconds) into `out` (its first `width`
+    /// components; the rest is zeroed).
+    pub fn sample_into(&self, t: f32, out: &mut [f32]) {
         let cubic = self.interpolation == Interpolation::CubicSpline;
-        let value = |k: usize| -> Vec4 {
-            let i = if cubic { 3 * k + 1 } else { k };
-            self.values.get(i).copied().unwrap_or(Vec4::ZERO)
-        };
+        let key = |k: usize| if cubic { 3 * k + 1 } else { k };
         let n = self.times.len();
         let (Some(&first), Some(&last)) = (self.times.first(), self.times.last()) else {
-            return Vec4::ZERO;
+            out.fill(0.0);
+            return;
         };
         if n == 1 || t.is_nan() || t <= first {
-            return value(0);
+            return self.value(key(0), out);
         }
         if t >= last {
-            return value(n - 1);
+            return self.value(key(n - 1), out);
         }
         // times[k] <= t < times[k + 1]
         let k = self
@@ -79,31 +97,60 @@ impl Channel {
         } else {
             0.0
         };
+        let mut a = vec![0.0; out.len()];
+        let mut b = vec![0.0; out.len()];
         match self.interpolation {
-            Interpolation::Step => value(k),
+            Interpolation::Step => self.value(k, out),
             Interpolation::Linear => {
-                let (a, b) = (value(k), value(k + 1));
+                self.value(k, &mut a);
+                self.value(k + 1, &mut b);
                 if self.property == Property::Rotation {
-                    Vec4::from(
-                        Quat::from_vec4(a)
-                            .normalize()
-                            .slerp(Quat::from_vec4(b).normalize(), s),
-                    )
+                    let q = |v: &[f32]| {
+                        Quat::from_xyzw(
+                            v.first().copied().unwrap_or(0.0),
+                            v.get(1).copied().unwrap_or(0.0),
+                            v.get(2).copied().unwrap_or(0.0),
+                            v.get(3).copied().unwrap_or(0.0),
+                        )
+                        .normalize()
+                    };
+                    let r = q(&a).slerp(q(&b), s).to_array();
+                    for (o, x) in out.iter_mut().zip(r) {
+                        *o = x;
+                    }
                 } else {
-                    a.lerp(b, s)
+                    for ((o, x), y) in out.iter_mut().zip(&a).zip(&b) {
+                        *o = x + (y - x) * s;
+                    }
                 }
             }
             Interpolation::CubicSpline => {
-                let get = |i: usize| self.values.get(i).copied().unwrap_or(Vec4::ZERO);
-                let (p0, m0) = (get(3 * k + 1), get(3 * k + 2) * dt);
-                let (p1, m1) = (get(3 * (k + 1) + 1), get(3 * (k + 1)) * dt);
+                // glTF 2.0 Appendix C: p(s) = h00 p0 + h10 dt m0 + h01 p1 + h11 dt m1, with
+                // m0 the out-tangent of key k and m1 the in-tangent of key k + 1.
                 let (s2, s3) = (s * s, s * s * s);
-                p0 * (2.0 * s3 - 3.0 * s2 + 1.0)
-                    + m0 * (s3 - 2.0 * s2 + s)
-                    + p1 * (-2.0 * s3 + 3.0 * s2)
-                    + m1 * (s3 - s2)
+                let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+                let h10 = s3 - 2.0 * s2 + s;
+                let h01 = -2.0 * s3 + 3.0 * s2;
+                let h11 = s3 - s2;
+                let mut m0 = vec![0.0; out.len()];
+                let mut m1 = vec![0.0; out.len()];
+                self.value(3 * k + 1, &mut a);
+                self.value(3 * k + 2, &mut m0);
+                self.value(3 * (k + 1) + 1, &mut b);
+                self.value(3 * (k + 1), &mut m1);
+                for (i, o) in out.iter_mut().enumerate() {
+                    *o = a[i] * h00 + m0[i] * dt * h10 + b[i] * h01 + m1[i] * dt * h11;
+                }
             }
         }
+    }
+
+    /// The channel's value at time `t` (seconds) as a vector: its first four components,
+    /// zeros past `width` (translation and scale in `xyz`, rotation in `xyzw`).
+    pub fn sample(&self, t: f32) -> Vec4 {
+        let mut v = [0.0; 4];
+        self.sample_into(t, &mut v);
+        Vec4::from_array(v)
     }
 }
 
@@ -125,17 +172,19 @@ impl Animation {
             .fold(0.0, f32::max)
     }
 
-    /// Overwrites the animated properties of `locals` with their values at time `t`.
+    /// Overwrites the animated transform properties of `locals` with their values at time
+    /// `t` (weight channels are left to [`Animation::apply_weights`]).
     pub fn apply(&self, t: f32, locals: &mut [Transform]) {
         for c in &self.channels {
             let Some(local) = locals.get_mut(c.node) else {
                 continue;
             };
-            let v = c.sample(t);
             match c.property {
-                Property::Translation => local.translation = v.truncate(),
-                Property::Scale => local.scale = v.truncate(),
+                Property::Weights => {}
+                Property::Translation => local.translation = c.sample(t).truncate(),
+                Property::Scale => local.scale = c.sample(t).truncate(),
                 Property::Rotation => {
+                    let v = c.sample(t);
                     let q = Quat::from_vec4(v);
                     local.rotation = if q.length_squared() > 0.0 {
                         q.normalize()
@@ -143,6 +192,19 @@ impl Animation {
                         Quat::IDENTITY
                     };
                 }
+            }
+        }
+    }
+
+    /// Overwrites the animated morph weights in `weights` (one list per node) with their
+    /// values at time `t`; a channel wider than its node's list writes only what fits.
+    pub fn apply_weights(&self, t: f32, weights: &mut [Vec<f32>]) {
+        for c in &self.channels {
+            if c.property != Property::Weights {
+                continue;
+            }
+            if let Some(w) = weights.get_mut(c.node) {
+                c.sample_into(t, w);
             }
         }
     }
@@ -163,12 +225,17 @@ mod tests {
         times: Vec<f32>,
         values: Vec<Vec4>,
     ) -> Channel {
+        let width = if property == Property::Rotation { 4 } else { 3 };
         Channel {
             node: 0,
             property,
             interpolation,
             times,
-            values,
+            width,
+            values: values
+                .iter()
+                .flat_map(|v| v.to_array().into_iter().take(width))
+                .collect(),
         }
     }
 
@@ -223,5 +290,42 @@ mod tests {
         // s = 0.25: h00 = .84375 h10 = .140625 h01 = .15625 h11 = -.046875
         let expect = 0.140625 * 2.0 + 0.15625 - 0.046875 * 2.0;
         assert!((c.sample(0.5).x - expect).abs() < 1e-6);
+    }
+
+    #[test]
+    fn weights_channels_have_any_width_and_write_per_node_lists() {
+        // Two targets, cubic spline: in, value, out per key, two floats each.
+        let c = Channel {
+            node: 1,
+            property: Property::Weights,
+            interpolation: Interpolation::CubicSpline,
+            times: vec![0.0, 1.0],
+            width: 2,
+            values: vec![0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0],
+        };
+        let a = Animation {
+            name: "w".into(),
+            channels: vec![c.clone()],
+        };
+        let mut weights = vec![vec![], vec![0.5, 0.5]];
+        a.apply_weights(0.5, &mut weights);
+        // Zero tangents: smoothstep from (0, 1) to (1, 0).
+        assert!((weights[1][0] - 0.5).abs() < 1e-6 && (weights[1][1] - 0.5).abs() < 1e-6);
+        a.apply_weights(0.25, &mut weights);
+        assert!((weights[1][0] - 0.15625).abs() < 1e-6, "{weights:?}");
+        assert!((weights[1][0] + weights[1][1] - 1.0).abs() < 1e-6);
+        assert!(weights[0].is_empty());
+        // Transforms are untouched by weight channels.
+        let mut locals = vec![Transform::default(); 2];
+        a.apply(0.5, &mut locals);
+        assert_eq!(locals[1], Transform::default());
+        let linear = Channel {
+            interpolation: Interpolation::Linear,
+            values: vec![0.0, 1.0, 1.0, 0.0],
+            ..c
+        };
+        let mut out = [9.0; 3];
+        linear.sample_into(0.75, &mut out);
+        assert_eq!(out, [0.75, 0.25, 0.0]);
     }
 }

@@ -3,17 +3,42 @@
 //!
 //! Output is deterministic: serde_json orders object keys, and every array is appended in
 //! call order.
+//!
+//! Besides static meshes it writes what animated scenes need: skins with inverse bind
+//! matrices ([`GlbWriter::skin`]), skinned and morphing primitives
+//! ([`GlbWriter::deforming_mesh`]: `JOINTS_0`, `WEIGHTS_0`, morph targets, default mesh
+//! weights) and animation keys of any kind ([`GlbWriter::keys`], `SCALAR` for weights).
 
-use glam::{Vec2, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 use serde_json::{Map, Value, json};
 
 use crate::builtin::shapes::MeshData;
+use crate::error::{Error, Result};
+use crate::types::MorphTarget;
 
 const ARRAY_BUFFER: u32 = 34962;
 const ELEMENT_ARRAY_BUFFER: u32 = 34963;
 const FLOAT: u32 = 5126;
 const UNSIGNED_INT: u32 = 5125;
 const UNSIGNED_SHORT: u32 = 5123;
+const UNSIGNED_BYTE: u32 = 5121;
+
+/// One primitive for [`GlbWriter::deforming_mesh`]: geometry and material, plus skinning
+/// and morph data (each empty when unused).
+#[derive(Clone, Copy, Debug)]
+pub struct DeformingPrimitive<'a> {
+    /// Positions, normals, UVs and indices (the base shape, in bind pose).
+    pub geometry: &'a MeshData,
+    /// Material index.
+    pub material: usize,
+    /// `JOINTS_0`, one per vertex (written as unsigned bytes when every index fits, else
+    /// unsigned shorts); empty when not skinned.
+    pub joints: &'a [[u32; 4]],
+    /// `WEIGHTS_0`, one per vertex, summing to 1 (floats); empty when not skinned.
+    pub weights: &'a [Vec4],
+    /// Morph targets (POSITION deltas with bounds, NORMAL deltas when present).
+    pub targets: &'a [MorphTarget],
+}
 
 /// Builds a glTF document and serialises it as GLB.
 #[derive(Debug, Default)]
@@ -142,10 +167,15 @@ impl GlbWriter {
         )
     }
 
-    /// Animation sampler data: `times` (SCALAR with min/max) and values of `kind` ("VEC3" or
-    /// "VEC4"). Returns `(input, output)` accessor indices.
+    /// Animation sampler data: `times` (SCALAR with min/max) and values of `kind` ("VEC3",
+    /// "VEC4", or "SCALAR" for morph weights: one float per target per value). Returns
+    /// `(input, output)` accessor indices.
     pub fn keys(&mut self, times: &[f32], values: &[f32], kind: &str) -> (usize, usize) {
-        let dims = if kind == "VEC4" { 4 } else { 3 };
+        let dims = match kind {
+            "VEC4" => 4,
+            "SCALAR" => 1,
+            _ => 3,
+        };
         let input = self.float_accessor(times, "SCALAR", 1, None, true);
         let output = self.float_accessor(values, kind, dims, None, false);
         (input, output)
@@ -168,6 +198,105 @@ impl GlbWriter {
         self.push("accessors", json!({"bufferView": view, "componentType": component, "count": indices.len(), "type": "SCALAR"}))
     }
 
+    /// A skin: `joints` (node indices) with one inverse bind matrix each, and the skeleton
+    /// root node when given. Returns the skin index for a node's `skin`.
+    pub fn skin(
+        &mut self,
+        name: &str,
+        joints: &[usize],
+        inverse_bind: &[Mat4],
+        skeleton: Option<usize>,
+    ) -> usize {
+        let floats: Vec<f32> = inverse_bind
+            .iter()
+            .flat_map(|m| m.to_cols_array())
+            .collect();
+        let ibm = self.float_accessor(&floats, "MAT4", 16, None, false);
+        let mut skin = json!({"name": name, "joints": joints, "inverseBindMatrices": ibm});
+        if let (Some(root), Some(obj)) = (skeleton, skin.as_object_mut()) {
+            obj.insert("skeleton".to_string(), json!(root));
+        }
+        self.push("skins", skin)
+    }
+
+    /// `JOINTS_0` as unsigned bytes when every index is below 256, else unsigned shorts;
+    /// `None` when an index does not fit a short.
+    fn joints(&mut self, joints: &[[u32; 4]]) -> Option<usize> {
+        let max = joints.iter().flatten().copied().max().unwrap_or(0);
+        let (view, component) = if max < 256 {
+            let bytes: Vec<u8> = joints.iter().flatten().map(|&j| j as u8).collect();
+            (self.buffer_view(&bytes, Some(ARRAY_BUFFER)), UNSIGNED_BYTE)
+        } else if max < 65536 {
+            let shorts: Vec<u16> = joints.iter().flatten().map(|&j| j as u16).collect();
+            (
+                self.buffer_view(bytemuck::cast_slice(&shorts), Some(ARRAY_BUFFER)),
+                UNSIGNED_SHORT,
+            )
+        } else {
+            return None;
+        };
+        Some(self.push(
+            "accessors",
+            json!({"bufferView": view, "componentType": component, "count": joints.len(), "type": "VEC4"}),
+        ))
+    }
+
+    /// A mesh whose primitives may be skinned and morphing, with default morph `weights`
+    /// (written when not empty). Fails on a joint index that does not fit an unsigned short.
+    pub fn deforming_mesh(
+        &mut self,
+        name: &str,
+        parts: &[DeformingPrimitive<'_>],
+        weights: &[f32],
+    ) -> Result<usize> {
+        let mut primitives = Vec::new();
+        for (k, part) in parts.iter().enumerate() {
+            let mut prim = self.primitive(part.geometry, part.material, None);
+            if !part.joints.is_empty() {
+                let joints = self.joints(part.joints).ok_or_else(|| Error::Invalid {
+                    file: "glTF writer".to_string(),
+                    element: format!("mesh {name:?} primitives[{k}] JOINTS_0"),
+                    message: "a joint index does not fit an unsigned short".to_string(),
+                })?;
+                let w = self.vec4(part.weights);
+                prim["attributes"]["JOINTS_0"] = json!(joints);
+                prim["attributes"]["WEIGHTS_0"] = json!(w);
+            }
+            let mut targets = Vec::new();
+            for t in part.targets {
+                let mut target = Map::new();
+                target.insert("POSITION".to_string(), json!(self.vec3(&t.positions, true)));
+                if !t.normals.is_empty() {
+                    target.insert("NORMAL".to_string(), json!(self.vec3(&t.normals, false)));
+                }
+                targets.push(Value::Object(target));
+            }
+            if !targets.is_empty() {
+                prim["targets"] = Value::Array(targets);
+            }
+            primitives.push(prim);
+        }
+        let mut mesh = json!({"name": name, "primitives": primitives});
+        if !weights.is_empty() {
+            mesh["weights"] = json!(weights);
+        }
+        Ok(self.push("meshes", mesh))
+    }
+
+    /// One primitive's JSON: POSITION, NORMAL, TEXCOORD_0, TANGENT when given, indices,
+    /// material, triangle mode.
+    fn primitive(&mut self, m: &MeshData, material: usize, tangents: Option<&[Vec4]>) -> Value {
+        let mut attributes = Map::new();
+        attributes.insert("POSITION".to_string(), json!(self.vec3(&m.positions, true)));
+        attributes.insert("NORMAL".to_string(), json!(self.vec3(&m.normals, false)));
+        attributes.insert("TEXCOORD_0".to_string(), json!(self.vec2(&m.uvs)));
+        if let Some(t) = tangents {
+            attributes.insert("TANGENT".to_string(), json!(self.vec4(t)));
+        }
+        let indices = self.indices(&m.indices);
+        json!({"attributes": attributes, "indices": indices, "material": material, "mode": 4})
+    }
+
     /// A mesh with one primitive per `(geometry, material)`; writes POSITION, NORMAL,
     /// TEXCOORD_0 and indices. Tangents are left to the loader's MikkTSpace.
     pub fn mesh(&mut self, name: &str, parts: &[(&MeshData, usize)]) -> usize {
@@ -181,7 +310,6 @@ impl GlbWriter {
     pub fn mesh_parts(&mut self, name: &str, parts: &[(&MeshData, usize, bool)]) -> usize {
         let mut primitives = Vec::new();
         for &(m, material, with_tangents) in parts {
-            let mut attributes = Map::new();
             let (m, tangents) = if with_tangents {
                 let t = m.clone().into_mesh(name, 0);
                 let p = t.primitives.into_iter().next().unwrap_or_default();
@@ -197,14 +325,8 @@ impl GlbWriter {
             } else {
                 (m.clone(), None)
             };
-            attributes.insert("POSITION".to_string(), json!(self.vec3(&m.positions, true)));
-            attributes.insert("NORMAL".to_string(), json!(self.vec3(&m.normals, false)));
-            attributes.insert("TEXCOORD_0".to_string(), json!(self.vec2(&m.uvs)));
-            if let Some(t) = tangents {
-                attributes.insert("TANGENT".to_string(), json!(self.vec4(&t)));
-            }
-            let indices = self.indices(&m.indices);
-            primitives.push(json!({"attributes": attributes, "indices": indices, "material": material, "mode": 4}));
+            let prim = self.primitive(&m, material, tangents.as_deref());
+            primitives.push(prim);
         }
         self.push("meshes", json!({"name": name, "primitives": primitives}))
     }

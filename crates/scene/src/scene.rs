@@ -8,7 +8,8 @@ use crate::animation::Animation;
 use crate::environment::Environment;
 use crate::proxies::{NodeProxies, ProxySphere};
 use crate::types::{
-    Aabb, Camera, Instance, Light, Material, Mesh, Node, Primitive, Texture, Transform,
+    Aabb, Camera, Instance, Light, Material, Mesh, NO_SKIN, Node, Primitive, Skin, Texture,
+    Transform,
 };
 
 /// A loaded scene.
@@ -23,6 +24,8 @@ pub struct Scene {
     pub roots: Vec<usize>,
     /// Meshes.
     pub meshes: Vec<Mesh>,
+    /// Skins, referred to by [`Node::skin`] and [`Instance::skin`].
+    pub skins: Vec<Skin>,
     /// Materials; the last one is the glTF default material when a primitive has none.
     pub materials: Vec<Material>,
     /// Material names, parallel to `materials`.
@@ -96,6 +99,9 @@ impl Scene {
 
     /// Instances (one per node with a mesh in the displayed scene) for the given world
     /// matrices, in depth-first order of the scene (roots and children in file order).
+    ///
+    /// A node with a skin gives a skinned instance: `skin` set and `world` the identity, as
+    /// the joints alone place its vertices (glTF 2.0 §3.7.3).
     pub fn instances(&self, world: &[Mat4]) -> Vec<Instance> {
         let mut out = Vec::new();
         let mut visited = vec![false; self.nodes.len()];
@@ -109,11 +115,13 @@ impl Scene {
                 continue;
             };
             if let (Some(mesh), Some(w)) = (node.mesh, world.get(n)) {
+                let skin = node.skin.filter(|&s| s < self.skins.len());
                 out.push(Instance {
-                    world: w.to_cols_array_2d(),
+                    world: if skin.is_some() { Mat4::IDENTITY } else { *w }.to_cols_array_2d(),
                     mesh: mesh as u32,
                     node: n as u32,
-                    _pad: [0; 2],
+                    skin: skin.map_or(NO_SKIN, |s| s as u32),
+                    _pad: 0,
                 });
             }
             stack.extend(node.children.iter().rev().copied());
@@ -121,15 +129,10 @@ impl Scene {
         out
     }
 
-    /// World-space bounds of all instances for the given world matrices.
+    /// World-space bounds of all instances for the given world matrices, morph targets at
+    /// their rest weights ([`Scene::pose_bounds`] for any pose).
     pub fn bounds(&self, world: &[Mat4]) -> Aabb {
-        self.instances(world).iter().fold(Aabb::EMPTY, |b, inst| {
-            let m = Mat4::from_cols_array_2d(&inst.world);
-            match self.meshes.get(inst.mesh as usize) {
-                Some(mesh) => b.union(&mesh.bounds().transformed(&m)),
-                None => b,
-            }
-        })
+        self.pose_bounds(&self.pose(world.to_vec(), self.rest_weights()))
     }
 
     /// Total number of triangles over all instances.

@@ -115,7 +115,7 @@ impl Transform {
 }
 
 /// A node of the scene hierarchy.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Node {
     /// The glTF name, or `node<i>`.
     pub name: String,
@@ -131,6 +131,35 @@ pub struct Node {
     pub camera: Option<usize>,
     /// Indices into [`Scene::lights`](crate::Scene::lights) of the lights on this node.
     pub lights: Vec<usize>,
+    /// Index into [`Scene::skins`](crate::Scene::skins) of the skin deforming this node's
+    /// mesh. A skinned mesh is placed by its joints alone: the node's own transform is
+    /// ignored (glTF 2.0 §3.7.3).
+    pub skin: Option<usize>,
+    /// Morph weights overriding [`Mesh::weights`] for this node (glTF 2.0 §3.7.2.2), as
+    /// many as the mesh has morph targets.
+    pub weights: Option<Vec<f32>>,
+}
+
+/// A skin (glTF 2.0 §3.7.3): the joints a skinned mesh follows.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Skin {
+    /// The glTF name, or `skin<i>`.
+    pub name: String,
+    /// Node indices of the joints; `JOINTS_0` values index this list.
+    pub joints: Vec<usize>,
+    /// One inverse bind matrix per joint (mesh space to the joint's space at bind time);
+    /// the identity when the file gives none.
+    pub inverse_bind: Vec<Mat4>,
+}
+
+/// One morph target of a primitive (glTF 2.0 §3.7.2.2): displacements added to the base
+/// attributes, scaled by the target's weight.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct MorphTarget {
+    /// Position deltas, one per vertex.
+    pub positions: Vec<Vec3>,
+    /// Normal deltas, one per vertex; empty when the file has none.
+    pub normals: Vec<Vec3>,
 }
 
 /// One drawable piece of a mesh: one glTF primitive with one material, as indexed triangles.
@@ -152,8 +181,16 @@ pub struct Primitive {
     pub indices: Vec<u32>,
     /// Index into [`Scene::materials`](crate::Scene::materials).
     pub material: u32,
-    /// Bounds of the positions.
+    /// Bounds of the positions (the base shape, in bind pose).
     pub bounds: Aabb,
+    /// `JOINTS_0`: per vertex, four indices into the joint list of the node's skin; empty
+    /// when the primitive is not skinned.
+    pub joints: Vec<[u32; 4]>,
+    /// `WEIGHTS_0`: per vertex, the weights of the four joints, non-negative and summing to
+    /// 1; empty when the primitive is not skinned.
+    pub weights: Vec<Vec4>,
+    /// Morph targets; every primitive of a mesh has the same number.
+    pub targets: Vec<MorphTarget>,
 }
 
 impl Primitive {
@@ -161,19 +198,35 @@ impl Primitive {
     pub fn triangle_count(&self) -> usize {
         self.indices.len() / 3
     }
+
+    /// Whether the primitive carries joints and weights.
+    pub fn is_skinned(&self) -> bool {
+        !self.joints.is_empty()
+    }
 }
 
 /// A mesh: a list of primitives sharing a node transform.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Mesh {
     /// The glTF name, or `mesh<i>`.
     pub name: String,
     /// The primitives (one per material).
     pub primitives: Vec<Primitive>,
+    /// Default morph weights, one per morph target (zeros when the file gives none).
+    pub weights: Vec<f32>,
 }
 
 impl Mesh {
-    /// Bounds of all primitives in mesh space.
+    /// Number of morph targets (the most over its primitives, which glTF requires equal).
+    pub fn target_count(&self) -> usize {
+        self.primitives
+            .iter()
+            .map(|p| p.targets.len())
+            .max()
+            .unwrap_or(0)
+    }
+
+    /// Bounds of all primitives in mesh space (base shapes, bind pose).
     pub fn bounds(&self) -> Aabb {
         self.primitives
             .iter()
@@ -348,6 +401,9 @@ pub struct Camera {
 }
 
 /// One mesh placed in the world: what a draw call or a BVH instance needs (80 bytes).
+///
+/// Deformation (skins, morph targets) is not in here: see [`crate::Pose`] and
+/// [`crate::Scene::instance_vertices`].
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, Pod, Zeroable)]
 pub struct Instance {
@@ -357,6 +413,13 @@ pub struct Instance {
     pub mesh: u32,
     /// Index into [`Scene::nodes`](crate::Scene::nodes).
     pub node: u32,
+    /// Index into [`Scene::skins`](crate::Scene::skins), or [`NO_SKIN`]. A skinned
+    /// instance's `world` is the identity: its vertices are placed by the joint matrices
+    /// alone (glTF 2.0 §3.7.3).
+    pub skin: u32,
     /// Padding to a multiple of 16 bytes.
-    pub _pad: [u32; 2],
+    pub _pad: u32,
 }
+
+/// No skin, in [`Instance::skin`].
+pub const NO_SKIN: u32 = u32::MAX;

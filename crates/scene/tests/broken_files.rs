@@ -236,7 +236,111 @@ fn cases() -> Vec<(&'static str, Vec<u8>, Expect)> {
     let mut j = tri();
     j["nodes"][0]["extensions"] = json!({"KHR_lights_punctual": {"light": 3}});
     out.push(("missing-light.gltf", text(&j), Expect::Error(&["light"])));
+    skin_cases(&mut out);
     out
+}
+
+/// Broken skins, skinning attributes and morph weights, edited from the skinned bar.
+fn skin_cases(out: &mut Vec<(&'static str, Vec<u8>, Expect)>) {
+    let bar = || common::gltf_json(&common::skinned_bar(|_| {}));
+    let attrs = "/meshes/0/primitives/0/attributes";
+    let mut j = bar();
+    j["skins"][0]["joints"] = json!([]);
+    j["skins"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("inverseBindMatrices");
+    j["skins"][0].as_object_mut().unwrap().remove("skeleton");
+    out.push((
+        "skin-without-joints.gltf",
+        text(&j),
+        Expect::Error(&["skins[0]", "no joints"]),
+    ));
+    let mut j = bar();
+    j["skins"][0]["joints"] = json!([1, 99]);
+    out.push((
+        "skin-dangling-joint.gltf",
+        text(&j),
+        Expect::Error(&["skins[0].joints"]),
+    ));
+    let mut j = bar();
+    j["skins"][0]["joints"] = json!([1, 0, 2]);
+    out.push((
+        "inverse-bind-count.gltf",
+        text(&j),
+        Expect::Error(&["skins[0]", "inverseBindMatrices", "2 matrices for 3 joints"]),
+    ));
+    let mut j = bar();
+    j["skins"][0]["joints"] = json!([1]);
+    j["skins"][0]
+        .as_object_mut()
+        .unwrap()
+        .remove("inverseBindMatrices");
+    out.push((
+        "joint-out-of-range.gltf",
+        text(&j),
+        Expect::Error(&[
+            "meshes[0]",
+            "JOINTS_0",
+            "joint index 1",
+            "1 joints",
+            "nodes[2]",
+        ]),
+    ));
+    const NO_WEIGHTS: &[&str] = &["meshes[0]", "primitives[0]", "no WEIGHTS_0"];
+    const NO_JOINTS: &[&str] = &["meshes[0]", "primitives[0]", "no JOINTS_0"];
+    for (name, semantic, missing) in [
+        ("joints-without-weights.gltf", "WEIGHTS_0", NO_WEIGHTS),
+        ("weights-without-joints.gltf", "JOINTS_0", NO_JOINTS),
+    ] {
+        let mut j = bar();
+        j.pointer_mut(attrs)
+            .unwrap()
+            .as_object_mut()
+            .unwrap()
+            .remove(semantic);
+        out.push((name, text(&j), Expect::Error(missing)));
+    }
+    let mut j = bar();
+    let joints = j.pointer(attrs).unwrap()["JOINTS_0"].as_u64().unwrap() as usize;
+    j["accessors"][joints]["componentType"] = json!(5126);
+    out.push((
+        "float-joints.gltf",
+        text(&j),
+        Expect::Error(&["JOINTS_0", "unsigned byte or short"]),
+    ));
+    const NEGATIVE: &[&str] = &["WEIGHTS_0", "element 5", "negative weight"];
+    const NAN: &[&str] = &["WEIGHTS_0", "element 5", "NaN or infinite"];
+    const ZERO: &[&str] = &["WEIGHTS_0", "element 5", "all four zero"];
+    for (name, value, fragments) in [
+        ("negative-weight.gltf", -0.5, NEGATIVE),
+        ("nan-weight.gltf", f32::NAN, NAN),
+        ("zero-weights.gltf", 0.0, ZERO),
+    ] {
+        let w = common::skinned_bar(|w| w[5] = glam::Vec4::new(value, 0.0, 0.0, 0.0));
+        out.push((name, text(&common::gltf_json(&w)), Expect::Error(fragments)));
+    }
+    let mut j = bar();
+    j["nodes"][2]["weights"] = json!([1.0]);
+    out.push((
+        "node-weight-count.gltf",
+        text(&j),
+        Expect::Error(&["nodes[2]", "1 weights for 2 morph targets"]),
+    ));
+    let mut j = bar();
+    j["animations"][0]["channels"][1]["target"]["node"] = json!(0);
+    out.push((
+        "weights-without-targets.gltf",
+        text(&j),
+        Expect::Error(&["channels[1]", "no morph targets"]),
+    ));
+    let mut j = bar();
+    j["nodes"][2].as_object_mut().unwrap().remove("skin");
+    out.push((
+        "joints-without-skin.gltf",
+        text(&j),
+        Expect::Warning(&["nodes[2]", "no skin", "drawn rigid"]),
+    ));
 }
 
 fn check(name: &str, result: Result<shine_scene::Scene, shine_scene::Error>, expect: &Expect) {
@@ -334,6 +438,7 @@ fn corrupted_builtins_never_panic() {
     ];
     inputs.push(common::triangle().to_gltf(None).0.into_bytes());
     inputs.push(common::animated_boxes(None).to_gltf(None).0.into_bytes());
+    inputs.push(common::skinned_bar(|_| {}).to_gltf(None).0.into_bytes());
     if std::env::var_os("SHINE_CORRUPTIONS").is_some() {
         // Slow in debug builds (every surviving copy is fully processed): soak runs only.
         inputs.push(shine_scene::builtin::build("spheres").unwrap());

@@ -183,3 +183,100 @@ fn export_is_atomic_and_reports_bad_paths() {
     assert!(!dir.join("missing-dir").exists());
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn animated_walks_morphs_and_sweeps_for_300_frames() {
+    let s = Scene::builtin("animated").unwrap();
+    assert!(s.environment.is_some());
+    assert!(s.triangle_count() <= 6000, "{}", s.triangle_count());
+    assert_eq!(s.skins.len(), 1);
+    assert_eq!(s.skins[0].joints.len(), 11);
+    let duration = s.animations[0].duration();
+    assert!(duration >= 300.0 / 24.0, "{duration}");
+    let rest = s.rest_pose();
+    let instances = s.instances(&rest.world);
+    let walker = *instances.iter().find(|i| i.skin == 0).unwrap();
+    let curtain = *instances
+        .iter()
+        .find(|i| s.nodes[i.node as usize].name == "curtain")
+        .unwrap();
+    assert!(s.is_deforming(&walker) && s.is_deforming(&curtain));
+    assert_eq!(
+        s.proxies
+            .iter()
+            .filter(|p| p.source == ProxySource::Explicit)
+            .count(),
+        11
+    );
+    let hips = s.skins[0].joints[0];
+    let mut last: Option<shine_scene::Pose> = None;
+    for frame in 0..300 {
+        let t = frame as f32 / 24.0;
+        let pose = s.pose_at(t);
+        let body = s.instance_vertices(&pose, &walker, 0).unwrap();
+        let (lo, hi) = body.positions.iter().fold(
+            (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        // On the floor, about 1.7 m tall, inside the 5 m × 4 m room.
+        assert!(lo.y > -0.06 && lo.y < 0.12, "t = {t}: feet at {}", lo.y);
+        assert!(hi.y > 1.6 && hi.y < 1.8, "t = {t}: head at {}", hi.y);
+        assert!(
+            lo.x > -2.4 && hi.x < 2.2 && lo.z > -1.9 && hi.z < 1.9,
+            "t = {t}: {lo} {hi}"
+        );
+        if let Some(prev) = &last {
+            assert_ne!(
+                prev.world[hips], pose.world[hips],
+                "frame {frame} does not move"
+            );
+        }
+        last = Some(pose);
+    }
+    // The curtain billows, the spot sweeps, proxies follow the bones.
+    let (a, b) = (s.pose_at(0.0), s.pose_at(3.0));
+    let c = s.nodes.iter().position(|n| n.name == "curtain").unwrap();
+    assert_eq!(a.weights[c], vec![0.0, 0.0]);
+    assert!(
+        b.weights[c][0] > 0.1 && b.weights[c][1] > 0.1,
+        "{:?}",
+        b.weights[c]
+    );
+    let moved = |p: &[glam::Vec3], q: &[glam::Vec3]| {
+        p.iter().zip(q).any(|(x, y)| (*x - *y).length() > 0.05)
+    };
+    let (ca, cb) = (
+        s.instance_vertices(&a, &curtain, 0).unwrap(),
+        s.instance_vertices(&b, &curtain, 0).unwrap(),
+    );
+    assert!(moved(&ca.positions, &cb.positions));
+    let spot = |p: &shine_scene::Pose| {
+        s.lights_at(&p.world)
+            .into_iter()
+            .find(|l| l.light_kind() == Some(LightKind::Spot))
+            .unwrap()
+            .direction
+    };
+    assert!((glam::Vec3::from(spot(&a)) - glam::Vec3::from(spot(&s.pose_at(4.0)))).length() > 0.3);
+    let pa: Vec<_> = s
+        .proxies_at(&a.world)
+        .iter()
+        .map(|p| glam::Vec3::from(p.center))
+        .collect();
+    let pb: Vec<_> = s
+        .proxies_at(&b.world)
+        .iter()
+        .map(|p| glam::Vec3::from(p.center))
+        .collect();
+    assert!(moved(&pa, &pb));
+    assert!(
+        s.materials
+            .iter()
+            .any(|m| m.metallic == 1.0 && (m.roughness - 0.3).abs() < 1e-6)
+    );
+    assert!(
+        s.materials
+            .iter()
+            .any(|m| m.metallic == 0.0 && m.roughness < 0.2)
+    );
+}

@@ -241,3 +241,153 @@ fn sparse_accessors_substitute_their_values() {
     assert_eq!(p[2], Vec3::new(5.0, 6.0, 7.0));
     assert_eq!(p[1], Vec3::X);
 }
+
+#[test]
+fn skins_morph_targets_and_weight_channels_round_trip() {
+    use shine_scene::animation::{Interpolation, Property};
+    let s = load_slice(&common::skinned_bar(|_| {}).to_glb(), None, "bar.glb").unwrap();
+    assert!(
+        s.warnings
+            .iter()
+            .all(|w| w.contains("no camera") || w.contains("no light")),
+        "{:?}",
+        s.warnings
+    );
+    let (bone1, bone0, bar) = (0, 1, 2);
+    assert_eq!(s.skins.len(), 1);
+    assert_eq!(s.skins[0].name, "bar skin");
+    assert_eq!(s.skins[0].joints, vec![bone0, bone1]);
+    assert_eq!(
+        s.skins[0].inverse_bind,
+        vec![
+            glam::Mat4::IDENTITY,
+            glam::Mat4::from_translation(Vec3::new(0.0, -1.0, 0.0))
+        ]
+    );
+    assert_eq!(s.nodes[bar].skin, Some(0));
+    assert_eq!(s.nodes[bar].weights, Some(vec![0.25, 0.0]));
+    let mesh = &s.meshes[0];
+    assert_eq!(mesh.weights, vec![0.0, 0.0]);
+    let p = &mesh.primitives[0];
+    assert_eq!(p.joints, vec![[0, 1, 0, 0]; 12]);
+    assert_eq!(p.weights[4], glam::Vec4::new(0.5, 0.5, 0.0, 0.0));
+    assert_eq!(p.targets.len(), 2);
+    assert_eq!(p.targets[0].positions[8], Vec3::new(0.5, 0.0, 0.0));
+    assert_eq!(p.targets[0].normals, vec![Vec3::ZERO; 12]);
+    assert!(p.targets[1].normals.is_empty());
+    let c = &s.animations[0].channels[1];
+    assert_eq!(
+        (c.node, c.property, c.interpolation, c.width),
+        (bar, Property::Weights, Interpolation::CubicSpline, 2)
+    );
+    assert_eq!(c.values.len(), 12);
+    assert_eq!(&c.values[9..10], &[0.5]);
+    // The skinned instance ignores its node transform and is deforming; triangles count.
+    let inst = s.instances(&s.rest_world_transforms())[0];
+    assert_eq!(inst.skin, 0);
+    assert_eq!(inst.world, glam::Mat4::IDENTITY.to_cols_array_2d());
+    assert!(s.is_deforming(&inst));
+    assert_eq!(s.triangle_count(), 16);
+
+    // The .gltf form (data URI) loads the same data.
+    let (text, _) = common::skinned_bar(|_| {}).to_gltf(None);
+    let again = load_slice(text.as_bytes(), None, "bar.gltf").unwrap();
+    assert_eq!(s.meshes, again.meshes);
+    assert_eq!(s.skins, again.skins);
+    assert_eq!(s.animations, again.animations);
+}
+
+#[test]
+fn deformation_morphs_then_skins() {
+    // Moving the skinned node must not move the mesh (glTF 2.0 §3.7.3).
+    let mut j = common::gltf_json(&common::skinned_bar(|_| {}));
+    j["nodes"][2]["translation"] = json!([10.0, 0.0, 0.0]);
+    let s = load_slice(j.to_string().as_bytes(), None, "bar.gltf").unwrap();
+    let base = s.meshes[0].primitives[0].positions.clone();
+    let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-5;
+
+    // Rest: no bend, node weights [0.25, 0]: the top ring moves 0.125 m along +X.
+    let rest = s.rest_pose();
+    let inst = s.instances(&rest.world)[0];
+    let v = s.instance_vertices(&rest, &inst, 0).unwrap();
+    assert_eq!(v.positions.len(), 12);
+    assert!(
+        close(v.positions[8], Vec3::new(-0.5 + 0.125, 2.0, 0.5)),
+        "{:?}",
+        v.positions[8]
+    );
+    assert!(close(v.positions[0], Vec3::new(-0.5, 0.0, 0.5)));
+
+    // t = 1: bone1 bent 90° about +Z at y = 1, weights (1, 0.5).
+    let pose = s.pose_at(1.0);
+    assert_eq!(pose.weights[2], vec![1.0, 0.5]);
+    let v = s.instance_vertices(&pose, &inst, 0).unwrap();
+    for (i, p) in v.positions.iter().enumerate() {
+        let (x, z) = (base[i].x, base[i].z);
+        let expect = match i / 4 {
+            0 => Vec3::new(x, 0.0, z),
+            // Half bone0 (unmoved), half bone1 ((x, 1, z) → (0, 1 + x, z)).
+            1 => Vec3::new(x * 0.5, 1.0 + x * 0.5, z),
+            // Morphed (x + 0.5, 2, z + 0.25), then rotated about (0, 1, 0).
+            _ => Vec3::new(-1.0, 1.5 + x, z + 0.25),
+        };
+        assert!(close(*p, expect), "vertex {i}: {p} != {expect}");
+    }
+    for (n, t) in v.normals.iter().zip(&v.tangents) {
+        assert!((n.length() - 1.0).abs() < 1e-5 && (t.truncate().length() - 1.0).abs() < 1e-5);
+    }
+    // Top ring normals turn with the bone: (x, 0, z) → (0, x, z) normalised.
+    assert!(
+        close(v.normals[8], Vec3::new(0.0, -0.5, 0.5).normalize()),
+        "{}",
+        v.normals[8]
+    );
+    let b = s.pose_bounds(&pose);
+    assert!(close(b.min, Vec3::new(-1.0, 0.0, -0.5)), "{b:?}");
+    assert!(close(b.max, Vec3::new(0.5, 2.0, 0.75)), "{b:?}");
+    // bounds() at rest uses the deformed vertices too, not the node at x = 10.
+    assert!(s.bounds(&rest.world).max.x < 1.0);
+    // A host posing nodes itself gets the same result from the same inputs.
+    let own = s.pose(s.world_transforms_at(1.0), s.weights_at(1.0));
+    assert_eq!(own, pose);
+}
+
+#[test]
+fn short_joints_and_normalized_byte_weights_are_read_and_renormalised() {
+    let mut j = common::gltf_json(&common::skinned_bar(|_| {}));
+    // JOINTS_0 as unsigned shorts, WEIGHTS_0 as normalized bytes that do not sum to 255.
+    let mut data = Vec::new();
+    for _ in 0..12 {
+        for v in [0u16, 1, 0, 0] {
+            data.extend(v.to_le_bytes());
+        }
+    }
+    for ring in 0..3 {
+        for _ in 0..4 {
+            data.extend(match ring {
+                0 => [200u8, 0, 0, 0],
+                1 => [100, 100, 0, 0],
+                _ => [0, 51, 0, 0],
+            });
+        }
+    }
+    j["buffers"].as_array_mut().unwrap().push(
+        json!({"byteLength": data.len(), "uri": format!("data:application/octet-stream;base64,{}", base64(&data))}),
+    );
+    let views = j["bufferViews"].as_array_mut().unwrap();
+    views.push(json!({"buffer": 1, "byteOffset": 0, "byteLength": 96}));
+    views.push(json!({"buffer": 1, "byteOffset": 96, "byteLength": 48}));
+    let (jv, wv) = (views.len() - 2, views.len() - 1);
+    let accessors = j["accessors"].as_array_mut().unwrap();
+    accessors.push(json!({"bufferView": jv, "componentType": 5123, "count": 12, "type": "VEC4"}));
+    accessors.push(json!({"bufferView": wv, "componentType": 5121, "normalized": true, "count": 12, "type": "VEC4"}));
+    let n = accessors.len();
+    j["meshes"][0]["primitives"][0]["attributes"]["JOINTS_0"] = json!(n - 2);
+    j["meshes"][0]["primitives"][0]["attributes"]["WEIGHTS_0"] = json!(n - 1);
+    let s = load_slice(j.to_string().as_bytes(), None, "short.gltf").unwrap();
+    let p = &s.meshes[0].primitives[0];
+    assert_eq!(p.joints, vec![[0, 1, 0, 0]; 12]);
+    assert_eq!(p.weights[0], glam::Vec4::new(1.0, 0.0, 0.0, 0.0));
+    assert_eq!(p.weights[4], glam::Vec4::new(0.5, 0.5, 0.0, 0.0));
+    assert_eq!(p.weights[8], glam::Vec4::new(0.0, 1.0, 0.0, 0.0));
+}

@@ -110,7 +110,9 @@ impl MeshData {
                 indices,
                 material,
                 bounds,
+                ..Primitive::default()
             }],
+            weights: Vec::new(),
         }
     }
 }

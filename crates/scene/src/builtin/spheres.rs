@@ -8,10 +8,11 @@
 use std::f32::consts::{FRAC_PI_2, TAU};
 
 use glam::{Mat4, Quat, Vec3};
-use serde_json::{Value, json};
+use serde_json::json;
 
 use super::shapes::{self, MeshData};
 use super::textures;
+use super::tracks::Tracks;
 use crate::environment::{self, Environment};
 use crate::glb_writer::GlbWriter;
 use crate::proxies;
@@ -45,33 +46,6 @@ fn object(
 
 fn fitted(mesh: &MeshData, k: usize) -> Vec<proxies::ProxySphere> {
     proxies::fit(&mesh.clone().into_mesh("fit", 0), k).spheres
-}
-
-/// The samplers and channels of the scene's one animation.
-#[derive(Default)]
-struct Tracks {
-    samplers: Vec<Value>,
-    channels: Vec<Value>,
-}
-
-impl Tracks {
-    fn add(
-        &mut self,
-        w: &mut GlbWriter,
-        node: usize,
-        path: &str,
-        interpolation: &str,
-        times: &[f32],
-        values: &[f32],
-    ) {
-        let kind = if path == "rotation" { "VEC4" } else { "VEC3" };
-        let (input, output) = w.keys(times, values, kind);
-        self.samplers
-            .push(json!({"input": input, "output": output, "interpolation": interpolation}));
-        self.channels.push(
-            json!({"sampler": self.samplers.len() - 1, "target": {"node": node, "path": path}}),
-        );
-    }
 }
 
 /// Builds the scene as GLB bytes.
@@ -187,10 +161,7 @@ pub fn build() -> Vec<u8> {
         &[0.0, 0.5, 1.0, 1.5, 2.0],
         &[1., 1., 1., s, s, s, 1., 1., 1., s, s, s, 1., 1., 1.],
     );
-    w.push(
-        "animations",
-        json!({"name": "motion", "samplers": tracks.samplers, "channels": tracks.channels}),
-    );
+    tracks.write(&mut w, "motion");
 
     let camera = w.push(
         "cameras",

@@ -1,10 +1,10 @@
-//! Animations: translation, rotation and scale channels with their keys checked
-//! (increasing finite times, one value per key, three for cubic splines).
+//! Animations: translation, rotation, scale and morph weight channels with their keys
+//! checked (increasing finite times, one value per key, three for cubic splines; weight
+//! values as many per key as the target node's mesh has morph targets).
 //!
 //! Read from the JSON: gltf 1.4's animation wrappers unwrap the target path and node, which
 //! its validation does not check.
 
-use glam::Vec4;
 use gltf::accessor::Dimensions;
 use gltf::json::animation::{Interpolation as I, Property as P};
 use gltf::json::validation::Checked;
@@ -14,10 +14,9 @@ use super::ctx::{Ctx, finite_rows};
 use crate::animation::{Animation, Channel, Interpolation, Property};
 use crate::error::Result;
 
-/// Every animation of `doc`; channels driving morph target weights are left out with a
-/// warning.
+/// Every animation of `doc`.
 pub(super) fn load_animations(
-    ctx: &mut Ctx,
+    ctx: &Ctx,
     buffers: &Buffers,
     doc: &gltf::Document,
 ) -> Result<Vec<Animation>> {
@@ -31,42 +30,50 @@ pub(super) fn load_animations(
         let mut channels = Vec::new();
         for (ci, ch) in anim.channels.iter().enumerate() {
             let element = format!("animations[{ai}] {name:?} channels[{ci}]");
-            if let Some(channel) = load_channel(ctx, buffers, doc, anim, ch, &element)? {
-                channels.push(channel);
-            }
+            channels.push(load_channel(ctx, buffers, doc, anim, ch, &element)?);
         }
         out.push(Animation { name, channels });
     }
     Ok(out)
 }
 
-/// One channel of `anim`, named `element` in messages; `None` (with a warning) for a
-/// channel driving morph target weights.
+/// One channel of `anim`, named `element` in messages.
 fn load_channel(
-    ctx: &mut Ctx,
+    ctx: &Ctx,
     buffers: &Buffers,
     doc: &gltf::Document,
     anim: &gltf::json::Animation,
     ch: &gltf::json::animation::Channel,
     element: &str,
-) -> Result<Option<Channel>> {
+) -> Result<Channel> {
     let property = match &ch.target.path {
         Checked::Valid(P::Translation) => Property::Translation,
         Checked::Valid(P::Rotation) => Property::Rotation,
         Checked::Valid(P::Scale) => Property::Scale,
-        Checked::Valid(P::MorphTargetWeights) => {
-            ctx.warn(
-                element,
-                "animates morph target weights, which shine ignores",
-            );
-            return Ok(None);
-        }
+        Checked::Valid(P::MorphTargetWeights) => Property::Weights,
         Checked::Invalid => return Err(ctx.invalid(element, "unknown target path")),
     };
     let node = ch.target.node.value();
-    if node >= doc.as_json().nodes.len() {
+    let Some(target) = doc.nodes().nth(node) else {
         return Err(ctx.invalid(element, format!("target node {node} does not exist")));
-    }
+    };
+    let width = match property {
+        Property::Rotation => 4,
+        Property::Translation | Property::Scale => 3,
+        Property::Weights => {
+            let targets = target
+                .mesh()
+                .and_then(|m| m.primitives().next())
+                .map_or(0, |p| p.morph_targets().count());
+            if targets == 0 {
+                return Err(ctx.invalid(
+                    element,
+                    format!("animates the weights of node {node}, whose mesh has no morph targets"),
+                ));
+            }
+            targets
+        }
+    };
     let sampler = anim.samplers.get(ch.sampler.value()).ok_or_else(|| {
         ctx.invalid(
             element,
@@ -92,17 +99,18 @@ fn load_channel(
         buffers,
         &output,
         element,
-        property,
+        (property, width),
         interpolation,
         times.len(),
     )?;
-    Ok(Some(Channel {
+    Ok(Channel {
         node,
         property,
         interpolation,
         times,
+        width,
         values,
-    }))
+    })
 }
 
 /// The key times in `input`: at least one, finite and strictly increasing.
@@ -127,29 +135,35 @@ fn key_times(
     Ok(times)
 }
 
-/// The key values in `output` for `keys` keys: finite, with the component count of
-/// `property` (4 for rotations, 3 otherwise, `w` zero) and as many values per key as
-/// `interpolation` needs (3 for cubic splines, 1 otherwise).
+/// The key values in `output` for `keys` keys, flat: finite, `width` floats per value (4
+/// for rotations, 3 for translations and scales, one per morph target for weights, which
+/// the file stores as SCALARs) and as many values per key as `interpolation` needs (3 for
+/// cubic splines, 1 otherwise).
 fn key_values(
     ctx: &Ctx,
     buffers: &Buffers,
     output: &gltf::Accessor<'_>,
     element: &str,
-    property: Property,
+    (property, width): (Property, usize),
     interpolation: Interpolation,
     keys: usize,
-) -> Result<Vec<Vec4>> {
-    let dims = if property == Property::Rotation { 4 } else { 3 };
+) -> Result<Vec<f32>> {
     let (values, got) = buffers.read_f32(output).map_err(|m| {
         ctx.invalid(
             format!("{element} output (accessors[{}])", output.index()),
             m,
         )
     })?;
-    if got != dims {
+    // Weights are SCALAR rows, `width` of them per value; the others one row per value.
+    let expected = if property == Property::Weights {
+        1
+    } else {
+        width
+    };
+    if got != expected {
         return Err(ctx.invalid(
             element,
-            format!("output has {got} components per key, expected {dims}"),
+            format!("output has {got} components per row, expected {expected}"),
         ));
     }
     let per_key = if interpolation == Interpolation::CubicSpline {
@@ -157,18 +171,15 @@ fn key_values(
     } else {
         1
     };
-    if values.len() / dims != keys * per_key {
+    if values.len() / width != keys * per_key || !values.len().is_multiple_of(width) {
         return Err(ctx.invalid(
             element,
             format!(
-                "{} output values for {} keys (expected {} per key)",
-                values.len() / dims,
-                keys,
-                per_key
+                "{} output values of {width} components for {keys} keys (expected {per_key} per key)",
+                values.len() / width
             ),
         ));
     }
-    finite_rows(ctx, element, "output", &values, dims, |c| {
-        Vec4::new(c[0], c[1], c[2], c.get(3).copied().unwrap_or(0.0))
-    })
+    finite_rows(ctx, element, "output", &values, width, |_| ())?;
+    Ok(values)
 }

@@ -106,7 +106,10 @@ pub(crate) struct VertexData {
 /// vertex disagree (UV seams, mirrored UVs) the vertex is duplicated so every corner keeps
 /// its own tangent. Corners MikkTSpace leaves undefined (degenerate triangles) get a tangent
 /// perpendicular to the normal.
-pub(crate) fn mikktspace_tangents(v: &mut VertexData) -> Vec<Vec4> {
+///
+/// Returns the tangents and, for each vertex appended by a split (in order), the index of
+/// the vertex it copies, so other per-vertex data (joints, morph deltas) can follow.
+pub(crate) fn mikktspace_tangents(v: &mut VertexData) -> (Vec<Vec4>, Vec<u32>) {
     let mut input = MikkInput {
         positions: &v.positions,
         normals: &v.normals,
@@ -117,6 +120,7 @@ pub(crate) fn mikktspace_tangents(v: &mut VertexData) -> Vec<Vec4> {
     let ok = bevy_mikktspace::generate_tangents(&mut input).is_ok();
     let corners = input.corners;
     let mut tangents: Vec<Option<Vec4>> = vec![None; v.positions.len()];
+    let mut origins = Vec::new();
     for (corner, index) in v.indices.iter_mut().enumerate() {
         let vi = *index as usize;
         let normal = v.normals.get(vi).copied().unwrap_or(Vec3::Y);
@@ -141,15 +145,17 @@ pub(crate) fn mikktspace_tangents(v: &mut VertexData) -> Vec<Vec4> {
                 v.normals.push(normal);
                 v.uvs.push(v.uvs.get(vi).copied().unwrap_or_default());
                 tangents.push(Some(t));
+                origins.push(vi as u32);
                 *index = new;
             }
         }
     }
-    tangents
+    let tangents = tangents
         .into_iter()
         .zip(&v.normals)
         .map(|(t, n)| t.unwrap_or_else(|| any_tangent(*n)))
-        .collect()
+        .collect();
+    (tangents, origins)
 }
 
 #[cfg(test)]
@@ -188,8 +194,9 @@ mod tests {
             ],
             indices: vec![0, 1, 2, 0, 2, 3],
         };
-        let t = mikktspace_tangents(&mut v);
+        let (t, origins) = mikktspace_tangents(&mut v);
         assert_eq!(t.len(), 4);
+        assert!(origins.is_empty());
         for t in &t {
             assert!((t.truncate() - Vec3::X).length() < 1e-5, "{t:?}");
             assert_eq!(t.w.abs(), 1.0);
@@ -215,8 +222,9 @@ mod tests {
             ],
             indices: vec![0, 1, 2, 4, 5, 3],
         };
-        let t = mikktspace_tangents(&mut m);
+        let (t, origins) = mikktspace_tangents(&mut m);
         assert_eq!(t.len(), m.positions.len());
+        assert_eq!(origins.len(), m.positions.len() - 6);
         assert!((t[0].truncate() - Vec3::X).length() < 1e-5);
         assert!((t[4].truncate() + Vec3::X).length() < 1e-5, "{:?}", t[4]);
     }

@@ -34,10 +34,40 @@ pub(super) fn load_meshes(
             mesh.primitives.push(p);
         }
     }
+    for (mesh, json) in meshes.iter_mut().zip(doc.meshes()) {
+        mesh.weights = mesh_weights(ctx, mesh, &json)?;
+    }
     Ok(LoadedMeshes {
         meshes,
         uses_default_material,
     })
+}
+
+/// The mesh's default morph weights, one per target (zeros when the file gives none),
+/// after checking that every primitive has the same number of targets and the file's
+/// weights match it and are finite.
+fn mesh_weights(ctx: &Ctx, mesh: &Mesh, json: &gltf::Mesh<'_>) -> Result<Vec<f32>> {
+    let element = format!("meshes[{}] {:?}", json.index(), mesh.name);
+    let targets = mesh.target_count();
+    if mesh.primitives.iter().any(|p| p.targets.len() != targets) {
+        return Err(ctx.invalid(
+            &element,
+            "its primitives have different numbers of morph targets; glTF requires the same",
+        ));
+    }
+    let Some(weights) = json.weights() else {
+        return Ok(vec![0.0; targets]);
+    };
+    if weights.len() != targets || weights.iter().any(|w| !w.is_finite()) {
+        return Err(ctx.invalid(
+            format!("{element} weights"),
+            format!(
+                "has {} weights for {targets} morph targets, or a NaN or infinite one",
+                weights.len()
+            ),
+        ));
+    }
+    Ok(weights.to_vec())
 }
 
 /// A loaded primitive (or `None`: skipped with a warning) and the warnings met.
@@ -89,6 +119,7 @@ fn plan<'d>(
         meshes.push(Mesh {
             name: mesh_name,
             primitives: Vec::new(),
+            weights: Vec::new(),
         });
     }
     (meshes, jobs)

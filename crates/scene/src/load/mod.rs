@@ -5,8 +5,17 @@
 //! indices, NaN or infinite positions, node cycles, unsupported required extensions) are an
 //! [`Error`] naming the file and the element. Problems the scene survives are warnings in
 //! [`Scene::warnings`]: a missing or undecodable image (the material keeps its factors),
-//! non-triangle primitives (skipped), skins and morph targets (ignored), and the defaults
-//! below.
+//! non-triangle primitives (skipped), morph target tangent deltas (ignored), a mesh with
+//! joints on a node without a skin or the reverse (drawn rigid), and the defaults below.
+//!
+//! Skins and morph targets are loaded (glTF 2.0 §3.7.2.2, §3.7.3): joints, inverse bind
+//! matrices (one per joint), `JOINTS_0` (unsigned byte or short), `WEIGHTS_0` (float or
+//! normalised unsigned byte or short, divided by their sum), POSITION and NORMAL deltas,
+//! mesh and node weights, and weight animation channels. Bad skinning data is an error: an
+//! empty joint list, a joint that is not a node, a `JOINTS_0` value outside the skin, a
+//! negative, NaN or infinite weight or four zero weights, an inverse bind count that is not
+//! the joint count, `JOINTS_0` without `WEIGHTS_0` or the reverse, weight counts that do not
+//! match the morph targets.
 //!
 //! Defaults:
 //! - no camera: a perspective camera ([`DEFAULT_YFOV`]) on the +Z side of the scene bounds,
@@ -26,6 +35,7 @@ mod animations;
 mod cameras;
 mod ctx;
 mod defaults;
+mod deform;
 mod document;
 mod extras;
 mod geometry;
@@ -34,6 +44,7 @@ mod materials;
 mod meshes;
 mod nodes;
 mod primitive;
+mod skins;
 mod textures;
 pub(crate) mod uri;
 
@@ -103,12 +114,14 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
         nodes,
         roots,
         meshes: meshes.meshes,
+        skins: skins::load_skins(&ctx, &buffers, doc)?,
         materials: materials.materials,
         material_names: materials.names,
         textures: textures.into_textures(),
         ..Scene::default()
     };
-    scene.animations = animations::load_animations(&mut ctx, &buffers, doc)?;
+    skins::check_nodes(&mut ctx, &mut scene)?;
+    scene.animations = animations::load_animations(&ctx, &buffers, doc)?;
     let world = scene.rest_world_transforms();
     lights::load_lights(&mut ctx, doc, &mut scene, &world)?;
     cameras::load_cameras(&ctx, doc, &mut scene, &world)?;
@@ -121,5 +134,5 @@ pub fn load_slice(bytes: &[u8], base_dir: Option<&Path>, name: &str) -> Result<S
 
 /// MikkTSpace tangents for `v`, splitting vertices where tangents disagree.
 pub(crate) fn tangents_for(v: &mut VertexData) -> Vec<Vec4> {
-    geometry::mikktspace_tangents(v)
+    geometry::mikktspace_tangents(v).0
 }

@@ -20,8 +20,8 @@ pub(super) fn load_nodes(ctx: &mut Ctx, doc: &gltf::Document) -> Result<(Vec<Nod
     Ok((nodes, roots))
 }
 
-/// One node without its parent: name, finite transform with a unit rotation, mesh and
-/// children. Skins are ignored with a warning.
+/// One node without its parent: name, finite transform with a unit rotation, mesh, skin,
+/// finite morph weights and children.
 fn load_node(ctx: &mut Ctx, node: &gltf::Node<'_>) -> Result<Node> {
     let name = node
         .name()
@@ -48,11 +48,12 @@ fn load_node(ctx: &mut Ctx, node: &gltf::Node<'_>) -> Result<Node> {
         },
         ..transform
     };
-    if node.skin().is_some() {
-        ctx.warn(
-            &element,
-            "is skinned; skinning is not supported yet, the mesh is drawn in its bind pose",
-        );
+    let weights = node.weights().map(<[f32]>::to_vec);
+    if weights
+        .as_ref()
+        .is_some_and(|w| w.iter().any(|x| !x.is_finite()))
+    {
+        return Err(ctx.invalid(format!("{element} weights"), "has a NaN or infinite weight"));
     }
     Ok(Node {
         name,
@@ -62,6 +63,8 @@ fn load_node(ctx: &mut Ctx, node: &gltf::Node<'_>) -> Result<Node> {
         mesh: node.mesh().map(|m| m.index()),
         camera: None,
         lights: Vec::new(),
+        skin: node.skin().map(|s| s.index()),
+        weights,
     })
 }
 

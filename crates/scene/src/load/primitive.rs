@@ -1,5 +1,5 @@
-//! One glTF primitive into a [`Primitive`]: attributes read and checked, strips and fans
-//! triangulated, missing normals and tangents generated.
+//! One glTF primitive into a [`Primitive`]: attributes read and checked (deformation ones in
+//! [`super::deform`]), strips and fans triangulated, missing normals and tangents generated.
 
 use glam::{Vec2, Vec3, Vec4};
 use gltf::accessor::Dimensions;
@@ -7,10 +7,11 @@ use gltf::mesh::Mode;
 
 use super::accessor::Buffers;
 use super::ctx::{Ctx, finite_rows};
+use super::deform::{self, SkinAttributes};
 use super::document::semantic_name;
 use super::geometry::{self, VertexData};
 use crate::error::Result;
-use crate::types::{Aabb, Primitive};
+use crate::types::{Aabb, MorphTarget, Primitive};
 
 /// Loads one primitive named `element` in messages; `None` when it is skipped (not
 /// triangles, or no POSITION) with a warning.
@@ -46,12 +47,8 @@ pub(super) fn load_primitive(
     let normals = reader.normals(ctx, &positions, &indices)?;
     let uvs = reader.uvs(ctx, n)?;
     let tangents = reader.tangents(ctx, &normals)?;
-    if prim.morph_targets().next().is_some() {
-        ctx.warn(
-            element,
-            "has morph targets; shine ignores them and uses the base shape",
-        );
-    }
+    let mut skin = deform::skin_attributes(ctx, buffers, prim, element, n)?;
+    let mut targets = deform::morph_targets(ctx, buffers, prim, element, n)?;
     let has_uvs = uvs.is_some();
     let mut v = VertexData {
         positions,
@@ -61,9 +58,34 @@ pub(super) fn load_primitive(
     };
     let tangents = match tangents {
         Some(t) => t,
-        None => generated_tangents(&mut v, has_uvs && normal_mapped),
+        None => {
+            let (tangents, origins) = generated_tangents(&mut v, has_uvs && normal_mapped);
+            copy_split_vertices(&origins, &mut skin, &mut targets);
+            tangents
+        }
     };
-    Ok(Some(finish(v, tangents, material)))
+    Ok(Some(finish(v, tangents, material, skin, targets)))
+}
+
+/// Appends, for each vertex split off by MikkTSpace, a copy of its origin's joints,
+/// weights and morph deltas, so every per-vertex array keeps the vertex count.
+fn copy_split_vertices(origins: &[u32], skin: &mut SkinAttributes, targets: &mut [MorphTarget]) {
+    fn copy<T: Copy>(v: &mut Vec<T>, origins: &[u32]) {
+        if v.is_empty() {
+            return;
+        }
+        for &o in origins {
+            if let Some(&x) = v.get(o as usize) {
+                v.push(x);
+            }
+        }
+    }
+    copy(&mut skin.joints, origins);
+    copy(&mut skin.weights, origins);
+    for t in targets {
+        copy(&mut t.positions, origins);
+        copy(&mut t.normals, origins);
+    }
 }
 
 /// Reads one primitive's accessors, naming the primitive and attribute in errors.
@@ -266,23 +288,33 @@ fn unit_tangents(raw: &[Vec4], normals: &[Vec3]) -> Vec<Vec4> {
 }
 
 /// Tangents for a primitive whose file has none: MikkTSpace when `mikktspace` (the
-/// primitive has UVs and a normal map), any perpendicular to the normal otherwise.
+/// primitive has UVs and a normal map), any perpendicular to the normal otherwise. Also
+/// returns the origins of the vertices MikkTSpace split off (see
+/// [`geometry::mikktspace_tangents`]).
 ///
 /// Tangents only matter under a normal map; elsewhere a perpendicular will do and
 /// MikkTSpace's cost (about 2.5 s per million triangles) is not paid.
-fn generated_tangents(v: &mut VertexData, mikktspace: bool) -> Vec<Vec4> {
+fn generated_tangents(v: &mut VertexData, mikktspace: bool) -> (Vec<Vec4>, Vec<u32>) {
     if mikktspace {
         geometry::mikktspace_tangents(v)
     } else {
-        v.normals
+        let tangents = v
+            .normals
             .iter()
             .map(|n| geometry::any_tangent(*n))
-            .collect()
+            .collect();
+        (tangents, Vec::new())
     }
 }
 
 /// The finished primitive with the bounds of its positions.
-fn finish(v: VertexData, tangents: Vec<Vec4>, material: u32) -> Primitive {
+fn finish(
+    v: VertexData,
+    tangents: Vec<Vec4>,
+    material: u32,
+    skin: SkinAttributes,
+    targets: Vec<MorphTarget>,
+) -> Primitive {
     let bounds = v.positions.iter().fold(Aabb::EMPTY, |mut b, p| {
         b.grow(*p);
         b
@@ -295,5 +327,8 @@ fn finish(v: VertexData, tangents: Vec<Vec4>, material: u32) -> Primitive {
         indices: v.indices,
         material,
         bounds,
+        joints: skin.joints,
+        weights: skin.weights,
+        targets,
     }
 }
