@@ -331,7 +331,7 @@ fn gpu_traversal_hits_equal_cpu_bvh_hits() {
 
 /// Traces 4096 pseudo-random rays through `gpu`'s BVH on the GPU and on the CPU.
 fn check_traversal(device: &shine::gpu::Device, gpu: &mut GpuScene) {
-    let (cpu_bvh, flat_index) = world_bvh(gpu.rig(), &gpu.state.world).expect("cpu bvh");
+    let (cpu_bvh, flat_index) = world_bvh(gpu.rig(), &gpu.state.pose.world).expect("cpu bvh");
     let (lo, hi) = gpu.state.bounds;
     // Deterministic pseudo-random rays: origins in the box grown by 20 %, directions anywhere.
     let mut state = 12345u32;

@@ -402,7 +402,7 @@ impl Renderer {
         let proxy = p
             .proxy
             .as_ref()
-            .map(|setup| scene.proxy.prepare(rg, setup, &frame.world))
+            .map(|setup| scene.proxy.prepare(rg, setup, &frame.pose.world))
             .transpose()?;
 
         let textures = if p.mipmaps {

@@ -5,6 +5,9 @@
 //!   built once when the scene is uploaded ([`BottomLevels::build`]); all of them live in one
 //!   node buffer and one triangle buffer (absolute indices, so traversal needs no offsets). A
 //!   triangle carries its index within its mesh (primitives concatenated in order).
+//! - **Deforming instances** (skinned or morphing) get a bottom level of their own in world
+//!   space, first in the buffers, refitted every frame (src/gpu_scene/deformers.rs); their
+//!   top-level record carries the identity.
 //! - **Top level**: a binned-SAH tree over the instances' world boxes, rebuilt on the CPU
 //!   every frame ([`TopLevel::build`]; tens to hundreds of boxes: microseconds, see
 //!   docs/performance.md) and uploaded with the frame. An instance record holds the
@@ -108,6 +111,14 @@ impl BottomLevels {
     /// One bottom level per mesh of `scene`, over its primitives in mesh space.
     pub fn build(scene: &Scene) -> Self {
         let mut out = Self::default();
+        out.add_meshes(scene);
+        out
+    }
+
+    /// Appends one bottom level per mesh of `scene` (setting [`BottomLevels::roots`] and
+    /// [`BottomLevels::bounds`]).
+    pub fn add_meshes(&mut self, scene: &Scene) {
+        let out = self;
         for mesh in &scene.meshes {
             let mut soup = Vec::new();
             for (p, primitive) in mesh.primitives.iter().enumerate() {
@@ -146,7 +157,6 @@ impl BottomLevels {
             out.roots.push(root);
             out.bounds.push(bounds);
         }
-        out
     }
 
     /// Appends `bvh` with each triangle's index given by `index`; returns its root

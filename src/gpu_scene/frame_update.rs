@@ -4,7 +4,7 @@
 //! deformed vertices) is made from a `FrameState` by [`crate::gpu_scene::GpuScene`].
 
 use glam::{Mat4, Vec3};
-use shine_scene::{Aabb, Light, Projection, Scene, Transform};
+use shine_scene::{Light, Pose, Projection, Scene, Transform};
 
 /// The camera of a frame when the host places it itself.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +29,9 @@ pub struct FrameUpdate {
     /// Lights the host sets, by index into the scene's lights, in world space, replacing
     /// the animated ones.
     pub lights: Vec<(usize, Light)>,
+    /// Morph weights the host sets, by node (one per target of its mesh), replacing the
+    /// animated ones.
+    pub weights: Vec<(usize, Vec<f32>)>,
     /// Sub-pixel offset of the camera's projection, in pixels (temporal anti-aliasing).
     pub jitter: [f32; 2],
 }
@@ -77,6 +80,27 @@ impl FrameUpdate {
                 return Err(format!("light {index}: not a finite light of a known kind"));
             }
         }
+        for (node, weights) in &self.weights {
+            let targets = scene
+                .nodes
+                .get(*node)
+                .and_then(|n| n.mesh)
+                .and_then(|m| scene.meshes.get(m))
+                .map(|m| m.target_count());
+            match targets {
+                None => return Err(format!("node {node} has no mesh to morph")),
+                Some(n) if n != weights.len() => {
+                    return Err(format!(
+                        "node {node}: {} morph weights for {n} targets",
+                        weights.len()
+                    ));
+                }
+                Some(_) if weights.iter().any(|w| !w.is_finite()) => {
+                    return Err(format!("node {node}: a morph weight is not finite"));
+                }
+                Some(_) => {}
+            }
+        }
         if let Some(camera) = &self.camera
             && !camera.world.is_finite()
         {
@@ -103,8 +127,8 @@ const FALLBACK_PROJECTION: Projection = Projection::Perspective {
 pub struct FrameState {
     /// The scene clock.
     pub time: f32,
-    /// World matrix of every node.
-    pub world: Vec<Mat4>,
+    /// World matrix of every node, morph weights and joint matrices.
+    pub pose: Pose,
     /// Lights in world space.
     pub lights: Vec<Light>,
     /// Camera-to-world matrix.
@@ -113,7 +137,8 @@ pub struct FrameState {
     pub projection: Projection,
     /// Sub-pixel jitter in pixels.
     pub jitter: [f32; 2],
-    /// World bounds of the geometry (instances' mesh boxes moved to the world).
+    /// World bounds of the geometry (rigid instances' mesh boxes moved to the world,
+    /// deforming ones' deformed vertices).
     pub bounds: (Vec3, Vec3),
 }
 
@@ -145,10 +170,17 @@ impl FrameState {
                     .map_or(FALLBACK_PROJECTION, |c| c.projection),
             ),
         };
-        let bounds: Aabb = scene.bounds(&world);
+        let mut weights = scene.weights_at(update.time);
+        for (node, w) in &update.weights {
+            if let Some(slot) = weights.get_mut(*node) {
+                slot.clone_from(w);
+            }
+        }
+        let pose = scene.pose(world, weights);
+        let bounds = scene.pose_bounds(&pose);
         Self {
             time: update.time,
-            world,
+            pose,
             lights,
             camera_world,
             projection,

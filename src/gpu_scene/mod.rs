@@ -10,6 +10,7 @@
 //! ([`SceneHandles`]). Nothing on the frame path waits for the queue.
 
 pub mod bvh;
+mod deformers;
 pub mod environment;
 pub mod environment_sh;
 pub mod frame_update;
@@ -22,9 +23,11 @@ use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, vk};
 use shine_graph::{ExternalState, Handle, RenderGraph};
 use shine_scene::{Light, LightKind, Material, Scene};
 
+use crate::passes::update_vertices::{DeformInputs, update_vertices};
 use bvh::{BottomLevels, GpuBvh, TopInstance, TopLevel, TraceBuffers};
+use deformers::Deformers;
 pub use frame_update::{CameraPose, FrameState, FrameUpdate};
-use geometry::{DeformInstance, Geometry, InstanceRange};
+use geometry::{DeformFrame, DeformInstance, Geometry, InstanceRange};
 use upload_ring::UploadRing;
 
 /// Edge of every layer of the texture arrays, in texels.
@@ -144,6 +147,16 @@ pub struct GpuScene {
     pub state: FrameState,
     /// Per instance: [`DeformInstance`] records of the current frame.
     deform_instances: Buffer,
+    /// Per vertex: skin influences ([`geometry::SkinVertex`]), static.
+    skin_vertices: Buffer,
+    /// Morph deltas, static.
+    morph_deltas: Buffer,
+    /// The frame's joint matrices.
+    joint_matrices: Buffer,
+    /// The frame's morph weights.
+    morph_weights: Buffer,
+    /// Bottom levels of the deforming instances, refitted every frame.
+    deformers: Deformers,
     /// The scene's CPU data that frames are evaluated from (textures dropped).
     rig: Scene,
     /// Staging buffers of the per-frame uploads.
@@ -181,12 +194,20 @@ impl GpuScene {
         };
         let vertex_bytes = std::mem::size_of_val(geometry.source.as_slice());
         let instance_count = geometry.instances.len();
-        let bottom = BottomLevels::build(scene);
         let rig = Scene {
             textures: Vec::new(),
             ..scene.clone()
         };
         let state = FrameState::evaluate(&rig, &FrameUpdate::default());
+        let mut bottom = BottomLevels::default();
+        let (deformers, _) = Deformers::build(&rig, &geometry.instances, &state.pose, &mut bottom);
+        bottom.add_meshes(scene);
+        let joint_count: usize = state.pose.joints.iter().map(Vec::len).sum();
+        let weight_count: usize = geometry
+            .instances
+            .iter()
+            .map(|r| r.target_count as usize)
+            .sum();
         Ok(Self {
             source_vertices: storage(
                 "scene source vertices",
@@ -236,6 +257,27 @@ impl GpuScene {
                 instance_count * std::mem::size_of::<DeformInstance>(),
                 vk::BufferUsageFlags::STORAGE_BUFFER,
             )?,
+            skin_vertices: storage(
+                "scene skin vertices",
+                bytemuck::cast_slice(&geometry.skin),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+            morph_deltas: storage(
+                "scene morph deltas",
+                bytemuck::cast_slice(&geometry.deltas),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+            joint_matrices: dynamic(
+                "joint matrices",
+                joint_count * std::mem::size_of::<Mat4>(),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+            morph_weights: dynamic(
+                "morph weights",
+                weight_count * std::mem::size_of::<f32>(),
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+            deformers,
             instances: geometry.instances,
             state,
             rig,
@@ -271,6 +313,7 @@ impl GpuScene {
             .iter()
             .map(|r| {
                 self.state
+                    .pose
                     .world
                     .get(r.node as usize)
                     .copied()
@@ -283,66 +326,93 @@ impl GpuScene {
     /// copied from the staging ring; the world vertices rewritten) and imports everything the
     /// frame reads.
     pub fn declare(&mut self, rg: &mut RenderGraph) -> Result<SceneHandles, SceneUploadError> {
-        let matrices = self.instance_matrices();
-        let records: Vec<DeformInstance> = matrices.iter().map(DeformInstance::rigid).collect();
+        let frame = DeformFrame::new(&self.instances, &self.state.pose);
+        let (nodes, triangles, deformer_roots) = self.declare_bottom_levels(rg)?;
+        let bottom = &self.bvh.bottom;
         let top = TopLevel::build(
             &self
                 .instances
                 .iter()
-                .zip(&matrices)
-                .map(|(r, world)| TopInstance {
-                    world: *world,
-                    root: self
-                        .bvh
-                        .bottom
-                        .roots
-                        .get(r.mesh as usize)
-                        .copied()
-                        .unwrap_or(u32::MAX),
-                    bounds: self
-                        .bvh
-                        .bottom
-                        .bounds
-                        .get(r.mesh as usize)
-                        .copied()
-                        .unwrap_or(shine_scene::Aabb::EMPTY),
-                    triangle_base: r.first_triangle,
+                .zip(&deformer_roots)
+                .map(|(r, deformer)| match deformer {
+                    // Deforming: its own bottom level, already in world space.
+                    Some((root, bounds)) => TopInstance {
+                        world: Mat4::IDENTITY,
+                        root: *root,
+                        bounds: *bounds,
+                        triangle_base: r.first_triangle,
+                    },
+                    None => TopInstance {
+                        world: self
+                            .state
+                            .pose
+                            .world
+                            .get(r.node as usize)
+                            .copied()
+                            .unwrap_or(Mat4::IDENTITY),
+                        root: bottom
+                            .roots
+                            .get(r.mesh as usize)
+                            .copied()
+                            .unwrap_or(u32::MAX),
+                        bounds: bottom
+                            .bounds
+                            .get(r.mesh as usize)
+                            .copied()
+                            .unwrap_or(shine_scene::Aabb::EMPTY),
+                        triangle_base: r.first_triangle,
+                    },
                 })
                 .collect::<Vec<_>>(),
         );
-        let deform = self.ring.upload(
+        let ring = &mut self.ring;
+        let deform = ring.upload(
             rg,
             "instances",
             &self.deform_instances,
-            bytemuck::cast_slice(&records),
+            bytemuck::cast_slice(&frame.instances),
         )?;
-        let lights = self.ring.upload(
+        let joints = ring.upload(
+            rg,
+            "joints",
+            &self.joint_matrices,
+            bytemuck::cast_slice(&frame.joints),
+        )?;
+        let weights = ring.upload(
+            rg,
+            "weights",
+            &self.morph_weights,
+            bytemuck::cast_slice(&frame.weights),
+        )?;
+        let lights = ring.upload(
             rg,
             "lights",
             &self.lights,
             bytemuck::cast_slice(&self.state.lights),
         )?;
-        let top_nodes = self.ring.upload(
+        let top_nodes = ring.upload(
             rg,
             "bvh top",
             &self.bvh.top,
             bytemuck::cast_slice(&top.nodes),
         )?;
-        let top_instances = self.ring.upload(
+        let top_instances = ring.upload(
             rg,
             "bvh instances",
             &self.bvh.instances,
             bytemuck::cast_slice(&top.instances),
         )?;
-        let source = rg.import_gpu_buffer(&self.source_vertices, BUFFER_READ, BUFFER_READ);
+        let inputs = DeformInputs {
+            source: rg.import_gpu_buffer(&self.source_vertices, BUFFER_READ, BUFFER_READ),
+            skin: rg.import_gpu_buffer(&self.skin_vertices, BUFFER_READ, BUFFER_READ),
+            deltas: rg.import_gpu_buffer(&self.morph_deltas, BUFFER_READ, BUFFER_READ),
+            instances: deform,
+            joints,
+            weights,
+            vertex_count: self.vertex_count,
+        };
         let mut vertices = rg.import_gpu_buffer(&self.vertices, BUFFER_READ, BUFFER_READ);
-        crate::passes::update_vertices::update_vertices(
-            rg,
-            &source,
-            &deform,
-            &mut vertices,
-            self.vertex_count,
-        );
+        update_vertices(rg, &inputs, &mut vertices);
         Ok(SceneHandles {
             vertices,
             indices: rg.import_gpu_buffer(&self.indices, BUFFER_READ, BUFFER_READ),
@@ -351,13 +421,52 @@ impl GpuScene {
             srgb_textures: rg.import_gpu_image(&self.srgb_textures, SAMPLED_READ, SAMPLED_READ),
             linear_textures: rg.import_gpu_image(&self.linear_textures, SAMPLED_READ, SAMPLED_READ),
             trace: TraceBuffers {
-                nodes: rg.import_gpu_buffer(&self.bvh.nodes, BUFFER_READ, BUFFER_READ),
-                triangles: rg.import_gpu_buffer(&self.bvh.triangles, BUFFER_READ, BUFFER_READ),
+                nodes,
+                triangles,
                 top: top_nodes,
                 instances: top_instances,
             },
             index_count: self.index_count,
         })
+    }
+
+    /// The bottom-level buffers of this frame: the deformers refitted and their prefix
+    /// uploaded (when there are any), and per instance its deformer's root and bounds.
+    #[allow(clippy::type_complexity)]
+    fn declare_bottom_levels(
+        &mut self,
+        rg: &mut RenderGraph,
+    ) -> Result<
+        (
+            Handle<shine_graph::Buffer>,
+            Handle<shine_graph::Buffer>,
+            Vec<Option<(u32, shine_scene::Aabb)>>,
+        ),
+        SceneUploadError,
+    > {
+        if self.deformers.is_empty() {
+            return Ok((
+                rg.import_gpu_buffer(&self.bvh.nodes, BUFFER_READ, BUFFER_READ),
+                rg.import_gpu_buffer(&self.bvh.triangles, BUFFER_READ, BUFFER_READ),
+                vec![None; self.instances.len()],
+            ));
+        }
+        let (prefix, roots) = self
+            .deformers
+            .refit(&self.rig, &self.instances, &self.state.pose);
+        let nodes = self.ring.upload_prefix(
+            rg,
+            "bvh deformer nodes",
+            &self.bvh.nodes,
+            bytemuck::cast_slice(&prefix.nodes),
+        )?;
+        let triangles = self.ring.upload_prefix(
+            rg,
+            "bvh deformer triangles",
+            &self.bvh.triangles,
+            bytemuck::cast_slice(&prefix.triangles),
+        )?;
+        Ok((nodes, triangles, roots))
     }
 
     /// Index of the primary light (the one with a shadow map and an RSM): the first spot or

@@ -6,7 +6,8 @@
 //! `slots` frames run ahead of the GPU (a host recording with [`crate::Renderer::record`]
 //! promises the same), so when frame `f` is declared, frame `f - slots`, the last reader of
 //! that slot, has completed. Staging buffers are created on first use with the size of their
-//! destination and then reused, so a steady stream of frames allocates nothing.
+//! destination (or of the prefix rewritten) and then reused, so a steady stream of frames
+//! allocates nothing.
 
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
 use shine_graph::{ExternalState, Handle, RenderGraph};
@@ -40,7 +41,32 @@ impl UploadRing {
         dst: &Buffer,
         data: &[u8],
     ) -> Result<Handle<crate::graph::Buffer>, shine_gpu::Error> {
-        if data.len() as u64 > dst.size() {
+        self.stage(rg, name, dst, data, dst.size())
+    }
+
+    /// As [`UploadRing::upload`], but rewrites only the first `data.len()` bytes of `dst`
+    /// (the rest keeps what it holds). `data` must keep its length from frame to frame, or
+    /// the staging buffer is replaced.
+    pub fn upload_prefix(
+        &mut self,
+        rg: &mut RenderGraph,
+        name: &str,
+        dst: &Buffer,
+        data: &[u8],
+    ) -> Result<Handle<crate::graph::Buffer>, shine_gpu::Error> {
+        self.stage(rg, name, dst, data, (data.len() as u64).max(4))
+    }
+
+    /// Stages `data` in a buffer of `size` bytes and copies that whole buffer into `dst`.
+    fn stage(
+        &mut self,
+        rg: &mut RenderGraph,
+        name: &str,
+        dst: &Buffer,
+        data: &[u8],
+        size: u64,
+    ) -> Result<Handle<crate::graph::Buffer>, shine_gpu::Error> {
+        if data.len() as u64 > dst.size() || size > dst.size() {
             return Err(shine_gpu::Error::InvalidUsage(format!(
                 "upload `{name}`: {} bytes do not fit its {}-byte buffer",
                 data.len(),
@@ -50,7 +76,7 @@ impl UploadRing {
         let slot_count = self.slots.len() as u64;
         let slot = &mut self.slots[(rg.frame() % slot_count) as usize];
         let index = match slot.iter().position(|(n, _)| n == name) {
-            Some(i) if slot[i].1.size() == dst.size() => i,
+            Some(i) if slot[i].1.size() == size => i,
             found => {
                 // A destination of a new size (a new scene): the old staging buffer's last
                 // reader finished (see the module docs), so it can go.
@@ -61,7 +87,7 @@ impl UploadRing {
                     &self.device,
                     &BufferDesc {
                         name: &format!("staging {name}"),
-                        size: dst.size(),
+                        size,
                         usage: vk::BufferUsageFlags::TRANSFER_SRC,
                         location: MemoryLocation::CpuToGpu,
                     },
