@@ -281,3 +281,69 @@ fn render_lights_the_scene_with_an_environment_map() {
     }
     assert!(!dir.join("x.png").exists());
 }
+
+/// `--frames 12` with a frame field writes 12 images of `builtin:animated`, all different (the
+/// walker, the curtain and the spot light move), `--camera-orbit` moves the camera around a
+/// static scene, and a sequence without a frame field is refused before any work, writing
+/// nothing.
+#[test]
+fn render_writes_every_frame_of_a_sequence() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_sequence");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("tmp dir");
+    let run = shine()
+        .args(["render", "builtin:animated", "--frames", "12", "--fps", "8"])
+        .args(["--width", "24", "--height", "24"])
+        .args(["--gi", "none", "--set", "shadow.size=128", "-o"])
+        .arg(dir.join("f_%04d.png"))
+        .output()
+        .expect("run shine render");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let frames: Vec<Vec<u8>> = (0..12)
+        .map(|k| std::fs::read(dir.join(format!("f_{k:04}.png"))).expect("frame written"))
+        .collect();
+    for (i, a) in frames.iter().enumerate() {
+        for b in &frames[i + 1..] {
+            assert_ne!(a, b, "two frames are identical");
+        }
+    }
+    assert_eq!(std::fs::read_dir(&dir).expect("dir").count(), 12);
+
+    let orbit = dir.join("orbit");
+    std::fs::create_dir_all(&orbit).expect("dir");
+    let run = shine()
+        .args(["render", "builtin:cornell-box", "--frames", "3"])
+        .args(["--camera-orbit", "30", "--width", "24", "--height", "24"])
+        .args(["--gi", "none", "--set", "shadow.size=128", "-o"])
+        .arg(orbit.join("o%d.png"))
+        .output()
+        .expect("run shine render");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let views: Vec<Vec<u8>> = (0..3)
+        .map(|k| std::fs::read(orbit.join(format!("o{k}.png"))).expect("frame written"))
+        .collect();
+    assert!(
+        views[0] != views[1] && views[1] != views[2],
+        "the camera did not move"
+    );
+
+    let refused = dir.join("refused");
+    std::fs::create_dir_all(&refused).expect("dir");
+    let run = shine()
+        .args(["render", "builtin:animated", "--frames", "3", "-o"])
+        .arg(refused.join("out.png"))
+        .output()
+        .expect("run shine render");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no frame field"), "{stderr}");
+    assert_eq!(std::fs::read_dir(&refused).expect("dir").count(), 0);
+}

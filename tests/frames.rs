@@ -4,9 +4,9 @@
 
 mod common;
 
-use glam::{Mat3, Mat4, Vec3};
+use glam::Vec3;
 use shine::capture::image_io::HdrImage;
-use shine::gpu_scene::geometry::Geometry;
+use shine::gpu::vk;
 use shine::gpu_scene::{FrameUpdate, GpuScene, Vertex};
 use shine::graph::{Executor, ExternalState};
 use shine::reference::{PathTracer, ReferenceParams};
@@ -39,7 +39,8 @@ fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
 }
 
 /// Frame k of a sequence (scene uploaded once, then updated) equals a cold render of the scene
-/// at the same time, in every GI mode, within 1e-4 of the mean.
+/// at the same time, in every GI mode, within 1e-4 of the mean (`builtin:animated`: skinning,
+/// morphing, a moving spot light, sky through a window).
 #[test]
 fn sequence_frames_equal_cold_renders() {
     let device = common::device();
@@ -67,8 +68,7 @@ fn sequence_frames_equal_cold_renders() {
             assert!(e <= 1e-4, "gi {gi}, t {t}: relative RMSE {e:e}");
         }
     }
-    // The frames differ from each other: the scene does move (the sky lights it only
-    // through a GI technique: no punctual light).
+    // The frames differ from each other: the scene does move.
     live.set_scene(&scene, 0.0).expect("scene");
     let first = live.render(&settings("proxy")).expect("render");
     live.update(&FrameUpdate::at(1.1)).expect("update");
@@ -78,11 +78,12 @@ fn sequence_frames_equal_cold_renders() {
     common::assert_clean(&device);
 }
 
-/// The path tracer moved to another instant by an update matches one started cold there.
+/// The path tracer moved to another instant by an update matches one started cold there
+/// (the skinned walker's refitted bottom level against one built at that instant).
 #[test]
 fn path_tracer_update_matches_cold_start() {
     let device = common::device();
-    let scene = Scene::builtin("spheres").expect("scene");
+    let scene = Scene::builtin("animated").expect("scene");
     let params = ReferenceParams {
         width: 24,
         height: 24,
@@ -101,55 +102,83 @@ fn path_tracer_update_matches_cold_start() {
     common::assert_clean(&device);
 }
 
-/// `update vertices` writes what the CPU computes: every mesh-space vertex moved by its
-/// instance's world matrix (normals by the inverse transpose, renormalised).
+/// `update vertices` writes what the CPU reference computes
+/// (`shine_scene::Scene::instance_vertices`: morph, then skin or rigid placement) for every
+/// vertex of `builtin:animated` (a skinned walker, a morphing curtain, rigid furniture) at
+/// several instants.
 #[test]
 fn update_vertices_matches_the_cpu() {
     let device = common::device();
-    let scene = Scene::builtin("spheres").expect("scene");
-    let mut gpu = GpuScene::upload(&device, &scene, 0.7).expect("upload");
+    let scene = Scene::builtin("animated").expect("scene");
+    let mut gpu = GpuScene::upload(&device, &scene, 0.0).expect("upload");
     let mut executor = Executor::new(&device, 1).expect("executor");
-    let mut rg = executor.begin_frame();
-    let handles = gpu.declare(&mut rg).expect("declare");
     let readback = common::buffer(
         &device,
         "vertices readback",
         gpu.vertices.size(),
-        shine::gpu::vk::BufferUsageFlags::TRANSFER_DST
-            | shine::gpu::vk::BufferUsageFlags::TRANSFER_SRC,
+        vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
     );
-    let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, common::read_by_copy());
-    rg.copy_buffer("read vertices", &handles.vertices, &mut out);
-    let mut commands = device.begin_commands().expect("commands");
-    executor.execute(commands.raw(), rg).expect("execute");
-    device
-        .submit(commands)
-        .expect("submit")
-        .wait()
-        .expect("wait");
-    let bytes = device.read_buffer(&readback).expect("read");
-    let got: &[Vertex] = bytemuck::cast_slice(&bytes);
-    let source = Geometry::flatten(&scene).expect("flatten").source;
-    let matrices = gpu.instance_matrices();
-    let mut moved = 0;
-    for (i, (s, g)) in source.iter().zip(got).enumerate() {
-        let m: Mat4 = matrices[s.instance as usize];
-        let p = m.transform_point3(Vec3::from(s.position));
-        let n = (Mat3::from_mat4(m).inverse().transpose() * Vec3::from(s.normal)).normalize();
-        let tolerance = 1e-5 * (1.0 + p.abs().max_element());
-        assert!(
-            (Vec3::from(g.position) - p).abs().max_element() <= tolerance,
-            "vertex {i}: {:?} vs {p}",
-            g.position
-        );
-        assert!(
-            (Vec3::from(g.normal) - n).abs().max_element() <= 1e-5,
-            "vertex {i}: normal"
-        );
-        assert_eq!((g.material, g.uv), (s.material, s.uv), "vertex {i}");
-        moved += usize::from(Vec3::from(s.position).distance(p) > 1e-3);
+    let (mut skinned, mut morphed) = (0usize, 0usize);
+    for t in [0.0, 1.3, 7.9] {
+        gpu.update(&FrameUpdate::at(t)).expect("update");
+        let mut rg = executor.begin_frame();
+        let handles = gpu.declare(&mut rg).expect("declare");
+        let mut out =
+            rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, common::read_by_copy());
+        rg.copy_buffer("read vertices", &handles.vertices, &mut out);
+        let mut commands = device.begin_commands().expect("commands");
+        executor.execute(commands.raw(), rg).expect("execute");
+        device
+            .submit(commands)
+            .expect("submit")
+            .wait()
+            .expect("wait");
+        let bytes = device.read_buffer(&readback).expect("read");
+        let got: &[Vertex] = bytemuck::cast_slice(&bytes);
+        let pose = &gpu.state.pose;
+        let placed = scene.instances(&pose.world);
+        for (range, instance) in gpu.instances.iter().zip(&placed) {
+            let mesh = &scene.meshes[range.mesh as usize];
+            let mut v = range.first_vertex as usize;
+            for p in 0..mesh.primitives.len() {
+                let cpu = scene.instance_vertices(pose, instance, p).expect("cpu");
+                for (i, position) in cpu.positions.iter().enumerate() {
+                    let g = &got[v];
+                    let tolerance = 1e-5 * (1.0 + position.abs().max_element());
+                    assert!(
+                        (Vec3::from(g.position) - *position).abs().max_element() <= tolerance,
+                        "t {t}, instance node {}, vertex {i}: {:?} vs {position}",
+                        range.node,
+                        g.position
+                    );
+                    assert!(
+                        (Vec3::from(g.normal) - cpu.normals[i]).abs().max_element() <= 1e-4,
+                        "t {t}, node {}, vertex {i}: normal {:?} vs {}",
+                        range.node,
+                        g.normal,
+                        cpu.normals[i]
+                    );
+                    let tangent = glam::Vec4::from(g.tangent);
+                    assert!(
+                        (tangent - cpu.tangents[i]).abs().max_element() <= 1e-4,
+                        "t {t}, node {}, vertex {i}: tangent",
+                        range.node
+                    );
+                    v += 1;
+                }
+            }
+            if range.skin != shine_scene::NO_SKIN {
+                skinned += range.vertex_count as usize;
+            }
+            if range.target_count > 0 {
+                morphed += range.vertex_count as usize;
+            }
+        }
     }
-    assert!(moved > 0, "no vertex moved");
+    assert!(
+        skinned > 0 && morphed > 0,
+        "skinned {skinned}, morphed {morphed}"
+    );
     common::assert_clean(&device);
 }
 
@@ -157,7 +186,7 @@ fn update_vertices_matches_the_cpu() {
 #[test]
 fn a_long_run_keeps_device_memory_flat() {
     let device = common::device();
-    let scene = Scene::builtin("spheres").expect("scene");
+    let scene = Scene::builtin("animated").expect("scene");
     let settings = {
         let mut s = settings("hvl,proxy");
         s.width = 16;
@@ -167,16 +196,16 @@ fn a_long_run_keeps_device_memory_flat() {
     let mut renderer = Renderer::new(&device).expect("renderer");
     renderer.set_scene(&scene, 0.0).expect("scene");
     let mut at = Vec::new();
-    for k in 0..120u32 {
+    for k in 0..300u32 {
         renderer
             .update(&FrameUpdate::at(k as f32 / 30.0))
             .expect("update");
         renderer.render(&settings).expect("render");
-        if k == 9 || k == 119 {
+        if k == 9 || k == 299 {
             at.push(device.memory_usage());
         }
     }
-    println!("device memory at frames 10 and 120: {at:?}");
+    println!("device memory at frames 10 and 300: {at:?}");
     assert_eq!(at[0].allocated_bytes, at[1].allocated_bytes, "{at:?}");
     assert_eq!(at[0].allocations, at[1].allocations, "{at:?}");
     common::assert_clean(&device);

@@ -32,7 +32,8 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = DEFAULT_FPS)]
     fps: f32,
     /// Turn the camera by this many degrees about the vertical axis through the scene's
-    /// centre over the sequence (frame k at k / N of it: 360 loops seamlessly).
+    /// centre over the sequence (frame k at k / N of it: 360 loops seamlessly). Meant for
+    /// scenes seen from outside: a camera inside a room leaves it.
     #[arg(long)]
     camera_orbit: Option<f32>,
     #[command(flatten)]
