@@ -1,7 +1,9 @@
 //! The CPU side of a frame update, measured: evaluating a [`FrameUpdate`] (animation, world
-//! matrices, lights, bounds) on the built-in scenes, and rebuilding the top-level BVH over
-//! 10 to 10 000 instances (the scenes have tens; the larger counts show where a GPU build
-//! would start to pay). Numbers go to docs/performance.md.
+//! matrices, lights, morph weights, joint matrices, bounds) on the built-in scenes; the whole
+//! host side of a frame's update (`GpuScene::update` + `GpuScene::declare`: instance records,
+//! the deformers' CPU refit, the top level, staging writes); and rebuilding the top-level BVH
+//! over 10 to 10 000 instances (the scenes have tens; the larger counts show where a GPU
+//! build would start to pay). Numbers go to docs/performance.md.
 //!
 //! ```text
 //! cargo run --release --example update_cost
@@ -11,7 +13,9 @@ use std::time::Instant;
 
 use glam::{Mat4, Quat, Vec3};
 use shine::gpu_scene::bvh::{TopInstance, TopLevel};
-use shine::gpu_scene::{FrameState, FrameUpdate};
+use shine::gpu::{Device, DeviceDesc};
+use shine::gpu_scene::{FrameState, FrameUpdate, GpuScene};
+use shine::graph::Executor;
 use shine_scene::{Aabb, Scene};
 
 /// Median over `runs` of `f`'s wall time, in microseconds.
@@ -40,6 +44,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ));
         });
         println!("  {name:<12} {:>4} nodes  {us:>8.1} µs", scene.nodes.len());
+    }
+    println!("GpuScene::update + declare (host side of a frame's update), median of 100:");
+    let device = Device::new(&DeviceDesc::from_env())?;
+    let executor = Executor::new(&device, 2)?;
+    for name in shine_scene::builtin::names() {
+        let scene = Scene::builtin(name)?;
+        let mut gpu = GpuScene::upload(&device, &scene, 0.0)?;
+        let mut k = 0u32;
+        let mut failed = None;
+        let us = median_us(100, || {
+            k += 1;
+            let mut rg = executor.begin_frame();
+            let result = gpu
+                .update(&FrameUpdate::at(k as f32 / 60.0))
+                .and_then(|()| gpu.declare(&mut rg).map(|_| ()));
+            if let Err(e) = result {
+                failed = Some(e);
+            }
+        });
+        if let Some(e) = failed {
+            return Err(e.into());
+        }
+        println!("  {name:<12} {:>6} triangles  {us:>8.1} µs", scene.triangle_count());
     }
     println!("TopLevel::build (CPU, binned SAH over instance boxes), median of 50:");
     let unit = Aabb {

@@ -429,9 +429,15 @@ pub fn build_over_boxes(boxes: &[Aabb]) -> (Vec<BvhNode>, Vec<u32>) {
     (nodes, items.iter().map(|item| item.index).collect())
 }
 
-/// Builds the nodes over `items` (non-empty), on as many threads as the machine has.
+/// Builds the nodes over `items` (non-empty), on as many threads as the machine has when
+/// there are enough items to share (asking the OS costs tens of microseconds: more than a
+/// top level over tens of instances takes to build, every frame).
 fn build_items(items: &mut [Item]) -> Vec<BvhNode> {
-    let threads = std::thread::available_parallelism().map_or(1, |t| t.get());
+    let threads = if items.len() >= PARALLEL_MIN {
+        std::thread::available_parallelism().map_or(1, |t| t.get())
+    } else {
+        1
+    };
     build_subtree(items, 0, threads)
 }
 
