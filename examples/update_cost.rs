@@ -12,8 +12,8 @@
 use std::time::Instant;
 
 use glam::{Mat4, Quat, Vec3};
-use shine::gpu_scene::bvh::{TopInstance, TopLevel};
 use shine::gpu::{Device, DeviceDesc};
+use shine::gpu_scene::bvh::{TopInstance, TopLevel};
 use shine::gpu_scene::{FrameState, FrameUpdate, GpuScene};
 use shine::graph::Executor;
 use shine_scene::{Aabb, Scene};
@@ -66,7 +66,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         if let Some(e) = failed {
             return Err(e.into());
         }
-        println!("  {name:<12} {:>6} triangles  {us:>8.1} µs", scene.triangle_count());
+        println!(
+            "  {name:<12} {:>6} triangles  {us:>8.1} µs",
+            scene.triangle_count()
+        );
     }
     println!("TopLevel::build (CPU, binned SAH over instance boxes), median of 50:");
     let unit = Aabb {

@@ -190,6 +190,11 @@ fn run_gpu(device: &Device, s: &Synthetic, params: &AafParams) -> GpuResult {
         material: import(&mut rg, &material),
         emissive: unused(&mut rg, "unused emissive", vk::Format::R16G16B16A16_SFLOAT),
         geometric_normal: unused(&mut rg, "unused normal", vk::Format::R16G16B16A16_SFLOAT),
+        motion: unused(
+            &mut rg,
+            "unused motion",
+            shine::passes::gbuffer::MOTION_FORMAT,
+        ),
         depth: unused(&mut rg, "unused depth", vk::Format::D32_SFLOAT),
         extent: e,
     };

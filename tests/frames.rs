@@ -4,7 +4,7 @@
 
 mod common;
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use shine::capture::image_io::HdrImage;
 use shine::gpu::vk;
 use shine::gpu_scene::{FrameUpdate, GpuScene, Vertex};
@@ -242,5 +242,137 @@ fn bad_updates_are_refused() {
     }
     let after = renderer.render(&settings("none")).expect("render");
     assert_eq!(after.hdr, before.hdr);
+    common::assert_clean(&device);
+}
+
+/// Runs the frame graph `rg` and reads `images` (one mip and layer, of the given byte sizes)
+/// back.
+fn run_and_read(
+    device: &shine::gpu::Device,
+    executor: &mut Executor,
+    mut rg: shine::graph::RenderGraph,
+    images: &[(&shine::graph::Handle<shine::graph::Image>, u64)],
+) -> Vec<Vec<u8>> {
+    let buffers: Vec<_> = images
+        .iter()
+        .map(|(_, bytes)| {
+            common::buffer(
+                device,
+                "readback",
+                *bytes,
+                vk::BufferUsageFlags::TRANSFER_DST | vk::BufferUsageFlags::TRANSFER_SRC,
+            )
+        })
+        .collect();
+    for (i, ((image, _), buffer)) in images.iter().zip(&buffers).enumerate() {
+        let mut out =
+            rg.import_gpu_buffer(buffer, ExternalState::UNDEFINED, common::read_by_copy());
+        rg.copy_image_to_buffer(&format!("read back {i}"), image, &mut out);
+    }
+    let mut commands = device.begin_commands().expect("commands");
+    executor.execute(commands.raw(), rg).expect("execute");
+    device
+        .submit(commands)
+        .expect("submit")
+        .wait()
+        .expect("wait");
+    buffers
+        .iter()
+        .map(|b| device.read_buffer(b).expect("read"))
+        .collect()
+}
+
+/// The G-buffer's motion vectors: on a scene's first frame zero; after the whole scene moved
+/// by `d` and the camera moved and jittered, every surface pixel holds where its point is now
+/// minus where it was (`p - d` seen by the previous, unjittered camera), in texture
+/// coordinates.
+#[test]
+fn motion_vectors_follow_the_scene_and_the_camera() {
+    use shine::frame::motion::MotionState;
+    use shine::passes::gbuffer;
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let mut gpu = GpuScene::upload(&device, &scene, 0.0).expect("upload");
+    let mut motion = MotionState::new(&device).expect("motion");
+    let mut executor = Executor::new(&device, 1).expect("executor");
+    let sampler =
+        shine::gpu::Sampler::new(&device, &vk::SamplerCreateInfo::default()).expect("sampler");
+    let extent = [32u32, 32];
+    let pixels = (extent[0] * extent[1]) as usize;
+    let mut frame = |gpu: &mut GpuScene, motion: &mut MotionState| {
+        let mut rg = executor.begin_frame();
+        let handles = gpu.declare(&mut rg).expect("declare");
+        let camera = gbuffer::camera_view(&gpu.state, extent[0], extent[1]);
+        let unjittered = gbuffer::unjittered_camera_view(&gpu.state, extent[0], extent[1]);
+        let view = motion
+            .declare(&mut rg, unjittered.view_proj(), extent)
+            .expect("motion view");
+        let g = gbuffer::gbuffer(&mut rg, &handles, &camera, &view, extent, sampler.raw());
+        let out = run_and_read(
+            &device,
+            &mut executor,
+            rg,
+            &[
+                (&g.position, pixels as u64 * 16),
+                (&g.motion, pixels as u64 * 4),
+            ],
+        );
+        let position: Vec<[f32; 4]> = bytemuck::cast_slice(&out[0]).to_vec();
+        let halves: &[u16] = bytemuck::cast_slice(&out[1]);
+        let motion: Vec<[f32; 2]> = halves
+            .chunks_exact(2)
+            .map(|h| [common::f16_to_f32(h[0]), common::f16_to_f32(h[1])])
+            .collect();
+        (position, motion, unjittered.view_proj())
+    };
+    let (_, first, previous) = frame(&mut gpu, &mut motion);
+    assert!(
+        first.iter().all(|m| m == &[0.0, 0.0]),
+        "motion on the first frame"
+    );
+
+    let d = Vec3::new(0.04, -0.03, 0.05);
+    let nodes = gpu
+        .instances
+        .iter()
+        .map(|r| {
+            let mut t = scene.nodes[r.node as usize].transform;
+            t.translation += d;
+            (r.node as usize, t)
+        })
+        .collect();
+    let camera = shine::CameraPose {
+        world: Mat4::from_translation(Vec3::new(0.03, 0.02, -0.05))
+            * Mat4::from_rotation_y(0.02)
+            * gpu.state.camera_world,
+        projection: gpu.state.projection,
+    };
+    gpu.update(&FrameUpdate {
+        nodes,
+        camera: Some(camera),
+        jitter: [0.3, -0.2],
+        ..FrameUpdate::default()
+    })
+    .expect("update");
+    let (position, got, current) = frame(&mut gpu, &mut motion);
+    let uv = |m: &Mat4, p: Vec3| {
+        let c = *m * p.extend(1.0);
+        glam::Vec2::new(c.x / c.w, c.y / c.w) * 0.5
+    };
+    let mut checked = 0;
+    for (p, m) in position.iter().zip(&got) {
+        if p[3] <= 0.0 {
+            continue;
+        }
+        let p = Vec3::new(p[0], p[1], p[2]);
+        let expected = uv(&current, p) - uv(&previous, p - d);
+        let m = glam::Vec2::from(*m);
+        assert!(
+            (m - expected).abs().max_element() <= 2e-3 + 1e-2 * expected.abs().max_element(),
+            "motion {m} vs {expected}"
+        );
+        checked += 1;
+    }
+    assert!(checked > pixels / 2, "only {checked} surface pixels");
     common::assert_clean(&device);
 }

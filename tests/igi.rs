@@ -277,6 +277,11 @@ fn run_gpu(
         material,
         emissive: unused(&mut rg, "unused emissive", vk::Format::R16G16B16A16_SFLOAT),
         geometric_normal,
+        motion: unused(
+            &mut rg,
+            "unused motion",
+            shine::passes::gbuffer::MOTION_FORMAT,
+        ),
         depth: unused(&mut rg, "unused depth", vk::Format::D32_SFLOAT),
         extent: e,
     };
@@ -515,6 +520,7 @@ fn bad_parameters_are_errors() {
         material: h,
         emissive: h,
         geometric_normal: h,
+        motion: h,
         depth: h,
         extent: [8, 8],
     };

@@ -143,6 +143,7 @@ impl GpuGBuffer {
                 "unused geometric normal",
                 vk::Format::R16G16B16A16_SFLOAT,
             ),
+            motion: unused(rg, "unused motion", shine::passes::gbuffer::MOTION_FORMAT),
             depth: unused(rg, "unused depth", vk::Format::D32_SFLOAT),
             extent: self.extent,
         }
@@ -231,6 +232,7 @@ fn bad_scales_extents_and_parameters_are_errors() {
         material: h,
         emissive: h,
         geometric_normal: h,
+        motion: h,
         depth: h,
         extent: [8, 8],
     };

@@ -7,6 +7,7 @@ use super::aaf::{AafInputs, AafTechnique};
 use super::error::RenderError;
 use super::hvl::{HvlInputs, HvlTechnique};
 use super::igi::{IgiInputs, IgiTechnique};
+use super::motion::MotionState;
 use super::params::FrameParams;
 use super::proxy::ProxyTechnique;
 use super::shadows::ShadowState;
@@ -15,7 +16,7 @@ use crate::gpu_scene::{FRAMES_IN_FLIGHT, FrameUpdate, GpuScene, SAMPLED_READ};
 use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::gbuffer;
 use crate::passes::gi_add::gi_add;
-use crate::passes::{direct, receivers, rsm, upsample};
+use crate::passes::{direct, history, receivers, rsm, upsample};
 use crate::profile::report::PassClock;
 use crate::settings::Settings;
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
@@ -116,6 +117,8 @@ pub struct Renderer {
     igi: IgiTechnique,
     /// Axis-aligned filtering of path-traced indirect light (paper 004).
     aaf: AafTechnique,
+    /// The previous frame's camera, for motion vectors.
+    motion: MotionState,
     /// Readback buffers of [`Renderer::render`].
     readback: Option<Readback>,
 }
@@ -180,6 +183,7 @@ impl Renderer {
             hvl: HvlTechnique::new(device),
             igi: IgiTechnique::new(device),
             aaf: AafTechnique,
+            motion: MotionState::new(device)?,
             readback: None,
         })
     }
@@ -203,6 +207,7 @@ impl Renderer {
         }
         self.scene = Some(state);
         self.shadows = None;
+        self.motion.reset();
         Ok(())
     }
 
@@ -412,7 +417,11 @@ impl Renderer {
         };
         let [width, height] = p.extent;
         let camera = gbuffer::camera_view(frame, width, height);
-        let g = gbuffer::gbuffer(rg, &handles, &camera, p.extent, textures);
+        let unjittered = gbuffer::unjittered_camera_view(frame, width, height).view_proj();
+        let motion_view = self.motion.declare(rg, unjittered, p.extent)?;
+        let g = gbuffer::gbuffer(rg, &handles, &camera, &motion_view, p.extent, textures);
+        // Kept for the next frame (its previous normal and depth); nothing reads it yet.
+        history::gbuffer_history(rg, &g);
         let light_count = u32::try_from(frame.lights.len())
             .map_err(|_| RenderError::Invalid("too many lights".into()))?;
         let atlas = shadows.declare(rg, &handles)?;

@@ -103,6 +103,9 @@ pub const FRAMES_IN_FLIGHT: usize = 2;
 pub struct SceneHandles {
     /// World-space vertices ([`Vertex`]), written by `update vertices`.
     pub vertices: Handle<shine_graph::Buffer>,
+    /// The previous frame's world-space vertices (this frame's on a scene's first frame):
+    /// the G-buffer's motion vectors start from them.
+    pub prev_vertices: Handle<shine_graph::Buffer>,
     /// Index buffer.
     pub indices: Handle<shine_graph::Buffer>,
     /// Materials.
@@ -125,6 +128,10 @@ pub struct GpuScene {
     pub source_vertices: Buffer,
     /// World-space vertices ([`Vertex`]), rewritten every frame.
     pub vertices: Buffer,
+    /// The previous frame's world-space vertices.
+    pub prev_vertices: Buffer,
+    /// Whether a frame was declared since upload (`prev_vertices` holds something).
+    has_previous: bool,
     /// Triangle-list indices (u32), shared by both vertex buffers.
     pub indices: Buffer,
     /// Number of indices.
@@ -222,6 +229,12 @@ impl GpuScene {
                     | vk::BufferUsageFlags::STORAGE_BUFFER
                     | vk::BufferUsageFlags::TRANSFER_SRC,
             )?,
+            prev_vertices: dynamic(
+                "scene previous vertices",
+                vertex_bytes,
+                vk::BufferUsageFlags::STORAGE_BUFFER,
+            )?,
+            has_previous: false,
             indices: storage(
                 "scene indices",
                 bytemuck::cast_slice(&geometry.indices),
@@ -412,9 +425,20 @@ impl GpuScene {
             vertex_count: self.vertex_count,
         };
         let mut vertices = rg.import_gpu_buffer(&self.vertices, BUFFER_READ, BUFFER_READ);
-        update_vertices(rg, &inputs, &mut vertices);
+        let mut prev_vertices = rg.import_gpu_buffer(&self.prev_vertices, BUFFER_READ, BUFFER_READ);
+        // The last frame's vertices become the previous ones before they are rewritten; on
+        // the first frame the previous ones are this frame's (no motion).
+        if self.has_previous {
+            rg.copy_buffer("update previous vertices", &vertices, &mut prev_vertices);
+            update_vertices(rg, &inputs, &mut vertices);
+        } else {
+            update_vertices(rg, &inputs, &mut vertices);
+            rg.copy_buffer("update previous vertices", &vertices, &mut prev_vertices);
+            self.has_previous = true;
+        }
         Ok(SceneHandles {
             vertices,
+            prev_vertices,
             indices: rg.import_gpu_buffer(&self.indices, BUFFER_READ, BUFFER_READ),
             materials: rg.import_gpu_buffer(&self.materials, BUFFER_READ, BUFFER_READ),
             lights,

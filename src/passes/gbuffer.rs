@@ -90,12 +90,21 @@ pub(crate) fn flip_y(mut proj: Mat4) -> Mat4 {
 /// The camera view of `frame` for a `width`×`height` image, its projection offset by the
 /// frame's sub-pixel jitter.
 pub fn camera_view(frame: &FrameState, width: u32, height: u32) -> View {
+    jittered_camera_view(frame, width, height, frame.jitter)
+}
+
+/// The camera view of `frame` without its jitter (motion vectors compare these).
+pub fn unjittered_camera_view(frame: &FrameState, width: u32, height: u32) -> View {
+    jittered_camera_view(frame, width, height, [0.0; 2])
+}
+
+/// The camera view offset by `[jx, jy]` pixels.
+fn jittered_camera_view(frame: &FrameState, width: u32, height: u32, [jx, jy]: [f32; 2]) -> View {
     let aspect = width as f32 / height.max(1) as f32;
     let view = frame.camera_world.inverse();
     let eye = frame.camera_world.transform_point3(Vec3::ZERO);
     // A shift by (jx, jy) pixels is 2j / size in clip space (Vulkan clip y points down, as
     // image rows do).
-    let [jx, jy] = frame.jitter;
     let jitter = Mat4::from_translation(Vec3::new(
         2.0 * jx / width.max(1) as f32,
         2.0 * jy / height.max(1) as f32,
@@ -203,21 +212,39 @@ pub struct GBuffer {
     /// World geometric normal: the interpolated vertex normal before normal mapping, facing
     /// the camera (`gb_geometric_normal`, RGBA16F; paper 000's filter tests it).
     pub geometric_normal: Handle<Image>,
+    /// Motion: texture coordinates now minus where the surface point was in the previous
+    /// frame (RG16F; jitter excluded; zero on the background and on a scene's first frame).
+    pub motion: Handle<Image>,
     /// Hardware depth.
     pub depth: Handle<Image>,
     /// Width and height.
     pub extent: [u32; 2],
 }
 
+/// Format of [`GBuffer::motion`].
+pub const MOTION_FORMAT: vk::Format = vk::Format::R16G16_SFLOAT;
+
+/// Both frames' unjittered world-to-clip matrices, as `gbuffer.vert` reads them (128 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct MotionView {
+    /// The previous frame's camera.
+    pub previous: [[f32; 4]; 4],
+    /// This frame's camera.
+    pub current: [[f32; 4]; 4],
+}
+
 /// The pipeline of every scene raster pass: the flattened scene's vertices through
-/// `gbuffer.vert`, an optional fragment shader and colour targets, depth tested and written.
+/// `gbuffer.vert` (`vertex`: its plain or motion variant), an optional fragment shader and
+/// colour targets, depth tested and written.
 pub(crate) fn scene_pipeline(
+    vertex: &'static shine_gpu::ShaderDesc,
     fragment: Option<&'static shine_gpu::ShaderDesc>,
     colors: &[vk::Format],
     depth_bias: Option<(f32, f32)>,
 ) -> GraphicsPipelineDesc {
     GraphicsPipelineDesc {
-        vertex: &shaders::GBUFFER_VERT,
+        vertex,
         fragment,
         vertex_buffers: vec![VertexBufferLayout {
             stride: std::mem::size_of::<Vertex>() as u32,
@@ -236,11 +263,13 @@ pub(crate) fn scene_pipeline(
     }
 }
 
-/// Rasterises the scene from the camera into a new G-buffer.
+/// Rasterises the scene from the camera into a new G-buffer; `motion_view` holds the
+/// [`MotionView`] of the frame (the previous vertices are the scene's).
 pub fn gbuffer(
     rg: &mut RenderGraph,
     scene: &SceneHandles,
     view: &View,
+    motion_view: &Handle<shine_graph::Buffer>,
     extent: [u32; 2],
     sampler: vk::Sampler,
 ) -> GBuffer {
@@ -254,10 +283,12 @@ pub fn gbuffer(
         material: image(rg, "gb_material", vk::Format::R8G8B8A8_UNORM),
         emissive: image(rg, "gb_emissive", vk::Format::R16G16B16A16_SFLOAT),
         geometric_normal: image(rg, "gb_geometric_normal", vk::Format::R16G16B16A16_SFLOAT),
+        motion: image(rg, "gb_motion", MOTION_FORMAT),
         depth: image(rg, "depth", vk::Format::D32_SFLOAT),
         extent,
     };
     let pipeline = scene_pipeline(
+        &shaders::GBUFFER_VERT_MOTION,
         Some(&shaders::GBUFFER_FRAG),
         &[
             vk::Format::R32G32B32A32_SFLOAT,
@@ -266,6 +297,7 @@ pub fn gbuffer(
             vk::Format::R8G8B8A8_UNORM,
             vk::Format::R16G16B16A16_SFLOAT,
             vk::Format::R16G16B16A16_SFLOAT,
+            MOTION_FORMAT,
         ],
         None,
     );
@@ -276,7 +308,10 @@ pub fn gbuffer(
         .color(&mut g.material, ColorLoad::Clear([0.0; 4]))
         .color(&mut g.emissive, ColorLoad::Clear([0.0; 4]))
         .color(&mut g.geometric_normal, ColorLoad::Clear([0.0; 4]))
+        .color(&mut g.motion, ColorLoad::Clear([0.0; 4]))
         .depth(&mut g.depth, DepthLoad::Clear(1.0))
+        .read("prev_vertices", &scene.prev_vertices)
+        .read("motion_view", motion_view)
         .read("materials", &scene.materials)
         .read("srgb_textures", &scene.srgb_textures)
         .read("linear_textures", &scene.linear_textures)

@@ -8,6 +8,7 @@ pub mod composite;
 pub mod direct;
 pub mod gbuffer;
 pub mod gi_add;
+pub mod history;
 pub mod hvl;
 pub mod igi;
 pub mod path_trace;

@@ -78,6 +78,7 @@ pub fn rsm(
         size,
     };
     let pipeline = scene_pipeline(
+        &shaders::GBUFFER_VERT_PLAIN,
         Some(&shaders::RSM_FRAG),
         &[
             vk::Format::R32G32B32A32_SFLOAT,

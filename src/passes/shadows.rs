@@ -16,6 +16,7 @@
 
 use super::gbuffer::{View, flip_y, light_view, scene_pipeline};
 use crate::gpu_scene::{FrameState, SceneHandles};
+use crate::shaders;
 use glam::{Mat4, Vec3};
 use shine_gpu::{GraphicsPipelineDesc, vk};
 use shine_graph::{DepthLoad, Handle, Image, ImageDesc, RenderGraph};
@@ -308,5 +309,5 @@ pub fn shadow_atlas(
 /// Depth-only scene pipeline with a slope-scaled bias against acne (constant in depth units,
 /// slope factor); the direct pass adds a normal offset on top.
 fn shadow_pipeline() -> GraphicsPipelineDesc {
-    scene_pipeline(None, &[], Some((1.0, 1.5)))
+    scene_pipeline(&shaders::GBUFFER_VERT_PLAIN, None, &[], Some((1.0, 1.5)))
 }

@@ -11,6 +11,7 @@ use shine_scene::Scene;
 use super::metrics::{self, ImageError};
 use super::{Progress, StudyError};
 use crate::frame::RenderError;
+use crate::frame::motion::MotionState;
 use crate::gpu_scene::GpuScene;
 use crate::passes::aaf::{self, AafParams, AafScene};
 use crate::passes::gbuffer::{self, View};
@@ -69,6 +70,7 @@ pub struct AafRunner {
     device: Device,
     executor: Executor,
     scene: GpuScene,
+    motion: MotionState,
     sampler: Sampler,
     extent: [u32; 2],
     camera: View,
@@ -121,6 +123,7 @@ impl AafRunner {
             device: device.clone(),
             executor: Executor::new(device, 1).map_err(RenderError::from)?,
             scene: gpu,
+            motion: MotionState::new(device)?,
             sampler,
             extent,
             camera,
@@ -152,10 +155,15 @@ impl AafRunner {
         let [w, h] = self.extent;
         let mut rg = self.executor.begin_frame();
         let handles = self.scene.declare(&mut rg).map_err(RenderError::from)?;
+        // A still camera: no motion.
+        let motion_view = self
+            .motion
+            .declare(&mut rg, self.camera.view_proj(), self.extent)?;
         let g = gbuffer::gbuffer(
             &mut rg,
             &handles,
             &self.camera,
+            &motion_view,
             self.extent,
             self.sampler.raw(),
         );
