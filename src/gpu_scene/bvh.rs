@@ -20,7 +20,7 @@
 use glam::{Mat4, Vec3};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
 use shine_scene::bvh::{Bvh, BvhNode, BvhTriangle, build_over_boxes};
-use shine_scene::{Aabb, Scene};
+use shine_scene::{Aabb, Mesh, Scene};
 
 use crate::gpu_scene::SceneUploadError;
 use crate::graph::{ExternalState, Handle, RenderGraph};
@@ -122,38 +122,10 @@ impl BottomLevels {
         for mesh in &scene.meshes {
             let mut soup = Vec::new();
             for (p, primitive) in mesh.primitives.iter().enumerate() {
-                let get = |i: u32| {
-                    primitive
-                        .positions
-                        .get(i as usize)
-                        .copied()
-                        .unwrap_or_default()
-                        .to_array()
-                };
-                for (t, tri) in primitive.indices.chunks_exact(3).enumerate() {
-                    soup.push(BvhTriangle {
-                        v0: get(tri[0]),
-                        instance: 0,
-                        v1: get(tri[1]),
-                        primitive: p as u32,
-                        v2: get(tri[2]),
-                        triangle: t as u32,
-                    });
-                }
+                push_triangles(&primitive.positions, &primitive.indices, p, &mut soup);
             }
-            // Index of a primitive's first triangle within the mesh.
-            let starts: Vec<u32> = mesh
-                .primitives
-                .iter()
-                .scan(0u32, |next, p| {
-                    let start = *next;
-                    *next += p.triangle_count() as u32;
-                    Some(start)
-                })
-                .collect();
-            let (root, bounds) = out.append(&Bvh::build(soup), |t| {
-                starts.get(t.primitive as usize).copied().unwrap_or(0) + t.triangle
-            });
+            let starts = triangle_starts(mesh);
+            let (root, bounds) = out.append(&Bvh::build(soup), |t| local_index(&starts, t));
             out.roots.push(root);
             out.bounds.push(bounds);
         }
@@ -190,6 +162,51 @@ impl BottomLevels {
         };
         (node_base, bounds)
     }
+}
+
+/// Appends the triangles of primitive `primitive` (its `positions` indexed by `indices`) to
+/// `out`, for a BVH build.
+pub fn push_triangles(
+    positions: &[Vec3],
+    indices: &[u32],
+    primitive: usize,
+    out: &mut Vec<BvhTriangle>,
+) {
+    let get = |i: u32| {
+        positions
+            .get(i as usize)
+            .copied()
+            .unwrap_or_default()
+            .to_array()
+    };
+    for (t, tri) in indices.chunks_exact(3).enumerate() {
+        out.push(BvhTriangle {
+            v0: get(tri[0]),
+            instance: 0,
+            v1: get(tri[1]),
+            primitive: primitive as u32,
+            v2: get(tri[2]),
+            triangle: t as u32,
+        });
+    }
+}
+
+/// Per primitive of `mesh`, the index of its first triangle within the mesh (primitives
+/// concatenated in order): how flattened triangle indices are made.
+pub fn triangle_starts(mesh: &Mesh) -> Vec<u32> {
+    mesh.primitives
+        .iter()
+        .scan(0u32, |next, p| {
+            let start = *next;
+            *next += p.triangle_count() as u32;
+            Some(start)
+        })
+        .collect()
+}
+
+/// A bottom-level triangle's index within its mesh.
+pub fn local_index(starts: &[u32], t: &BvhTriangle) -> u32 {
+    starts.get(t.primitive as usize).copied().unwrap_or(0) + t.triangle
 }
 
 /// The top level of one frame (CPU side).

@@ -4,11 +4,10 @@
 //! vertices). They come first in the bottom-level buffers, so one prefix copy per frame
 //! refreshes all of them (docs/performance.md has the cost).
 
-use glam::Vec3;
 use shine_scene::bvh::{Bvh, BvhTriangle};
 use shine_scene::{Aabb, Instance, Pose, Scene};
 
-use super::bvh::BottomLevels;
+use super::bvh::{BottomLevels, local_index, push_triangles, triangle_starts};
 use super::geometry::InstanceRange;
 
 /// One deforming instance's bottom level.
@@ -51,25 +50,8 @@ fn triangles(scene: &Scene, range: &InstanceRange, pose: &Pose) -> Vec<BvhTriang
         return out;
     };
     for (p, primitive) in mesh.primitives.iter().enumerate() {
-        let Some(v) = scene.instance_vertices(pose, &inst, p) else {
-            continue;
-        };
-        let get = |i: u32| {
-            v.positions
-                .get(i as usize)
-                .copied()
-                .unwrap_or(Vec3::ZERO)
-                .to_array()
-        };
-        for (t, tri) in primitive.indices.chunks_exact(3).enumerate() {
-            out.push(BvhTriangle {
-                v0: get(tri[0]),
-                instance: 0,
-                v1: get(tri[1]),
-                primitive: p as u32,
-                v2: get(tri[2]),
-                triangle: t as u32,
-            });
+        if let Some(v) = scene.instance_vertices(pose, &inst, p) {
+            push_triangles(&v.positions, &primitive.indices, p, &mut out);
         }
     }
     out
@@ -91,19 +73,10 @@ impl Deformers {
             if !scene.is_deforming(&instance(range, pose)) {
                 continue;
             }
-            let starts: Vec<u32> = scene
+            let starts = scene
                 .meshes
                 .get(range.mesh as usize)
-                .map(|m| {
-                    m.primitives
-                        .iter()
-                        .scan(0u32, |next, p| {
-                            let start = *next;
-                            *next += p.triangle_count() as u32;
-                            Some(start)
-                        })
-                        .collect()
-                })
+                .map(triangle_starts)
                 .unwrap_or_default();
             let bvh = Bvh::build(triangles(scene, range, pose));
             roots[i] = Some(bottom.append(&bvh, |t| local_index(&starts, t)));
@@ -148,9 +121,4 @@ impl Deformers {
         }
         (prefix, roots)
     }
-}
-
-/// A triangle's index within its mesh (primitives concatenated).
-fn local_index(starts: &[u32], t: &BvhTriangle) -> u32 {
-    starts.get(t.primitive as usize).copied().unwrap_or(0) + t.triangle
 }
