@@ -347,3 +347,31 @@ fn render_writes_every_frame_of_a_sequence() {
     assert!(stderr.contains("no frame field"), "{stderr}");
     assert_eq!(std::fs::read_dir(&refused).expect("dir").count(), 0);
 }
+
+/// Broken skins are refused with a message naming the element, and no image is written: a
+/// joint naming a node that does not exist, a joint index past the skin, a NaN weight.
+#[test]
+fn render_refuses_broken_skins_and_writes_nothing() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_broken_skins");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("tmp dir");
+    let broken = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("crates/scene/tests/broken");
+    for (file, message) in [
+        ("skin-dangling-joint.gltf", "skins[0].joints[1]"),
+        ("joint-out-of-range.gltf", "joint index 1 is out of range"),
+        ("nan-weight.gltf", "WEIGHTS_0: element 5 has a NaN"),
+    ] {
+        let run = shine()
+            .args(["render"])
+            .arg(broken.join(file))
+            .args(["--width", "16", "--height", "16", "-o"])
+            .arg(dir.join("out.png"))
+            .output()
+            .expect("run shine render");
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(1), "{file}: {stderr}");
+        assert!(stderr.contains(message), "{file}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert_eq!(std::fs::read_dir(&dir).expect("dir").count(), 0, "{file}");
+    }
+}
