@@ -109,7 +109,9 @@ layout(push_constant) uniform Push {
     vec2 roughness_nodes;
     // number of glossy tables
     uint glossy_tables;
-    uint pad;
+    // 0: every receiver; 1 + k: only the receiver at offset (k & 1, k >> 1) of every 2×2
+    // cell (amortised frames, src/passes/hvl/resolve.rs)
+    uint slice;
 } push;
 
 // Receivers closer than this to an HVL centre get nothing from it (metres).
@@ -128,6 +130,10 @@ void glossy_row(float roughness, float theta_o, out float f[SH_COEFFS]) {
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    if (push.slice != 0u) {
+        uint k = push.slice - 1u;
+        px = 2 * px + ivec2(k & 1u, k >> 1u);
+    }
     if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
         return;
     }

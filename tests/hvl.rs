@@ -157,6 +157,7 @@ fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
         emission_bands,
         path,
         visibility: false,
+        slices: 1,
     }
 }
 
@@ -344,6 +345,7 @@ fn gpu_gather(
         bvh_handles.as_ref(),
         camera,
         params,
+        0,
     )
     .unwrap();
     read_indirect(&mut rg, &indirect, &readback);
@@ -804,7 +806,8 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
         let recv = recv_images.import(&mut rg, RECV);
         let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
         let hvls = hvl_cache(&mut rg, &rsm_handles, &p).unwrap();
-        let indirect = hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, None, CAMERA, &p).unwrap();
+        let indirect =
+            hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, None, CAMERA, &p, 0).unwrap();
         read_indirect(&mut rg, &indirect, &readback);
         run(&device, &mut executor, rg);
         let out = decode_rgba16f(&device.read_buffer(&readback).unwrap());

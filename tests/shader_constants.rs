@@ -104,3 +104,32 @@ fn scene_encodings_match_the_shaders() {
         assert_eq!(light.light_kind(), Some(kind), "{name}");
     }
 }
+
+/// The value of the float constant `name` in `shaders/<file>`, written
+/// `const float NAME = 0.5;`.
+fn glsl_float(file: &str, name: &str) -> f32 {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("shaders")
+        .join(file);
+    let source = std::fs::read_to_string(&path).expect("shader source");
+    source
+        .lines()
+        .map(str::trim)
+        .find_map(|line| {
+            let rest = line.strip_prefix(&format!("const float {name} ="))?;
+            rest.trim().trim_end_matches(';').trim().parse().ok()
+        })
+        .unwrap_or_else(|| panic!("{name} is not a float constant in {}", path.display()))
+}
+
+#[test]
+fn hvl_resolve_constants_match_the_shader() {
+    use shine::passes::hvl::resolve::{RESOLVE_ALPHA, RESOLVE_DEPTH_TOLERANCE, RESOLVE_NORMAL_COS};
+    let file = "include/hvl_resolve.glsl";
+    assert_eq!(glsl_float(file, "RESOLVE_ALPHA"), RESOLVE_ALPHA);
+    assert_eq!(
+        glsl_float(file, "RESOLVE_DEPTH_TOLERANCE"),
+        RESOLVE_DEPTH_TOLERANCE
+    );
+    assert_eq!(glsl_float(file, "RESOLVE_NORMAL_COS"), RESOLVE_NORMAL_COS);
+}

@@ -1,6 +1,9 @@
 //! The HVL technique (paper 003) as the frame uses it: the BRDF SH tables it keeps on the
 //! device, and the passes it adds to a frame (`hvl_cache` over the primary light's RSM, then
-//! `hvl_gather` at every receiver; `src/passes/hvl/mod.rs`).
+//! `hvl_gather` at every receiver; `src/passes/hvl/mod.rs`). With `hvl.slices = 4` the gather
+//! is amortised over frames (paper 001): one receiver per 2×2 cell per frame, the rest
+//! reprojected by `hvl_resolve` (`src/passes/hvl/resolve.rs`) from the history this object
+//! keeps track of.
 
 use glam::Vec3;
 use shine_gpu::Device;
@@ -10,20 +13,26 @@ use super::error::RenderError;
 use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::brdf_tables::BrdfTables;
-use crate::passes::hvl::{self, HvlParams};
+use crate::passes::hvl::{self, HvlParams, resolve};
 use crate::passes::receivers::Receivers;
 use crate::passes::rsm::Rsm;
 
-/// The HVL technique's persistent state: its receiver BRDF tables per band count.
+/// The HVL technique's persistent state: its receiver BRDF tables per band count, and which
+/// frame last wrote the amortised gather's history.
 pub struct HvlTechnique {
     device: Device,
     brdf: BrdfTables,
+    /// Frame number and receiver extent of the last frame that resolved into the history.
+    last_resolve: Option<(u64, [u32; 2])>,
 }
 
 /// An HVL frame ready to be declared: its parameters and its tables imported into the graph.
 pub struct PreparedHvl {
     params: HvlParams,
     brdf: Handle<Buffer>,
+    /// Amortised frames: the refreshed slice (0: every receiver) and whether the history
+    /// holds the previous frame.
+    amortised: Option<(u32, bool)>,
 }
 
 /// What the HVL passes read from the rest of the frame.
@@ -36,6 +45,8 @@ pub struct HvlInputs<'a> {
     pub bvh: &'a TraceBuffers,
     /// The camera position (the gather's view direction).
     pub camera: Vec3,
+    /// The G-buffer's motion vectors (amortised frames reproject with them).
+    pub motion: &'a Handle<Image>,
 }
 
 impl HvlTechnique {
@@ -44,20 +55,44 @@ impl HvlTechnique {
         Self {
             device: device.clone(),
             brdf: BrdfTables::default(),
+            last_resolve: None,
         }
     }
 
+    /// Forgets the history (a new scene).
+    pub fn reset(&mut self) {
+        self.last_resolve = None;
+    }
+
     /// Uploads the BRDF tables `params` needs (once per band count) and imports them into
-    /// `rg`.
+    /// `rg`; for amortised frames (`params.slices > 1`) at receivers of `receiver_extent`,
+    /// picks this frame's slice. Without the previous frame's history (first frame, a resize,
+    /// a frame skipped) the gather shades every receiver.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
         params: HvlParams,
+        receiver_extent: [u32; 2],
     ) -> Result<PreparedHvl, RenderError> {
         let table = self.brdf.get(&self.device, params.conv_bands)?;
+        let frame = rg.frame();
+        let amortised = (params.slices > 1).then(|| {
+            let has_history = self.last_resolve == Some((frame.wrapping_sub(1), receiver_extent));
+            self.last_resolve = Some((frame, receiver_extent));
+            let slice = if has_history {
+                resolve::slice_of_frame(frame)
+            } else {
+                0
+            };
+            (slice, has_history)
+        });
+        if amortised.is_none() {
+            self.last_resolve = None;
+        }
         Ok(PreparedHvl {
             params,
             brdf: rg.import_gpu_buffer(table, BUFFER_READ, BUFFER_READ),
+            amortised,
         })
     }
 }
@@ -72,7 +107,8 @@ impl PreparedHvl {
     ) -> Result<Handle<Image>, RenderError> {
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &self.params)?;
         let bvh = self.params.visibility.then_some(inputs.bvh);
-        Ok(hvl::hvl_gather(
+        let (slice, has_history) = self.amortised.unwrap_or((0, false));
+        let gathered = hvl::hvl_gather(
             rg,
             inputs.receivers,
             &hvls,
@@ -80,6 +116,20 @@ impl PreparedHvl {
             bvh,
             inputs.camera,
             &self.params,
+            slice,
+        )?;
+        if self.amortised.is_none() {
+            return Ok(gathered);
+        }
+        let mut history = resolve::ResolveHistory::declare(rg, inputs.receivers.extent);
+        Ok(resolve::hvl_resolve(
+            rg,
+            inputs.receivers,
+            &gathered,
+            inputs.motion,
+            &mut history,
+            slice,
+            has_history,
         )?)
     }
 }

@@ -83,6 +83,7 @@ impl FrameParams {
                 emission_bands: h.emission_bands,
                 path: h.gather,
                 visibility: h.visibility,
+                slices: h.slices,
             }),
             igi: gi.contains(GiTechnique::Igi).then_some(IgiParams {
                 pattern: [i.n, i.m],

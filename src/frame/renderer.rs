@@ -208,6 +208,7 @@ impl Renderer {
         self.scene = Some(state);
         self.shadows = None;
         self.motion.reset();
+        self.hvl.reset();
         Ok(())
     }
 
@@ -401,7 +402,11 @@ impl Renderer {
             p.shadow.pcf_radius,
         )?;
         let shadows = self.shadows.insert(shadows);
-        let hvl = p.hvl.map(|h| self.hvl.prepare(rg, h)).transpose()?;
+        let receiver_extent = receivers::receiver_extent(p.extent, p.receiver_scale)?;
+        let hvl = p
+            .hvl
+            .map(|h| self.hvl.prepare(rg, h, receiver_extent))
+            .transpose()?;
         let igi = p.igi.map(|i| self.igi.prepare(rg, i)).transpose()?;
         let aaf = p.aaf.map(|a| self.aaf.prepare(a)).transpose()?;
         let proxy = p
@@ -468,6 +473,7 @@ impl Renderer {
                     rsm,
                     bvh: &handles.trace,
                     camera: camera.eye,
+                    motion: &g.motion,
                 },
             )?),
             _ => None,

@@ -320,6 +320,7 @@ pub fn vpls(
         emission_bands: 1,
         path: hvl::GatherPath::Zonal,
         visibility: false,
+        slices: 1,
     };
     Ok(hvl::hvl_cache(rg, rsm, &cache)?)
 }

@@ -17,6 +17,7 @@ pub mod aaf;
 pub mod hvl;
 pub mod igi;
 pub mod proxy;
+pub mod resolve;
 
 use crate::capture::image_io::HdrImage;
 use crate::frame::RenderError;

@@ -191,6 +191,10 @@ pub struct HvlSettings {
     /// Gather path: `full` (any BRDF, O(n²)) or `zonal` (symmetric lobes, O(n)).
     /// Default `full`.
     pub gather: GatherPath,
+    /// Receivers per gather refresh (paper 001): 1 gathers every receiver every frame; 4
+    /// gathers one receiver per 2×2 cell per frame and reprojects the others from the
+    /// previous frames (`hvl_resolve`). Default 1.
+    pub slices: u32,
 }
 
 /// `[rsm]`: reflective shadow map.
@@ -355,6 +359,7 @@ impl Default for HvlSettings {
             emission_bands: h.emission_bands,
             visibility: h.visibility,
             gather: h.path,
+            slices: h.slices,
         }
     }
 }

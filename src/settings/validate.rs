@@ -79,6 +79,13 @@ impl Settings {
                 ),
             });
         }
+        if ![1, hvl::resolve::SLICES].contains(&self.hvl.slices) {
+            return Err(SettingsError::OutOfRange {
+                field: "hvl.slices",
+                value: self.hvl.slices.to_string(),
+                allowed: format!("1 or {}", hvl::resolve::SLICES),
+            });
+        }
         if self.hvl.emission_bands > self.hvl.convolution_bands {
             return Err(SettingsError::OutOfRange {
                 field: "hvl.emission_bands",

@@ -76,6 +76,7 @@ use crate::passes::rsm::{Rsm, RsmProjection};
 use crate::shaders;
 
 mod grid;
+pub mod resolve;
 pub use grid::HvlGrid;
 
 /// Most emission bands an [`Hvl`] stores (paper 003 §3 uses 0–5 bands for the emission).
@@ -145,8 +146,9 @@ pub struct GatherPush {
     pub roughness_nodes: [f32; 2],
     /// Number of glossy tables ([`GLOSSY_TABLES`]).
     pub glossy_tables: u32,
-    /// Padding.
-    pub pad: u32,
+    /// 0: every receiver; 1 + k: one receiver per 2×2 cell, at offset (k & 1, k >> 1)
+    /// ([`resolve::slice_of_frame`]).
+    pub slice: u32,
 }
 
 crate::choice::named_choice! {
@@ -188,6 +190,9 @@ pub struct HvlParams {
     /// Shadow rays from each receiver to each HVL through the scene's BVH (not in paper 003,
     /// whose HVLs are unshadowed).
     pub visibility: bool,
+    /// Receivers per refresh: 1 gathers every receiver every frame; [`resolve::SLICES`]
+    /// gathers one per 2×2 cell and reprojects the rest (paper 001).
+    pub slices: u32,
 }
 
 impl Default for HvlParams {
@@ -202,6 +207,7 @@ impl Default for HvlParams {
             emission_bands: 3,
             path: GatherPath::Full,
             visibility: false,
+            slices: 1,
         }
     }
 }
@@ -488,7 +494,9 @@ fn cache_push(
 /// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
 /// radiance towards `camera` from all `params.count` HVLs of `hvls`, 0 on background), returned.
 /// `brdf` holds [`GatherBrdf::gpu_data`] at `params.conv_bands` bands (unused by the zonal
-/// path); `bvh` is needed when `params.visibility` is set.
+/// path); `bvh` is needed when `params.visibility` is set. `slice` 0 shades every receiver,
+/// 1 + k one per 2×2 cell (the others are left undefined: `hvl_resolve` fills them).
+#[allow(clippy::too_many_arguments)]
 pub fn hvl_gather(
     rg: &mut RenderGraph,
     receivers: &Receivers,
@@ -497,6 +505,7 @@ pub fn hvl_gather(
     bvh: Option<&TraceBuffers>,
     camera: Vec3,
     params: &HvlParams,
+    slice: u32,
 ) -> Result<Handle<Image>, HvlError> {
     let shader = params.validate_gather()?;
     let bvh = match (params.visibility, bvh) {
@@ -543,7 +552,7 @@ pub fn hvl_gather(
         emission_bands: params.emission_bands,
         roughness_nodes: [GLOSSY_ROUGHNESS_MIN, glossy_roughness_step()],
         glossy_tables: GLOSSY_TABLES,
-        pad: 0,
+        slice,
     };
     let mut pass = rg.compute("hvl_gather", shader);
     pass.read("recv_position", &receivers.position)
@@ -557,8 +566,13 @@ pub fn hvl_gather(
     if let Some(b) = bvh {
         b.bind(&mut pass);
     }
+    let threads = if slice == 0 {
+        [w, h, 1]
+    } else {
+        [w.div_ceil(2), h.div_ceil(2), 1]
+    };
     pass.write("indirect", &mut indirect)
         .push(&push)
-        .dispatch([w, h, 1]);
+        .dispatch(threads);
     Ok(indirect)
 }

@@ -1,0 +1,80 @@
+//! CPU twin of `hvl_resolve` (src/passes/hvl/resolve.rs, shaders/hvl_resolve.comp): the
+//! amortised HVL gather's reprojection, disocclusion test and blend, texel for texel.
+
+use glam::{Vec2, Vec3, Vec4};
+
+use crate::passes::hvl::resolve::{RESOLVE_ALPHA, same_surface};
+
+/// The images `hvl_resolve` reads, row-major.
+pub struct ResolveInputs<'a> {
+    /// Receiver extent.
+    pub extent: [u32; 2],
+    /// Full-resolution extent (of `motion`).
+    pub full_extent: [u32; 2],
+    /// Receiver positions (w: linear depth, 0 on the background).
+    pub position: &'a [Vec4],
+    /// Receiver normals.
+    pub normal: &'a [Vec3],
+    /// This frame's gather (valid at the slice's receivers).
+    pub fresh: &'a [Vec4],
+    /// Full-resolution motion (uv now minus uv then).
+    pub motion: &'a [Vec2],
+    /// The previous frame's resolved light.
+    pub history_light: &'a [Vec4],
+    /// The previous frame's (normal, linear depth).
+    pub history_geometry: &'a [Vec4],
+    /// 0: every receiver gathered; 1 + k: the refreshed receiver of each 2×2 cell.
+    pub slice: u32,
+    /// Whether the history holds the previous frame.
+    pub has_history: bool,
+}
+
+/// The resolved light and geometry, as the pass writes them.
+pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
+    let [w, h] = inp.extent;
+    let [fw, fh] = inp.full_extent;
+    let at = |x: u32, y: u32| (y * w + x) as usize;
+    let mut light = vec![Vec4::ZERO; (w * h) as usize];
+    let mut geometry = vec![Vec4::ZERO; (w * h) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            let i = at(x, y);
+            let position = inp.position[i];
+            if position.w == 0.0 {
+                continue;
+            }
+            let n = inp.normal[i].normalize();
+            geometry[i] = n.extend(position.w);
+            if inp.slice == 0 {
+                light[i] = inp.fresh[i];
+                continue;
+            }
+            let k = inp.slice - 1;
+            let refreshed = (x & 1) == (k & 1) && (y & 1) == (k >> 1);
+            let full_x = (((x as f32 + 0.5) * fw as f32 / w as f32) as u32).min(fw - 1);
+            let full_y = (((y as f32 + 0.5) * fh as f32 / h as f32) as u32).min(fh - 1);
+            let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+            let then = uv - inp.motion[(full_y * fw + full_x) as usize];
+            let q = (then * Vec2::new(w as f32, h as f32)).floor();
+            let mut history = None;
+            if inp.has_history && q.x >= 0.0 && q.y >= 0.0 && q.x < w as f32 && q.y < h as f32 {
+                let j = at(q.x as u32, q.y as u32);
+                let g = inp.history_geometry[j];
+                if same_surface(position.w, n, g.w, g.truncate()) {
+                    history = Some(inp.history_light[j]);
+                }
+            }
+            light[i] = match (refreshed, history) {
+                (true, Some(old)) => old.lerp(inp.fresh[i], RESOLVE_ALPHA),
+                (true, None) => inp.fresh[i],
+                (false, Some(old)) => old,
+                (false, None) => {
+                    let cx = ((x / 2) * 2 + (k & 1)).min(w - 1);
+                    let cy = ((y / 2) * 2 + (k >> 1)).min(h - 1);
+                    inp.fresh[at(cx, cy)]
+                }
+            };
+        }
+    }
+    (light, geometry)
+}

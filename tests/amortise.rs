@@ -1,0 +1,306 @@
+//! The amortised HVL gather (paper 001; src/passes/hvl/resolve.rs): `hvl_resolve` against its
+//! CPU twin (reprojection, disocclusion, blend), and a static scene amortised over frames
+//! against the per-frame image.
+
+mod common;
+
+use common::{bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
+use glam::{Vec2, Vec3, Vec4};
+use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
+use shine::passes::hvl::resolve::{ResolveHistory, hvl_resolve};
+use shine::passes::receivers::Receivers;
+use shine::reference::resolve::{ResolveInputs, resolve_cpu};
+use shine::{Renderer, Settings};
+use shine_scene::Scene;
+
+/// A deterministic pseudo-random number in [0, 1).
+struct Rng(u32);
+
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        (self.0 >> 8) as f32 / (1u32 << 24) as f32
+    }
+}
+
+/// Decodes RGBA16F texels.
+fn decode_rgba16f(bytes: &[u8]) -> Vec<Vec4> {
+    let halves: Vec<f32> = bytes
+        .chunks_exact(2)
+        .map(|c| f16_to_f32(u16::from_le_bytes([c[0], c[1]])))
+        .collect();
+    halves.chunks_exact(4).map(Vec4::from_slice).collect()
+}
+
+/// Runs `hvl_resolve` on the GPU over `inp` (as uploaded: f16 values where the images are
+/// f16) and returns the resolved light.
+fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4> {
+    let [w, h] = inp.extent;
+    let rgba16 = vk::Format::R16G16B16A16_SFLOAT;
+    let position = storage_image_with(
+        device,
+        "recv_position",
+        vk::Format::R32G32B32A32_SFLOAT,
+        inp.extent,
+        bytemuck::cast_slice(inp.position),
+    );
+    let normals: Vec<Vec4> = inp.normal.iter().map(|n| n.extend(0.0)).collect();
+    let normal = storage_image_with(
+        device,
+        "recv_normal",
+        rgba16,
+        inp.extent,
+        &bytes_f16(&normals),
+    );
+    let fresh = storage_image_with(device, "fresh", rgba16, inp.extent, &bytes_f16(inp.fresh));
+    let motion_bytes: Vec<u8> = inp
+        .motion
+        .iter()
+        .flat_map(|m| [f32_to_f16(m.x), f32_to_f16(m.y)])
+        .flat_map(u16::to_le_bytes)
+        .collect();
+    let motion = storage_image_with(
+        device,
+        "gb_motion",
+        vk::Format::R16G16_SFLOAT,
+        inp.full_extent,
+        &motion_bytes,
+    );
+    let light = storage_image_with(
+        device,
+        "history light",
+        rgba16,
+        inp.extent,
+        &bytes_f16(inp.history_light),
+    );
+    let geometry = storage_image_with(
+        device,
+        "history geometry",
+        rgba16,
+        inp.extent,
+        &bytes_f16(inp.history_geometry),
+    );
+    let out = common::transfer_storage(device, "out", u64::from(w * h) * 8, None);
+    let mut executor = Executor::new(device, 1).expect("executor");
+    let mut rg = executor.begin_frame();
+    let import = |rg: &mut RenderGraph, image| {
+        rg.import_gpu_image(image, uploaded_state(), ExternalState::UNDEFINED)
+    };
+    let receivers = Receivers {
+        position: import(&mut rg, &position),
+        normal: import(&mut rg, &normal),
+        albedo: import(&mut rg, &fresh),
+        material: import(&mut rg, &fresh),
+        extent: inp.extent,
+        scale: inp.full_extent[0] / inp.extent[0],
+    };
+    let fresh_handle = import(&mut rg, &fresh);
+    let motion_handle = import(&mut rg, &motion);
+    let desc = shine::graph::ImageDesc::new_2d(rgba16, w, h);
+    let mut history = ResolveHistory {
+        light: History {
+            previous: import(&mut rg, &light),
+            current: rg.create_image("resolved", desc),
+        },
+        geometry: History {
+            previous: import(&mut rg, &geometry),
+            current: rg.create_image("resolved geometry", desc),
+        },
+    };
+    let resolved = hvl_resolve(
+        &mut rg,
+        &receivers,
+        &fresh_handle,
+        &motion_handle,
+        &mut history,
+        inp.slice,
+        inp.has_history,
+    )
+    .expect("resolve");
+    let mut out_handle =
+        rg.import_gpu_buffer(&out, ExternalState::UNDEFINED, common::read_by_copy());
+    rg.copy_image_to_buffer("read resolved", &resolved, &mut out_handle);
+    let mut commands = device.begin_commands().expect("commands");
+    executor.execute(commands.raw(), rg).expect("execute");
+    device
+        .submit(commands)
+        .expect("submit")
+        .wait()
+        .expect("wait");
+    decode_rgba16f(&device.read_buffer(&out).expect("read"))
+}
+
+/// The GPU resolve equals its CPU twin for every slice, with history kept, moved, and
+/// rejected (other depth or normal, off screen) at random, and without history.
+#[test]
+fn resolve_matches_the_cpu_twin() {
+    let device = common::device();
+    let (extent, full_extent) = ([12u32, 10], [24u32, 20]);
+    let n = (extent[0] * extent[1]) as usize;
+    let mut rng = Rng(2024);
+    let mut position = Vec::new();
+    let mut normal = Vec::new();
+    for _ in 0..n {
+        let background = rng.next() < 0.1;
+        let depth = 1.0 + 4.0 * rng.next();
+        position.push(Vec4::new(
+            rng.next(),
+            rng.next(),
+            rng.next(),
+            if background { 0.0 } else { depth },
+        ));
+        normal.push(Vec3::new(rng.next() - 0.5, rng.next() - 0.5, 1.0).normalize());
+    }
+    let fresh: Vec<Vec4> = (0..n)
+        .map(|_| q16(Vec4::new(rng.next(), rng.next(), rng.next(), 0.0)))
+        .collect();
+    let history_light: Vec<Vec4> = (0..n)
+        .map(|_| q16(Vec4::new(rng.next(), rng.next(), rng.next(), 0.0)))
+        .collect();
+    // History geometry: mostly the receiver's own (kept), sometimes another depth or normal.
+    let history_geometry: Vec<Vec4> = (0..n)
+        .map(|i| {
+            let r = rng.next();
+            let (nn, d) = (normal[i], position[i].w);
+            q16(if r < 0.6 {
+                nn.extend(d)
+            } else if r < 0.8 {
+                nn.extend(d * 1.5)
+            } else {
+                (-nn).extend(d)
+            })
+        })
+        .collect();
+    // Motion: none for most pixels, a few receivers' worth (some off screen) for the rest.
+    let motion: Vec<Vec2> = (0..full_extent[0] * full_extent[1])
+        .map(|_| {
+            if rng.next() < 0.7 {
+                Vec2::ZERO
+            } else {
+                (Vec2::new(rng.next(), rng.next()) - 0.5) * 0.6
+            }
+        })
+        .map(|m| Vec2::new(f16_to_f32(f32_to_f16(m.x)), f16_to_f32(f32_to_f16(m.y))))
+        .collect();
+    let normal_q: Vec<Vec3> = normal
+        .iter()
+        .map(|v| q16(v.extend(0.0)).truncate())
+        .collect();
+    let mut branches = [0usize; 2];
+    for (slice, has_history) in [
+        (0, false),
+        (1, true),
+        (2, true),
+        (3, true),
+        (4, true),
+        (3, false),
+    ] {
+        let inputs = ResolveInputs {
+            extent,
+            full_extent,
+            position: &position,
+            normal: &normal_q,
+            fresh: &fresh,
+            motion: &motion,
+            history_light: &history_light,
+            history_geometry: &history_geometry,
+            slice,
+            has_history,
+        };
+        let (cpu, _) = resolve_cpu(&inputs);
+        let gpu = resolve_gpu(&device, &inputs);
+        for (i, (c, g)) in cpu.iter().zip(&gpu).enumerate() {
+            assert!(
+                (*c - *g).abs().max_element() <= 2e-3,
+                "slice {slice}, history {has_history}, texel {i}: cpu {c} gpu {g}"
+            );
+            if slice > 0 && has_history && position[i].w > 0.0 {
+                branches[usize::from(history_light[i] == *c)] += 1;
+            }
+        }
+    }
+    assert!(branches[0] > 0 && branches[1] > 0, "branches {branches:?}");
+    common::assert_clean(&device);
+}
+
+/// A receiver whose history shows another surface (depth 1.5× or a flipped normal) does not
+/// take it: it takes its cell's fresh value.
+#[test]
+fn disocclusion_rejects_history() {
+    let device = common::device();
+    let (extent, full_extent) = ([2u32, 2], [4u32, 4]);
+    let position = vec![Vec4::new(0.0, 0.0, 0.0, 2.0); 4];
+    let normal = vec![Vec3::Z; 4];
+    let fresh = vec![Vec4::new(1.0, 0.5, 0.25, 0.0); 4];
+    let history_light = vec![Vec4::new(0.0, 0.0, 8.0, 0.0); 4];
+    let motion = vec![Vec2::ZERO; 16];
+    for (geometry, keeps) in [
+        (Vec4::new(0.0, 0.0, 1.0, 2.0), true),
+        (Vec4::new(0.0, 0.0, 1.0, 3.0), false),
+        (Vec4::new(0.0, 0.0, -1.0, 2.0), false),
+    ] {
+        let history_geometry = vec![geometry; 4];
+        let inputs = ResolveInputs {
+            extent,
+            full_extent,
+            position: &position,
+            normal: &normal,
+            fresh: &fresh,
+            motion: &motion,
+            history_light: &history_light,
+            history_geometry: &history_geometry,
+            slice: 1,
+            has_history: true,
+        };
+        let gpu = resolve_gpu(&device, &inputs);
+        // Receiver (1, 1) is not refreshed in slice 1: history or its cell's fresh value.
+        let expected = if keeps { history_light[3] } else { fresh[0] };
+        assert_eq!(gpu[3], expected, "history geometry {geometry}");
+    }
+    common::assert_clean(&device);
+}
+
+/// A static scene with the gather amortised over 2×2 cells renders the per-frame image (the
+/// first frame gathers every receiver; later frames blend identical values), frame after frame.
+#[test]
+fn a_static_scene_amortised_converges_to_the_per_frame_image() {
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let frame = |slices: &str, frames: u32| {
+        let mut s = Settings {
+            width: 32,
+            height: 32,
+            ..Settings::default()
+        };
+        s.set("gi", "hvl").expect("gi");
+        s.set("shadow.size", "128").expect("shadow");
+        s.set("hvl.slices", slices).expect("slices");
+        let mut renderer = Renderer::new(&device).expect("renderer");
+        renderer.set_scene(&scene, 0.0).expect("scene");
+        let mut last = None;
+        for _ in 0..frames {
+            last = Some(renderer.render(&s).expect("render"));
+        }
+        last.expect("a frame").hdr
+    };
+    let per_frame = frame("1", 1);
+    let amortised = frame("4", 6);
+    let mean: f32 = per_frame
+        .texels
+        .iter()
+        .map(|t| t[0] + t[1] + t[2])
+        .sum::<f32>()
+        / (3 * per_frame.texels.len()) as f32;
+    let rmse = (per_frame
+        .texels
+        .iter()
+        .zip(&amortised.texels)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f32>())
+        .sum::<f32>()
+        / (3 * per_frame.texels.len()) as f32)
+        .sqrt();
+    assert!(rmse / mean <= 2e-3, "relative RMSE {}", rmse / mean);
+    common::assert_clean(&device);
+}
