@@ -131,8 +131,10 @@ void glossy_row(float roughness, float theta_o, out float f[SH_COEFFS]) {
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
     if (push.slice != 0u) {
+        // Cells cut by an odd edge are shaded at their last receiver (hvl_resolve's
+        // cell_pixel clamps the same way).
         uint k = push.slice - 1u;
-        px = 2 * px + ivec2(k & 1u, k >> 1u);
+        px = min(2 * px + ivec2(k & 1u, k >> 1u), ivec2(push.extent) - 1);
     }
     if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
         return;

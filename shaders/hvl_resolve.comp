@@ -3,8 +3,9 @@
 // the previous frame's resolved light, reprojected with the G-buffer's motion vectors. History
 // is rejected where the receiver was not visible then (disocclusion: linear depth off by more
 // than RESOLVE_DEPTH_TOLERANCE, or normals apart by more than acos RESOLVE_NORMAL_COS); such a
-// receiver takes its cell's fresh value. Refreshed receivers blend the fresh value into the
-// history with weight RESOLVE_ALPHA. CPU twin: shine::reference::hvl::resolve_cpu.
+// receiver takes its cell's fresh value. Refreshed receivers blend the fresh value into the history with
+// weight RESOLVE_ALPHA; the others keep their history. CPU twin:
+// shine::reference::resolve::resolve_cpu.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -40,12 +41,11 @@ layout(push_constant) uniform Push {
     uint pad1;
 } push;
 
-// The fresh value of the refreshed receiver of p's cell.
-vec4 cell_fresh(ivec2 p) {
+// The refreshed receiver of p's cell.
+ivec2 cell_pixel(ivec2 p) {
     uint k = push.slice - 1u;
     ivec2 q = (p / 2) * 2 + ivec2(k & 1u, k >> 1u);
-    q = min(q, ivec2(push.extent) - 1);
-    return imageLoad(fresh, q);
+    return min(q, ivec2(push.extent) - 1);
 }
 
 void main() {
@@ -84,8 +84,10 @@ void main() {
     vec4 light;
     if (refreshed) {
         light = valid ? mix(history, imageLoad(fresh, p), RESOLVE_ALPHA) : imageLoad(fresh, p);
+    } else if (valid) {
+        light = history;
     } else {
-        light = valid ? history : cell_fresh(p);
+        light = imageLoad(fresh, cell_pixel(p));
     }
     imageStore(resolved, p, light);
     imageStore(resolved_geometry, p, vec4(n, position.w));

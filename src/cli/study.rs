@@ -8,6 +8,7 @@ use super::frame_args::{EnvironmentArgs, load_scene};
 use shine::gpu::{Device, DeviceDesc};
 use shine::study::aaf::AafStudyConfig;
 use shine::study::report::StudyFormat;
+use shine::study::temporal::{self, TemporalConfig, TemporalMode};
 use shine::study::{Progress, aaf};
 use std::path::PathBuf;
 
@@ -23,6 +24,49 @@ enum Study {
     /// AAF (paper 004): error against spp of uniform Monte Carlo, filtered uniform Monte Carlo
     /// and AAF at several μ; the samples and time uniform sampling needs for AAF's error.
     Aaf(AafStudyArgs),
+    /// GI modes in motion (paper 001): cost per frame, error against a path-traced truth of
+    /// every frame, and flicker, on an animated sequence; plot.png beside the report.
+    Temporal(TemporalStudyArgs),
+}
+
+/// Arguments of `shine study temporal`.
+#[derive(clap::Args, Debug)]
+pub struct TemporalStudyArgs {
+    /// Scene: a .gltf/.glb file or `builtin:NAME` (animated, spheres, ...).
+    scene: String,
+    /// Frames of the sequence (at least 3).
+    #[arg(long, default_value_t = 24)]
+    frames: u32,
+    /// Scene clock rate.
+    #[arg(long, default_value_t = 24.0)]
+    fps: f32,
+    /// Scene time of the first frame.
+    #[arg(long, default_value_t = 0.0)]
+    time: f32,
+    /// Image width in pixels.
+    #[arg(long, default_value_t = 64)]
+    width: u32,
+    /// Image height in pixels.
+    #[arg(long, default_value_t = 64)]
+    height: u32,
+    /// Samples per pixel of each truth frame.
+    #[arg(long, default_value_t = 256)]
+    truth_spp: u32,
+    /// Frames rendered first and not measured (temporal state settles).
+    #[arg(long, default_value_t = 4)]
+    warmup: u32,
+    /// A mode, `LABEL=KEY=VALUE;KEY=VALUE…` (settings keys as `--set` takes them), repeated;
+    /// default: `hvl=gi=hvl` and `hvl/4=gi=hvl;hvl.slices=4`.
+    #[arg(long = "mode")]
+    modes: Vec<String>,
+    /// Output folder for plot.png (default: out/study-temporal-SCENE).
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Report format on stdout: table or json.
+    #[arg(long, default_value = "table")]
+    format: String,
+    #[command(flatten)]
+    environment: EnvironmentArgs,
 }
 
 /// Arguments of `shine study aaf`.
@@ -79,19 +123,84 @@ pub struct AafStudyArgs {
 pub fn run(args: &StudyArgs) -> Result<(), CliError> {
     match &args.study {
         Study::Aaf(args) => run_aaf(args),
+        Study::Temporal(args) => run_temporal(args),
     }
 }
 
-/// The default output folder of a scene argument: `out/study-aaf-NAME`, NAME the built-in's
-/// name or the file's stem.
-fn default_out(scene: &str) -> PathBuf {
+/// The modes of `shine study temporal`, parsed (bad ones refused before any work).
+fn temporal_modes(args: &TemporalStudyArgs) -> Result<Vec<TemporalMode>, CliError> {
+    let specs = if args.modes.is_empty() {
+        vec![
+            "hvl=gi=hvl".to_owned(),
+            "hvl/4=gi=hvl;hvl.slices=4".to_owned(),
+        ]
+    } else {
+        args.modes.clone()
+    };
+    specs
+        .iter()
+        .map(|spec| {
+            let (label, rest) = spec
+                .split_once('=')
+                .ok_or_else(|| format!("--mode `{spec}`: expected LABEL=KEY=VALUE;…"))?;
+            let mut settings = shine::Settings {
+                width: args.width,
+                height: args.height,
+                ..shine::Settings::default()
+            };
+            for pair in rest.split(';').filter(|p| !p.is_empty()) {
+                let (key, value) = pair
+                    .split_once('=')
+                    .ok_or_else(|| format!("--mode `{spec}`: `{pair}` is not KEY=VALUE"))?;
+                settings.set(key.trim(), value.trim())?;
+            }
+            settings.validate()?;
+            Ok(TemporalMode {
+                label: label.to_owned(),
+                settings,
+            })
+        })
+        .collect()
+}
+
+fn run_temporal(args: &TemporalStudyArgs) -> Result<(), CliError> {
+    let format: StudyFormat = args.format.parse()?;
+    let modes = temporal_modes(args)?;
+    let config = TemporalConfig {
+        frames: args.frames,
+        fps: args.fps,
+        time: args.time,
+        truth_spp: args.truth_spp,
+        warmup: args.warmup,
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out("temporal", &args.scene));
+    let scene = load_scene(&args.scene, &args.environment)?;
+    let device = Device::new(&DeviceDesc::from_env())?;
+    let mut bars = Bars::default();
+    let report = temporal::run(&device, &scene, &args.scene, &config, &modes, &mut bars)?;
+    std::fs::create_dir_all(&out)?;
+    report.plot(&out.join("plot.png"))?;
+    match format {
+        StudyFormat::Json => println!("{}", serde_json::to_string_pretty(&report)?),
+        StudyFormat::Table => print!("{}", report.table()),
+    }
+    eprintln!("wrote {}", out.join("plot.png").display());
+    Ok(())
+}
+
+/// The default output folder of a study of a scene argument: `out/study-STUDY-NAME`, NAME the
+/// built-in's name or the file's stem.
+fn default_out(study: &str, scene: &str) -> PathBuf {
     let name = match scene.strip_prefix("builtin:") {
         Some(name) => name.to_owned(),
         None => PathBuf::from(scene)
             .file_stem()
             .map_or_else(|| "scene".to_owned(), |s| s.to_string_lossy().into_owned()),
     };
-    PathBuf::from("out").join(format!("study-aaf-{name}"))
+    PathBuf::from("out").join(format!("study-{study}-{name}"))
 }
 
 fn run_aaf(args: &AafStudyArgs) -> Result<(), CliError> {
@@ -111,7 +220,10 @@ fn run_aaf(args: &AafStudyArgs) -> Result<(), CliError> {
     };
     // Refuse bad numbers before loading anything.
     config.validate()?;
-    let out = args.out.clone().unwrap_or_else(|| default_out(&args.scene));
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out("aaf", &args.scene));
     let scene = load_scene(&args.scene, &args.environment)?;
     let device = Device::new(&DeviceDesc::from_env())?;
     let mut bars = Bars::default();

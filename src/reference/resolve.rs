@@ -64,15 +64,16 @@ pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
                     history = Some(inp.history_light[j]);
                 }
             }
+            // The refreshed receiver of this cell (clamped at an odd edge, as the gather).
+            let own = (
+                ((x / 2) * 2 + (k & 1)).min(w - 1),
+                ((y / 2) * 2 + (k >> 1)).min(h - 1),
+            );
             light[i] = match (refreshed, history) {
                 (true, Some(old)) => old.lerp(inp.fresh[i], RESOLVE_ALPHA),
                 (true, None) => inp.fresh[i],
                 (false, Some(old)) => old,
-                (false, None) => {
-                    let cx = ((x / 2) * 2 + (k & 1)).min(w - 1);
-                    let cy = ((y / 2) * 2 + (k >> 1)).min(h - 1);
-                    inp.fresh[at(cx, cy)]
-                }
+                (false, None) => inp.fresh[at(own.0, own.1)],
             };
         }
     }

@@ -15,6 +15,7 @@ pub mod metrics;
 pub mod plot;
 pub mod report;
 pub mod runner;
+pub mod temporal;
 
 use crate::capture::image_io::ImageIoError;
 use crate::frame::RenderError;

@@ -31,7 +31,7 @@ const FONT_PATHS: [&str; 7] = [
 ];
 
 /// The font the plots' text is drawn with, loaded and registered once (`None`: no text).
-fn font() -> Option<&'static str> {
+pub(crate) fn font() -> Option<&'static str> {
     static FONT: OnceLock<Option<(String, Vec<u8>)>> = OnceLock::new();
     let loaded = FONT.get_or_init(|| {
         let chosen = std::env::var("SHINE_PLOT_FONT").ok();

@@ -4,7 +4,11 @@
 //! previous frame's resolved light, reprojected with the G-buffer's motion vectors, and rejects
 //! history where the surface was not visible then (depth or normal too different), taking the
 //! cell's fresh value instead. Refreshed receivers blend fresh light into valid history
-//! ([`RESOLVE_ALPHA`]). CPU twin: [`crate::reference::resolve::resolve_cpu`].
+//! ([`RESOLVE_ALPHA`]), the others keep theirs. Tried and dropped (docs/quality.md): pulling
+//! every receiver towards its cell's fresh value each frame, and filling disocclusions from
+//! the nearest of nine refreshed receivers on the same surface; both made it flicker more.
+//! CPU twin:
+//! [`crate::reference::resolve::resolve_cpu`].
 
 use glam::Vec3;
 
