@@ -122,7 +122,8 @@ pub fn run(
     modes: &[TemporalMode],
     progress: &mut dyn Progress,
 ) -> Result<TemporalReport, StudyError> {
-    if config.frames < 3 || !(config.fps > 0.0) || config.truth_spp == 0 {
+    let fps_ok = config.fps.is_finite() && config.fps > 0.0;
+    if config.frames < 3 || !fps_ok || config.truth_spp == 0 {
         return Err(StudyError::Invalid(
             "a temporal study needs at least 3 frames, a positive --fps and --truth-spp".into(),
         ));
