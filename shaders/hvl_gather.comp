@@ -82,6 +82,8 @@ layout(set = 0, binding = 5, std430) readonly buffer Brdf {
 
 layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
 
+#include "hvl_resolve.glsl"
+
 #ifdef HVL_VISIBILITY
 #define TRACE_NODES_BINDING 7
 #define TRACE_TRIANGLES_BINDING 8
@@ -110,7 +112,8 @@ layout(push_constant) uniform Push {
     // number of glossy tables
     uint glossy_tables;
     // 0: every receiver; 1 + k: only the receiver at offset (k & 1, k >> 1) of every 2×2
-    // cell (amortised frames, src/passes/hvl/resolve.rs)
+    // cell; HVL_REGATHER_SLICE: only the receivers marked by alpha -1 in `indirect`
+    // (amortised frames, src/passes/hvl/resolve.rs)
     uint slice;
 } push;
 
@@ -130,14 +133,20 @@ void glossy_row(float roughness, float theta_o, out float f[SH_COEFFS]) {
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
-    if (push.slice != 0u) {
-        // Cells cut by an odd edge are shaded at their last receiver (hvl_resolve's
-        // cell_pixel clamps the same way).
-        uint k = push.slice - 1u;
-        px = min(2 * px + ivec2(k & 1u, k >> 1u), ivec2(push.extent) - 1);
-    }
     if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
         return;
+    }
+    if (push.slice == HVL_REGATHER_SLICE) {
+        // Only the receivers hvl_regather_mask marked.
+        if (imageLoad(indirect, px).a >= 0.0) {
+            return;
+        }
+    } else if (push.slice != 0u) {
+        uint k = push.slice - 1u;
+        px = 2 * px + ivec2(k & 1u, k >> 1u);
+        if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
+            return;
+        }
     }
     vec4 position = imageLoad(recv_position, px);
     if (position.w == 0.0) {

@@ -2,10 +2,16 @@
 // HVL gather refreshed one receiver of every 2×2 cell per frame, the others carried over from
 // the previous frame's resolved light, reprojected with the G-buffer's motion vectors. History
 // is rejected where the receiver was not visible then (disocclusion: linear depth off by more
-// than RESOLVE_DEPTH_TOLERANCE, or normals apart by more than acos RESOLVE_NORMAL_COS); such a
-// receiver takes its cell's fresh value. Refreshed receivers blend the fresh value into the history with
-// weight RESOLVE_ALPHA; the others keep their history. CPU twin:
-// shine::reference::resolve::resolve_cpu.
+// than RESOLVE_DEPTH_TOLERANCE, or normals apart by more than acos RESOLVE_NORMAL_COS).
+//
+// Variant `mask` (`hvl_regather_mask`) runs between the two gathers: it marks every receiver
+// that is neither refreshed nor covered by its history (alpha -1 in `fresh`; 0 elsewhere), and
+// the second gather (slice HVL_REGATHER_SLICE) shades exactly those: the issue's "priority"
+// refresh of what moved. Variant `resolve` then blends: refreshed receivers mix the fresh value
+// into valid history with weight RESOLVE_ALPHA, the others keep their history or, where it was
+// rejected, take their own fresh value. CPU twin: shine::reference::resolve::resolve_cpu.
+//! variant mask RESOLVE_MASK=1
+//! variant resolve RESOLVE_MASK=0
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -15,16 +21,22 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
-// This frame's gather: valid at the refreshed receivers only.
-layout(set = 0, binding = 2, rgba16f) readonly uniform image2D fresh;
 // Full-resolution motion (uv now minus uv then).
 layout(set = 0, binding = 3, rg16f) readonly uniform image2D gb_motion;
-// The previous frame's resolved light and its receivers' (normal, linear depth).
-layout(set = 0, binding = 4, rgba16f) readonly uniform image2D history_light;
+// The previous frame's receivers' (normal, linear depth).
 layout(set = 0, binding = 5, rgba16f) readonly uniform image2D history_geometry;
+#if RESOLVE_MASK
+// This frame's gather, valid at the refreshed receivers: the others are marked here.
+layout(set = 0, binding = 2, rgba16f) uniform image2D fresh;
+#else
+// This frame's gathers: every receiver the resolve takes fresh light from.
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D fresh;
+// The previous frame's resolved light.
+layout(set = 0, binding = 4, rgba16f) readonly uniform image2D history_light;
 // This frame's resolved light and geometry (next frame's history).
 layout(set = 0, binding = 6, rgba16f) uniform image2D resolved;
 layout(set = 0, binding = 7, rgba16f) uniform image2D resolved_geometry;
+#endif
 
 // shine::passes::hvl::resolve::ResolvePush
 layout(push_constant) uniform Push {
@@ -41,11 +53,26 @@ layout(push_constant) uniform Push {
     uint pad1;
 } push;
 
-// The refreshed receiver of p's cell.
-ivec2 cell_pixel(ivec2 p) {
+// Whether receiver p (linear depth `depth`, unit normal n) is refreshed this frame.
+bool refreshed(ivec2 p) {
     uint k = push.slice - 1u;
-    ivec2 q = (p / 2) * 2 + ivec2(k & 1u, k >> 1u);
-    return min(q, ivec2(push.extent) - 1);
+    return (uint(p.x) & 1u) == (k & 1u) && (uint(p.y) & 1u) == (k >> 1u);
+}
+
+// Where p's history is (reprojected with the motion vectors), and whether it shows p's
+// surface.
+bool history_at(ivec2 p, float depth, vec3 n, out ivec2 q) {
+    ivec2 full = ivec2((vec2(p) + 0.5) * vec2(push.full_extent) / vec2(push.extent));
+    full = min(full, ivec2(push.full_extent) - 1);
+    vec2 uv = (vec2(p) + 0.5) / vec2(push.extent);
+    vec2 then_uv = uv - imageLoad(gb_motion, full).xy;
+    q = ivec2(floor(then_uv * vec2(push.extent)));
+    if (push.has_history == 0u || any(lessThan(q, ivec2(0)))
+        || any(greaterThanEqual(q, ivec2(push.extent)))) {
+        return false;
+    }
+    vec4 g = imageLoad(history_geometry, q);
+    return resolve_same_surface(depth, n, g.w, g.xyz);
 }
 
 void main() {
@@ -54,41 +81,32 @@ void main() {
         return;
     }
     vec4 position = imageLoad(recv_position, p);
+    vec3 n = normalize(imageLoad(recv_normal, p).xyz);
+#if RESOLVE_MASK
+    if (push.slice == 0u || refreshed(p)) {
+        return;
+    }
+    ivec2 q;
+    bool regather = position.w != 0.0 && !history_at(p, position.w, n, q);
+    imageStore(fresh, p, vec4(0.0, 0.0, 0.0, regather ? -1.0 : 0.0));
+#else
     if (position.w == 0.0) {
         imageStore(resolved, p, vec4(0.0));
         imageStore(resolved_geometry, p, vec4(0.0));
         return;
     }
-    vec3 n = normalize(imageLoad(recv_normal, p).xyz);
+    imageStore(resolved_geometry, p, vec4(n, position.w));
     if (push.slice == 0u) {
         imageStore(resolved, p, imageLoad(fresh, p));
-        imageStore(resolved_geometry, p, vec4(n, position.w));
         return;
     }
-    uint k = push.slice - 1u;
-    bool refreshed = (uint(p.x) & 1u) == (k & 1u) && (uint(p.y) & 1u) == (k >> 1u);
-    // The full-resolution pixel under the receiver's centre.
-    ivec2 full = ivec2((vec2(p) + 0.5) * vec2(push.full_extent) / vec2(push.extent));
-    full = min(full, ivec2(push.full_extent) - 1);
-    vec2 uv = (vec2(p) + 0.5) / vec2(push.extent);
-    vec2 then_uv = uv - imageLoad(gb_motion, full).xy;
-    ivec2 q = ivec2(floor(then_uv * vec2(push.extent)));
-    bool valid = push.has_history != 0u && all(greaterThanEqual(q, ivec2(0)))
-        && all(lessThan(q, ivec2(push.extent)));
-    vec4 history = vec4(0.0);
+    ivec2 q;
+    bool valid = history_at(p, position.w, n, q);
+    vec4 light = imageLoad(fresh, p);
     if (valid) {
-        vec4 g = imageLoad(history_geometry, q);
-        valid = resolve_same_surface(position.w, n, g.w, g.xyz);
-        history = imageLoad(history_light, q);
-    }
-    vec4 light;
-    if (refreshed) {
-        light = valid ? mix(history, imageLoad(fresh, p), RESOLVE_ALPHA) : imageLoad(fresh, p);
-    } else if (valid) {
-        light = history;
-    } else {
-        light = imageLoad(fresh, cell_pixel(p));
+        vec4 history = imageLoad(history_light, q);
+        light = refreshed(p) ? mix(history, light, RESOLVE_ALPHA) : history;
     }
     imageStore(resolved, p, light);
-    imageStore(resolved_geometry, p, vec4(n, position.w));
+#endif
 }

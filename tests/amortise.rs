@@ -227,14 +227,19 @@ fn resolve_matches_the_cpu_twin() {
 }
 
 /// A receiver whose history shows another surface (depth 1.5× or a flipped normal) does not
-/// take it: it takes its cell's fresh value.
+/// take it: it takes its own fresh value (regathered this frame).
 #[test]
 fn disocclusion_rejects_history() {
     let device = common::device();
     let (extent, full_extent) = ([2u32, 2], [4u32, 4]);
     let position = vec![Vec4::new(0.0, 0.0, 0.0, 2.0); 4];
     let normal = vec![Vec3::Z; 4];
-    let fresh = vec![Vec4::new(1.0, 0.5, 0.25, 0.0); 4];
+    let fresh = vec![
+        Vec4::new(1.0, 0.5, 0.25, 0.0),
+        Vec4::new(0.5, 0.5, 0.5, 0.0),
+        Vec4::new(0.25, 0.5, 1.0, 0.0),
+        Vec4::new(2.0, 1.0, 0.5, 0.0),
+    ];
     let history_light = vec![Vec4::new(0.0, 0.0, 8.0, 0.0); 4];
     let motion = vec![Vec2::ZERO; 16];
     for (geometry, keeps) in [
@@ -257,7 +262,7 @@ fn disocclusion_rejects_history() {
         };
         let gpu = resolve_gpu(&device, &inputs);
         // Receiver (1, 1) is not refreshed in slice 1: history or its cell's fresh value.
-        let expected = if keeps { history_light[3] } else { fresh[0] };
+        let expected = if keeps { history_light[3] } else { fresh[3] };
         assert_eq!(gpu[3], expected, "history geometry {geometry}");
     }
     common::assert_clean(&device);

@@ -235,6 +235,47 @@ fn bad_updates_are_refused() {
             },
             "light 77 does not exist",
         ),
+        (
+            FrameUpdate {
+                lights: vec![(
+                    0,
+                    shine_scene::Light {
+                        kind: 1 - scene.lights[0].kind.min(1),
+                        ..scene.lights[0]
+                    },
+                )],
+                ..FrameUpdate::default()
+            },
+            "its kind cannot change",
+        ),
+        (
+            FrameUpdate {
+                nodes: vec![(
+                    0,
+                    shine_scene::Transform {
+                        scale: Vec3::new(1.0, 0.0, 1.0),
+                        ..Default::default()
+                    },
+                )],
+                ..FrameUpdate::default()
+            },
+            "zero scale",
+        ),
+        (
+            FrameUpdate {
+                camera: Some(shine::CameraPose {
+                    world: Mat4::IDENTITY,
+                    projection: shine_scene::Projection::Perspective {
+                        yfov: 0.8,
+                        aspect_ratio: None,
+                        znear: 0.0,
+                        zfar: None,
+                    },
+                }),
+                ..FrameUpdate::default()
+            },
+            "projection",
+        ),
     ];
     for (update, message) in bad {
         let err = renderer.update(&update).expect_err("refused").to_string();

@@ -4,6 +4,9 @@
 #ifndef HVL_RESOLVE_GLSL
 #define HVL_RESOLVE_GLSL
 
+// The gather's slice that shades the receivers `hvl_regather_mask` marked (alpha -1).
+const uint HVL_REGATHER_SLICE = 5u;
+
 // Weight of the fresh gather where a receiver is refreshed and its history is valid.
 const float RESOLVE_ALPHA = 0.5;
 // Largest relative difference of linear depth between a receiver and its history.

@@ -108,7 +108,7 @@ impl PreparedHvl {
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &self.params)?;
         let bvh = self.params.visibility.then_some(inputs.bvh);
         let (slice, has_history) = self.amortised.unwrap_or((0, false));
-        let gathered = hvl::hvl_gather(
+        let mut gathered = hvl::hvl_gather(
             rg,
             inputs.receivers,
             &hvls,
@@ -122,6 +122,28 @@ impl PreparedHvl {
             return Ok(gathered);
         }
         let mut history = resolve::ResolveHistory::declare(rg, inputs.receivers.extent);
+        if slice != 0 {
+            // The receivers whose history was rejected are gathered now (what moved first).
+            resolve::hvl_regather_mask(
+                rg,
+                inputs.receivers,
+                &mut gathered,
+                inputs.motion,
+                &history,
+                slice,
+                has_history,
+            )?;
+            hvl::hvl_regather(
+                rg,
+                inputs.receivers,
+                &hvls,
+                &self.brdf,
+                bvh,
+                inputs.camera,
+                &self.params,
+                &mut gathered,
+            )?;
+        }
         Ok(resolve::hvl_resolve(
             rg,
             inputs.receivers,

@@ -465,6 +465,10 @@ impl Renderer {
         } else {
             None
         };
+        if hvl.is_some() && rsm.is_none() {
+            // No primary light: the HVL passes (and their history) are not in this frame.
+            self.hvl.reset();
+        }
         let hvl_low = match (hvl, &rsm, &recv) {
             (Some(hvl), Some(rsm), Some(receivers)) => Some(hvl.declare(
                 rg,

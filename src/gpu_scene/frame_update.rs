@@ -62,6 +62,11 @@ impl FrameUpdate {
             if !finite {
                 return Err(format!("node {node}: the transform is not finite"));
             }
+            if t.scale.x * t.scale.y * t.scale.z == 0.0 || t.rotation.length_squared() == 0.0 {
+                return Err(format!(
+                    "node {node}: a zero scale or rotation cannot be inverted (rays need it)"
+                ));
+            }
         }
         for (index, light) in &self.lights {
             if *index >= scene.lights.len() {
@@ -78,6 +83,16 @@ impl FrameUpdate {
                 .chain([&light.intensity, &light.range]);
             if values.into_iter().any(|v| !v.is_finite()) || light.light_kind().is_none() {
                 return Err(format!("light {index}: not a finite light of a known kind"));
+            }
+            // The shadow atlas is laid out per light kind when the scene is set.
+            if scene.lights[*index].kind != light.kind {
+                return Err(format!(
+                    "light {index}: its kind cannot change between frames (set a new scene)"
+                ));
+            }
+            let directed = light.light_kind() != Some(shine_scene::LightKind::Point);
+            if directed && glam::Vec3::from(light.direction).length_squared() == 0.0 {
+                return Err(format!("light {index}: the direction is zero"));
             }
         }
         for (node, weights) in &self.weights {
@@ -101,10 +116,43 @@ impl FrameUpdate {
                 Some(_) => {}
             }
         }
-        if let Some(camera) = &self.camera
-            && !camera.world.is_finite()
-        {
-            return Err("the camera matrix is not finite".into());
+        if let Some(camera) = &self.camera {
+            if !camera.world.is_finite() || camera.world.determinant() == 0.0 {
+                return Err("the camera matrix is not finite and invertible".into());
+            }
+            let sane = match camera.projection {
+                Projection::Perspective {
+                    yfov,
+                    aspect_ratio,
+                    znear,
+                    zfar,
+                } => {
+                    yfov > 0.0
+                        && yfov < std::f32::consts::PI
+                        && znear > 0.0
+                        && aspect_ratio.is_none_or(|a| a > 0.0 && a.is_finite())
+                        && zfar.is_none_or(|f| f > znear && f.is_finite())
+                }
+                Projection::Orthographic {
+                    xmag,
+                    ymag,
+                    znear,
+                    zfar,
+                } => {
+                    xmag.is_finite()
+                        && ymag > 0.0
+                        && ymag.is_finite()
+                        && znear.is_finite()
+                        && zfar > znear
+                        && zfar.is_finite()
+                }
+            };
+            if !sane {
+                return Err(format!(
+                    "the camera projection {:?} is out of range (fov in (0, π), 0 < near < far)",
+                    camera.projection
+                ));
+            }
         }
         if !self.jitter.iter().all(|j| j.is_finite()) {
             return Err("the jitter is not finite".into());

@@ -15,7 +15,8 @@ pub struct ResolveInputs<'a> {
     pub position: &'a [Vec4],
     /// Receiver normals.
     pub normal: &'a [Vec3],
-    /// This frame's gather (valid at the slice's receivers).
+    /// This frame's gathers (valid at the slice's receivers and at those whose history is
+    /// rejected).
     pub fresh: &'a [Vec4],
     /// Full-resolution motion (uv now minus uv then).
     pub motion: &'a [Vec2],
@@ -64,16 +65,12 @@ pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
                     history = Some(inp.history_light[j]);
                 }
             }
-            // The refreshed receiver of this cell (clamped at an odd edge, as the gather).
-            let own = (
-                ((x / 2) * 2 + (k & 1)).min(w - 1),
-                ((y / 2) * 2 + (k >> 1)).min(h - 1),
-            );
             light[i] = match (refreshed, history) {
                 (true, Some(old)) => old.lerp(inp.fresh[i], RESOLVE_ALPHA),
                 (true, None) => inp.fresh[i],
                 (false, Some(old)) => old,
-                (false, None) => inp.fresh[at(own.0, own.1)],
+                // Regathered this frame (`hvl_regather`).
+                (false, None) => inp.fresh[i],
             };
         }
     }

@@ -545,6 +545,67 @@ pub fn hvl_gather(
         "indirect",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
+    let inputs = GatherInputs {
+        receivers,
+        hvls,
+        brdf,
+        bvh,
+        camera,
+    };
+    record_gather(rg, shader, &inputs, params, &mut indirect, slice);
+    Ok(indirect)
+}
+
+/// Adds `hvl_regather`: the gather at the receivers `hvl_regather_mask` marked in `target`
+/// (alpha -1), written there (amortised frames, [`resolve`]).
+#[allow(clippy::too_many_arguments)]
+pub fn hvl_regather(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    hvls: &Handle<Buffer>,
+    brdf: &Handle<Buffer>,
+    bvh: Option<&TraceBuffers>,
+    camera: Vec3,
+    params: &HvlParams,
+    target: &mut Handle<Image>,
+) -> Result<(), HvlError> {
+    let shader = params.validate_gather()?;
+    let bvh = match (params.visibility, bvh) {
+        (true, None) => return Err(HvlError::NoBvh),
+        (true, Some(b)) => Some(b),
+        (false, _) => None,
+    };
+    let inputs = GatherInputs {
+        receivers,
+        hvls,
+        brdf,
+        bvh,
+        camera,
+    };
+    record_gather(rg, shader, &inputs, params, target, resolve::REGATHER_SLICE);
+    Ok(())
+}
+
+/// What a gather pass reads.
+struct GatherInputs<'a> {
+    receivers: &'a Receivers,
+    hvls: &'a Handle<Buffer>,
+    brdf: &'a Handle<Buffer>,
+    bvh: Option<&'a TraceBuffers>,
+    camera: Vec3,
+}
+
+/// Records one gather pass of `slice` into `indirect`.
+fn record_gather(
+    rg: &mut RenderGraph,
+    shader: &'static crate::gpu::ShaderDesc,
+    inputs: &GatherInputs<'_>,
+    params: &HvlParams,
+    indirect: &mut Handle<Image>,
+    slice: u32,
+) {
+    let (receivers, camera) = (inputs.receivers, inputs.camera);
+    let [w, h] = receivers.extent;
     let push = GatherPush {
         camera: camera.extend(0.0).to_array(),
         extent: receivers.extent,
@@ -554,25 +615,24 @@ pub fn hvl_gather(
         glossy_tables: GLOSSY_TABLES,
         slice,
     };
-    let mut pass = rg.compute("hvl_gather", shader);
+    let (name, threads) = match slice {
+        0 => ("hvl_gather", [w, h, 1]),
+        resolve::REGATHER_SLICE => ("hvl_regather", [w, h, 1]),
+        _ => ("hvl_gather", [w.div_ceil(2), h.div_ceil(2), 1]),
+    };
+    let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
         .read("recv_albedo", &receivers.albedo)
         .read("recv_material", &receivers.material)
-        .read("hvls", hvls);
+        .read("hvls", inputs.hvls);
     if params.path == GatherPath::Full {
-        pass.read("brdf", brdf);
+        pass.read("brdf", inputs.brdf);
     }
-    if let Some(b) = bvh {
+    if let Some(b) = inputs.bvh {
         b.bind(&mut pass);
     }
-    let threads = if slice == 0 {
-        [w, h, 1]
-    } else {
-        [w.div_ceil(2), h.div_ceil(2), 1]
-    };
-    pass.write("indirect", &mut indirect)
+    pass.write("indirect", indirect)
         .push(&push)
         .dispatch(threads);
-    Ok(indirect)
 }

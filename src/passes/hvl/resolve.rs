@@ -2,12 +2,13 @@
 //! frame"). With `hvl.slices = 4` the gather shades one receiver of every 2×2 cell per frame,
 //! in turn; `hvl_resolve` (shaders/hvl_resolve.comp) carries the other three over from the
 //! previous frame's resolved light, reprojected with the G-buffer's motion vectors, and rejects
-//! history where the surface was not visible then (depth or normal too different), taking the
-//! cell's fresh value instead. Refreshed receivers blend fresh light into valid history
-//! ([`RESOLVE_ALPHA`]), the others keep theirs. Tried and dropped (docs/quality.md): pulling
-//! every receiver towards its cell's fresh value each frame, and filling disocclusions from
-//! the nearest of nine refreshed receivers on the same surface; both made it flicker more.
-//! CPU twin:
+//! history where the surface was not visible then (depth or normal too different):
+//! `hvl_regather_mask` marks those receivers and a second gather shades them the same frame
+//! (paper 001's priority refresh of what moved). Refreshed receivers blend fresh light into
+//! valid history ([`RESOLVE_ALPHA`]), the others keep theirs. Tried and dropped
+//! (docs/quality.md): filling disocclusions from the cell's fresh value, pulling every receiver
+//! towards it each frame, and filling from the nearest of nine refreshed receivers; all
+//! flickered more than the per-frame gather. CPU twin:
 //! [`crate::reference::resolve::resolve_cpu`].
 
 use glam::Vec3;
@@ -27,6 +28,9 @@ pub const RESOLVE_DEPTH_TOLERANCE: f32 = 0.1;
 pub const RESOLVE_NORMAL_COS: f32 = 0.9;
 /// Receivers per refresh cell (2×2): the HVL gather of a frame shades one of them.
 pub const SLICES: u32 = 4;
+/// The gather's slice that shades the receivers `hvl_regather_mask` marked
+/// (`HVL_REGATHER_SLICE` in shaders/include/hvl_resolve.glsl).
+pub const REGATHER_SLICE: u32 = SLICES + 1;
 
 /// Whether history at `depth_then` with normal `n_then` shows the same surface as a receiver
 /// at `depth` with unit normal `n` (`resolve_same_surface` in shaders/include/hvl_resolve.glsl).
@@ -77,9 +81,57 @@ impl ResolveHistory {
     }
 }
 
-/// Adds `hvl_resolve`: this frame's gather `fresh` (valid at the receivers of `slice`; at
-/// every receiver for `slice` 0, which then passes through) and the reprojected history into
-/// the history's current images; returns the resolved light.
+/// Adds `hvl_regather_mask`: marks, in `fresh` (this frame's gather at the receivers of
+/// `slice`), every other receiver whose history does not show its surface (alpha -1; 0
+/// elsewhere), for a second gather with [`REGATHER_SLICE`]. Returns `fresh` after it.
+pub fn hvl_regather_mask(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    fresh: &mut Handle<Image>,
+    motion: &Handle<Image>,
+    history: &ResolveHistory,
+    slice: u32,
+    has_history: bool,
+) -> Result<(), HvlError> {
+    let push = resolve_push(receivers, motion, slice, has_history)?;
+    rg.compute("hvl_regather_mask", &shaders::HVL_RESOLVE_COMP_MASK)
+        .read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("gb_motion", motion)
+        .read("history_geometry", &history.geometry.previous)
+        .write("fresh", fresh)
+        .push(&push)
+        .dispatch([push.extent[0], push.extent[1], 1]);
+    Ok(())
+}
+
+/// The push constants of both variants, after checking `slice`.
+fn resolve_push(
+    receivers: &Receivers,
+    motion: &Handle<Image>,
+    slice: u32,
+    has_history: bool,
+) -> Result<ResolvePush, HvlError> {
+    if slice > SLICES {
+        return Err(HvlError::Size {
+            name: "slice",
+            actual: slice.to_string(),
+            expected: format!("0..={SLICES}"),
+        });
+    }
+    let full = motion.desc().extent;
+    Ok(ResolvePush {
+        extent: receivers.extent,
+        full_extent: [full.width, full.height],
+        slice,
+        has_history: u32::from(has_history),
+        pad: [0; 2],
+    })
+}
+
+/// Adds `hvl_resolve`: this frame's gathers `fresh` (at the receivers of `slice` and those
+/// `hvl_regather_mask` marked; at every receiver for `slice` 0, which then passes through) and
+/// the reprojected history into the history's current images; returns the resolved light.
 pub fn hvl_resolve(
     rg: &mut RenderGraph,
     receivers: &Receivers,
@@ -89,16 +141,8 @@ pub fn hvl_resolve(
     slice: u32,
     has_history: bool,
 ) -> Result<Handle<Image>, HvlError> {
-    let [w, h] = receivers.extent;
-    let full = motion.desc().extent;
-    if slice > SLICES {
-        return Err(HvlError::Size {
-            name: "slice",
-            actual: slice.to_string(),
-            expected: format!("0..={SLICES}"),
-        });
-    }
-    rg.compute("hvl_resolve", &shaders::HVL_RESOLVE_COMP)
+    let push = resolve_push(receivers, motion, slice, has_history)?;
+    rg.compute("hvl_resolve", &shaders::HVL_RESOLVE_COMP_RESOLVE)
         .read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
         .read("fresh", fresh)
@@ -107,13 +151,7 @@ pub fn hvl_resolve(
         .read("history_geometry", &history.geometry.previous)
         .write("resolved", &mut history.light.current)
         .write("resolved_geometry", &mut history.geometry.current)
-        .push(&ResolvePush {
-            extent: [w, h],
-            full_extent: [full.width, full.height],
-            slice,
-            has_history: u32::from(has_history),
-            pad: [0; 2],
-        })
-        .dispatch([w, h, 1]);
+        .push(&push)
+        .dispatch([push.extent[0], push.extent[1], 1]);
     Ok(history.light.current)
 }
