@@ -8,8 +8,10 @@
 // that is neither refreshed nor covered by its history (alpha -1 in `fresh`; 0 elsewhere), and
 // the second gather (slice HVL_REGATHER_SLICE) shades exactly those: the issue's "priority"
 // refresh of what moved. Variant `resolve` then blends: refreshed receivers mix the fresh value
-// into valid history with weight RESOLVE_ALPHA, the others keep their history or, where it was
-// rejected, take their own fresh value. CPU twin: shine::reference::resolve::resolve_cpu.
+// into valid history with weight RESOLVE_ALPHA; the others keep their history, changed by the
+// change their cell's refreshed receiver makes where it shows the same surface, or, where their
+// history was rejected, take their own fresh value. CPU twin:
+// shine::reference::resolve::resolve_cpu.
 //! variant mask RESOLVE_MASK=1
 //! variant resolve RESOLVE_MASK=0
 #version 460
@@ -53,7 +55,14 @@ layout(push_constant) uniform Push {
     uint pad1;
 } push;
 
-// Whether receiver p (linear depth `depth`, unit normal n) is refreshed this frame.
+// The refreshed receiver of p's cell (clamped where an odd edge cuts the cell: callers check
+// that it is refreshed).
+ivec2 cell_pixel(ivec2 p) {
+    uint k = push.slice - 1u;
+    return min((p / 2) * 2 + ivec2(k & 1u, k >> 1u), ivec2(push.extent) - 1);
+}
+
+// Whether receiver p is refreshed this frame.
 bool refreshed(ivec2 p) {
     uint k = push.slice - 1u;
     return (uint(p.x) & 1u) == (k & 1u) && (uint(p.y) & 1u) == (k >> 1u);
@@ -105,7 +114,23 @@ void main() {
     vec4 light = imageLoad(fresh, p);
     if (valid) {
         vec4 history = imageLoad(history_light, q);
-        light = refreshed(p) ? mix(history, light, RESOLVE_ALPHA) : history;
+        if (refreshed(p)) {
+            light = mix(history, light, RESOLVE_ALPHA);
+        } else {
+            // The change the cell's refreshed receiver makes this frame, shared where it
+            // shows the same surface: held receivers follow the light every frame instead of
+            // stepping every fourth (and a static scene, whose change is 0, stays exact).
+            light = history;
+            ivec2 c = cell_pixel(p);
+            vec4 cp = imageLoad(recv_position, c);
+            vec3 cn = normalize(imageLoad(recv_normal, c).xyz);
+            ivec2 cq;
+            if (refreshed(c) && resolve_same_surface(position.w, n, cp.w, cn)
+                && history_at(c, cp.w, cn, cq)) {
+                vec4 change = RESOLVE_ALPHA * (imageLoad(fresh, c) - imageLoad(history_light, cq));
+                light = max(history + change, vec4(0.0));
+            }
+        }
     }
     imageStore(resolved, p, light);
 #endif

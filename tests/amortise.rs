@@ -261,9 +261,15 @@ fn disocclusion_rejects_history() {
             has_history: true,
         };
         let gpu = resolve_gpu(&device, &inputs);
-        // Receiver (1, 1) is not refreshed in slice 1: history or its cell's fresh value.
-        let expected = if keeps { history_light[3] } else { fresh[3] };
+        // Receiver (1, 1) is not refreshed in slice 1: its history (moved by the change of
+        // its cell's refreshed receiver (0, 0), as the CPU twin says) or its own fresh value.
+        let expected = if keeps {
+            resolve_cpu(&inputs).0[3]
+        } else {
+            fresh[3]
+        };
         assert_eq!(gpu[3], expected, "history geometry {geometry}");
+        assert_eq!(keeps, gpu[3] != fresh[3], "history geometry {geometry}");
     }
     common::assert_clean(&device);
 }

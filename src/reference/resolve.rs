@@ -35,6 +35,23 @@ pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
     let [w, h] = inp.extent;
     let [fw, fh] = inp.full_extent;
     let at = |x: u32, y: u32| (y * w + x) as usize;
+    let k = inp.slice.saturating_sub(1);
+    let refreshed = |x: u32, y: u32| (x & 1) == (k & 1) && (y & 1) == (k >> 1);
+    // Where receiver (x, y) at `depth` with normal `n` finds its history, if it shows its
+    // surface (`history_at` in the shader).
+    let history_at = |x: u32, y: u32, depth: f32, n: Vec3| -> Option<usize> {
+        let full_x = (((x as f32 + 0.5) * fw as f32 / w as f32) as u32).min(fw - 1);
+        let full_y = (((y as f32 + 0.5) * fh as f32 / h as f32) as u32).min(fh - 1);
+        let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
+        let then = uv - inp.motion[(full_y * fw + full_x) as usize];
+        let q = (then * Vec2::new(w as f32, h as f32)).floor();
+        if !inp.has_history || q.x < 0.0 || q.y < 0.0 || q.x >= w as f32 || q.y >= h as f32 {
+            return None;
+        }
+        let j = at(q.x as u32, q.y as u32);
+        let g = inp.history_geometry[j];
+        same_surface(depth, n, g.w, g.truncate()).then_some(j)
+    };
     let mut light = vec![Vec4::ZERO; (w * h) as usize];
     let mut geometry = vec![Vec4::ZERO; (w * h) as usize];
     for y in 0..h {
@@ -50,27 +67,31 @@ pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
                 light[i] = inp.fresh[i];
                 continue;
             }
-            let k = inp.slice - 1;
-            let refreshed = (x & 1) == (k & 1) && (y & 1) == (k >> 1);
-            let full_x = (((x as f32 + 0.5) * fw as f32 / w as f32) as u32).min(fw - 1);
-            let full_y = (((y as f32 + 0.5) * fh as f32 / h as f32) as u32).min(fh - 1);
-            let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
-            let then = uv - inp.motion[(full_y * fw + full_x) as usize];
-            let q = (then * Vec2::new(w as f32, h as f32)).floor();
-            let mut history = None;
-            if inp.has_history && q.x >= 0.0 && q.y >= 0.0 && q.x < w as f32 && q.y < h as f32 {
-                let j = at(q.x as u32, q.y as u32);
-                let g = inp.history_geometry[j];
-                if same_surface(position.w, n, g.w, g.truncate()) {
-                    history = Some(inp.history_light[j]);
-                }
-            }
-            light[i] = match (refreshed, history) {
-                (true, Some(old)) => old.lerp(inp.fresh[i], RESOLVE_ALPHA),
-                (true, None) => inp.fresh[i],
-                (false, Some(old)) => old,
+            light[i] = match history_at(x, y, position.w, n) {
                 // Regathered this frame (`hvl_regather`).
-                (false, None) => inp.fresh[i],
+                None => inp.fresh[i],
+                Some(j) if refreshed(x, y) => {
+                    inp.history_light[j].lerp(inp.fresh[i], RESOLVE_ALPHA)
+                }
+                Some(j) => {
+                    // The change of the cell's refreshed receiver, where it shows this
+                    // surface.
+                    let held = inp.history_light[j];
+                    let (cx, cy) = (
+                        ((x / 2) * 2 + (k & 1)).min(w - 1),
+                        ((y / 2) * 2 + (k >> 1)).min(h - 1),
+                    );
+                    let c = at(cx, cy);
+                    let (cd, cn) = (inp.position[c].w, inp.normal[c].normalize());
+                    let shared = (refreshed(cx, cy) && same_surface(position.w, n, cd, cn))
+                        .then(|| history_at(cx, cy, cd, cn))
+                        .flatten();
+                    match shared {
+                        Some(cj) => (held + RESOLVE_ALPHA * (inp.fresh[c] - inp.history_light[cj]))
+                            .max(Vec4::ZERO),
+                        None => held,
+                    }
+                }
             };
         }
     }
