@@ -120,36 +120,9 @@ impl FrameUpdate {
             if !camera.world.is_finite() || camera.world.determinant() == 0.0 {
                 return Err("the camera matrix is not finite and invertible".into());
             }
-            let sane = match camera.projection {
-                Projection::Perspective {
-                    yfov,
-                    aspect_ratio,
-                    znear,
-                    zfar,
-                } => {
-                    yfov > 0.0
-                        && yfov < std::f32::consts::PI
-                        && znear > 0.0
-                        && aspect_ratio.is_none_or(|a| a > 0.0 && a.is_finite())
-                        && zfar.is_none_or(|f| f > znear && f.is_finite())
-                }
-                Projection::Orthographic {
-                    xmag,
-                    ymag,
-                    znear,
-                    zfar,
-                } => {
-                    xmag.is_finite()
-                        && ymag > 0.0
-                        && ymag.is_finite()
-                        && znear.is_finite()
-                        && zfar > znear
-                        && zfar.is_finite()
-                }
-            };
-            if !sane {
+            if !camera.projection.is_valid() {
                 return Err(format!(
-                    "the camera projection {:?} is out of range (fov in (0, π), 0 < near < far)",
+                    "the camera projection {:?} cannot be rendered (fov in (0, π), 0 < near < far)",
                     camera.projection
                 ));
             }

@@ -28,7 +28,7 @@ pub(super) fn load_cameras(
             node.index()
         );
         let projection = projection(&cam);
-        if !is_valid(&projection) {
+        if !projection.is_valid() {
             return Err(ctx.invalid(&element, format!("invalid projection {projection:?}")));
         }
         let index = scene.cameras.len();
@@ -62,40 +62,5 @@ fn projection(cam: &gltf::Camera<'_>) -> Projection {
             znear: o.znear(),
             zfar: o.zfar(),
         },
-    }
-}
-
-/// Whether the projection can be rendered: perspective with a field of view in (0, π), a
-/// positive near plane, and a positive finite aspect ratio and a finite far plane beyond the
-/// near one when given; orthographic with finite non-zero magnifications and a non-negative
-/// near plane before a finite far plane.
-fn is_valid(projection: &Projection) -> bool {
-    match *projection {
-        Projection::Perspective {
-            yfov,
-            aspect_ratio,
-            znear,
-            zfar,
-        } => {
-            yfov > 0.0
-                && yfov < std::f32::consts::PI
-                && znear > 0.0
-                && aspect_ratio.is_none_or(|a| a > 0.0 && a.is_finite())
-                && zfar.is_none_or(|f| f > znear && f.is_finite())
-        }
-        Projection::Orthographic {
-            xmag,
-            ymag,
-            znear,
-            zfar,
-        } => {
-            xmag.is_finite()
-                && ymag.is_finite()
-                && xmag != 0.0
-                && ymag != 0.0
-                && znear >= 0.0
-                && zfar > znear
-                && zfar.is_finite()
-        }
     }
 }
