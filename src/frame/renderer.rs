@@ -391,6 +391,25 @@ impl Renderer {
         rg: &mut RenderGraph,
         p: &FrameParams,
     ) -> Result<CompositeOutputs, RenderError> {
+        let declared = self.declare_passes(rg, p);
+        if declared.is_err() {
+            // The graph is dropped unrun: what this frame meant to leave for the next one
+            // (previous vertices, camera, HVL history) was never written.
+            if let Some(scene) = self.scene.as_mut() {
+                scene.gpu.forget_previous();
+            }
+            self.motion.reset();
+            self.hvl.reset();
+        }
+        declared
+    }
+
+    /// The passes of [`Renderer::declare_frame`].
+    fn declare_passes(
+        &mut self,
+        rg: &mut RenderGraph,
+        p: &FrameParams,
+    ) -> Result<CompositeOutputs, RenderError> {
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
         let handles = scene.gpu.declare(rg)?;
         let frame = &scene.gpu.state;

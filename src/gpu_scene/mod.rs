@@ -315,6 +315,12 @@ impl GpuScene {
         Ok(())
     }
 
+    /// Forgets the previous frame's vertices (a declared frame was not run): the next frame
+    /// starts its motion from itself.
+    pub fn forget_previous(&mut self) {
+        self.has_previous = false;
+    }
+
     /// The scene's CPU data (without textures), as frames are evaluated from it.
     pub fn rig(&self) -> &Scene {
         &self.rig
