@@ -38,7 +38,8 @@
 //! * **Receiver BRDF.** `kd` times Lambert and `ks` times GGX (its tables hold the dielectric
 //!   Fresnel of η = 1.5; [`table_fresnel_weight`] swaps it for the material's, approximately,
 //!   at n·v) at the receiver's roughness, with the weights of [`indirect_weights`]: the paper
-//!   tabulates one table per material; we tabulate [`GLOSSY_TABLES`] roughness nodes
+//!   tabulates one table per material; we tabulate
+//!   [`GLOSSY_TABLES`](crate::passes::brdf_tables::GLOSSY_TABLES) roughness nodes
 //!   ([`glossy_roughness`]) and interpolate the two tables around the receiver's roughness
 //!   linearly, which serves every material of every scene with one buffer. Rougher than the
 //!   first node is clamped to it (lobes sharper than roughness 0.2 are beyond what ≤ 10 bands
@@ -66,17 +67,14 @@ use std::ops::RangeInclusive;
 use glam::Vec3;
 
 use crate::gpu::ShaderDesc;
-use crate::gpu_scene::bvh::TraceBuffers;
-use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
-use crate::passes::brdf_tables::{
-    GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
-};
-use crate::passes::receivers::Receivers;
+use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::passes::rsm::{Rsm, RsmProjection};
 use crate::shaders;
 
+mod gather;
 mod grid;
 pub mod resolve;
+pub use gather::{hvl_gather, hvl_regather};
 pub use grid::HvlGrid;
 
 /// Most emission bands an [`Hvl`] stores (paper 003 §3 uses 0–5 bands for the emission).
@@ -144,7 +142,7 @@ pub struct GatherPush {
     /// Roughness of the first glossy table and the step between tables
     /// ([`glossy_roughness`](crate::passes::brdf_tables::glossy_roughness)).
     pub roughness_nodes: [f32; 2],
-    /// Number of glossy tables ([`GLOSSY_TABLES`]).
+    /// Number of glossy tables ([`GLOSSY_TABLES`](crate::passes::brdf_tables::GLOSSY_TABLES)).
     pub glossy_tables: u32,
     /// 0: every receiver; 1 + k: one receiver per 2×2 cell, at offset (k & 1, k >> 1)
     /// ([`resolve::slice_of_frame`]).
@@ -489,150 +487,4 @@ fn cache_push(
         radius_scale: params.radius_scale,
         pad: [0.0; 3],
     }
-}
-
-/// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
-/// radiance towards `camera` from all `params.count` HVLs of `hvls`, 0 on background), returned.
-/// `brdf` holds [`GatherBrdf::gpu_data`] at `params.conv_bands` bands (unused by the zonal
-/// path); `bvh` is needed when `params.visibility` is set. `slice` 0 shades every receiver,
-/// 1 + k one per 2×2 cell (the others are left undefined: `hvl_resolve` fills them).
-#[allow(clippy::too_many_arguments)]
-pub fn hvl_gather(
-    rg: &mut RenderGraph,
-    receivers: &Receivers,
-    hvls: &Handle<Buffer>,
-    brdf: &Handle<Buffer>,
-    bvh: Option<&TraceBuffers>,
-    camera: Vec3,
-    params: &HvlParams,
-    slice: u32,
-) -> Result<Handle<Image>, HvlError> {
-    let shader = params.validate_gather()?;
-    let bvh = match (params.visibility, bvh) {
-        (true, None) => return Err(HvlError::NoBvh),
-        (true, Some(b)) => Some(b),
-        (false, _) => None,
-    };
-    for (name, image) in [
-        ("recv_position", &receivers.position),
-        ("recv_normal", &receivers.normal),
-        ("recv_albedo", &receivers.albedo),
-        ("recv_material", &receivers.material),
-    ] {
-        check_extent(name, image, receivers.extent)?;
-    }
-    let need = cache_bytes(params.count);
-    if hvls.desc().size < need {
-        return Err(HvlError::Size {
-            name: "hvls",
-            actual: format!("{} bytes", hvls.desc().size),
-            expected: format!("at least {need} bytes for {} HVLs", params.count),
-        });
-    }
-    let table = GatherBrdf::gpu_bytes(params.conv_bands);
-    if params.path == GatherPath::Full && brdf.desc().size != table {
-        return Err(HvlError::Size {
-            name: "brdf",
-            actual: format!("{} bytes", brdf.desc().size),
-            expected: format!(
-                "{table} bytes (GatherBrdf::gpu_data at {} bands)",
-                params.conv_bands
-            ),
-        });
-    }
-    let [w, h] = receivers.extent;
-    let mut indirect = rg.create_image(
-        "indirect",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
-    let inputs = GatherInputs {
-        receivers,
-        hvls,
-        brdf,
-        bvh,
-        camera,
-    };
-    record_gather(rg, shader, &inputs, params, &mut indirect, slice);
-    Ok(indirect)
-}
-
-/// Adds `hvl_regather`: the gather at the receivers `hvl_regather_mask` marked in `target`
-/// (alpha -1), written there (amortised frames, [`resolve`]).
-#[allow(clippy::too_many_arguments)]
-pub fn hvl_regather(
-    rg: &mut RenderGraph,
-    receivers: &Receivers,
-    hvls: &Handle<Buffer>,
-    brdf: &Handle<Buffer>,
-    bvh: Option<&TraceBuffers>,
-    camera: Vec3,
-    params: &HvlParams,
-    target: &mut Handle<Image>,
-) -> Result<(), HvlError> {
-    let shader = params.validate_gather()?;
-    let bvh = match (params.visibility, bvh) {
-        (true, None) => return Err(HvlError::NoBvh),
-        (true, Some(b)) => Some(b),
-        (false, _) => None,
-    };
-    let inputs = GatherInputs {
-        receivers,
-        hvls,
-        brdf,
-        bvh,
-        camera,
-    };
-    record_gather(rg, shader, &inputs, params, target, resolve::REGATHER_SLICE);
-    Ok(())
-}
-
-/// What a gather pass reads.
-struct GatherInputs<'a> {
-    receivers: &'a Receivers,
-    hvls: &'a Handle<Buffer>,
-    brdf: &'a Handle<Buffer>,
-    bvh: Option<&'a TraceBuffers>,
-    camera: Vec3,
-}
-
-/// Records one gather pass of `slice` into `indirect`.
-fn record_gather(
-    rg: &mut RenderGraph,
-    shader: &'static crate::gpu::ShaderDesc,
-    inputs: &GatherInputs<'_>,
-    params: &HvlParams,
-    indirect: &mut Handle<Image>,
-    slice: u32,
-) {
-    let (receivers, camera) = (inputs.receivers, inputs.camera);
-    let [w, h] = receivers.extent;
-    let push = GatherPush {
-        camera: camera.extend(0.0).to_array(),
-        extent: receivers.extent,
-        hvl_count: params.count,
-        emission_bands: params.emission_bands,
-        roughness_nodes: [GLOSSY_ROUGHNESS_MIN, glossy_roughness_step()],
-        glossy_tables: GLOSSY_TABLES,
-        slice,
-    };
-    let (name, threads) = match slice {
-        0 => ("hvl_gather", [w, h, 1]),
-        resolve::REGATHER_SLICE => ("hvl_regather", [w, h, 1]),
-        _ => ("hvl_gather", [w.div_ceil(2), h.div_ceil(2), 1]),
-    };
-    let mut pass = rg.compute(name, shader);
-    pass.read("recv_position", &receivers.position)
-        .read("recv_normal", &receivers.normal)
-        .read("recv_albedo", &receivers.albedo)
-        .read("recv_material", &receivers.material)
-        .read("hvls", inputs.hvls);
-    if params.path == GatherPath::Full {
-        pass.read("brdf", inputs.brdf);
-    }
-    if let Some(b) = inputs.bvh {
-        b.bind(&mut pass);
-    }
-    pass.write("indirect", indirect)
-        .push(&push)
-        .dispatch(threads);
 }

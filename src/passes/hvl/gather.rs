@@ -1,0 +1,162 @@
+//! `hvl_gather` (and `hvl_regather`, amortised frames): every receiver shaded by the HVLs of
+//! the cache (paper 003 §4.3, §6), after checking the inputs against the parameters.
+
+use glam::Vec3;
+
+use super::{GatherPath, GatherPush, HvlError, HvlParams, cache_bytes, check_extent, resolve};
+use crate::gpu_scene::bvh::TraceBuffers;
+use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::brdf_tables::{
+    GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
+};
+use crate::passes::receivers::Receivers;
+
+/// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
+/// radiance towards `camera` from all `params.count` HVLs of `hvls`, 0 on background), returned.
+/// `brdf` holds [`GatherBrdf::gpu_data`] at `params.conv_bands` bands (unused by the zonal
+/// path); `bvh` is needed when `params.visibility` is set. `slice` 0 shades every receiver,
+/// 1 + k one per 2×2 cell (the others are left undefined: `hvl_resolve` fills them).
+#[allow(clippy::too_many_arguments)]
+pub fn hvl_gather(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    hvls: &Handle<Buffer>,
+    brdf: &Handle<Buffer>,
+    bvh: Option<&TraceBuffers>,
+    camera: Vec3,
+    params: &HvlParams,
+    slice: u32,
+) -> Result<Handle<Image>, HvlError> {
+    let (shader, inputs) = GatherInputs::checked(receivers, hvls, brdf, bvh, camera, params)?;
+    let [w, h] = receivers.extent;
+    let mut indirect = rg.create_image(
+        "indirect",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    record_gather(rg, shader, &inputs, params, &mut indirect, slice);
+    Ok(indirect)
+}
+
+/// Adds `hvl_regather`: the gather at the receivers `hvl_regather_mask` marked in `target`
+/// (alpha -1), written there (amortised frames, [`resolve`]).
+#[allow(clippy::too_many_arguments)]
+pub fn hvl_regather(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    hvls: &Handle<Buffer>,
+    brdf: &Handle<Buffer>,
+    bvh: Option<&TraceBuffers>,
+    camera: Vec3,
+    params: &HvlParams,
+    target: &mut Handle<Image>,
+) -> Result<(), HvlError> {
+    let (shader, inputs) = GatherInputs::checked(receivers, hvls, brdf, bvh, camera, params)?;
+    record_gather(rg, shader, &inputs, params, target, resolve::REGATHER_SLICE);
+    Ok(())
+}
+
+/// What a gather pass reads.
+struct GatherInputs<'a> {
+    receivers: &'a Receivers,
+    hvls: &'a Handle<Buffer>,
+    brdf: &'a Handle<Buffer>,
+    bvh: Option<&'a TraceBuffers>,
+    camera: Vec3,
+}
+
+impl<'a> GatherInputs<'a> {
+    /// The gather's shader and inputs after checking them against `params`: image extents,
+    /// buffer sizes, a BVH when `params.visibility` is set.
+    fn checked(
+        receivers: &'a Receivers,
+        hvls: &'a Handle<Buffer>,
+        brdf: &'a Handle<Buffer>,
+        bvh: Option<&'a TraceBuffers>,
+        camera: Vec3,
+        params: &HvlParams,
+    ) -> Result<(&'static crate::gpu::ShaderDesc, Self), HvlError> {
+        let shader = params.validate_gather()?;
+        let bvh = match (params.visibility, bvh) {
+            (true, None) => return Err(HvlError::NoBvh),
+            (true, Some(b)) => Some(b),
+            (false, _) => None,
+        };
+        for (name, image) in [
+            ("recv_position", &receivers.position),
+            ("recv_normal", &receivers.normal),
+            ("recv_albedo", &receivers.albedo),
+            ("recv_material", &receivers.material),
+        ] {
+            check_extent(name, image, receivers.extent)?;
+        }
+        let need = cache_bytes(params.count);
+        if hvls.desc().size < need {
+            return Err(HvlError::Size {
+                name: "hvls",
+                actual: format!("{} bytes", hvls.desc().size),
+                expected: format!("at least {need} bytes for {} HVLs", params.count),
+            });
+        }
+        let table = GatherBrdf::gpu_bytes(params.conv_bands);
+        if params.path == GatherPath::Full && brdf.desc().size != table {
+            return Err(HvlError::Size {
+                name: "brdf",
+                actual: format!("{} bytes", brdf.desc().size),
+                expected: format!(
+                    "{table} bytes (GatherBrdf::gpu_data at {} bands)",
+                    params.conv_bands
+                ),
+            });
+        }
+        let inputs = Self {
+            receivers,
+            hvls,
+            brdf,
+            bvh,
+            camera,
+        };
+        Ok((shader, inputs))
+    }
+}
+
+/// Records one gather pass of `slice` into `indirect`.
+fn record_gather(
+    rg: &mut RenderGraph,
+    shader: &'static crate::gpu::ShaderDesc,
+    inputs: &GatherInputs<'_>,
+    params: &HvlParams,
+    indirect: &mut Handle<Image>,
+    slice: u32,
+) {
+    let (receivers, camera) = (inputs.receivers, inputs.camera);
+    let [w, h] = receivers.extent;
+    let push = GatherPush {
+        camera: camera.extend(0.0).to_array(),
+        extent: receivers.extent,
+        hvl_count: params.count,
+        emission_bands: params.emission_bands,
+        roughness_nodes: [GLOSSY_ROUGHNESS_MIN, glossy_roughness_step()],
+        glossy_tables: GLOSSY_TABLES,
+        slice,
+    };
+    let (name, threads) = match slice {
+        0 => ("hvl_gather", [w, h, 1]),
+        resolve::REGATHER_SLICE => ("hvl_regather", [w, h, 1]),
+        _ => ("hvl_gather", [w.div_ceil(2), h.div_ceil(2), 1]),
+    };
+    let mut pass = rg.compute(name, shader);
+    pass.read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("recv_albedo", &receivers.albedo)
+        .read("recv_material", &receivers.material)
+        .read("hvls", inputs.hvls);
+    if params.path == GatherPath::Full {
+        pass.read("brdf", inputs.brdf);
+    }
+    if let Some(b) = inputs.bvh {
+        b.bind(&mut pass);
+    }
+    pass.write("indirect", indirect)
+        .push(&push)
+        .dispatch(threads);
+}
