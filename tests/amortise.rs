@@ -25,15 +25,6 @@ impl Rng {
     }
 }
 
-/// Decodes RGBA16F texels.
-fn decode_rgba16f(bytes: &[u8]) -> Vec<Vec4> {
-    let halves: Vec<f32> = bytes
-        .chunks_exact(2)
-        .map(|c| f16_to_f32(u16::from_le_bytes([c[0], c[1]])))
-        .collect();
-    halves.chunks_exact(4).map(Vec4::from_slice).collect()
-}
-
 /// Runs `hvl_resolve` on the GPU over `inp` (as uploaded: f16 values where the images are
 /// f16) and returns the resolved light.
 fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4> {
@@ -122,14 +113,8 @@ fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4
     let mut out_handle =
         rg.import_gpu_buffer(&out, ExternalState::UNDEFINED, common::read_by_copy());
     rg.copy_image_to_buffer("read resolved", &resolved, &mut out_handle);
-    let mut commands = device.begin_commands().expect("commands");
-    executor.execute(commands.raw(), rg).expect("execute");
-    device
-        .submit(commands)
-        .expect("submit")
-        .wait()
-        .expect("wait");
-    decode_rgba16f(&device.read_buffer(&out).expect("read"))
+    common::run_graph(device, &mut executor, rg);
+    common::decode_rgba16f(&device.read_buffer(&out).expect("read"))
 }
 
 /// The GPU resolve equals its CPU twin for every slice, with history kept, moved, and

@@ -126,13 +126,7 @@ fn update_vertices_matches_the_cpu() {
         let mut out =
             rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, common::read_by_copy());
         rg.copy_buffer("read vertices", &handles.vertices, &mut out);
-        let mut commands = device.begin_commands().expect("commands");
-        executor.execute(commands.raw(), rg).expect("execute");
-        device
-            .submit(commands)
-            .expect("submit")
-            .wait()
-            .expect("wait");
+        common::run_graph(&device, &mut executor, rg);
         let bytes = device.read_buffer(&readback).expect("read");
         let got: &[Vertex] = bytemuck::cast_slice(&bytes);
         let pose = &gpu.state.pose;
@@ -310,13 +304,7 @@ fn run_and_read(
             rg.import_gpu_buffer(buffer, ExternalState::UNDEFINED, common::read_by_copy());
         rg.copy_image_to_buffer(&format!("read back {i}"), image, &mut out);
     }
-    let mut commands = device.begin_commands().expect("commands");
-    executor.execute(commands.raw(), rg).expect("execute");
-    device
-        .submit(commands)
-        .expect("submit")
-        .wait()
-        .expect("wait");
+    common::run_graph(device, executor, rg);
     buffers
         .iter()
         .map(|b| device.read_buffer(b).expect("read"))

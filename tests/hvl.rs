@@ -5,8 +5,8 @@
 mod common;
 
 use common::{
-    assert_clean, bytes_f16, bytes_unorm8, device, f16_to_f32, q16, read_by_copy,
-    storage_image_with, transfer_storage, uploaded_state,
+    assert_clean, bytes_f16, bytes_unorm8, device, q16, read_by_copy, storage_image_with,
+    transfer_storage, uploaded_state,
 };
 use glam::{Vec3, Vec4};
 use shine::gpu::Device;
@@ -278,24 +278,10 @@ impl ReceiverImages {
     }
 }
 
-fn run(device: &Device, executor: &mut Executor, rg: RenderGraph) {
-    let mut commands = device.begin_commands().unwrap();
-    executor.execute(commands.raw(), rg).unwrap();
-    device.submit(commands).unwrap().wait().unwrap();
-}
-
 /// Copies `indirect` into `readback` inside the graph.
 fn read_indirect(rg: &mut RenderGraph, indirect: &Handle<Image>, readback: &shine::gpu::Buffer) {
     let mut out = rg.import_gpu_buffer(readback, ExternalState::UNDEFINED, read_by_copy());
     rg.copy_image_to_buffer("read_indirect", indirect, &mut out);
-}
-
-fn decode_rgba16f(bytes: &[u8]) -> Vec<Vec4> {
-    let halves: Vec<f32> = bytes
-        .chunks_exact(2)
-        .map(|c| f16_to_f32(u16::from_le_bytes([c[0], c[1]])))
-        .collect();
-    halves.chunks_exact(4).map(Vec4::from_slice).collect()
 }
 
 /// The one-level world-space BVH of `scene` at rest.
@@ -349,8 +335,8 @@ fn gpu_gather(
     )
     .unwrap();
     read_indirect(&mut rg, &indirect, &readback);
-    run(device, &mut executor, rg);
-    decode_rgba16f(&device.read_buffer(&readback).unwrap())
+    common::run_graph(device, &mut executor, rg);
+    common::decode_rgba16f(&device.read_buffer(&readback).unwrap())
 }
 
 /// Runs the cache alone and returns its records.
@@ -368,7 +354,7 @@ fn gpu_cache(device: &Device, rsm: &RsmData, params: &HvlParams) -> Vec<Hvl> {
     let hvls = hvl_cache(&mut rg, &rsm_handles, params).unwrap();
     let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
     rg.copy_buffer("read_hvls", &hvls, &mut out);
-    run(device, &mut executor, rg);
+    common::run_graph(device, &mut executor, rg);
     bytemuck::cast_slice(&device.read_buffer(&readback).unwrap()).to_vec()
 }
 
@@ -809,8 +795,8 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
         let indirect =
             hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, None, CAMERA, &p, 0).unwrap();
         read_indirect(&mut rg, &indirect, &readback);
-        run(&device, &mut executor, rg);
-        let out = decode_rgba16f(&device.read_buffer(&readback).unwrap());
+        common::run_graph(&device, &mut executor, rg);
+        let out = common::decode_rgba16f(&device.read_buffer(&readback).unwrap());
         (out.iter().map(|v| v.truncate().element_sum()).sum(), out)
     };
     let (e1, _) = energy(1.0);

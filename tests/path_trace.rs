@@ -382,13 +382,7 @@ fn check_traversal(device: &shine::gpu::Device, gpu: &mut GpuScene) {
         .write("hits", &mut hits_handle)
         .push(&[count as u32, 0, 0, 0])
         .dispatch([count as u32, 1, 1]);
-    let mut commands = device.begin_commands().expect("commands");
-    executor.execute(commands.raw(), rg).expect("execute");
-    device
-        .submit(commands)
-        .expect("submit")
-        .wait()
-        .expect("wait");
+    common::run_graph(device, &mut executor, rg);
     let gpu_hits: Vec<[f32; 4]> =
         bytemuck::cast_slice(&device.read_buffer(&hits).expect("readback")).to_vec();
     let (mut hit_count, mut ties) = (0, 0);

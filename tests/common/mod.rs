@@ -232,3 +232,27 @@ pub fn bytes_unorm8(texels: &[Vec4]) -> Vec<u8> {
         .flat_map(|t| t.to_array().map(|c| (c * 255.0).round() as u8))
         .collect()
 }
+
+/// Records `rg` with `executor` into one command buffer, submits it and waits.
+pub fn run_graph(
+    device: &Device,
+    executor: &mut shine::graph::Executor,
+    rg: shine::graph::RenderGraph,
+) {
+    let mut commands = device.begin_commands().expect("commands");
+    executor.execute(commands.raw(), rg).expect("execute");
+    device
+        .submit(commands)
+        .expect("submit")
+        .wait()
+        .expect("wait");
+}
+
+/// RGBA16F texels from their bytes.
+pub fn decode_rgba16f(bytes: &[u8]) -> Vec<Vec4> {
+    let halves: Vec<f32> = bytes
+        .chunks_exact(2)
+        .map(|c| f16_to_f32(u16::from_le_bytes([c[0], c[1]])))
+        .collect();
+    halves.chunks_exact(4).map(Vec4::from_slice).collect()
+}
