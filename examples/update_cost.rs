@@ -16,19 +16,19 @@ use shine::gpu::{Device, DeviceDesc};
 use shine::gpu_scene::bvh::{TopInstance, TopLevel};
 use shine::gpu_scene::{FrameState, FrameUpdate, GpuScene};
 use shine::graph::Executor;
+use shine::profile::report::Stats;
 use shine_scene::{Aabb, Scene};
 
-/// Median over `runs` of `f`'s wall time, in microseconds.
+/// Median over `runs` of `f`'s wall time, in microseconds (the profiler's [`Stats`]).
 fn median_us(runs: usize, mut f: impl FnMut()) -> f64 {
-    let mut times: Vec<f64> = (0..runs)
+    let ns: Vec<f64> = (0..runs)
         .map(|_| {
             let start = Instant::now();
             f();
-            start.elapsed().as_secs_f64() * 1e6
+            start.elapsed().as_secs_f64() * 1e9
         })
         .collect();
-    times.sort_by(f64::total_cmp);
-    times[times.len() / 2]
+    Stats::from_ns(&ns).map_or(0.0, |s| s.median_ms * 1e3)
 }
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {

@@ -10,6 +10,7 @@ use shine::gpu::vk;
 use shine::gpu_scene::{FrameUpdate, GpuScene, Vertex};
 use shine::graph::{Executor, ExternalState};
 use shine::reference::{PathTracer, ReferenceParams};
+use shine::study::metrics::image_error;
 use shine::{Renderer, Settings};
 use shine_scene::Scene;
 
@@ -27,15 +28,12 @@ fn settings(gi: &str) -> Settings {
 
 /// RMS of `a - b` over the mean of `b` (all channels).
 fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
-    let (mut se, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
-    for (x, y) in a.texels.iter().zip(&b.texels) {
-        for c in 0..3 {
-            se += f64::from(x[c] - y[c]).powi(2);
-            sum += f64::from(y[c]);
-            n += 1;
-        }
-    }
-    (se / n as f64).sqrt() / (sum / n as f64).max(1e-12)
+    let rgb =
+        |i: &HdrImage| -> Vec<[f32; 3]> { i.texels.iter().map(|t| [t[0], t[1], t[2]]).collect() };
+    let mask = vec![true; b.texels.len()];
+    image_error(&rgb(a), &rgb(b), &mask)
+        .expect("a lit reference")
+        .relative_rmse
 }
 
 /// Frame k of a sequence (scene uploaded once, then updated) equals a cold render of the scene

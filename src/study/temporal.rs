@@ -14,6 +14,7 @@ use plotters::prelude::*;
 use serde::Serialize;
 use shine_scene::Scene;
 
+use super::metrics;
 use super::plot::font;
 use super::{Progress, StudyError};
 use crate::capture::image_io::{HdrImage, LdrImage, write_png};
@@ -75,17 +76,13 @@ pub struct TemporalReport {
     pub modes: Vec<ModeResult>,
 }
 
-/// RMS of `a - b` over the mean of `b` (rgb).
+/// `√MSE / mean(b)` of `a` against `b` over every pixel ([`metrics::image_error`]); 0 when `b`
+/// is black.
 fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
-    let (mut se, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
-    for (x, y) in a.texels.iter().zip(&b.texels) {
-        for c in 0..3 {
-            se += f64::from(x[c] - y[c]).powi(2);
-            sum += f64::from(y[c]);
-            n += 1;
-        }
-    }
-    (se / n.max(1) as f64).sqrt() / (sum / n.max(1) as f64).max(1e-12)
+    let rgb =
+        |i: &HdrImage| -> Vec<[f32; 3]> { i.texels.iter().map(|t| [t[0], t[1], t[2]]).collect() };
+    let mask = vec![true; b.texels.len()];
+    metrics::image_error(&rgb(a), &rgb(b), &mask).map_or(0.0, |e| e.relative_rmse)
 }
 
 /// RMS of the second temporal difference `I[k+1] - 2 I[k] + I[k-1]` over the mean of the
