@@ -166,7 +166,7 @@ impl ProxyTechnique {
         };
         let proxies = match self.proxies.take() {
             Some(cached) if cached.fit_count == setup.fit_count => cached,
-            _ => self.upload_proxies(setup.fit_count)?,
+            _ => self.proxy_buffer(setup.fit_count)?,
         };
         let placed: Vec<GpuProxy> = proxies
             .local
@@ -202,7 +202,7 @@ impl ProxyTechnique {
     }
 
     /// The proxies for `fit_count` and a device buffer for them.
-    fn upload_proxies(&self, fit_count: u32) -> Result<ProxyBuffer, RenderError> {
+    fn proxy_buffer(&self, fit_count: u32) -> Result<ProxyBuffer, RenderError> {
         let local = self.local_proxies(fit_count);
         let count = u32::try_from(local.len())
             .ok()
