@@ -10,7 +10,6 @@ use shine_gpu::Device;
 use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
-use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::hvl::{self, HvlParams, resolve};
@@ -20,7 +19,6 @@ use crate::passes::rsm::Rsm;
 /// The HVL technique's persistent state: its receiver BRDF tables per band count, and which
 /// frame last wrote the amortised gather's history.
 pub struct HvlTechnique {
-    device: Device,
     brdf: BrdfTables,
     /// Frame number and receiver extent of the last frame that resolved into the history.
     last_resolve: Option<(u64, [u32; 2])>,
@@ -53,8 +51,7 @@ impl HvlTechnique {
     /// The technique on `device`; nothing is uploaded until the first frame.
     pub fn new(device: &Device) -> Self {
         Self {
-            device: device.clone(),
-            brdf: BrdfTables::default(),
+            brdf: BrdfTables::new(device),
             last_resolve: None,
         }
     }
@@ -62,6 +59,13 @@ impl HvlTechnique {
     /// Forgets the history (a new scene).
     pub fn reset(&mut self) {
         self.last_resolve = None;
+    }
+
+    /// Forgets the history and the tables: a frame that may have uploaded them was dropped
+    /// unrun.
+    pub fn forget_uploads(&mut self) {
+        self.reset();
+        self.brdf.clear();
     }
 
     /// Uploads the BRDF tables `params` needs (once per band count) and imports them into
@@ -74,7 +78,7 @@ impl HvlTechnique {
         params: HvlParams,
         receiver_extent: [u32; 2],
     ) -> Result<PreparedHvl, RenderError> {
-        let table = self.brdf.get(&self.device, params.conv_bands)?;
+        let brdf = self.brdf.import(rg, params.conv_bands)?;
         let frame = rg.frame();
         let amortised = (params.slices > 1).then(|| {
             let has_history = self.last_resolve == Some((frame.wrapping_sub(1), receiver_extent));
@@ -91,7 +95,7 @@ impl HvlTechnique {
         }
         Ok(PreparedHvl {
             params,
-            brdf: rg.import_gpu_buffer(table, BUFFER_READ, BUFFER_READ),
+            brdf,
             amortised,
         })
     }

@@ -7,7 +7,6 @@ use shine_gpu::Device;
 use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
-use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::gbuffer::GBuffer;
@@ -16,7 +15,6 @@ use crate::passes::rsm::Rsm;
 
 /// The IGI technique's persistent state: the BRDF tables of the GGX resolve per SH order.
 pub struct IgiTechnique {
-    device: Device,
     brdf: BrdfTables,
 }
 
@@ -43,9 +41,13 @@ impl IgiTechnique {
     /// The technique on `device`; nothing is uploaded until the first frame.
     pub fn new(device: &Device) -> Self {
         Self {
-            device: device.clone(),
-            brdf: BrdfTables::default(),
+            brdf: BrdfTables::new(device),
         }
+    }
+
+    /// Forgets the tables: a frame that may have uploaded them was dropped unrun.
+    pub fn forget_uploads(&mut self) {
+        self.brdf.clear();
     }
 
     /// Uploads the BRDF tables of the GGX resolve when `params` uses it (once per SH order)
@@ -56,8 +58,7 @@ impl IgiTechnique {
         params: IgiParams,
     ) -> Result<PreparedIgi, RenderError> {
         let brdf = if params.needs_brdf_tables() {
-            let table = self.brdf.get(&self.device, params.sh_order)?;
-            Some(rg.import_gpu_buffer(table, BUFFER_READ, BUFFER_READ))
+            Some(self.brdf.import(rg, params.sh_order)?)
         } else {
             None
         };

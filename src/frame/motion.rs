@@ -7,7 +7,6 @@ use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
 use shine_graph::{Handle, RenderGraph};
 
 use super::error::RenderError;
-use crate::gpu_scene::FRAMES_IN_FLIGHT;
 use crate::gpu_scene::upload_ring::UploadRing;
 use crate::passes::gbuffer::MotionView;
 
@@ -34,7 +33,7 @@ impl MotionState {
                     location: MemoryLocation::GpuOnly,
                 },
             )?,
-            ring: UploadRing::new(device, FRAMES_IN_FLIGHT),
+            ring: UploadRing::new(device),
         })
     }
 

@@ -16,9 +16,9 @@ use shine_scene::{Mesh, Scene};
 
 use super::error::RenderError;
 use super::params::ProxySetup;
+use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::environment_sh::EnvironmentSh;
 use crate::gpu_scene::upload_ring::UploadRing;
-use crate::gpu_scene::{BUFFER_READ, FRAMES_IN_FLIGHT};
 use crate::passes::proxy::{
     self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyParams, ProxyTables,
 };
@@ -100,8 +100,14 @@ impl ProxyTechnique {
             proxies: None,
             environments: Vec::new(),
             tables: Vec::new(),
-            ring: UploadRing::new(device, FRAMES_IN_FLIGHT),
+            ring: UploadRing::new(device),
         }
+    }
+
+    /// Forgets the uploaded tables: a frame that may have uploaded them was dropped unrun.
+    pub fn forget_uploads(&mut self) {
+        self.environments.clear();
+        self.tables.clear();
     }
 
     /// The proxies for `fit_count` (0: the scene's own) in their nodes' space.
@@ -131,37 +137,48 @@ impl ProxyTechnique {
     ) -> Result<PreparedProxy<'_>, RenderError> {
         let bands = setup.pass.bands;
         let environment = self.environment.as_ref().ok_or(ProxyError::NoEnvironment)?;
-        let environment_index = match self.environments.iter().position(|(b, _)| *b == bands) {
-            Some(i) => i,
-            None => {
-                let sh = EnvironmentSh::project(environment, bands as usize)
-                    .map_err(ProxyError::from)?;
-                let buffer = Buffer::storage_with_data(
-                    &self.device,
-                    "proxy environment sh",
-                    bytemuck::cast_slice(&sh.gpu_data()),
-                )?;
-                self.environments.push((bands, buffer));
-                self.environments.len() - 1
-            }
-        };
+        let (environment_index, uploaded_environment) =
+            match self.environments.iter().position(|(b, _)| *b == bands) {
+                Some(i) => (i, None),
+                None => {
+                    let sh = EnvironmentSh::project(environment, bands as usize)
+                        .map_err(ProxyError::from)?;
+                    let data = sh.gpu_data();
+                    let buffer = table_buffer(&self.device, "proxy environment sh", &data)?;
+                    let handle = self.ring.upload_once(
+                        rg,
+                        "proxy environment sh",
+                        &buffer,
+                        bytemuck::cast_slice(&data),
+                    )?;
+                    self.environments.push((bands, buffer));
+                    (self.environments.len() - 1, Some(handle))
+                }
+            };
         let key = (
             bands,
             setup.shadow_expansion.to_bits(),
             setup.indirect_expansion.to_bits(),
         );
-        let table_index = match self.tables.iter().position(|(k, _, _)| *k == key) {
-            Some(i) => i,
+        let (table_index, uploaded_tables) = match self
+            .tables
+            .iter()
+            .position(|(k, _, _)| *k == key)
+        {
+            Some(i) => (i, None),
             None => {
                 let tables =
                     ProxyTables::build(bands, setup.shadow_expansion, setup.indirect_expansion)?;
-                let buffer = Buffer::storage_with_data(
-                    &self.device,
+                let data = tables.gpu_data();
+                let buffer = table_buffer(&self.device, "proxy tables", &data)?;
+                let handle = self.ring.upload_once(
+                    rg,
                     "proxy tables",
-                    bytemuck::cast_slice(&tables.gpu_data()),
+                    &buffer,
+                    bytemuck::cast_slice(&data),
                 )?;
                 self.tables.push((key, tables, buffer));
-                self.tables.len() - 1
+                (self.tables.len() - 1, Some(handle))
             }
         };
         let proxies = match self.proxies.take() {
@@ -187,12 +204,15 @@ impl ProxyTechnique {
         let inputs = ProxyInputs {
             proxies: proxy_handle,
             count: proxies.count,
-            tables: rg.import_gpu_buffer(table_buffer, BUFFER_READ, BUFFER_READ),
-            environment: rg.import_gpu_buffer(
-                &self.environments[environment_index].1,
-                BUFFER_READ,
-                BUFFER_READ,
-            ),
+            tables: uploaded_tables
+                .unwrap_or_else(|| rg.import_gpu_buffer(table_buffer, BUFFER_READ, BUFFER_READ)),
+            environment: uploaded_environment.unwrap_or_else(|| {
+                rg.import_gpu_buffer(
+                    &self.environments[environment_index].1,
+                    BUFFER_READ,
+                    BUFFER_READ,
+                )
+            }),
         };
         Ok(PreparedProxy {
             params: setup.pass,
@@ -208,16 +228,16 @@ impl ProxyTechnique {
             .ok()
             .filter(|&c| c <= MAX_PROXIES)
             .ok_or(ProxyError::TooMany(local.len()))?;
-        // A storage buffer cannot be empty: one zero record stands for "no proxy".
-        let buffer = Buffer::with_data(
+        // A storage buffer cannot be empty: room for one record even without proxies (the
+        // passes read `count` records; the proxies are uploaded every frame).
+        let buffer = Buffer::new(
             &self.device,
             &BufferDesc {
                 name: "proxies",
                 size: (local.len().max(1) * std::mem::size_of::<GpuProxy>()) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
                 location: MemoryLocation::GpuOnly,
             },
-            bytemuck::bytes_of(&GpuProxy::new(Vec3::ZERO, 0.0, Vec3::ZERO)),
         )?;
         Ok(ProxyBuffer {
             fit_count,
@@ -241,4 +261,17 @@ impl PreparedProxy<'_> {
         let out = proxy::proxy_shade(rg, receivers, &sums, &self.inputs, self.tables, params)?;
         Ok(out.radiance)
     }
+}
+
+/// A device storage buffer for a table of `data`, written by a one-off upload.
+fn table_buffer(device: &Device, name: &str, data: &[f32]) -> Result<Buffer, shine_gpu::Error> {
+    Buffer::new(
+        device,
+        &BufferDesc {
+            name,
+            size: std::mem::size_of_val(data) as u64,
+            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+            location: MemoryLocation::GpuOnly,
+        },
+    )
 }

@@ -2,12 +2,12 @@
 //! the scene and the tile size are unchanged, and rewritten every frame (lights move) through
 //! a staging ring.
 
-use shine_gpu::{Buffer, Device};
+use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
 use shine_graph::RenderGraph;
 
 use super::error::RenderError;
 use crate::gpu_scene::upload_ring::UploadRing;
-use crate::gpu_scene::{FRAMES_IN_FLIGHT, FrameState, SceneHandles};
+use crate::gpu_scene::{FrameState, SceneHandles};
 use crate::passes::shadows::{self, ShadowAtlas, ShadowLayout};
 
 /// The atlas layout of the current frame for one `(tile size, PCF radius)` and the record
@@ -23,8 +23,8 @@ pub struct ShadowState {
 impl ShadowState {
     /// The state for `frame` with tiles of `size` texels and a PCF kernel of `pcf_radius`:
     /// the layout is made anew (lights move), the buffers are `cached`'s when the key
-    /// matches, new ones otherwise (after the queue idles, since frames a host recorded may
-    /// still read the old records and shine cannot see host submissions).
+    /// matches, new ones otherwise (the old ones' destruction is deferred past the frames
+    /// that read them). [`ShadowState::declare`] fills them.
     pub fn prepare(
         device: &Device,
         cached: Option<Self>,
@@ -35,28 +35,35 @@ impl ShadowState {
         let key = (size, pcf_radius);
         let max_dimension = device.limits().max_image_dimension2_d;
         let layout = ShadowLayout::new(frame, size, pcf_radius, max_dimension)?;
-        if let Some(state) = cached {
-            if state.key == key {
-                return Ok(Self { layout, ..state });
-            }
-            device.wait_idle()?;
+        if let Some(state) = cached.filter(|s| s.key == key) {
+            return Ok(Self { layout, ..state });
         }
-        let views = Buffer::storage_with_data(
-            device,
+        let records = |name, bytes: usize| {
+            Buffer::new(
+                device,
+                &BufferDesc {
+                    name,
+                    size: bytes.max(16) as u64,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )
+        };
+        let views = records(
             "shadow views",
-            bytemuck::cast_slice(&layout.view_records()),
+            std::mem::size_of_val(layout.view_records().as_slice()),
         )?;
-        let lights = Buffer::storage_with_data(
-            device,
+        let lights = records(
             "shadow lights",
-            bytemuck::cast_slice(&layout.light_records()),
+            std::mem::size_of_val(layout.light_records().as_slice()),
         )?;
         Ok(Self {
             key,
             layout,
             views,
             lights,
-            ring: UploadRing::new(device, FRAMES_IN_FLIGHT),
+            ring: UploadRing::new(device),
         })
     }
 

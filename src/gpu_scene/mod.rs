@@ -94,10 +94,6 @@ pub enum SceneUploadError {
     Update(String),
 }
 
-/// Frames the renderer lets run ahead of the GPU: the executor's transient resources and the
-/// scene's staging ring rotate over this many slots.
-pub const FRAMES_IN_FLIGHT: usize = 2;
-
 /// The scene's resources imported into one frame graph, after its `update …` passes.
 #[derive(Clone, Copy, Debug)]
 pub struct SceneHandles {
@@ -294,7 +290,7 @@ impl GpuScene {
             instances: geometry.instances,
             state,
             rig,
-            ring: UploadRing::new(device, FRAMES_IN_FLIGHT),
+            ring: UploadRing::new(device),
         })
     }
 

@@ -2,10 +2,10 @@
 //! frame in flight, copied into device buffers by `update …` transfer passes recorded into
 //! the frame's own command buffer.
 //!
-//! Frame `f` writes the staging buffers of slot `f mod slots`. The executor lets at most
-//! `slots` frames run ahead of the GPU (a host recording with [`crate::Renderer::record`]
-//! promises the same), so when frame `f` is declared, frame `f - slots`, the last reader of
-//! that slot, has completed. Staging buffers are created on first use with the size of their
+//! Frame `f` writes the staging buffers of its graph's slot (`RenderGraph::slot`, `f mod n`
+//! for an executor with `n` frames in flight). The executor lets at most `n` frames run ahead
+//! of the GPU (a host recording with [`crate::Renderer::record`] promises the same), so when
+//! frame `f` is declared, frame `f - n`, the last reader of that slot, has completed. Staging buffers are created on first use with the size of their
 //! destination (or of the prefix rewritten) and then reused, so a steady stream of frames
 //! allocates nothing.
 
@@ -17,17 +17,76 @@ use super::BUFFER_READ;
 /// A ring of staging buffers for the device buffers a frame rewrites.
 pub struct UploadRing {
     device: Device,
-    /// Per slot: (name, staging buffer).
+    /// Per slot: (name, staging buffer); as many slots as the graphs' frames in flight.
     slots: Vec<Vec<(String, Buffer)>>,
+    /// Per slot: the frame that last used it and the staging buffers of its one-off uploads
+    /// ([`UploadRing::upload_once`]), dropped when the slot comes round again.
+    once: Vec<(u64, Vec<Buffer>)>,
 }
 
 impl UploadRing {
-    /// A ring for `frames_in_flight` frames (at least one slot).
-    pub fn new(device: &Device, frames_in_flight: usize) -> Self {
+    /// An empty ring: slots are made as the frames' graphs ask for them.
+    pub fn new(device: &Device) -> Self {
         Self {
             device: device.clone(),
-            slots: (0..frames_in_flight.max(1)).map(|_| Vec::new()).collect(),
+            slots: Vec::new(),
+            once: Vec::new(),
         }
+    }
+
+    /// Adds a transfer pass `upload <name>` writing `data` into `dst` (a device buffer with
+    /// `TRANSFER_DST`, read by any stage after the frame) from a staging buffer of its own,
+    /// kept until this frame's slot comes round again: for data written once (tables), where
+    /// [`UploadRing::upload`] would keep a staging buffer per slot for ever. Returns `dst`'s
+    /// handle after the copy. Nothing waits: the copy runs in the frame's command buffer.
+    pub fn upload_once(
+        &mut self,
+        rg: &mut RenderGraph,
+        name: &str,
+        dst: &Buffer,
+        data: &[u8],
+    ) -> Result<Handle<crate::graph::Buffer>, shine_gpu::Error> {
+        if data.is_empty() || data.len() as u64 > dst.size() {
+            return Err(shine_gpu::Error::InvalidUsage(format!(
+                "upload `{name}`: {} bytes for a {}-byte buffer",
+                data.len(),
+                dst.size()
+            )));
+        }
+        let mut staging = Buffer::new(
+            &self.device,
+            &BufferDesc {
+                name: &format!("staging {name}"),
+                size: data.len() as u64,
+                usage: vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::CpuToGpu,
+            },
+        )?;
+        staging
+            .mapped_mut()
+            .ok_or_else(|| {
+                shine_gpu::Error::InvalidUsage(format!(
+                    "staging buffer `{name}` is not host-visible"
+                ))
+            })?
+            .copy_from_slice(data);
+        let src =
+            rg.import_gpu_buffer(&staging, ExternalState::UNDEFINED, ExternalState::UNDEFINED);
+        let mut handle = rg.import_gpu_buffer(dst, ExternalState::UNDEFINED, BUFFER_READ);
+        rg.copy_buffer(&format!("upload {name}"), &src, &mut handle);
+        if self.once.len() != rg.frames_in_flight() {
+            self.once = (0..rg.frames_in_flight())
+                .map(|_| (0, Vec::new()))
+                .collect();
+        }
+        let (frame, buffers) = &mut self.once[rg.slot()];
+        if *frame != rg.frame() {
+            // The slot's last frame has completed (module docs): its staging buffers can go.
+            buffers.clear();
+            *frame = rg.frame();
+        }
+        buffers.push(staging);
+        Ok(handle)
     }
 
     /// Writes `data` into this frame's staging buffer `name` and adds a transfer pass
@@ -73,8 +132,12 @@ impl UploadRing {
                 dst.size()
             )));
         }
-        let slot_count = self.slots.len() as u64;
-        let slot = &mut self.slots[(rg.frame() % slot_count) as usize];
+        // A graph with another number of frames in flight (a new executor) starts over: the
+        // old staging buffers are dropped, their destruction deferred past their last frame.
+        if self.slots.len() != rg.frames_in_flight() {
+            self.slots = (0..rg.frames_in_flight()).map(|_| Vec::new()).collect();
+        }
+        let slot = &mut self.slots[rg.slot()];
         let index = match slot.iter().position(|(n, _)| n == name) {
             Some(i) if slot[i].1.size() == size => i,
             found => {

@@ -4,8 +4,11 @@
 //!
 //! The GLSL twin is `shaders/include/brdf_table.glsl`.
 
+use crate::gpu_scene::BUFFER_READ;
+use crate::gpu_scene::upload_ring::UploadRing;
 use glam::Vec3;
-use shine_gpu::{Buffer, Device};
+use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_graph::{Handle, RenderGraph};
 use shine_sh::ShError;
 use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
 
@@ -121,29 +124,54 @@ impl GatherBrdf {
 }
 
 /// The [`GatherBrdf`] tables on the device, built once per convolution band count and kept
-/// for the renderer's life (a few hundred KiB each).
-#[derive(Default)]
+/// for the renderer's life (a few hundred KiB each). The first frame that needs a band count
+/// uploads it with a transfer pass of its own (nothing waits).
 pub struct BrdfTables {
+    device: Device,
     tables: Vec<(u32, Buffer)>,
+    ring: UploadRing,
 }
 
 impl BrdfTables {
-    /// The tables at `bands` bands (built and uploaded on first use).
-    pub fn get(&mut self, device: &Device, bands: u32) -> Result<&Buffer, BrdfTablesError> {
-        let index = match self.tables.iter().position(|(b, _)| *b == bands) {
-            Some(i) => i,
-            None => {
-                let tables = GatherBrdf::build(bands, HemisphereSampling::default())?;
-                let buffer = Buffer::storage_with_data(
-                    device,
-                    "brdf tables",
-                    bytemuck::cast_slice(&tables.gpu_data()),
-                )?;
-                self.tables.push((bands, buffer));
-                self.tables.len() - 1
-            }
-        };
-        Ok(&self.tables[index].1)
+    /// No tables yet.
+    pub fn new(device: &Device) -> Self {
+        Self {
+            device: device.clone(),
+            tables: Vec::new(),
+            ring: UploadRing::new(device),
+        }
+    }
+
+    /// Forgets every table (a frame that uploaded one was dropped unrun).
+    pub fn clear(&mut self) {
+        self.tables.clear();
+    }
+
+    /// The tables at `bands` bands in `rg`: imported, or built and uploaded by this frame.
+    pub fn import(
+        &mut self,
+        rg: &mut RenderGraph,
+        bands: u32,
+    ) -> Result<Handle<shine_graph::Buffer>, BrdfTablesError> {
+        if let Some((_, buffer)) = self.tables.iter().find(|(b, _)| *b == bands) {
+            return Ok(rg.import_gpu_buffer(buffer, BUFFER_READ, BUFFER_READ));
+        }
+        let tables = GatherBrdf::build(bands, HemisphereSampling::default())?;
+        let data = tables.gpu_data();
+        let buffer = Buffer::new(
+            &self.device,
+            &BufferDesc {
+                name: "brdf tables",
+                size: std::mem::size_of_val(data.as_slice()) as u64,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )?;
+        let handle =
+            self.ring
+                .upload_once(rg, "brdf tables", &buffer, bytemuck::cast_slice(&data))?;
+        self.tables.push((bands, buffer));
+        Ok(handle)
     }
 }
 

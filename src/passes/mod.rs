@@ -9,6 +9,7 @@ pub mod direct;
 pub mod gbuffer;
 pub mod gi_add;
 pub mod history;
+pub mod host_gbuffer;
 pub mod hvl;
 pub mod igi;
 pub mod path_trace;

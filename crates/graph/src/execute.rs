@@ -81,7 +81,7 @@ impl Executor {
 
     /// An empty graph for the next frame.
     pub fn begin_frame(&self) -> RenderGraph {
-        RenderGraph::new(self.frame)
+        RenderGraph::in_flight(self.frame, self.slots.len())
     }
 
     /// The number of the next frame.

@@ -44,6 +44,8 @@ pub struct History<R: ResourceType> {
 #[derive(Debug)]
 pub struct RenderGraph {
     pub(crate) frame: u64,
+    /// Frames the executor lets run at once (per-frame resources come in this many slots).
+    frames_in_flight: usize,
     pub(crate) resources: Vec<ResourceDecl>,
     pub(crate) passes: Vec<PassDecl>,
     /// What each pass records, by pass index.
@@ -60,8 +62,16 @@ impl RenderGraph {
     /// An empty graph for frame number `frame` (it decides which periodic passes run and which
     /// half of each history pair is current).
     pub fn new(frame: u64) -> Self {
+        Self::in_flight(frame, 1)
+    }
+
+    /// An empty graph for frame number `frame` of an executor that lets `frames_in_flight`
+    /// frames run at once: per-frame resources the caller keeps outside the graph (staging
+    /// rings) need that many slots, frame `f` using slot [`RenderGraph::slot`].
+    pub fn in_flight(frame: u64, frames_in_flight: usize) -> Self {
         Self {
             frame,
+            frames_in_flight: frames_in_flight.max(1),
             resources: Vec::new(),
             passes: Vec::new(),
             works: Vec::new(),
@@ -74,6 +84,17 @@ impl RenderGraph {
     /// The frame number this graph was built for.
     pub fn frame(&self) -> u64 {
         self.frame
+    }
+
+    /// How many frames may be in flight at once (at least 1).
+    pub fn frames_in_flight(&self) -> usize {
+        self.frames_in_flight
+    }
+
+    /// This frame's slot among [`RenderGraph::frames_in_flight`]: when the frame is declared,
+    /// the last frame that used the same slot has completed.
+    pub fn slot(&self) -> usize {
+        (self.frame % self.frames_in_flight as u64) as usize
     }
 
     fn add<R: ResourceType>(

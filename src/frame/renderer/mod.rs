@@ -1,22 +1,23 @@
 //! The renderer: a scene on a device, rendered frame by frame through the render graph.
 //!
-//! Each frame declares its passes (docs/frame.md) into a fresh graph; the executor compiles it
-//! (cached while the shape is unchanged), records it and times every pass.
+//! Each frame declares its passes (docs/frame.md) into a fresh graph (`compose`); the
+//! executor compiles it (cached while the shape is unchanged), records it and times every
+//! pass.
 
-use super::aaf::{AafInputs, AafTechnique};
+mod compose;
+mod host;
+
+use super::aaf::AafTechnique;
 use super::error::RenderError;
-use super::hvl::{HvlInputs, HvlTechnique};
-use super::igi::{IgiInputs, IgiTechnique};
+use super::hvl::HvlTechnique;
+use super::igi::IgiTechnique;
 use super::motion::MotionState;
 use super::params::FrameParams;
 use super::proxy::ProxyTechnique;
 use super::shadows::ShadowState;
 use crate::capture::image_io::{HdrImage, LdrImage};
-use crate::gpu_scene::{FRAMES_IN_FLIGHT, FrameUpdate, GpuScene, SAMPLED_READ};
-use crate::passes::composite::{self, Component, CompositeOutputs};
-use crate::passes::gbuffer;
-use crate::passes::gi_add::gi_add;
-use crate::passes::{direct, history, receivers, rsm, upsample};
+use crate::gpu_scene::{FrameUpdate, GpuScene};
+use crate::passes::composite;
 use crate::profile::report::PassClock;
 use crate::settings::Settings;
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
@@ -63,6 +64,10 @@ fn texture_sampler(device: &Device) -> Result<Sampler, shine_gpu::Error> {
             .max_lod(vk::LOD_CLAMP_NONE),
     )
 }
+
+/// Frames a renderer lets run ahead of the GPU unless told otherwise
+/// ([`Renderer::with_frames_in_flight`]).
+pub const DEFAULT_FRAMES_IN_FLIGHT: usize = 2;
 
 /// A rendered frame read back to the CPU.
 #[derive(Clone, Debug)]
@@ -163,12 +168,23 @@ impl Readback {
 }
 
 impl Renderer {
-    /// A renderer on `device` (shine's own, or a host's wrapped with `Device::from_raw`).
+    /// A renderer on `device` (shine's own, or a host's wrapped with `Device::from_raw`)
+    /// letting [`DEFAULT_FRAMES_IN_FLIGHT`] frames run ahead of the GPU.
     pub fn new(device: &Device) -> Result<Self, RenderError> {
+        Self::with_frames_in_flight(device, DEFAULT_FRAMES_IN_FLIGHT)
+    }
+
+    /// A renderer whose caller lets up to `frames_in_flight` (at least 1) recorded frames run
+    /// ahead of the GPU: per-frame resources (transients, descriptor sets, timestamps, staging
+    /// rings) come in that many slots.
+    pub fn with_frames_in_flight(
+        device: &Device,
+        frames_in_flight: usize,
+    ) -> Result<Self, RenderError> {
         use vk::SamplerAddressMode as A;
         Ok(Self {
             device: device.clone(),
-            executor: Executor::new(device, FRAMES_IN_FLIGHT)?,
+            executor: Executor::new(device, frames_in_flight)?,
             textures: texture_sampler(device)?,
             textures_level0: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::REPEAT)?,
             nearest: sampler(
@@ -190,9 +206,9 @@ impl Renderer {
 
     /// Uploads the static data of `scene` (meshes, materials, textures, the BVH's bottom
     /// levels) and poses it at time `t` (seconds); later frames change only what
-    /// [`Renderer::update`] sends. Replacing a scene first waits for the queue to go idle:
-    /// frames a host recorded with [`Renderer::record`] may still read the old one, and shine
-    /// cannot see host submissions.
+    /// [`Renderer::update`] sends. The upload itself waits for its copies (a load-time call);
+    /// the scene it replaces is destroyed only once the frames that read it have completed
+    /// (shine's own submissions, or the host frames of [`Renderer::record`]), without waiting.
     pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
         let state = SceneState {
             gpu: GpuScene::upload(&self.device, scene, t)?,
@@ -202,9 +218,6 @@ impl Renderer {
             )?,
             proxy: ProxyTechnique::new(&self.device, scene),
         };
-        if self.scene.is_some() {
-            self.device.wait_idle()?;
-        }
         self.scene = Some(state);
         self.shadows = None;
         self.motion.reset();
@@ -380,194 +393,6 @@ impl Renderer {
     /// GPU times of the passes of frames whose timestamps are available.
     pub fn timings(&mut self) -> Result<Vec<PassTiming>, RenderError> {
         Ok(self.executor.timings()?)
-    }
-
-    /// Declares every pass of a frame: each technique first prepares its persistent state
-    /// (uploads, imports), then the frame's passes are composed in dependency order (G-buffer,
-    /// shadows, direct light, RSM, the techniques, upsample, composite). Returns the HDR and
-    /// LDR images.
-    fn declare_frame(
-        &mut self,
-        rg: &mut RenderGraph,
-        p: &FrameParams,
-    ) -> Result<CompositeOutputs, RenderError> {
-        let declared = self.declare_passes(rg, p);
-        if declared.is_err() {
-            // The graph is dropped unrun: what this frame meant to leave for the next one
-            // (previous vertices, camera, HVL history) was never written.
-            if let Some(scene) = self.scene.as_mut() {
-                scene.gpu.forget_previous();
-            }
-            self.motion.reset();
-            self.hvl.reset();
-        }
-        declared
-    }
-
-    /// The passes of [`Renderer::declare_frame`].
-    fn declare_passes(
-        &mut self,
-        rg: &mut RenderGraph,
-        p: &FrameParams,
-    ) -> Result<CompositeOutputs, RenderError> {
-        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
-        let handles = scene.gpu.declare(rg)?;
-        let frame = &scene.gpu.state;
-        let shadows = ShadowState::prepare(
-            &self.device,
-            self.shadows.take(),
-            frame,
-            p.shadow_size,
-            p.shadow.pcf_radius,
-        )?;
-        let shadows = self.shadows.insert(shadows);
-        let receiver_extent = receivers::receiver_extent(p.extent, p.receiver_scale)?;
-        let hvl = p
-            .hvl
-            .map(|h| self.hvl.prepare(rg, h, receiver_extent))
-            .transpose()?;
-        let igi = p.igi.map(|i| self.igi.prepare(rg, i)).transpose()?;
-        let aaf = p.aaf.map(|a| self.aaf.prepare(a)).transpose()?;
-        let proxy = p
-            .proxy
-            .as_ref()
-            .map(|setup| scene.proxy.prepare(rg, setup, &frame.pose.world))
-            .transpose()?;
-
-        let textures = if p.mipmaps {
-            self.textures.raw()
-        } else {
-            self.textures_level0.raw()
-        };
-        let [width, height] = p.extent;
-        let camera = gbuffer::camera_view(frame, width, height);
-        let unjittered = gbuffer::unjittered_camera_view(frame, width, height).view_proj();
-        let motion_view = self.motion.declare(rg, unjittered, p.extent)?;
-        let g = gbuffer::gbuffer(rg, &handles, &camera, &motion_view, p.extent, textures);
-        // Kept for the next frame (its previous normal and depth); nothing reads it yet.
-        history::gbuffer_history(rg, &g);
-        let light_count = u32::try_from(frame.lights.len())
-            .map_err(|_| RenderError::Invalid("too many lights".into()))?;
-        let atlas = shadows.declare(rg, &handles)?;
-        let background = direct::Background {
-            environment: rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ),
-            sampler: self.environment_sampler.raw(),
-        };
-        let direct = direct::direct(
-            rg,
-            &g,
-            &handles,
-            light_count,
-            &atlas,
-            &camera,
-            &background,
-            p.shadow,
-            self.nearest.raw(),
-        );
-
-        // HVL and IGI bounce the primary light (the first spot or directional light) off its
-        // RSM; without one they add nothing.
-        let primary = scene
-            .gpu
-            .primary_light()
-            .and_then(|i| Some((i as u32, gbuffer::light_view(frame, i)?)));
-        let rsm = match primary {
-            Some((light, view)) if hvl.is_some() || igi.is_some() => {
-                Some(rsm::rsm(rg, &handles, view, light, p.rsm_size, textures))
-            }
-            _ => None,
-        };
-        // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
-        // upsample; `hvl,proxy` sums both at receiver resolution first.
-        let recv = if hvl.is_some() || proxy.is_some() {
-            Some(receivers::receivers(rg, &g, p.receiver_scale)?)
-        } else {
-            None
-        };
-        if hvl.is_some() && rsm.is_none() {
-            // No primary light: the HVL passes (and their history) are not in this frame.
-            self.hvl.reset();
-        }
-        let hvl_low = match (hvl, &rsm, &recv) {
-            (Some(hvl), Some(rsm), Some(receivers)) => Some(hvl.declare(
-                rg,
-                &HvlInputs {
-                    receivers,
-                    rsm,
-                    bvh: &handles.trace,
-                    camera: camera.eye,
-                    motion: &g.motion,
-                },
-            )?),
-            _ => None,
-        };
-        let proxy_low = match (proxy, &recv) {
-            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers)?),
-            _ => None,
-        };
-        let low = match (hvl_low, proxy_low) {
-            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
-            (a, b) => a.or(b),
-        };
-        let upsampled = match (low, &recv) {
-            (Some(low), Some(recv)) => Some(upsample::upsample(rg, &low, recv, &g, &p.upsample)?),
-            _ => None,
-        };
-        // IGI runs at full resolution (its interleaving needs the pixel grid).
-        let igi_full = match (igi, &rsm) {
-            (Some(igi), Some(rsm)) => Some(igi.declare(
-                rg,
-                &IgiInputs {
-                    gbuffer: &g,
-                    rsm,
-                    bvh: &handles.trace,
-                    camera: camera.eye,
-                },
-            )?),
-            _ => None,
-        };
-        let aaf_full = match aaf {
-            Some(aaf) => Some(aaf.declare(
-                rg,
-                &AafInputs {
-                    gbuffer: &g,
-                    scene: &handles,
-                    bvh: &handles.trace,
-                    light_count,
-                    bounds: frame.bounds,
-                    camera: &camera,
-                    // Ray hits read level 0 (no derivatives there, and lavapipe's
-                    // anisotropic path is ~300× slower for explicit-LOD lookups).
-                    texture_sampler: self.textures_level0.raw(),
-                },
-            )?),
-            None => None,
-        };
-        // `igi,proxy` and `aaf,proxy`: both full-resolution indirect terms summed (settings
-        // allow at most one of hvl, igi and aaf).
-        let full = igi_full.or(aaf_full);
-        let indirect = match (upsampled, full) {
-            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
-            (a, b) => a.or(b),
-        };
-        // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
-        let (first, second) = match (p.component, indirect.as_ref()) {
-            (Component::Full, indirect) => (&direct, indirect),
-            (Component::Direct, _) => (&direct, None),
-            (Component::Indirect, Some(indirect)) => (indirect, None),
-            (Component::Indirect, None) => {
-                return Err(RenderError::Invalid(
-                    "output.component = indirect needs a GI technique (this frame has none)".into(),
-                ));
-            }
-        };
-        Ok(composite::composite(
-            rg,
-            first,
-            second,
-            p.extent,
-            &p.composite,
-        ))
     }
 }
 

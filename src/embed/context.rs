@@ -1,0 +1,249 @@
+//! [`GiContext`]: shine as a GI pass inside a host engine's frame.
+
+use super::inputs::GiDispatch;
+use crate::frame::RenderError;
+use crate::frame::params::FrameParams;
+use crate::frame::renderer::{HostTarget, Renderer};
+use crate::gpu_scene::FrameUpdate;
+use crate::gpu_scene::upload_ring::UploadRing;
+use crate::passes::host_gbuffer::{self, HostFrame, HostImages};
+use crate::settings::Settings;
+use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
+use shine_graph::{Handle, Image, ImageDesc, ImageImport, PassTiming, RenderGraph};
+use shine_scene::Scene;
+
+/// How a [`GiContext`] is made: fixed for its life (make a new context to change them).
+#[derive(Clone, Debug, PartialEq)]
+pub struct GiContextDesc {
+    /// Width and height of the host's G-buffer and of the output.
+    pub display: [u32; 2],
+    /// How many frames the host records ahead of the GPU (at least 1): per-frame resources
+    /// come in that many slots.
+    pub frames_in_flight: usize,
+    /// The technique and its options, as for a full frame: `gi` picks the technique(s),
+    /// `receiver_scale` the internal scale of the receiver-resolution ones (HVL, proxies),
+    /// `hvl.count` the HVL budget, `[igi]`, `[proxy]`, `[aaf]`, `[rsm]`, `[upsample]` the
+    /// rest. `width`, `height` and everything about direct light and output are not used.
+    pub settings: Settings,
+    /// The most lights and proxy spheres a scene may bring (a larger one is refused).
+    pub budgets: GiBudgets,
+}
+
+/// Upper bounds on what a scene handed to a [`GiContext`] may hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct GiBudgets {
+    /// Punctual lights.
+    pub lights: u32,
+    /// Sphere proxies (paper 002).
+    pub proxies: u32,
+}
+
+impl Default for GiBudgets {
+    /// 64 lights and 256 proxy spheres.
+    fn default() -> Self {
+        Self {
+            lights: 64,
+            proxies: 256,
+        }
+    }
+}
+
+impl GiContextDesc {
+    /// A context of `display` size running `technique` (`"hvl"`, `"igi"`, `"hvl,proxy"` …)
+    /// with default options, two frames in flight and default budgets.
+    pub fn new(display: [u32; 2], technique: &str) -> Result<Self, RenderError> {
+        Ok(Self {
+            display,
+            frames_in_flight: crate::frame::renderer::DEFAULT_FRAMES_IN_FLIGHT,
+            settings: Settings {
+                gi: technique.parse()?,
+                ..Settings::default()
+            },
+            budgets: GiBudgets::default(),
+        })
+    }
+}
+
+/// shine's indirect light as a pass of a host engine's frame, the way FidelityFX's GI
+/// effects are integrated: made once on the host's device ([`Device::from_raw`]), given a
+/// scene ([`GiContext::set_scene`]) and per-frame changes ([`GiContext::update`]), then
+/// [`GiContext::dispatch`] records one frame into the host's command buffer from the host's
+/// G-buffer. Nothing it does on the frame path submits or waits (docs/embedding.md).
+///
+/// `GiContext` is `Send` (move it to a render thread) but not `Sync`: calls on one context
+/// come from one thread at a time. Contexts on one device are independent.
+pub struct GiContext {
+    renderer: Renderer,
+    display: [u32; 2],
+    budgets: GiBudgets,
+    params: FrameParams,
+    /// The device buffer of the frame's [`HostFrame`], rewritten every dispatch.
+    frame_constants: Buffer,
+    ring: UploadRing,
+    nearest: Sampler,
+    /// The last dispatched host frame (frame numbers must increase).
+    last_frame: Option<u64>,
+}
+
+impl GiContext {
+    /// A context on `device` as `desc` says; nothing of a scene is uploaded yet.
+    pub fn new(device: &Device, desc: &GiContextDesc) -> Result<Self, RenderError> {
+        let [width, height] = desc.display;
+        let settings = Settings {
+            width,
+            height,
+            ..desc.settings.clone()
+        };
+        settings.validate()?;
+        if settings.gi.is_none() {
+            return Err(RenderError::Invalid(
+                "GI context: settings.gi names no technique".into(),
+            ));
+        }
+        let mut params = FrameParams::from_settings(&settings);
+        // Direct light and the composite are the host's.
+        params.component = crate::passes::composite::Component::Indirect;
+        Ok(Self {
+            renderer: Renderer::with_frames_in_flight(device, desc.frames_in_flight)?,
+            display: desc.display,
+            budgets: desc.budgets,
+            params,
+            frame_constants: Buffer::new(
+                device,
+                &BufferDesc {
+                    name: "host frame",
+                    size: std::mem::size_of::<HostFrame>() as u64,
+                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
+                        | vk::BufferUsageFlags::TRANSFER_DST,
+                    location: MemoryLocation::GpuOnly,
+                },
+            )?,
+            ring: UploadRing::new(device),
+            nearest: Sampler::new(
+                device,
+                &vk::SamplerCreateInfo::default()
+                    .mag_filter(vk::Filter::NEAREST)
+                    .min_filter(vk::Filter::NEAREST)
+                    .address_mode_u(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .address_mode_v(vk::SamplerAddressMode::CLAMP_TO_EDGE)
+                    .max_lod(0.0),
+            )?,
+            last_frame: None,
+        })
+    }
+
+    /// The display size the context was made for.
+    pub fn display(&self) -> [u32; 2] {
+        self.display
+    }
+
+    /// Hands over the scene the GI is computed from (geometry for the RSM and the BVH, lights,
+    /// proxies, the environment), posed at time `t`: a load-time call that uploads and waits
+    /// for its copies. A scene over the budgets is refused (the old one stays).
+    pub fn set_scene(&mut self, scene: &Scene, t: f32) -> Result<(), RenderError> {
+        let lights = scene.lights.len();
+        let proxies: usize = scene.proxies.iter().map(|p| p.spheres.len()).sum();
+        if lights > self.budgets.lights as usize || proxies > self.budgets.proxies as usize {
+            return Err(RenderError::Invalid(format!(
+                "GI context: the scene has {lights} lights and {proxies} proxy spheres, the \
+                 budgets are {} and {}",
+                self.budgets.lights, self.budgets.proxies
+            )));
+        }
+        self.renderer.set_scene(scene, t)
+    }
+
+    /// Sets the scene's time, node transforms, lights and morph weights for the next
+    /// dispatch (CPU work only; the dispatch uploads them). The camera of a `FrameUpdate` is
+    /// not used: each dispatch brings the host's. A bad update is refused.
+    pub fn update(&mut self, update: &FrameUpdate) -> Result<(), RenderError> {
+        self.renderer.update(update)
+    }
+
+    /// Records one frame into `cb` (recording, outside a render pass): the host's G-buffer
+    /// converted, the technique's passes, and the indirect light written to
+    /// `dispatch.diffuse`, left in its `after` state. Never submits or waits; the host
+    /// submits `cb` and keeps the images alive until it completes. After an error nothing
+    /// usable was recorded: do not submit `cb`.
+    pub fn dispatch(
+        &mut self,
+        cb: vk::CommandBuffer,
+        dispatch: &GiDispatch,
+    ) -> Result<(), RenderError> {
+        dispatch.validate(self.display)?;
+        if self
+            .last_frame
+            .is_some_and(|last| dispatch.frame_index <= last)
+        {
+            return Err(RenderError::Invalid(format!(
+                "GI dispatch: frame {} after frame {}: frame numbers must increase",
+                dispatch.frame_index,
+                self.last_frame.unwrap_or_default()
+            )));
+        }
+        let display = self.display;
+        let constants = dispatch.host_frame(display);
+        let camera = dispatch.camera.to_view(display);
+        let (frame_constants, ring, sampler) =
+            (&self.frame_constants, &mut self.ring, self.nearest.raw());
+        self.renderer
+            .record_indirect(cb, &self.params, &camera, &mut |rg: &mut RenderGraph| {
+                let frame = ring.upload(
+                    rg,
+                    "host frame",
+                    frame_constants,
+                    bytemuck::bytes_of(&constants),
+                )?;
+                let host = HostImages {
+                    depth: import(rg, "host depth", &dispatch.depth),
+                    normal: import(rg, "host normals", &dispatch.normals),
+                    albedo: import(rg, "host albedo", &dispatch.albedo),
+                    material: import(rg, "host material", &dispatch.material),
+                    motion: dispatch.motion.map(|m| import(rg, "host motion", &m.image)),
+                };
+                let g = host_gbuffer::host_gbuffer(rg, &host, &frame, display, sampler);
+                let output = import_output(rg, &dispatch.diffuse);
+                Ok((g, output))
+            })?;
+        self.last_frame = Some(dispatch.frame_index);
+        Ok(())
+    }
+
+    /// GPU times of the passes of dispatched frames whose timestamps are available (call
+    /// once those frames have completed).
+    pub fn timings(&mut self) -> Result<Vec<PassTiming>, RenderError> {
+        self.renderer.timings()
+    }
+}
+
+/// A host input image, read only.
+fn import(rg: &mut RenderGraph, name: &str, image: &HostTarget) -> Handle<Image> {
+    rg.import_vk_image(
+        name,
+        ImageDesc::new_2d(image.format, image.extent[0], image.extent[1]),
+        ImageImport {
+            initial: image.before,
+            final_state: image.after,
+            usage: image.usage,
+            read_only: true,
+        },
+        image.image,
+        image.view,
+    )
+}
+
+/// The host's output image.
+fn import_output(rg: &mut RenderGraph, image: &HostTarget) -> Handle<Image> {
+    rg.import_vk_image(
+        "host diffuse gi",
+        ImageDesc::new_2d(image.format, image.extent[0], image.extent[1]),
+        ImageImport {
+            initial: image.before,
+            final_state: image.after,
+            usage: image.usage,
+            read_only: false,
+        },
+        image.image,
+        image.view,
+    )
+}

@@ -1,0 +1,11 @@
+//! shine embedded in a host engine as a GI pass (docs/embedding.md): a [`GiContext`] made
+//! once on the host's device, fed the host's G-buffer every frame ([`GiDispatch`]) and
+//! recording into the host's command buffer, the way FidelityFX's GI effects integrate.
+
+mod context;
+mod inputs;
+
+pub use context::{GiBudgets, GiContext, GiContextDesc};
+pub use inputs::{
+    DepthConvention, GiCamera, GiDispatch, HostMotion, MaterialChannels, NormalEncoding,
+};

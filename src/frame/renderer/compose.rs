@@ -1,0 +1,242 @@
+//! The composition of a frame, in one place: the G-buffer, shadows and direct light of a full
+//! frame, and the techniques' indirect light, which a full frame and a GI context (a host's
+//! G-buffer, `crate::embed`) share.
+
+use super::Renderer;
+use crate::frame::aaf::AafInputs;
+use crate::frame::error::RenderError;
+use crate::frame::hvl::HvlInputs;
+use crate::frame::igi::IgiInputs;
+use crate::frame::params::FrameParams;
+use crate::frame::shadows::ShadowState;
+use crate::gpu_scene::{SAMPLED_READ, SceneHandles};
+use crate::passes::composite::{self, Component, CompositeOutputs};
+use crate::passes::gbuffer::{self, GBuffer, View};
+use crate::passes::gi_add::gi_add;
+use crate::passes::{direct, history, receivers, rsm, upsample};
+use shine_graph::{Handle, Image, RenderGraph};
+
+impl Renderer {
+    /// Declares every pass of a frame: the G-buffer, shadows and direct light, the techniques'
+    /// indirect light ([`Renderer::declare_indirect`]), and the composite. Returns the HDR and
+    /// LDR images.
+    pub(super) fn declare_frame(
+        &mut self,
+        rg: &mut RenderGraph,
+        p: &FrameParams,
+    ) -> Result<CompositeOutputs, RenderError> {
+        let declared = self.declare_passes(rg, p);
+        if declared.is_err() {
+            self.forget_history();
+        }
+        declared
+    }
+
+    /// After a graph that is dropped unrun: what that frame meant to leave for the next one
+    /// (previous vertices, camera, HVL history) or upload once (tables) was never written.
+    pub(super) fn forget_history(&mut self) {
+        if let Some(scene) = self.scene.as_mut() {
+            scene.gpu.forget_previous();
+        }
+        self.motion.reset();
+        self.hvl.forget_uploads();
+        self.igi.forget_uploads();
+        if let Some(scene) = self.scene.as_mut() {
+            scene.proxy.forget_uploads();
+        }
+    }
+
+    /// The passes of [`Renderer::declare_frame`].
+    fn declare_passes(
+        &mut self,
+        rg: &mut RenderGraph,
+        p: &FrameParams,
+    ) -> Result<CompositeOutputs, RenderError> {
+        let textures = self.texture_sampler(p);
+        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        let handles = scene.gpu.declare(rg)?;
+        let frame = &scene.gpu.state;
+        let shadows = ShadowState::prepare(
+            &self.device,
+            self.shadows.take(),
+            frame,
+            p.shadow_size,
+            p.shadow.pcf_radius,
+        )?;
+        let shadows = self.shadows.insert(shadows);
+        let [width, height] = p.extent;
+        let camera = gbuffer::camera_view(frame, width, height);
+        let unjittered = gbuffer::unjittered_camera_view(frame, width, height).view_proj();
+        let motion_view = self.motion.declare(rg, unjittered, p.extent)?;
+        let g = gbuffer::gbuffer(rg, &handles, &camera, &motion_view, p.extent, textures);
+        // Kept for the next frame (its previous normal and depth); nothing reads it yet.
+        history::gbuffer_history(rg, &g);
+        let light_count = light_count(&scene.gpu.state)?;
+        let atlas = shadows.declare(rg, &handles)?;
+        let background = direct::Background {
+            environment: rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ),
+            sampler: self.environment_sampler.raw(),
+        };
+        let direct = direct::direct(
+            rg,
+            &g,
+            &handles,
+            light_count,
+            &atlas,
+            &camera,
+            &background,
+            p.shadow,
+            self.nearest.raw(),
+        );
+        let indirect = self.declare_indirect(rg, p, &handles, &g, &camera)?;
+        // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
+        let (first, second) = match (p.component, indirect.as_ref()) {
+            (Component::Full, indirect) => (&direct, indirect),
+            (Component::Direct, _) => (&direct, None),
+            (Component::Indirect, Some(indirect)) => (indirect, None),
+            (Component::Indirect, None) => {
+                return Err(RenderError::Invalid(
+                    "output.component = indirect needs a GI technique (this frame has none)".into(),
+                ));
+            }
+        };
+        Ok(composite::composite(
+            rg,
+            first,
+            second,
+            p.extent,
+            &p.composite,
+        ))
+    }
+
+    /// The scene textures' sampler of `p`: trilinear, or level 0 without mipmaps.
+    pub(super) fn texture_sampler(&self, p: &FrameParams) -> shine_gpu::vk::Sampler {
+        if p.mipmaps {
+            self.textures.raw()
+        } else {
+            self.textures_level0.raw()
+        }
+    }
+
+    /// The indirect light of the surfaces in `g`, seen from `camera`: each technique of `p`
+    /// prepares its persistent state, then the primary light's RSM, the receiver-resolution
+    /// techniques (HVL, proxies) and their upsample, and the full-resolution ones (IGI, AAF)
+    /// are declared and summed. Returns full-resolution outgoing indirect radiance (RGBA16F),
+    /// or `None` when `p` has no technique.
+    pub(super) fn declare_indirect(
+        &mut self,
+        rg: &mut RenderGraph,
+        p: &FrameParams,
+        handles: &SceneHandles,
+        g: &GBuffer,
+        camera: &View,
+    ) -> Result<Option<Handle<Image>>, RenderError> {
+        let textures = self.texture_sampler(p);
+        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        let frame = &scene.gpu.state;
+        let receiver_extent = receivers::receiver_extent(p.extent, p.receiver_scale)?;
+        let hvl = p
+            .hvl
+            .map(|h| self.hvl.prepare(rg, h, receiver_extent))
+            .transpose()?;
+        let igi = p.igi.map(|i| self.igi.prepare(rg, i)).transpose()?;
+        let aaf = p.aaf.map(|a| self.aaf.prepare(a)).transpose()?;
+        let proxy = p
+            .proxy
+            .as_ref()
+            .map(|setup| scene.proxy.prepare(rg, setup, &frame.pose.world))
+            .transpose()?;
+        let light_count = light_count(frame)?;
+
+        // HVL and IGI bounce the primary light (the first spot or directional light) off its
+        // RSM; without one they add nothing.
+        let primary = scene
+            .gpu
+            .primary_light()
+            .and_then(|i| Some((i as u32, gbuffer::light_view(frame, i)?)));
+        let rsm = match primary {
+            Some((light, view)) if hvl.is_some() || igi.is_some() => {
+                Some(rsm::rsm(rg, handles, view, light, p.rsm_size, textures))
+            }
+            _ => None,
+        };
+        // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
+        // upsample; `hvl,proxy` sums both at receiver resolution first.
+        let recv = if hvl.is_some() || proxy.is_some() {
+            Some(receivers::receivers(rg, g, p.receiver_scale)?)
+        } else {
+            None
+        };
+        if hvl.is_some() && rsm.is_none() {
+            // No primary light: the HVL passes (and their history) are not in this frame.
+            self.hvl.reset();
+        }
+        let hvl_low = match (hvl, &rsm, &recv) {
+            (Some(hvl), Some(rsm), Some(receivers)) => Some(hvl.declare(
+                rg,
+                &HvlInputs {
+                    receivers,
+                    rsm,
+                    bvh: &handles.trace,
+                    camera: camera.eye,
+                    motion: &g.motion,
+                },
+            )?),
+            _ => None,
+        };
+        let proxy_low = match (proxy, &recv) {
+            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers)?),
+            _ => None,
+        };
+        let low = match (hvl_low, proxy_low) {
+            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
+            (a, b) => a.or(b),
+        };
+        let upsampled = match (low, &recv) {
+            (Some(low), Some(recv)) => Some(upsample::upsample(rg, &low, recv, g, &p.upsample)?),
+            _ => None,
+        };
+        // IGI runs at full resolution (its interleaving needs the pixel grid).
+        let igi_full = match (igi, &rsm) {
+            (Some(igi), Some(rsm)) => Some(igi.declare(
+                rg,
+                &IgiInputs {
+                    gbuffer: g,
+                    rsm,
+                    bvh: &handles.trace,
+                    camera: camera.eye,
+                },
+            )?),
+            _ => None,
+        };
+        let aaf_full = match aaf {
+            Some(aaf) => Some(aaf.declare(
+                rg,
+                &AafInputs {
+                    gbuffer: g,
+                    scene: handles,
+                    bvh: &handles.trace,
+                    light_count,
+                    bounds: frame.bounds,
+                    camera,
+                    // Ray hits read level 0 (no derivatives there, and lavapipe's
+                    // anisotropic path is ~300× slower for explicit-LOD lookups).
+                    texture_sampler: self.textures_level0.raw(),
+                },
+            )?),
+            None => None,
+        };
+        // `igi,proxy` and `aaf,proxy`: both full-resolution indirect terms summed (settings
+        // allow at most one of hvl, igi and aaf).
+        let full = igi_full.or(aaf_full);
+        Ok(match (upsampled, full) {
+            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
+            (a, b) => a.or(b),
+        })
+    }
+}
+
+/// The number of lights of `frame`, as the passes take it.
+fn light_count(frame: &crate::gpu_scene::FrameState) -> Result<u32, RenderError> {
+    u32::try_from(frame.lights.len()).map_err(|_| RenderError::Invalid("too many lights".into()))
+}

@@ -1,0 +1,65 @@
+//! The indirect light of a host's G-buffer, recorded into the host's command buffer: the
+//! frame a GI context (`crate::embed`) records.
+
+use super::Renderer;
+use crate::frame::error::RenderError;
+use crate::frame::params::FrameParams;
+use crate::passes::gbuffer::{GBuffer, View};
+use shine_gpu::vk;
+use shine_graph::{Handle, Image, RenderGraph};
+
+/// Declares the host's side of a frame into its graph: the G-buffer converted from the host's
+/// images and the host's output image, imported.
+pub(crate) type DeclareHost<'a> =
+    dyn FnMut(&mut RenderGraph) -> Result<(GBuffer, Handle<Image>), RenderError> + 'a;
+
+impl Renderer {
+    /// Records into `cb` the scene's updates, `host`'s G-buffer conversion, the techniques of
+    /// `p` seen from `camera`, and their indirect light written into the host's output image
+    /// (cleared to 0 when the frame has no indirect light, e.g. no primary light for HVL).
+    /// Neither submits nor waits. After an error nothing usable was recorded, and what this
+    /// frame meant to leave for the next (history, uploads) is forgotten.
+    pub(crate) fn record_indirect(
+        &mut self,
+        cb: vk::CommandBuffer,
+        p: &FrameParams,
+        camera: &View,
+        host: &mut DeclareHost<'_>,
+    ) -> Result<(), RenderError> {
+        let mut rg = self.executor.begin_frame();
+        let recorded = match self.declare_host_frame(&mut rg, p, camera, host) {
+            Ok(()) => self
+                .executor
+                .execute(cb, rg)
+                .map(drop)
+                .map_err(RenderError::from),
+            Err(e) => Err(e),
+        };
+        if recorded.is_err() {
+            self.forget_history();
+        }
+        recorded
+    }
+
+    /// The passes of [`Renderer::record_indirect`].
+    fn declare_host_frame(
+        &mut self,
+        rg: &mut RenderGraph,
+        p: &FrameParams,
+        camera: &View,
+        host: &mut DeclareHost<'_>,
+    ) -> Result<(), RenderError> {
+        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        let handles = scene.gpu.declare(rg)?;
+        let (g, mut output) = host(rg)?;
+        match self.declare_indirect(rg, p, &handles, &g, camera)? {
+            Some(indirect) => {
+                rg.blit_image("gi to host", &indirect, &mut output, vk::Filter::NEAREST);
+            }
+            None => {
+                rg.clear_image("gi to host", &mut output, [0.0; 4]);
+            }
+        }
+        Ok(())
+    }
+}
