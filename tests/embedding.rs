@@ -3,6 +3,10 @@
 //! still owns working handles after every shine object is gone.
 
 mod common;
+#[path = "embedding/gi_context.rs"]
+mod gi_context;
+#[path = "../examples/host_gbuffer/host.rs"]
+mod host;
 
 use shine::gpu::ash;
 use shine::gpu::{Device, RawDevice, vk};

@@ -76,6 +76,9 @@ pub struct GiContext {
     renderer: Renderer,
     display: [u32; 2],
     budgets: GiBudgets,
+    /// The options of the context's description.
+    settings: Settings,
+    /// What each frame computes, at the display size.
     params: FrameParams,
     /// The device buffer of the frame's [`HostFrame`], rewritten every dispatch.
     frame_constants: Buffer,
@@ -88,26 +91,12 @@ pub struct GiContext {
 impl GiContext {
     /// A context on `device` as `desc` says; nothing of a scene is uploaded yet.
     pub fn new(device: &Device, desc: &GiContextDesc) -> Result<Self, RenderError> {
-        let [width, height] = desc.display;
-        let settings = Settings {
-            width,
-            height,
-            ..desc.settings.clone()
-        };
-        settings.validate()?;
-        if settings.gi.is_none() {
-            return Err(RenderError::Invalid(
-                "GI context: settings.gi names no technique".into(),
-            ));
-        }
-        let mut params = FrameParams::from_settings(&settings);
-        // Direct light and the composite are the host's.
-        params.component = crate::passes::composite::Component::Indirect;
         Ok(Self {
             renderer: Renderer::with_frames_in_flight(device, desc.frames_in_flight)?,
             display: desc.display,
             budgets: desc.budgets,
-            params,
+            params: frame_params(&desc.settings, desc.display)?,
+            settings: desc.settings.clone(),
             frame_constants: Buffer::new(
                 device,
                 &BufferDesc {
@@ -135,6 +124,15 @@ impl GiContext {
     /// The display size the context was made for.
     pub fn display(&self) -> [u32; 2] {
         self.display
+    }
+
+    /// Changes the display size (the host's swapchain was resized): the next dispatch takes
+    /// images of `display` size; histories start over, and the transients of the old size
+    /// are released once the frames that used them have completed. Nothing waits.
+    pub fn resize(&mut self, display: [u32; 2]) -> Result<(), RenderError> {
+        self.params = frame_params(&self.settings, display)?;
+        self.display = display;
+        Ok(())
     }
 
     /// Hands over the scene the GI is computed from (geometry for the RSM and the BVH, lights,
@@ -214,6 +212,26 @@ impl GiContext {
     pub fn timings(&mut self) -> Result<Vec<PassTiming>, RenderError> {
         self.renderer.timings()
     }
+}
+
+/// The frame parameters of `settings` at `display` size: indirect light only (direct light
+/// and the composite are the host's).
+fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, RenderError> {
+    let [width, height] = display;
+    let settings = Settings {
+        width,
+        height,
+        ..settings.clone()
+    };
+    settings.validate()?;
+    if settings.gi.is_none() {
+        return Err(RenderError::Invalid(
+            "GI context: settings.gi names no technique".into(),
+        ));
+    }
+    let mut params = FrameParams::from_settings(&settings);
+    params.component = crate::passes::composite::Component::Indirect;
+    Ok(params)
 }
 
 /// A host input image, read only.

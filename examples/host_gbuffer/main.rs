@@ -1,0 +1,137 @@
+//! A host engine using shine as a GI pass (docs/embedding.md): the host rasterises its own
+//! G-buffer and direct light with its own pipeline into its own images, hands them to a
+//! `GiContext` recorded into its own command buffer, composites direct + GI itself, and
+//! writes a PNG after 3 frames of a moving camera.
+//!
+//! `cargo run --release --example host_gbuffer -- out.png`
+
+mod host;
+
+use host::{HostDevice, HostScene, Raster, Targets};
+use shine::embed::{
+    GiCamera, GiContext, GiContextDesc, GiDispatch, MaterialChannels, NormalEncoding,
+};
+use shine::graph::ExternalState;
+use std::error::Error;
+use std::sync::atomic::Ordering;
+
+/// Frames rendered; the camera turns a little each frame.
+const FRAMES: u32 = 3;
+/// Radians the camera turns per frame about the scene's vertical axis.
+const ORBIT_PER_FRAME: f32 = 0.05;
+
+fn main() -> Result<(), Box<dyn Error>> {
+    let output = std::env::args()
+        .nth(1)
+        .unwrap_or_else(|| "host_gbuffer.png".into());
+    let extent = [256, 256];
+    let scene = shine_scene::Scene::builtin("cornell-box")?;
+
+    let host = HostDevice::new(true)?;
+    let targets = Targets::new(&host, extent)?;
+    let host_scene = HostScene::new(&host, &scene)?;
+    let raster = Raster::new(&host)?;
+    let (direct, gi) = {
+        // shine on the host's device, allocating from the host's allocator.
+        let device = shine::gpu::Device::from_raw(host.lend(true))?;
+        let mut gi = GiContext::new(&device, &GiContextDesc::new(extent, "hvl")?)?;
+        gi.set_scene(&scene, 0.0)?;
+        let mut previous = None;
+        for frame in 0..FRAMES {
+            let (view, projection) = host::camera(&scene, extent, frame as f32 * ORBIT_PER_FRAME);
+            let (previous_view, previous_projection) = previous.unwrap_or((view, projection));
+            previous = Some((view, projection));
+            let cb = host.begin()?;
+            raster.record(&host, cb, &targets, &host_scene, projection * view);
+            let color =
+                |image: &host::HostImage| image.lend(host::color_written(), host::sampled_after());
+            gi.dispatch(
+                cb,
+                &GiDispatch {
+                    frame_index: u64::from(frame),
+                    camera: GiCamera {
+                        view,
+                        projection,
+                        jitter: [0.0; 2],
+                        previous_view,
+                        previous_projection,
+                    },
+                    depth: targets
+                        .depth
+                        .lend(host::depth_written(), host::sampled_after()),
+                    depth_convention: Default::default(),
+                    normals: color(&targets.normal),
+                    normal_encoding: NormalEncoding::UNORM,
+                    albedo: color(&targets.albedo),
+                    material: color(&targets.material),
+                    material_channels: MaterialChannels::default(),
+                    motion: None,
+                    diffuse: targets
+                        .gi
+                        .lend(ExternalState::UNDEFINED, host::copy_source()),
+                },
+            )?;
+            host.submit_and_wait(cb)?;
+            println!("frame {}/{FRAMES}", frame + 1);
+        }
+        let direct = host::read_rgba16f(&host, &targets.direct, host::color_written())?;
+        let gi_texels = host::read_rgba16f(&host, &targets.gi, host::copy_source())?;
+        // Teardown order: shine's objects (context, then device), then the host's.
+        drop(gi);
+        drop(device);
+        (direct, gi_texels)
+    };
+    raster.destroy(&host);
+    host_scene.destroy(&host);
+    targets.destroy(&host);
+
+    let mean =
+        |t: &[[f32; 4]]| t.iter().map(|p| (p[0] + p[1] + p[2]) / 3.0).sum::<f32>() / t.len() as f32;
+    println!(
+        "mean radiance: direct {:.4}, indirect {:.4}",
+        mean(&direct),
+        mean(&gi)
+    );
+    // The host's composite: direct + indirect, Reinhard, sRGB.
+    let encode = |x: f32| {
+        let x = x / (1.0 + x);
+        let s = if x <= 0.003_130_8 {
+            12.92 * x
+        } else {
+            1.055 * x.powf(1.0 / 2.4) - 0.055
+        };
+        (s.clamp(0.0, 1.0) * 255.0).round() as u8
+    };
+    let pixels: Vec<u8> = direct
+        .iter()
+        .zip(&gi)
+        .flat_map(|(d, g)| {
+            [
+                encode(d[0] + g[0]),
+                encode(d[1] + g[1]),
+                encode(d[2] + g[2]),
+                255,
+            ]
+        })
+        .collect();
+    let problems = host::VALIDATION_MESSAGES.load(Ordering::Relaxed);
+    if problems > 0 {
+        return Err(format!("{problems} validation messages").into());
+    }
+    if mean(&gi) <= 0.0 || mean(&direct) <= 0.0 {
+        return Err("the frame is black".into());
+    }
+    // Written beside the target and renamed: no half-written file.
+    let path = std::path::Path::new(&output);
+    let partial = path.with_extension("partial.png");
+    image::save_buffer(
+        &partial,
+        &pixels,
+        extent[0],
+        extent[1],
+        image::ColorType::Rgba8,
+    )?;
+    std::fs::rename(&partial, path)?;
+    println!("wrote {output}");
+    Ok(())
+}

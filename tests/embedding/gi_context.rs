@@ -1,0 +1,406 @@
+//! The GI context (`shine::embed`) driven by a host engine that rasterises its own G-buffer
+//! with its own pipeline into its own images (examples/host_gbuffer/host.rs), validation on.
+
+use super::host::{self, HostDevice, HostScene, Raster, Targets};
+use glam::Mat4;
+use shine::embed::{
+    GiCamera, GiContext, GiContextDesc, GiDispatch, MaterialChannels, NormalEncoding,
+};
+use shine::gpu::{Device, vk};
+use shine::graph::ExternalState;
+use shine::passes::composite::Component;
+use shine::study::metrics::image_error;
+use shine::{CameraPose, FrameUpdate, Renderer, Settings};
+use shine_scene::Scene;
+use std::sync::atomic::Ordering;
+
+/// Test image size.
+const EXTENT: [u32; 2] = [64, 64];
+/// Radians the camera turns per frame in the moving-camera tests.
+const ORBIT: f32 = 0.04;
+
+/// A host with the cornell box, its G-buffer pipeline and targets, and shine's device on it.
+struct Bench {
+    scene: Scene,
+    host_scene: Option<HostScene>,
+    raster: Option<Raster>,
+    targets: Option<Targets>,
+    device: Option<Device>,
+    /// Last: dropped after every object above (the documented teardown order).
+    host: HostDevice,
+}
+
+impl Bench {
+    fn new(share_allocator: bool) -> Self {
+        let host = HostDevice::new(true).expect("host device");
+        assert!(
+            host.validation || std::env::var_os("CI").is_none(),
+            "CI needs the validation layer"
+        );
+        let scene = Scene::builtin("cornell-box").expect("scene");
+        let device = Device::from_raw(host.lend(share_allocator)).expect("shine device");
+        Self {
+            host_scene: Some(HostScene::new(&host, &scene).expect("host scene")),
+            raster: Some(Raster::new(&host).expect("raster")),
+            targets: Some(Targets::new(&host, EXTENT).expect("targets")),
+            device: Some(device),
+            scene,
+            host,
+        }
+    }
+
+    fn device(&self) -> &Device {
+        self.device.as_ref().expect("device")
+    }
+
+    fn targets(&self) -> &Targets {
+        self.targets.as_ref().expect("targets")
+    }
+
+    /// A context for `technique` with the scene set.
+    fn context(&self, technique: &str) -> GiContext {
+        let mut gi = GiContext::new(
+            self.device(),
+            &GiContextDesc::new(EXTENT, technique).expect("desc"),
+        )
+        .expect("context");
+        gi.set_scene(&self.scene, 0.0).expect("scene");
+        gi
+    }
+
+    /// The camera of frame `k` (turned by `k · ORBIT`) and the previous frame's.
+    fn camera(&self, k: u32) -> GiCamera {
+        let (view, projection) = host::camera(&self.scene, EXTENT, k as f32 * ORBIT);
+        let (previous_view, previous_projection) =
+            host::camera(&self.scene, EXTENT, k.saturating_sub(1) as f32 * ORBIT);
+        GiCamera {
+            view,
+            projection,
+            jitter: [0.0; 2],
+            previous_view,
+            previous_projection,
+        }
+    }
+
+    /// Records the host's G-buffer of frame `k` into `cb` and returns the dispatch of it.
+    fn record_gbuffer(&self, cb: vk::CommandBuffer, k: u32) -> GiDispatch {
+        let camera = self.camera(k);
+        let t = self.targets();
+        self.raster.as_ref().expect("raster").record(
+            &self.host,
+            cb,
+            t,
+            self.host_scene.as_ref().expect("scene"),
+            camera.projection * camera.view,
+        );
+        let color = |i: &host::HostImage| i.lend(host::color_written(), host::sampled_after());
+        GiDispatch {
+            frame_index: u64::from(k),
+            camera,
+            depth: t.depth.lend(host::depth_written(), host::sampled_after()),
+            depth_convention: Default::default(),
+            normals: color(&t.normal),
+            normal_encoding: NormalEncoding::UNORM,
+            albedo: color(&t.albedo),
+            material: color(&t.material),
+            material_channels: MaterialChannels::default(),
+            motion: None,
+            diffuse: t.gi.lend(ExternalState::UNDEFINED, host::copy_source()),
+        }
+    }
+
+    /// Frames `frames` through `gi`, each in one host submission; the GI image of the last.
+    fn run(&self, gi: &mut GiContext, frames: std::ops::Range<u32>) -> Vec<[f32; 3]> {
+        for k in frames {
+            let cb = self.host.begin().expect("begin");
+            let dispatch = self.record_gbuffer(cb, k);
+            gi.dispatch(cb, &dispatch).expect("dispatch");
+            self.host.submit_and_wait(cb).expect("submit");
+        }
+        rgb(host::read_rgba16f(&self.host, &self.targets().gi, host::copy_source()).expect("read"))
+    }
+
+    /// The full renderer's indirect light for frame `k`'s camera.
+    fn full_renderer(&self, technique: &str, k: u32) -> Vec<[f32; 3]> {
+        let mut renderer = Renderer::new(self.device()).expect("renderer");
+        renderer.set_scene(&self.scene, 0.0).expect("scene");
+        let projection = self.scene.cameras[0].projection;
+        renderer
+            .update(&FrameUpdate {
+                camera: Some(CameraPose {
+                    world: self.camera(k).view.inverse(),
+                    projection,
+                }),
+                ..FrameUpdate::default()
+            })
+            .expect("update");
+        let mut settings = Settings {
+            width: EXTENT[0],
+            height: EXTENT[1],
+            gi: technique.parse().expect("technique"),
+            ..Settings::default()
+        };
+        settings.output.component = Component::Indirect;
+        settings.output.exposure = 1.0;
+        rgb(renderer.render(&settings).expect("render").hdr.texels)
+    }
+
+    /// Zero validation messages so far (the host's messenger sees shine's calls too).
+    fn assert_clean(&self) {
+        assert_eq!(host::VALIDATION_MESSAGES.load(Ordering::Relaxed), 0);
+    }
+}
+
+impl Drop for Bench {
+    fn drop(&mut self) {
+        // The documented teardown: the host's submissions are complete (each was waited
+        // for), shine's device goes, then the host's own objects, then the host's device.
+        self.device.take();
+        if let Some(t) = self.targets.take() {
+            t.destroy(&self.host);
+        }
+        if let Some(r) = self.raster.take() {
+            r.destroy(&self.host);
+        }
+        if let Some(s) = self.host_scene.take() {
+            s.destroy(&self.host);
+        }
+    }
+}
+
+fn rgb(texels: Vec<[f32; 4]>) -> Vec<[f32; 3]> {
+    texels.into_iter().map(|t| [t[0], t[1], t[2]]).collect()
+}
+
+/// Relative RMSE and energy ratio of `image` against `truth` over every pixel.
+fn error(image: &[[f32; 3]], truth: &[[f32; 3]]) -> (f64, f64) {
+    let e = image_error(image, truth, &vec![true; truth.len()]).expect("signal");
+    (e.relative_rmse, e.energy_ratio)
+}
+
+/// The context's output for a host G-buffer matches the full renderer's indirect light from
+/// its own G-buffer, same scene and camera. They differ only in the G-buffer's encoding: the
+/// host stores normals in 10-bit UNORM, albedo as 8-bit sRGB, and positions come back from
+/// depth. Tolerance: relative RMSE ≤ 3 %, energy within 1 %.
+#[test]
+fn gi_context_matches_the_full_renderer() {
+    let bench = Bench::new(false);
+    for technique in ["hvl", "igi"] {
+        let mut gi = bench.context(technique);
+        let output = bench.run(&mut gi, 0..1);
+        let truth = bench.full_renderer(technique, 0);
+        let (relative_rmse, energy) = error(&output, &truth);
+        println!("{technique}: relative RMSE {relative_rmse:.4}, energy {energy:.4}");
+        assert!(
+            relative_rmse <= 0.03,
+            "{technique}: relative RMSE {relative_rmse}"
+        );
+        assert!((energy - 1.0).abs() <= 0.01, "{technique}: energy {energy}");
+    }
+    bench.assert_clean();
+}
+
+/// Five frames of a turning camera: every frame's output matches the full renderer at that
+/// camera (the amortised HVL gather of the default settings reprojects through the camera
+/// motion the context derives from the host's matrices).
+#[test]
+fn moving_camera_frames_follow_the_camera() {
+    let bench = Bench::new(false);
+    let mut gi = bench.context("hvl");
+    let mut previous: Option<Vec<[f32; 3]>> = None;
+    for k in 0..5 {
+        let output = bench.run(&mut gi, k..k + 1);
+        let (relative_rmse, energy) = error(&output, &bench.full_renderer("hvl", k));
+        println!("frame {k}: relative RMSE {relative_rmse:.4}, energy {energy:.4}");
+        assert!(relative_rmse <= 0.05 && (energy - 1.0).abs() <= 0.02);
+        if let Some(p) = &previous {
+            assert_ne!(p, &output, "frame {k} did not change with the camera");
+        }
+        previous = Some(output);
+    }
+    bench.assert_clean();
+}
+
+/// A resize: the context takes images of the new size, and its output there matches a
+/// context made at that size.
+#[test]
+fn resize_gives_what_a_new_context_gives() {
+    let mut bench = Bench::new(false);
+    let mut gi = bench.context("hvl");
+    bench.run(&mut gi, 0..2);
+    let small = [48, 40];
+    let old = bench
+        .targets
+        .replace(Targets::new(&bench.host, small).expect("targets"));
+    old.expect("targets").destroy(&bench.host);
+    let resized_at = small;
+    gi.resize(resized_at).expect("resize");
+    assert_eq!(gi.display(), small);
+    let dispatch_small = |gi: &mut GiContext, k: u32| {
+        let cb = bench.host.begin().expect("begin");
+        let mut d = bench.record_gbuffer(cb, k);
+        d.camera = GiCamera::still(d.camera.view, d.camera.projection);
+        gi.dispatch(cb, &d).expect("dispatch");
+        bench.host.submit_and_wait(cb).expect("submit");
+        rgb(
+            host::read_rgba16f(&bench.host, &bench.targets().gi, host::copy_source())
+                .expect("read"),
+        )
+    };
+    let resized = dispatch_small(&mut gi, 2);
+    let mut fresh = GiContext::new(
+        bench.device(),
+        &GiContextDesc::new(small, "hvl").expect("d"),
+    )
+    .expect("context");
+    fresh.set_scene(&bench.scene, 0.0).expect("scene");
+    let made = dispatch_small(&mut fresh, 2);
+    assert_eq!(resized.len(), (small[0] * small[1]) as usize);
+    assert_eq!(resized, made);
+    // A dispatch of the old size is refused, with a message naming both sizes.
+    let cb = bench.host.begin().expect("begin");
+    let mut d = bench.record_gbuffer(cb, 3);
+    d.depth.extent = EXTENT;
+    let error = gi.dispatch(cb, &d).expect_err("old size").to_string();
+    assert!(
+        error.contains("[64, 64]") && error.contains("[48, 40]"),
+        "{error}"
+    );
+    bench.host.submit_and_wait(cb).expect("submit");
+    bench.assert_clean();
+}
+
+/// Two contexts on one device, dispatched into one command buffer, give what each gives
+/// alone.
+#[test]
+fn two_contexts_share_a_device() {
+    let bench = Bench::new(false);
+    let alone = |technique| {
+        let mut gi = bench.context(technique);
+        bench.run(&mut gi, 0..1)
+    };
+    let (hvl_alone, igi_alone) = (alone("hvl"), alone("igi"));
+    let mut hvl = bench.context("hvl");
+    let mut igi = bench.context("igi");
+    let cb = bench.host.begin().expect("begin");
+    let d = bench.record_gbuffer(cb, 0);
+    hvl.dispatch(cb, &d).expect("hvl");
+    let hvl_image = host::HostImage::new(
+        &bench.host,
+        "second gi",
+        host::RADIANCE_FORMAT,
+        EXTENT,
+        vk::ImageUsageFlags::TRANSFER_DST
+            | vk::ImageUsageFlags::TRANSFER_SRC
+            | vk::ImageUsageFlags::SAMPLED,
+    )
+    .expect("image");
+    // The second context reads the same G-buffer (left by the first in `sampled_after`) and
+    // writes its own output.
+    let read = |i: &host::HostImage| i.lend(host::sampled_after(), host::sampled_after());
+    let t = bench.targets();
+    let second = GiDispatch {
+        depth: read(&t.depth),
+        normals: read(&t.normal),
+        albedo: read(&t.albedo),
+        material: read(&t.material),
+        diffuse: hvl_image.lend(ExternalState::UNDEFINED, host::copy_source()),
+        ..d
+    };
+    igi.dispatch(cb, &second).expect("igi");
+    bench.host.submit_and_wait(cb).expect("submit");
+    let hvl_out = rgb(host::read_rgba16f(&bench.host, &t.gi, host::copy_source()).expect("read"));
+    let igi_out =
+        rgb(host::read_rgba16f(&bench.host, &hvl_image, host::copy_source()).expect("read"));
+    hvl_image.destroy(&bench.host);
+    assert_eq!(hvl_out, hvl_alone);
+    assert_eq!(igi_out, igi_alone);
+    bench.assert_clean();
+}
+
+/// shine allocates from the host's allocator when handed it, and gives every byte back.
+#[test]
+fn host_allocator_holds_shine_memory_until_teardown() {
+    let bench = Bench::new(true);
+    let host_only = bench
+        .host
+        .allocator()
+        .lock()
+        .expect("lock")
+        .generate_report()
+        .total_allocated_bytes;
+    let mut gi = bench.context("hvl");
+    bench.run(&mut gi, 0..2);
+    let with_shine = bench
+        .host
+        .allocator()
+        .lock()
+        .expect("lock")
+        .generate_report()
+        .total_allocated_bytes;
+    let shine_bytes = bench.device().memory_usage().allocated_bytes;
+    assert!(shine_bytes > 0);
+    assert!(
+        with_shine >= host_only + shine_bytes,
+        "host allocator {with_shine} B, host alone {host_only} B, shine {shine_bytes} B"
+    );
+    drop(gi);
+    let mut bench = bench;
+    bench.device.take();
+    let after = bench
+        .host
+        .allocator()
+        .lock()
+        .expect("lock")
+        .generate_report()
+        .total_allocated_bytes;
+    assert_eq!(
+        after, host_only,
+        "shine left memory in the host's allocator"
+    );
+}
+
+/// Host matrices that are not invertible are refused before anything is recorded.
+#[test]
+fn bad_dispatches_are_refused() {
+    let bench = Bench::new(false);
+    let mut gi = bench.context("hvl");
+    let cb = bench.host.begin().expect("begin");
+    let good = bench.record_gbuffer(cb, 0);
+    let cases = [
+        GiDispatch {
+            camera: GiCamera::still(Mat4::ZERO, good.camera.projection),
+            ..good
+        },
+        GiDispatch {
+            material_channels: MaterialChannels {
+                roughness: 7,
+                ..MaterialChannels::default()
+            },
+            ..good
+        },
+        GiDispatch {
+            diffuse: host::HostImage::lend(
+                &bench.targets().depth,
+                ExternalState::UNDEFINED,
+                ExternalState::UNDEFINED,
+            ),
+            ..good
+        },
+    ];
+    for case in &cases {
+        let error = gi.dispatch(cb, case).expect_err("refused").to_string();
+        assert!(
+            error.starts_with("GI dispatch:") || error.contains("GI dispatch"),
+            "{error}"
+        );
+    }
+    gi.dispatch(cb, &good).expect("good");
+    let error = gi
+        .dispatch(cb, &good)
+        .expect_err("same frame twice")
+        .to_string();
+    assert!(error.contains("must increase"), "{error}");
+    bench.host.submit_and_wait(cb).expect("submit");
+    bench.assert_clean();
+}
