@@ -76,6 +76,8 @@ fn main() -> Result<(), Box<dyn Error>> {
             queue_family_index: family,
             queue,
             debug_utils: false,
+            enabled: shine::gpu::EnabledFeatures::required(),
+            allocator: None,
         })?;
         let mut renderer = Renderer::new(&shine_device)?;
         renderer.set_scene(&shine_scene::Scene::builtin("cornell-box")?, 0.0)?;
@@ -101,6 +103,7 @@ fn main() -> Result<(), Box<dyn Error>> {
             device.begin_command_buffer(cb, &vk::CommandBufferBeginInfo::default())?;
             renderer.record(
                 cb,
+                0,
                 &HostTarget {
                     image: target.raw(),
                     view: target.view(),

@@ -148,6 +148,8 @@ impl Host {
             queue_family_index: self.family,
             queue: self.queue,
             debug_utils: true,
+            enabled: shine::gpu::EnabledFeatures::required(),
+            allocator: None,
         })
         .expect("wrap the host device")
     }
@@ -266,6 +268,7 @@ fn a_frame_recorded_into_a_host_command_buffer_lands_in_the_host_image() {
         renderer
             .record(
                 cb,
+                0,
                 &shine::frame::renderer::HostTarget {
                     image: target.raw(),
                     view: target.view(),

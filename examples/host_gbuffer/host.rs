@@ -211,7 +211,7 @@ impl HostDevice {
     }
 
     /// The host's device lent to shine (`allocator`: shine also allocates from the host's).
-    pub fn lend(&self, _share_allocator: bool) -> shine::gpu::RawDevice {
+    pub fn lend(&self, share_allocator: bool) -> shine::gpu::RawDevice {
         shine::gpu::RawDevice {
             entry: self.entry.clone(),
             instance: self.instance.clone(),
@@ -220,7 +220,8 @@ impl HostDevice {
             queue_family_index: self.family,
             queue: self.queue,
             debug_utils: false,
-            // HELPER-MERGE: enabled features and the host allocator.
+            enabled: shine::gpu::EnabledFeatures::required(),
+            allocator: share_allocator.then(|| self.allocator()),
         }
     }
 }

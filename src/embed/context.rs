@@ -184,8 +184,12 @@ impl GiContext {
         let camera = dispatch.camera.to_view(display);
         let (frame_constants, ring, sampler) =
             (&self.frame_constants, &mut self.ring, self.nearest.raw());
-        self.renderer
-            .record_indirect(cb, &self.params, &camera, &mut |rg: &mut RenderGraph| {
+        self.renderer.record_indirect(
+            cb,
+            dispatch.frame_index,
+            &self.params,
+            &camera,
+            &mut |rg: &mut RenderGraph| {
                 let frame = ring.upload(
                     rg,
                     "host frame",
@@ -202,7 +206,8 @@ impl GiContext {
                 let g = host_gbuffer::host_gbuffer(rg, &host, &frame, display, sampler);
                 let output = import_output(rg, &dispatch.diffuse);
                 Ok((g, output))
-            })?;
+            },
+        )?;
         self.last_frame = Some(dispatch.frame_index);
         Ok(())
     }

@@ -32,13 +32,21 @@ struct Bench {
 
 impl Bench {
     fn new(share_allocator: bool) -> Self {
+        Self::with_device(share_allocator, |raw| raw)
+    }
+
+    /// A bench whose shine device is `wrap` of what the host lends.
+    fn with_device(
+        share_allocator: bool,
+        wrap: impl FnOnce(shine::gpu::RawDevice) -> shine::gpu::RawDevice,
+    ) -> Self {
         let host = HostDevice::new(true).expect("host device");
         assert!(
             host.validation || std::env::var_os("CI").is_none(),
             "CI needs the validation layer"
         );
         let scene = Scene::builtin("cornell-box").expect("scene");
-        let device = Device::from_raw(host.lend(share_allocator)).expect("shine device");
+        let device = Device::from_raw(wrap(host.lend(share_allocator))).expect("shine device");
         Self {
             host_scene: Some(HostScene::new(&host, &scene).expect("host scene")),
             raster: Some(Raster::new(&host).expect("raster")),
@@ -403,4 +411,150 @@ fn bad_dispatches_are_refused() {
     assert!(error.contains("must increase"), "{error}");
     bench.host.submit_and_wait(cb).expect("submit");
     bench.assert_clean();
+}
+
+/// Queue submissions and waits made through the counting device of
+/// [`dispatches_neither_submit_nor_wait`].
+static SUBMITS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+static WAITS: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+/// The real functions behind the counting ones.
+static REAL: std::sync::OnceLock<(ash::DeviceFnV1_0, ash::DeviceFnV1_3)> =
+    std::sync::OnceLock::new();
+
+use shine::gpu::ash;
+
+unsafe extern "system" fn count_submit(
+    queue: vk::Queue,
+    count: u32,
+    submits: *const vk::SubmitInfo<'_>,
+    fence: vk::Fence,
+) -> vk::Result {
+    SUBMITS.fetch_add(1, Ordering::SeqCst);
+    // SAFETY: forwards the caller's arguments to the driver's function.
+    unsafe { (REAL.get().expect("real").0.queue_submit)(queue, count, submits, fence) }
+}
+
+unsafe extern "system" fn count_submit2(
+    queue: vk::Queue,
+    count: u32,
+    submits: *const vk::SubmitInfo2<'_>,
+    fence: vk::Fence,
+) -> vk::Result {
+    SUBMITS.fetch_add(1, Ordering::SeqCst);
+    // SAFETY: as above.
+    unsafe { (REAL.get().expect("real").1.queue_submit2)(queue, count, submits, fence) }
+}
+
+unsafe extern "system" fn count_queue_wait(queue: vk::Queue) -> vk::Result {
+    WAITS.fetch_add(1, Ordering::SeqCst);
+    // SAFETY: as above.
+    unsafe { (REAL.get().expect("real").0.queue_wait_idle)(queue) }
+}
+
+unsafe extern "system" fn count_device_wait(device: vk::Device) -> vk::Result {
+    WAITS.fetch_add(1, Ordering::SeqCst);
+    // SAFETY: as above.
+    unsafe { (REAL.get().expect("real").0.device_wait_idle)(device) }
+}
+
+unsafe extern "system" fn count_fence_wait(
+    device: vk::Device,
+    count: u32,
+    fences: *const vk::Fence,
+    all: vk::Bool32,
+    timeout: u64,
+) -> vk::Result {
+    WAITS.fetch_add(1, Ordering::SeqCst);
+    // SAFETY: as above.
+    unsafe { (REAL.get().expect("real").0.wait_for_fences)(device, count, fences, all, timeout) }
+}
+
+/// The host's device with every submit and wait entry point counted.
+fn counting(mut raw: shine::gpu::RawDevice) -> shine::gpu::RawDevice {
+    let d = &raw.device;
+    let _ = REAL.set((d.fp_v1_0().clone(), d.fp_v1_3().clone()));
+    let mut f10 = d.fp_v1_0().clone();
+    f10.queue_submit = count_submit;
+    f10.queue_wait_idle = count_queue_wait;
+    f10.device_wait_idle = count_device_wait;
+    f10.wait_for_fences = count_fence_wait;
+    let mut f13 = d.fp_v1_3().clone();
+    f13.queue_submit2 = count_submit2;
+    raw.device = ash::Device::from_parts_1_3(
+        d.handle(),
+        f10,
+        d.fp_v1_1().clone(),
+        d.fp_v1_2().clone(),
+        f13,
+    );
+    raw
+}
+
+/// Ten dispatches of a moving camera (the first one uploading the BRDF tables), then ten
+/// full frames recorded with `Renderer::record`: shine submits nothing and waits for nothing;
+/// the host submits every frame itself.
+#[test]
+fn dispatches_neither_submit_nor_wait() {
+    let bench = Bench::with_device(false, counting);
+    let mut gi = bench.context("hvl");
+    let mut renderer = Renderer::new(bench.device()).expect("renderer");
+    renderer.set_scene(&bench.scene, 0.0).expect("scene");
+    for k in 0..10 {
+        let cb = bench.host.begin().expect("begin");
+        let dispatch = bench.record_gbuffer(cb, k);
+        let before = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
+        gi.dispatch(cb, &dispatch).expect("dispatch");
+        let after = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
+        assert_eq!(
+            before, after,
+            "dispatch {k}: (submits, waits) before and after"
+        );
+        bench.host.submit_and_wait(cb).expect("submit");
+    }
+    let settings = Settings {
+        width: EXTENT[0],
+        height: EXTENT[1],
+        ..Settings::default()
+    };
+    for k in 0..10u32 {
+        let cb = bench.host.begin().expect("begin");
+        let before = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
+        renderer
+            .record(
+                cb,
+                u64::from(k),
+                &bench
+                    .targets()
+                    .gi
+                    .lend(ExternalState::UNDEFINED, host::copy_source()),
+                &settings,
+            )
+            .expect("record");
+        let after = (SUBMITS.load(Ordering::SeqCst), WAITS.load(Ordering::SeqCst));
+        assert_eq!(
+            before, after,
+            "record {k}: (submits, waits) before and after"
+        );
+        bench.host.submit_and_wait(cb).expect("submit");
+    }
+    bench.assert_clean();
+}
+
+/// A host that did not enable synchronization2 gets an error naming it.
+#[test]
+fn missing_host_features_are_named() {
+    let host = HostDevice::new(false).expect("host device");
+    let mut raw = host.lend(false);
+    raw.enabled = shine::gpu::EnabledFeatures::from_parts(
+        vk::API_VERSION_1_3,
+        &vk::PhysicalDeviceFeatures::default(),
+        &vk::PhysicalDeviceVulkan13Features::default().dynamic_rendering(true),
+        &[],
+    );
+    let error = Device::from_raw(raw).expect_err("refused").to_string();
+    assert!(
+        error.contains("synchronization2") && error.contains("not enabled by the host"),
+        "{error}"
+    );
+    assert!(!error.contains("dynamicRendering"), "{error}");
 }

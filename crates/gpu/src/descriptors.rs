@@ -300,8 +300,13 @@ impl DescriptorArena {
 impl Drop for DescriptorArena {
     fn drop(&mut self) {
         for pool in self.pools.drain(..) {
-            // SAFETY: the owner drops the arena only after the GPU is done with its sets.
-            unsafe { self.raw.destroy_descriptor_pool(pool, None) };
+            match &self._keep_alive {
+                // Destroyed once the frames that bound its sets have completed.
+                Some(device) => device.defer(crate::retire::Garbage::DescriptorPool(pool)),
+                // SAFETY: inside the device's own command contexts, which it destroys only
+                // once their submissions completed.
+                None => unsafe { self.raw.destroy_descriptor_pool(pool, None) },
+            }
         }
     }
 }

@@ -4,7 +4,7 @@
 //! deferred until every submission that may have used them has completed ([`crate::retire`]).
 
 use crate::error::{Error, Result, VkContext};
-use crate::features::{FeatureStatus, Support};
+use crate::features::{EnabledFeatures, FeatureStatus, Support};
 use crate::instance::{
     Adapter, InstanceGuard, Owned, OwnedGuard, VALIDATION_LAYER, choose, create_instance,
     destroy_owned, list_adapters, messenger_info, physical_name,
@@ -53,6 +53,14 @@ pub struct RawDevice {
     /// Whether the host enabled VK_EXT_debug_utils on the instance (labels, names). Must be
     /// false unless it really is enabled: its functions are called when true.
     pub debug_utils: bool,
+    /// What the host enabled when it created `device`: checked against
+    /// [`Device::requirements`] (`EnabledFeatures::required()` when the host enabled exactly
+    /// shine's needs).
+    pub enabled: EnabledFeatures,
+    /// The host's allocator, made on `device`, for shine to allocate from and free into;
+    /// `None`: shine makes its own. Shine frees all of its allocations before it drops its
+    /// reference.
+    pub allocator: Option<Arc<Mutex<Allocator>>>,
 }
 
 /// Facts about the device, for `shine info` and for sizing work.
@@ -94,7 +102,9 @@ pub(crate) struct Inner {
     pub(crate) queue: Mutex<vk::Queue>,
     pub(crate) queue_family: u32,
     pub(crate) debug_utils: Option<ash::ext::debug_utils::Device>,
-    pub(crate) allocator: ManuallyDrop<Mutex<Allocator>>,
+    pub(crate) allocator: ManuallyDrop<Arc<Mutex<Allocator>>>,
+    /// Bytes and allocations shine holds (the allocator may be the host's, with its own).
+    pub(crate) usage: Mutex<(u64, usize)>,
     pub(crate) tracker: Mutex<Tracker>,
     pub(crate) info: DeviceInfo,
     pub(crate) limits: vk::PhysicalDeviceLimits,
@@ -232,6 +242,8 @@ impl Device {
                 queue_family,
                 debug_utils: have_debug_utils,
                 validation: use_layer,
+                allocator: None,
+                anisotropy: false,
             },
             owned,
             log,
@@ -244,6 +256,7 @@ impl Device {
     pub fn from_raw(raw: RawDevice) -> Result<Self> {
         let support = Support::query(&raw.instance, raw.physical_device);
         let mut missing = support.missing();
+        missing.extend(raw.enabled.missing());
         if support.queue_family.is_some() {
             // SAFETY: the host's physical device belongs to the host's instance.
             let families = unsafe {
@@ -277,6 +290,8 @@ impl Device {
                 queue_family: raw.queue_family_index,
                 debug_utils: raw.debug_utils,
                 validation: false,
+                allocator: raw.allocator,
+                anisotropy: raw.enabled.features.sampler_anisotropy == vk::TRUE,
             },
             None,
             Arc::new(MessageLog::default()),
@@ -291,14 +306,20 @@ impl Device {
                 unsafe { parts.raw.destroy_device(None) };
             }
         };
-        let allocator = match Allocator::new(&AllocatorCreateDesc {
-            instance: parts.instance.clone(),
-            device: parts.raw.clone(),
-            physical_device: parts.physical,
-            debug_settings: Default::default(),
-            buffer_device_address: false,
-            allocation_sizes: Default::default(),
-        }) {
+        let allocator = match parts.allocator.clone().map_or_else(
+            || {
+                Allocator::new(&AllocatorCreateDesc {
+                    instance: parts.instance.clone(),
+                    device: parts.raw.clone(),
+                    physical_device: parts.physical,
+                    debug_settings: Default::default(),
+                    buffer_device_address: false,
+                    allocation_sizes: Default::default(),
+                })
+                .map(|a| Arc::new(Mutex::new(a)))
+            },
+            Ok,
+        ) {
             Ok(a) => a,
             Err(source) => {
                 cleanup(&parts);
@@ -364,8 +385,9 @@ impl Device {
             subgroup_size: subgroup.subgroup_size,
             validation: parts.validation,
             features: support.report(),
-            max_anisotropy: if owned.is_some()
-                && support.enabled_core().sampler_anisotropy == vk::TRUE
+            max_anisotropy: if (owned.is_some()
+                && support.enabled_core().sampler_anisotropy == vk::TRUE)
+                || parts.anisotropy
             {
                 properties.limits.max_sampler_anisotropy
             } else {
@@ -384,7 +406,8 @@ impl Device {
                 queue: Mutex::new(parts.queue),
                 queue_family: parts.queue_family,
                 debug_utils,
-                allocator: ManuallyDrop::new(Mutex::new(allocator)),
+                allocator: ManuallyDrop::new(allocator),
+                usage: Mutex::new((0, 0)),
                 tracker: Mutex::new(Tracker::default()),
                 info,
                 limits: properties.limits,
@@ -464,19 +487,34 @@ impl Device {
         let _ = unsafe { debug.set_debug_utils_object_name(&info) };
     }
 
-    /// Device memory held by shine's allocator right now (buffers, images, the render
-    /// graph's heaps): what a long run must keep flat.
+    /// Device memory shine holds right now (buffers, images, the render graph's heaps): what
+    /// a long run must keep flat. Counted by shine, so a host's allocations in a shared
+    /// allocator are not in it.
     pub fn memory_usage(&self) -> MemoryUsage {
-        let report = self.allocator().generate_report();
+        let (allocated_bytes, allocations) = *lock(&self.inner.usage);
         MemoryUsage {
-            allocated_bytes: report.total_allocated_bytes,
-            capacity_bytes: report.total_capacity_bytes,
-            allocations: report.allocations.len(),
+            allocated_bytes,
+            capacity_bytes: self.allocator().generate_report().total_capacity_bytes,
+            allocations,
         }
     }
 
     pub(crate) fn allocator(&self) -> MutexGuard<'_, Allocator> {
         lock(&self.inner.allocator)
+    }
+
+    /// Counts an allocation of `bytes` shine made.
+    pub(crate) fn allocated(&self, bytes: u64) {
+        let mut usage = lock(&self.inner.usage);
+        usage.0 += bytes;
+        usage.1 += 1;
+    }
+
+    /// Counts `(bytes, allocations)` shine freed.
+    pub(crate) fn freed(&self, (bytes, count): (u64, usize)) {
+        let mut usage = lock(&self.inner.usage);
+        usage.0 = usage.0.saturating_sub(bytes);
+        usage.1 = usage.1.saturating_sub(count);
     }
 }
 
@@ -485,7 +523,8 @@ impl Device {
 pub struct MemoryUsage {
     /// Bytes in live allocations.
     pub allocated_bytes: u64,
-    /// Bytes of the memory blocks they are carved from (allocated or free).
+    /// Bytes of the memory blocks of the allocator shine uses (allocated or free; the host's
+    /// blocks too when it shares its allocator).
     pub capacity_bytes: u64,
     /// Number of live allocations.
     pub allocations: usize,
@@ -500,6 +539,10 @@ struct Parts {
     queue_family: u32,
     debug_utils: bool,
     validation: bool,
+    /// A host's allocator to share.
+    allocator: Option<Arc<Mutex<Allocator>>>,
+    /// Whether the host enabled samplerAnisotropy.
+    anisotropy: bool,
 }
 
 /// Locks a mutex, recovering the data if a panicking thread poisoned it.
@@ -529,13 +572,11 @@ impl Drop for Inner {
                 .tracker
                 .get_mut()
                 .unwrap_or_else(std::sync::PoisonError::into_inner);
-            let allocator = self
-                .allocator
-                .get_mut()
-                .unwrap_or_else(std::sync::PoisonError::into_inner);
-            tracker.destroy_all(&self.raw, allocator);
+            let mut allocator = lock(&self.allocator);
+            tracker.destroy_all(&self.raw, &mut allocator);
         }
-        // SAFETY: dropped exactly once, before the device it allocates from.
+        // SAFETY: dropped exactly once, before the device it allocates from (the last
+        // reference frees shine's own allocator; a host's lives on in the host).
         unsafe { ManuallyDrop::drop(&mut self.allocator) };
         if let Some(owned) = self.owned.take() {
             // SAFETY: the device was created by shine and every child object is destroyed.

@@ -343,3 +343,88 @@ mod tests {
         assert!(report.iter().filter(|f| f.required).all(|f| f.present));
     }
 }
+
+/// What a host enabled when it created the device it lends shine ([`crate::RawDevice`]):
+/// `Device::from_raw` checks it against [`REQUIREMENTS`], since a physical device that offers
+/// a feature says nothing about whether the host turned it on.
+#[derive(Clone, Debug)]
+pub struct EnabledFeatures {
+    /// The API version the host's instance asked for.
+    pub api_version: u32,
+    /// Core features enabled (`VkPhysicalDeviceFeatures`).
+    pub features: vk::PhysicalDeviceFeatures,
+    /// `synchronization2` of `VkPhysicalDeviceVulkan13Features`.
+    pub synchronization2: bool,
+    /// `dynamicRendering` of `VkPhysicalDeviceVulkan13Features`.
+    pub dynamic_rendering: bool,
+    /// Device extensions enabled.
+    pub extensions: Vec<std::ffi::CString>,
+}
+
+impl EnabledFeatures {
+    /// Exactly what [`REQUIREMENTS`] asks for: what a host that enables only shine's needs
+    /// passes.
+    pub fn required() -> Self {
+        Self {
+            api_version: REQUIREMENTS.api_version,
+            features: vk::PhysicalDeviceFeatures::default(),
+            synchronization2: true,
+            dynamic_rendering: true,
+            extensions: REQUIREMENTS
+                .device_extensions
+                .iter()
+                .map(|e| (*e).to_owned())
+                .collect(),
+        }
+    }
+
+    /// What the host put in its `VkDeviceCreateInfo`: its API version, core features, the
+    /// Vulkan 1.3 feature struct it chained and its extension names.
+    pub fn from_parts(
+        api_version: u32,
+        features: &vk::PhysicalDeviceFeatures,
+        vulkan13: &vk::PhysicalDeviceVulkan13Features<'_>,
+        extensions: &[&CStr],
+    ) -> Self {
+        Self {
+            api_version,
+            features: *features,
+            synchronization2: vulkan13.synchronization2 == vk::TRUE,
+            dynamic_rendering: vulkan13.dynamic_rendering == vk::TRUE,
+            extensions: extensions.iter().map(|e| (*e).to_owned()).collect(),
+        }
+    }
+
+    /// Every requirement the host did not enable, named as in the spec.
+    pub(crate) fn missing(&self) -> Vec<String> {
+        let mut missing = Vec::new();
+        if self.api_version < REQUIREMENTS.api_version {
+            missing.push(format!(
+                "Vulkan {}.{} (the host asked for {}.{})",
+                vk::api_version_major(REQUIREMENTS.api_version),
+                vk::api_version_minor(REQUIREMENTS.api_version),
+                vk::api_version_major(self.api_version),
+                vk::api_version_minor(self.api_version)
+            ));
+        }
+        for (name, on) in [
+            ("synchronization2", self.synchronization2),
+            ("dynamicRendering", self.dynamic_rendering),
+        ] {
+            if !on {
+                missing.push(format!(
+                    "{name} (Vulkan 1.3 feature): not enabled by the host"
+                ));
+            }
+        }
+        for e in REQUIREMENTS.device_extensions {
+            if !self.extensions.iter().any(|x| x.as_c_str() == *e) {
+                missing.push(format!(
+                    "{} (device extension): not enabled by the host",
+                    e.to_string_lossy()
+                ));
+            }
+        }
+        missing
+    }
+}

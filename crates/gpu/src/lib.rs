@@ -29,7 +29,7 @@ pub use commands::{Commands, SCOPES_PER_RECORDING, Submission};
 pub use descriptors::{Descriptor, DescriptorArena};
 pub use device::{Device, DeviceDesc, DeviceInfo, MemoryUsage, RawDevice};
 pub use error::{Error, Result};
-pub use features::{FeatureStatus, REQUIREMENTS, Requirements};
+pub use features::{EnabledFeatures, FeatureStatus, REQUIREMENTS, Requirements};
 pub use instance::Adapter;
 pub use memory::{
     Buffer, BufferDesc, Image, ImageDesc, MemoryBlock, MemoryLocation, Sampler, format_aspect,

@@ -487,7 +487,8 @@ impl Device {
         location: MemoryLocation,
         linear: bool,
     ) -> Result<Allocation> {
-        self.allocator()
+        let allocation = self
+            .allocator()
             .allocate(&AllocationCreateDesc {
                 name,
                 requirements,
@@ -498,6 +499,8 @@ impl Device {
             .map_err(|source| Error::Allocation {
                 name: name.to_string(),
                 source,
-            })
+            })?;
+        self.allocated(allocation.size());
+        Ok(allocation)
     }
 }

@@ -25,38 +25,68 @@ pub(crate) enum Garbage {
     Pipeline(vk::Pipeline),
     PipelineLayout(vk::PipelineLayout, Vec<vk::DescriptorSetLayout>),
     Sampler(vk::Sampler),
+    DescriptorPool(vk::DescriptorPool),
+    QueryPool(vk::QueryPool),
+}
+
+/// Bytes and allocations freed by destroying objects that freed `sizes` bytes each (an
+/// object frees at most one allocation; 0: none).
+pub(crate) fn tally(sizes: impl IntoIterator<Item = u64>) -> (u64, usize) {
+    sizes
+        .into_iter()
+        .filter(|&s| s > 0)
+        .fold((0, 0), |(bytes, count), s| (bytes + s, count + 1))
+}
+
+/// Frees `allocation`, returning its size (shine's own count of the memory it holds).
+pub(crate) fn free(allocator: &mut Allocator, allocation: Allocation) -> u64 {
+    let size = allocation.size();
+    let _ = allocator.free(allocation);
+    size
 }
 
 impl Garbage {
-    fn destroy(self, device: &ash::Device, allocator: &mut Allocator) {
+    /// Destroys the object; returns the bytes of memory it freed.
+    fn destroy(self, device: &ash::Device, allocator: &mut Allocator) -> u64 {
         // SAFETY (all arms): the object was created on `device` and the GPU is done with it.
         match self {
             Self::Buffer(buffer, allocation) => {
                 unsafe { device.destroy_buffer(buffer, None) };
-                if let Some(a) = allocation {
-                    let _ = allocator.free(a);
-                }
+                allocation.map_or(0, |a| free(allocator, a))
             }
             Self::Image(image, view, allocation) => {
                 unsafe {
                     device.destroy_image_view(view, None);
                     device.destroy_image(image, None);
                 }
-                if let Some(a) = allocation {
-                    let _ = allocator.free(a);
-                }
+                allocation.map_or(0, |a| free(allocator, a))
             }
-            Self::Memory(a) => {
-                let _ = allocator.free(a);
+            Self::Memory(a) => free(allocator, a),
+            Self::Pipeline(pipeline) => {
+                unsafe { device.destroy_pipeline(pipeline, None) };
+                0
             }
-            Self::Pipeline(pipeline) => unsafe { device.destroy_pipeline(pipeline, None) },
-            Self::PipelineLayout(layout, set_layouts) => unsafe {
-                device.destroy_pipeline_layout(layout, None);
-                for l in set_layouts {
-                    device.destroy_descriptor_set_layout(l, None);
+            Self::PipelineLayout(layout, set_layouts) => {
+                unsafe {
+                    device.destroy_pipeline_layout(layout, None);
+                    for l in set_layouts {
+                        device.destroy_descriptor_set_layout(l, None);
+                    }
                 }
-            },
-            Self::Sampler(sampler) => unsafe { device.destroy_sampler(sampler, None) },
+                0
+            }
+            Self::Sampler(sampler) => {
+                unsafe { device.destroy_sampler(sampler, None) };
+                0
+            }
+            Self::DescriptorPool(pool) => {
+                unsafe { device.destroy_descriptor_pool(pool, None) };
+                0
+            }
+            Self::QueryPool(pool) => {
+                unsafe { device.destroy_query_pool(pool, None) };
+                0
+            }
         }
     }
 }
@@ -79,6 +109,14 @@ pub(crate) struct Tracker {
     pub orphaned: Vec<(u64, Context)>,
     /// Command buffers being recorded: an object dropped now may be used by their submission.
     pub recording: usize,
+    /// The host frame being recorded ([`Device::begin_host_frame`]); `None` until a host
+    /// records shine work into its own command buffers.
+    host_frame: Option<u64>,
+    /// Every host frame up to this one has completed on the GPU.
+    host_completed: Option<u64>,
+    /// Dropped while host frames were recorded: (host frame, shine serial, object), destroyed
+    /// once both have completed.
+    host_garbage: Vec<(u64, u64, Garbage)>,
 }
 
 impl Tracker {
@@ -102,7 +140,8 @@ impl Tracker {
             .garbage
             .drain(..)
             .map(|(_, g)| g)
-            .chain(self.held.drain(..));
+            .chain(self.held.drain(..))
+            .chain(self.host_garbage.drain(..).map(|(_, _, g)| g));
         for g in garbage {
             g.destroy(device, allocator);
         }
@@ -114,28 +153,84 @@ impl Tracker {
             c.destroy(device);
         }
     }
+
+    /// Takes the host garbage whose host frame and shine serial have both completed.
+    fn ready_host_garbage(&mut self) -> Vec<Garbage> {
+        let (Some(host_done), done) = (self.host_completed, self.completed) else {
+            return Vec::new();
+        };
+        let (ready, waiting): (Vec<_>, Vec<_>) = self
+            .host_garbage
+            .drain(..)
+            .partition(|(frame, serial, _)| *frame <= host_done && *serial <= done);
+        self.host_garbage = waiting;
+        ready.into_iter().map(|(_, _, g)| g).collect()
+    }
 }
 
 impl Device {
     /// Hands an object over for destruction once the GPU can no longer be using it.
     pub(crate) fn defer(&self, garbage: Garbage) {
         let mut tracker = lock(&self.inner.tracker);
-        if tracker.recording > 0 {
+        if let Some(frame) = tracker.host_frame {
+            // The host's submissions of frames up to `frame` may use it.
+            let serial = tracker.submitted;
+            tracker.host_garbage.push((frame, serial, garbage));
+        } else if tracker.recording > 0 {
             // An open recording may use it; its serial is known only once it is submitted.
             tracker.held.push(garbage);
         } else if tracker.completed == tracker.submitted {
             drop(tracker);
-            garbage.destroy(&self.inner.raw, &mut self.allocator());
+            let freed = garbage.destroy(&self.inner.raw, &mut self.allocator());
+            self.freed(tally([freed]));
         } else {
             let serial = tracker.submitted;
             tracker.garbage.push((serial, garbage));
         }
     }
 
+    /// Destroys a buffer whose memory is not its own (bound into a memory block) once the GPU
+    /// can no longer be using it: the render graph's placed resources.
+    pub fn defer_buffer(&self, buffer: vk::Buffer) {
+        self.defer(Garbage::Buffer(buffer, None));
+    }
+
+    /// Destroys an image and its view (null: none) whose memory is not their own, once the
+    /// GPU can no longer be using them.
+    pub fn defer_image(&self, image: vk::Image, view: vk::ImageView) {
+        self.defer(Garbage::Image(image, view, None));
+    }
+
     /// Objects dropped but not yet destroyed because the GPU may still use them.
     pub fn pending_destructions(&self) -> usize {
         let tracker = lock(&self.inner.tracker);
-        tracker.garbage.len() + tracker.held.len()
+        tracker.garbage.len() + tracker.held.len() + tracker.host_garbage.len()
+    }
+
+    /// A host engine is about to record host frame `frame` with shine work into its own
+    /// command buffers, and promises that every host frame up to `frame − frames_in_flight`
+    /// has completed on the GPU. From the first call on, objects shine drops are destroyed
+    /// only once the host frame they were dropped in has completed by that promise (and any
+    /// submission of shine's own made before the drop), here or at a later call, or when the
+    /// device goes. Neither waits nor submits. Frame numbers must not decrease.
+    pub fn begin_host_frame(&self, frame: u64, frames_in_flight: u32) {
+        let ready = {
+            let mut tracker = lock(&self.inner.tracker);
+            tracker.host_frame = Some(frame);
+            tracker.host_completed = frame.checked_sub(u64::from(frames_in_flight.max(1)));
+            tracker.ready_host_garbage()
+        };
+        if !ready.is_empty() {
+            let mut allocator = self.allocator();
+            let freed = tally(
+                ready
+                    .into_iter()
+                    .map(|g| g.destroy(&self.inner.raw, &mut allocator))
+                    .collect::<Vec<_>>(),
+            );
+            drop(allocator);
+            self.freed(freed);
+        }
     }
 
     /// Polls submissions in flight and destroys or recycles what they no longer use.
@@ -157,6 +252,11 @@ impl Device {
             .drain(..)
             .partition(|(serial, _)| *serial <= completed);
         tracker.garbage = waiting;
+        let ready: Vec<Garbage> = ready
+            .into_iter()
+            .map(|(_, g)| g)
+            .chain(tracker.ready_host_garbage())
+            .collect();
         let (free, orphaned): (Vec<_>, Vec<_>) = tracker
             .orphaned
             .drain(..)
@@ -168,9 +268,14 @@ impl Device {
         drop(tracker);
         if !ready.is_empty() {
             let mut allocator = self.allocator();
-            for (_, g) in ready {
-                g.destroy(&self.inner.raw, &mut allocator);
-            }
+            let freed = tally(
+                ready
+                    .into_iter()
+                    .map(|g| g.destroy(&self.inner.raw, &mut allocator))
+                    .collect::<Vec<_>>(),
+            );
+            drop(allocator);
+            self.freed(freed);
         }
         Ok(())
     }

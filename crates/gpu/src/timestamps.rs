@@ -167,8 +167,13 @@ impl TimestampPool {
 
 impl Drop for TimestampPool {
     fn drop(&mut self) {
-        // SAFETY: the owner drops the pool only after the GPU is done with it.
-        unsafe { self.raw_device.destroy_query_pool(self.pool, None) };
+        match &self._keep_alive {
+            // Destroyed once the frames that wrote it have completed.
+            Some(device) => device.defer(crate::retire::Garbage::QueryPool(self.pool)),
+            // SAFETY: inside the device's own command contexts, destroyed after their
+            // submissions completed.
+            None => unsafe { self.raw_device.destroy_query_pool(self.pool, None) },
+        }
     }
 }
 

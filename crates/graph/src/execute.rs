@@ -237,10 +237,9 @@ impl Executor {
 
 impl Drop for Executor {
     fn drop(&mut self) {
-        // Wait first: freeing memory (a `MemoryBlock` drop) does not wait for submissions the
-        // caller made itself. If waiting fails the device is lost and nothing can still be
-        // using the objects.
-        let _ = self.device.wait_idle();
+        // Nothing waits: the objects, their memory blocks, descriptor pools and query pools are
+        // destroyed by the device once the frames that used them have completed (its own
+        // submissions, and the host frames of `Device::begin_host_frame`).
         self.objects.destroy(&self.device);
     }
 }

@@ -154,20 +154,12 @@ impl RawObject {
         }
     }
 
-    /// Destroys the object. The GPU must be done with it.
+    /// Hands the object to the device for destruction once the GPU can no longer use it
+    /// (shine's submissions and the host frames of `Device::begin_host_frame`): nothing waits.
     pub fn destroy(self, device: &Device) {
-        let raw = device.raw();
-        // SAFETY: the caller waited for the GPU; the objects were created by this device.
-        unsafe {
-            match self.0 {
-                GpuResource::Buffer(b) => raw.destroy_buffer(b, None),
-                GpuResource::Image { image, view } => {
-                    if view != vk::ImageView::null() {
-                        raw.destroy_image_view(view, None);
-                    }
-                    raw.destroy_image(image, None);
-                }
-            }
+        match self.0 {
+            GpuResource::Buffer(b) => device.defer_buffer(b),
+            GpuResource::Image { image, view } => device.defer_image(image, view),
         }
     }
 }
@@ -187,16 +179,9 @@ pub(crate) fn allocate(
     MemoryBlock::new(device, name, requirements, MemoryLocation::GpuOnly, linear)
 }
 
-/// Waits for the device, then destroys `objects` (nothing to wait for when there are none).
-pub(crate) fn destroy_after_idle(
-    device: &Device,
-    objects: Vec<RawObject>,
-) -> Result<(), shine_gpu::Error> {
-    if !objects.is_empty() {
-        device.wait_idle()?;
-        for o in objects {
-            o.destroy(device);
-        }
+/// Destroys `objects` once the GPU is done with them ([`RawObject::destroy`]); nothing waits.
+pub(crate) fn release(device: &Device, objects: Vec<RawObject>) {
+    for o in objects {
+        o.destroy(device);
     }
-    Ok(())
 }

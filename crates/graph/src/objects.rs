@@ -9,14 +9,14 @@ use shine_gpu::{Device, MemoryBlock};
 
 use crate::alias::{HeapClass, MemoryNeeds, MemoryRequirements};
 use crate::error::ExecuteError;
-use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate, destroy_after_idle};
+use crate::gpu_resources::{DeviceMemory, GpuResource, RawObject, allocate, release};
 use crate::graph::External;
 use crate::handle::ResourceId;
 use crate::plan::{Plan, ResourceKind, Usage};
 use crate::resource::AnyDesc;
 
-/// Transient sets kept per frame slot for plans seen recently; older ones are destroyed (after a
-/// device wait).
+/// Transient sets kept per frame slot for plans seen recently; older ones are destroyed once
+/// the frames that used them have completed (deferred by the device, no wait).
 const KEPT_TRANSIENT_SETS: usize = 8;
 
 /// The transients of one plan for one frame slot: memory blocks and the objects bound into them.
@@ -80,7 +80,7 @@ impl GraphObjects {
         if self.transients.len() >= KEPT_TRANSIENT_SETS * frames_in_flight {
             let old = self.transients.remove(0);
             // The objects go first, then (when `old` drops) the memory they were bound to.
-            destroy_after_idle(device, old.objects.into_iter().map(|(_, o)| o).collect())?;
+            release(device, old.objects.into_iter().map(|(_, o)| o).collect());
         }
         let heaps = plan
             .memory
@@ -112,7 +112,7 @@ impl GraphObjects {
             match RawObject::create(device, &r.name, &r.desc, usage, &heaps[p.heap], p.offset) {
                 Ok(o) => objects.push((p.resource, o)),
                 Err(e) => {
-                    destroy_after_idle(device, objects.into_iter().map(|(_, o)| o).collect())?;
+                    release(device, objects.into_iter().map(|(_, o)| o).collect());
                     return Err(e.into());
                 }
             }
@@ -165,7 +165,7 @@ impl GraphObjects {
             };
             if let Some(old) = self.temporal.insert(key.clone(), new) {
                 // The object goes first, then (when `old` drops) its memory.
-                destroy_after_idle(device, vec![old.object])?;
+                release(device, vec![old.object]);
             }
         }
         Ok(())

@@ -104,6 +104,8 @@ pub struct HostTarget {
 pub struct Renderer {
     device: Device,
     executor: Executor,
+    /// Frames the caller lets run ahead of the GPU.
+    frames_in_flight: usize,
     /// Trilinear, repeating: the scene textures' sampler.
     textures: Sampler,
     /// Bilinear on level 0, repeating: the scene textures' sampler without mipmaps, and at ray
@@ -185,6 +187,7 @@ impl Renderer {
         Ok(Self {
             device: device.clone(),
             executor: Executor::new(device, frames_in_flight)?,
+            frames_in_flight: frames_in_flight.max(1),
             textures: texture_sampler(device)?,
             textures_level0: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::REPEAT)?,
             nearest: sampler(
@@ -339,13 +342,15 @@ impl Renderer {
     }
 
     /// Records a frame into a host command buffer, ending with the frame blitted into the
-    /// host's image, which is left in `target.after`. The host submits `cb`; it must not record
-    /// more than the executor's frames in flight (2) ahead of the GPU, and must keep the scene
-    /// and this renderer alive until its submissions complete. Per-pass GPU times of earlier
-    /// frames come from [`Renderer::timings`].
+    /// host's image, which is left in `target.after`. Neither submits nor waits. The host
+    /// submits `cb` as its frame `frame_index` (increasing), promising that its frame
+    /// `frame_index − frames in flight` has completed ([`Device::begin_host_frame`]: what
+    /// shine drops is destroyed only after the host frames that may use it). Per-pass GPU
+    /// times of earlier frames come from [`Renderer::timings`].
     pub fn record(
         &mut self,
         cb: vk::CommandBuffer,
+        frame_index: u64,
         target: &HostTarget,
         settings: &Settings,
     ) -> Result<(), RenderError> {
@@ -356,6 +361,7 @@ impl Renderer {
             ..settings.clone()
         };
         settings.validate()?;
+        self.begin_host_frame(frame_index);
         let mut rg = self.executor.begin_frame();
         let frame = self.declare_frame(&mut rg, &FrameParams::from_settings(&settings))?;
         let mut host = rg.import_vk_image(
@@ -388,6 +394,13 @@ impl Renderer {
             .iter()
             .filter_map(|s| s.warning().map(str::to_owned))
             .collect()
+    }
+
+    /// Tells the device a host frame is being recorded (deferred destruction follows the
+    /// host's frames from now on).
+    pub(crate) fn begin_host_frame(&self, frame_index: u64) {
+        self.device
+            .begin_host_frame(frame_index, self.frames_in_flight as u32);
     }
 
     /// GPU times of the passes of frames whose timestamps are available.
