@@ -181,7 +181,7 @@ impl GiContext {
         }
         let display = self.display;
         let constants = dispatch.host_frame(display);
-        let camera = dispatch.camera.to_view(display);
+        let camera = dispatch.camera.view_for(display);
         let (frame_constants, ring, sampler) =
             (&self.frame_constants, &mut self.ring, self.nearest.raw());
         self.renderer.record_indirect(

@@ -63,7 +63,7 @@ impl GiCamera {
     }
 
     /// The view the passes read (eye, orthographic or not, field of view) for `extent`.
-    pub(crate) fn to_view(&self, extent: [u32; 2]) -> View {
+    pub(crate) fn view_for(&self, extent: [u32; 2]) -> View {
         let orthographic = self.projection.w_axis.w == 1.0 && self.projection.z_axis.w == 0.0;
         let y_scale = self.projection.y_axis.y.abs().max(f32::MIN_POSITIVE);
         View {
