@@ -5,7 +5,7 @@
 mod common;
 #[path = "embedding/gi_context.rs"]
 mod gi_context;
-#[path = "../examples/host_gbuffer/host.rs"]
+#[path = "../examples/host_gbuffer/host/mod.rs"]
 mod host;
 
 use shine::gpu::ash;

@@ -2,6 +2,7 @@
 
 use super::inputs::GiDispatch;
 use crate::frame::RenderError;
+use crate::frame::memory::MemoryReport;
 use crate::frame::params::FrameParams;
 use crate::frame::renderer::{HostTarget, Renderer};
 use crate::gpu_scene::FrameUpdate;
@@ -210,6 +211,16 @@ impl GiContext {
         )?;
         self.last_frame = Some(dispatch.frame_index);
         Ok(())
+    }
+
+    /// The device memory the context holds, by category: the scene, the technique's caches,
+    /// per-frame data, staging, the graph's transients and histories, and objects waiting for
+    /// the host's frames to complete.
+    pub fn memory_report(&self) -> MemoryReport {
+        let mut report = self.renderer.memory_report();
+        report.frame_data += self.frame_constants.allocated_bytes();
+        report.staging += self.ring.allocated_bytes();
+        report
     }
 
     /// GPU times of the passes of dispatched frames whose timestamps are available (call

@@ -5,6 +5,7 @@
 mod context;
 mod inputs;
 
+pub use crate::frame::memory::MemoryReport;
 pub use context::{GiBudgets, GiContext, GiContextDesc};
 pub use inputs::{
     DepthConvention, GiCamera, GiDispatch, HostMotion, MaterialChannels, NormalEncoding,

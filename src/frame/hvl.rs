@@ -56,6 +56,11 @@ impl HvlTechnique {
         }
     }
 
+    /// Bytes of device memory: `(tables, staging)`.
+    pub fn allocated_bytes(&self) -> (u64, u64) {
+        self.brdf.allocated_bytes()
+    }
+
     /// Forgets the history (a new scene).
     pub fn reset(&mut self) {
         self.last_resolve = None;

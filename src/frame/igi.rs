@@ -45,6 +45,11 @@ impl IgiTechnique {
         }
     }
 
+    /// Bytes of device memory: `(tables, staging)`.
+    pub fn allocated_bytes(&self) -> (u64, u64) {
+        self.brdf.allocated_bytes()
+    }
+
     /// Forgets the tables: a frame that may have uploaded them was dropped unrun.
     pub fn forget_uploads(&mut self) {
         self.brdf.clear();

@@ -11,6 +11,7 @@ pub mod aaf;
 pub mod error;
 pub mod hvl;
 pub mod igi;
+pub mod memory;
 pub mod motion;
 pub mod params;
 pub mod proxy;

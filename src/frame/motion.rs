@@ -37,6 +37,11 @@ impl MotionState {
         })
     }
 
+    /// Bytes of device memory: `(the motion view, staging)`.
+    pub fn allocated_bytes(&self) -> (u64, u64) {
+        (self.buffer.allocated_bytes(), self.ring.allocated_bytes())
+    }
+
     /// Forgets the last frame (a new scene: its first frame has no motion).
     pub fn reset(&mut self) {
         self.previous = None;

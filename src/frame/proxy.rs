@@ -104,6 +104,19 @@ impl ProxyTechnique {
         }
     }
 
+    /// Bytes of device memory: `(tables and proxies, staging)`.
+    pub fn allocated_bytes(&self) -> (u64, u64) {
+        let caches = self
+            .environments
+            .iter()
+            .map(|(_, b)| b)
+            .chain(self.tables.iter().map(|(_, _, b)| b))
+            .chain(self.proxies.iter().map(|p| &p.buffer))
+            .map(Buffer::allocated_bytes)
+            .sum();
+        (caches, self.ring.allocated_bytes())
+    }
+
     /// Forgets the uploaded tables: a frame that may have uploaded them was dropped unrun.
     pub fn forget_uploads(&mut self) {
         self.environments.clear();

@@ -67,6 +67,14 @@ impl ShadowState {
         })
     }
 
+    /// Bytes of device memory: `(records, staging)`.
+    pub fn allocated_bytes(&self) -> (u64, u64) {
+        (
+            self.views.allocated_bytes() + self.lights.allocated_bytes(),
+            self.ring.allocated_bytes(),
+        )
+    }
+
     /// What the layout had to compromise on (tiles shrunk to fit the device), if anything.
     pub fn warning(&self) -> Option<&str> {
         self.layout.warning.as_deref()

@@ -311,6 +311,32 @@ impl GpuScene {
         Ok(())
     }
 
+    /// Bytes of device memory: `(scene data, staging)`: geometry, materials, textures,
+    /// lights, the BVH and the deformers' data, and the staging ring of its updates.
+    pub fn allocated_bytes(&self) -> (u64, u64) {
+        let buffers = [
+            &self.source_vertices,
+            &self.vertices,
+            &self.prev_vertices,
+            &self.indices,
+            &self.materials,
+            &self.lights,
+            &self.bvh.nodes,
+            &self.bvh.triangles,
+            &self.bvh.top,
+            &self.bvh.instances,
+            &self.deform_instances,
+            &self.skin_vertices,
+            &self.morph_deltas,
+            &self.joint_matrices,
+            &self.morph_weights,
+        ];
+        let scene = buffers.iter().map(|b| b.allocated_bytes()).sum::<u64>()
+            + self.srgb_textures.allocated_bytes()
+            + self.linear_textures.allocated_bytes();
+        (scene, self.ring.allocated_bytes())
+    }
+
     /// Forgets the previous frame's vertices (a declared frame was not run): the next frame
     /// starts its motion from itself.
     pub fn forget_previous(&mut self) {

@@ -34,6 +34,17 @@ impl UploadRing {
         }
     }
 
+    /// Bytes of device memory its staging buffers hold.
+    pub fn allocated_bytes(&self) -> u64 {
+        self.slots
+            .iter()
+            .flatten()
+            .map(|(_, b)| b)
+            .chain(self.once.iter().flat_map(|(_, b)| b))
+            .map(Buffer::allocated_bytes)
+            .sum()
+    }
+
     /// Adds a transfer pass `upload <name>` writing `data` into `dst` (a device buffer with
     /// `TRANSFER_DST`, read by any stage after the frame) from a staging buffer of its own,
     /// kept until this frame's slot comes round again: for data written once (tables), where

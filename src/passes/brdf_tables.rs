@@ -142,6 +142,14 @@ impl BrdfTables {
         }
     }
 
+    /// Bytes of device memory: `(tables, staging)`.
+    pub fn allocated_bytes(&self) -> (u64, u64) {
+        (
+            self.tables.iter().map(|(_, b)| b.allocated_bytes()).sum(),
+            self.ring.allocated_bytes(),
+        )
+    }
+
     /// Forgets every table (a frame that uploaded one was dropped unrun).
     pub fn clear(&mut self) {
         self.tables.clear();

@@ -296,7 +296,7 @@ fn two_contexts_share_a_device() {
     let hvl_image = host::HostImage::new(
         &bench.host,
         "second gi",
-        host::RADIANCE_FORMAT,
+        bench.targets().gi.format,
         EXTENT,
         vk::ImageUsageFlags::TRANSFER_DST
             | vk::ImageUsageFlags::TRANSFER_SRC
@@ -557,4 +557,55 @@ fn missing_host_features_are_named() {
         "{error}"
     );
     assert!(!error.contains("dynamicRendering"), "{error}");
+}
+
+/// The memory report's categories add up to every byte shine holds on the device, and each
+/// category a HVL context needs is there.
+#[test]
+fn memory_report_accounts_for_every_byte() {
+    let bench = Bench::new(false);
+    // Amortised HVL keeps a history across frames.
+    let mut desc = GiContextDesc::new(EXTENT, "hvl").expect("desc");
+    desc.settings.hvl.slices = 4;
+    let mut gi = GiContext::new(bench.device(), &desc).expect("context");
+    gi.set_scene(&bench.scene, 0.0).expect("scene");
+    bench.run(&mut gi, 0..3);
+    let report = gi.memory_report();
+    let usage = bench.device().memory_usage();
+    println!("{report:?}, device {usage:?}");
+    assert_eq!(report.total(), usage.allocated_bytes, "{report:?}");
+    for (name, bytes) in [
+        ("scene", report.scene),
+        ("gi caches", report.gi_caches),
+        ("frame data", report.frame_data),
+        ("staging", report.staging),
+        ("transients", report.transients),
+        ("history", report.history),
+    ] {
+        assert!(bytes > 0, "{name} is empty: {report:?}");
+    }
+}
+
+/// The documented teardown (host submissions complete → context → shine's device → the
+/// host's images, pipeline and buffers → the host's device) leaves the validation layer
+/// nothing to report: no object of shine's outlives its device.
+#[test]
+fn teardown_in_the_documented_order_is_clean() {
+    {
+        let bench = Bench::new(true);
+        let mut gi = bench.context("igi");
+        bench.run(&mut gi, 0..2);
+        drop(gi);
+        // `bench` drops shine's device, then the host's objects, then the host's device.
+    }
+    assert_eq!(host::VALIDATION_MESSAGES.load(Ordering::Relaxed), 0);
+}
+
+/// A context can move to a render thread; a device is shared between threads.
+#[test]
+fn contexts_are_send_and_devices_send_and_sync() {
+    fn send<T: Send>() {}
+    fn send_sync<T: Send + Sync>() {}
+    send::<GiContext>();
+    send_sync::<Device>();
 }

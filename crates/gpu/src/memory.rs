@@ -122,6 +122,12 @@ impl Buffer {
         self.size
     }
 
+    /// Bytes of device memory its allocation holds (its size rounded up to the allocator's
+    /// granularity): what memory reports sum.
+    pub fn allocated_bytes(&self) -> u64 {
+        self.allocation.as_ref().map_or(0, |a| a.size())
+    }
+
     /// Usage flags it was created with.
     pub fn usage(&self) -> vk::BufferUsageFlags {
         self.usage
@@ -253,6 +259,11 @@ impl std::fmt::Debug for Image {
 }
 
 impl Image {
+    /// Bytes of device memory its allocation holds: what memory reports sum.
+    pub fn allocated_bytes(&self) -> u64 {
+        self.allocation.as_ref().map_or(0, |a| a.size())
+    }
+
     /// Creates an image, binds fresh memory and creates its view.
     pub fn new(device: &Device, desc: &ImageDesc<'_>) -> Result<Self> {
         if desc.extent[0] == 0

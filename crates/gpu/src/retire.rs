@@ -46,6 +46,14 @@ pub(crate) fn free(allocator: &mut Allocator, allocation: Allocation) -> u64 {
 }
 
 impl Garbage {
+    /// Bytes of device memory its destruction will free.
+    fn bytes(&self) -> u64 {
+        match self {
+            Self::Buffer(_, Some(a)) | Self::Image(_, _, Some(a)) | Self::Memory(a) => a.size(),
+            _ => 0,
+        }
+    }
+
     /// Destroys the object; returns the bytes of memory it freed.
     fn destroy(self, device: &ash::Device, allocator: &mut Allocator) -> u64 {
         // SAFETY (all arms): the object was created on `device` and the GPU is done with it.
@@ -199,6 +207,19 @@ impl Device {
     /// GPU can no longer be using them.
     pub fn defer_image(&self, image: vk::Image, view: vk::ImageView) {
         self.defer(Garbage::Image(image, view, None));
+    }
+
+    /// Bytes of device memory held by objects dropped but not yet destroyed.
+    pub fn pending_destruction_bytes(&self) -> u64 {
+        let tracker = lock(&self.inner.tracker);
+        tracker
+            .garbage
+            .iter()
+            .map(|(_, g)| g)
+            .chain(&tracker.held)
+            .chain(tracker.host_garbage.iter().map(|(_, _, g)| g))
+            .map(Garbage::bytes)
+            .sum()
     }
 
     /// Objects dropped but not yet destroyed because the GPU may still use them.

@@ -89,6 +89,13 @@ impl Executor {
         self.frame
     }
 
+    /// Device memory the executor holds: `(transients, temporal)` bytes: the aliased heaps of
+    /// every kept transient set (one per plan and frame slot) and the temporal and history
+    /// resources kept across frames.
+    pub fn memory(&self) -> (u64, u64) {
+        self.objects.memory()
+    }
+
     /// The compiler (plan cache and temporal history).
     pub fn compiler(&self) -> &Compiler {
         &self.compiler

@@ -209,6 +209,18 @@ impl GraphObjects {
         Ok(objects)
     }
 
+    /// Bytes of device memory held by the transient sets and by the temporal resources.
+    pub fn memory(&self) -> (u64, u64) {
+        let transients = self
+            .transients
+            .iter()
+            .flat_map(|t| &t._heaps)
+            .map(MemoryBlock::size)
+            .sum();
+        let temporal = self.temporal.values().map(|t| t._memory.size()).sum();
+        (transients, temporal)
+    }
+
     /// Destroys every object, each before the memory it is bound to. The GPU must be done with
     /// all of them.
     pub fn destroy(&mut self, device: &Device) {

@@ -11,6 +11,7 @@ use super::aaf::AafTechnique;
 use super::error::RenderError;
 use super::hvl::HvlTechnique;
 use super::igi::IgiTechnique;
+use super::memory::MemoryReport;
 use super::motion::MotionState;
 use super::params::FrameParams;
 use super::proxy::ProxyTechnique;
@@ -394,6 +395,38 @@ impl Renderer {
             .iter()
             .filter_map(|s| s.warning().map(str::to_owned))
             .collect()
+    }
+
+    /// The device memory this renderer holds, by category (see [`MemoryReport`]); objects
+    /// waiting for destruction are the device's, shared by every renderer on it.
+    pub fn memory_report(&self) -> MemoryReport {
+        let mut report = MemoryReport::default();
+        let mut add = |(owned, staging): (u64, u64), gi: bool| {
+            if gi {
+                report.gi_caches += owned;
+            } else {
+                report.frame_data += owned;
+            }
+            report.staging += staging;
+        };
+        add(self.hvl.allocated_bytes(), true);
+        add(self.igi.allocated_bytes(), true);
+        add(self.motion.allocated_bytes(), false);
+        if let Some(shadows) = &self.shadows {
+            add(shadows.allocated_bytes(), false);
+        }
+        if let Some(scene) = &self.scene {
+            add(scene.proxy.allocated_bytes(), true);
+            let (data, staging) = scene.gpu.allocated_bytes();
+            report.scene += data + scene.environment.allocated_bytes();
+            report.staging += staging;
+        }
+        if let Some(r) = &self.readback {
+            report.frame_data += r.hdr.allocated_bytes() + r.ldr.allocated_bytes();
+        }
+        (report.transients, report.history) = self.executor.memory();
+        report.pending_release = self.device.pending_destruction_bytes();
+        report
     }
 
     /// Tells the device a host frame is being recorded (deferred destruction follows the

@@ -1,4 +1,4 @@
-// The host engine's own G-buffer fragment shader (examples/host_gbuffer): normals packed as
+// The host engine's own G-buffer fragment shader (examples/host_gbuffer/host): normals packed as
 // UNORM (n * 0.5 + 0.5), albedo, roughness/metallic, and the host's own direct light (one
 // unshadowed spot light, Lambert).
 #version 460

@@ -1,4 +1,4 @@
-// The host engine's own G-buffer vertex shader (examples/host_gbuffer): world-space vertices.
+// The host engine's own G-buffer vertex shader (examples/host_gbuffer/host): world-space vertices.
 #version 460
 
 layout(location = 0) in vec3 position;

@@ -1,0 +1,134 @@
+//! The host's copy of a scene's geometry and its camera code.
+
+use super::HostDevice;
+use super::resources::HostBuffer;
+use glam::{Mat4, Vec3};
+use gpu_allocator::MemoryLocation;
+use shine::gpu::ash::vk;
+use shine_scene::Scene;
+use std::error::Error;
+
+/// The host's copy of a scene's geometry: world-space vertices (position, normal), indices,
+/// and one draw per primitive with its material.
+pub struct HostScene {
+    pub vertices: HostBuffer,
+    pub indices: HostBuffer,
+    pub draws: Vec<Draw>,
+    /// The first light (the host lights with it directly).
+    pub light: Option<shine_scene::Light>,
+}
+
+/// One primitive: its index range and material.
+pub struct Draw {
+    pub first_index: u32,
+    pub index_count: u32,
+    pub base_color: [f32; 3],
+    pub roughness: f32,
+    pub metallic: f32,
+}
+
+impl HostScene {
+    /// Flattens `scene` at rest into host-visible vertex and index buffers.
+    pub fn new(host: &HostDevice, scene: &Scene) -> Result<Self, Box<dyn Error>> {
+        let world = scene.rest_world_transforms();
+        let mut vertices: Vec<[f32; 6]> = Vec::new();
+        let mut indices: Vec<u32> = Vec::new();
+        let mut draws = Vec::new();
+        for (node, m) in scene.nodes.iter().zip(&world) {
+            let Some(mesh) = node.mesh.and_then(|i| scene.meshes.get(i)) else {
+                continue;
+            };
+            let normal_matrix = m.inverse().transpose();
+            for p in &mesh.primitives {
+                let base = vertices.len() as u32;
+                for (i, pos) in p.positions.iter().enumerate() {
+                    let wp = m.transform_point3(*pos);
+                    let n = p.normals.get(i).copied().unwrap_or(Vec3::Y);
+                    let wn = normal_matrix.transform_vector3(n).normalize_or(Vec3::Y);
+                    vertices.push([wp.x, wp.y, wp.z, wn.x, wn.y, wn.z]);
+                }
+                let material = scene.materials.get(p.material as usize);
+                draws.push(Draw {
+                    first_index: indices.len() as u32,
+                    index_count: p.indices.len() as u32,
+                    base_color: material.map_or([0.8; 3], |m| {
+                        [m.base_color[0], m.base_color[1], m.base_color[2]]
+                    }),
+                    roughness: material.map_or(1.0, |m| m.roughness),
+                    metallic: material.map_or(0.0, |m| m.metallic),
+                });
+                indices.extend(p.indices.iter().map(|i| i + base));
+            }
+        }
+        let upload = |name, bytes: &[u8], usage| -> Result<HostBuffer, Box<dyn Error>> {
+            let mut buffer = HostBuffer::new(
+                host,
+                name,
+                bytes.len() as u64,
+                usage,
+                MemoryLocation::CpuToGpu,
+            )?;
+            buffer.bytes()[..bytes.len()].copy_from_slice(bytes);
+            Ok(buffer)
+        };
+        Ok(Self {
+            vertices: upload(
+                "host vertices",
+                bytemuck::cast_slice(&vertices),
+                vk::BufferUsageFlags::VERTEX_BUFFER,
+            )?,
+            indices: upload(
+                "host indices",
+                bytemuck::cast_slice(&indices),
+                vk::BufferUsageFlags::INDEX_BUFFER,
+            )?,
+            draws,
+            light: scene.lights_at(&world).into_iter().next(),
+        })
+    }
+
+    /// Destroys the buffers.
+    pub fn destroy(self, host: &HostDevice) {
+        self.vertices.destroy(host);
+        self.indices.destroy(host);
+    }
+}
+
+/// The view and (unjittered, Vulkan y-down) projection of `scene`'s first camera for an
+/// `extent` image, with the camera turned by `orbit` radians about the vertical axis through
+/// the scene's centre: the host's own camera code.
+pub fn camera(scene: &Scene, extent: [u32; 2], orbit: f32) -> (Mat4, Mat4) {
+    let world = scene.rest_world_transforms();
+    let camera_world = scene.camera_world(0, &world).unwrap_or(Mat4::IDENTITY);
+    let bounds = world
+        .iter()
+        .zip(&scene.nodes)
+        .filter_map(|(m, n)| Some((m, scene.meshes.get(n.mesh?)?)))
+        .flat_map(|(m, mesh)| {
+            mesh.primitives
+                .iter()
+                .flat_map(|p| p.positions.iter().map(|v| m.transform_point3(*v)))
+        })
+        .fold(
+            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+            |(lo, hi), p| (lo.min(p), hi.max(p)),
+        );
+    let centre = (bounds.0 + bounds.1) * 0.5;
+    let turn = Mat4::from_translation(centre)
+        * Mat4::from_rotation_y(orbit)
+        * Mat4::from_translation(-centre);
+    let view = (turn * camera_world).inverse();
+    let aspect = extent[0] as f32 / extent[1].max(1) as f32;
+    let (yfov, znear, zfar) = match scene.cameras.first().map(|c| c.projection) {
+        Some(shine_scene::Projection::Perspective {
+            yfov, znear, zfar, ..
+        }) => (yfov, znear, zfar),
+        _ => (0.8, 0.05, None),
+    };
+    let mut projection = match zfar {
+        Some(far) => Mat4::perspective_rh(yfov, aspect, znear, far),
+        None => Mat4::perspective_infinite_rh(yfov, aspect, znear),
+    };
+    projection.y_axis.y = -projection.y_axis.y;
+    (view, projection)
+}
