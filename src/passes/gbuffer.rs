@@ -221,6 +221,26 @@ pub struct GBuffer {
     pub extent: [u32; 2],
 }
 
+impl GBuffer {
+    /// The G-buffer's images of `extent`, new in `rg` (docs/frame.md lists their formats),
+    /// for a pass to write.
+    pub fn create(rg: &mut RenderGraph, extent: [u32; 2]) -> Self {
+        let [w, h] = extent;
+        let mut image = |name, format| rg.create_image(name, ImageDesc::new_2d(format, w, h));
+        Self {
+            position: image("gb_position", vk::Format::R32G32B32A32_SFLOAT),
+            normal: image("gb_normal", vk::Format::R16G16B16A16_SFLOAT),
+            albedo: image("gb_albedo", vk::Format::R8G8B8A8_UNORM),
+            material: image("gb_material", vk::Format::R8G8B8A8_UNORM),
+            emissive: image("gb_emissive", vk::Format::R16G16B16A16_SFLOAT),
+            geometric_normal: image("gb_geometric_normal", vk::Format::R16G16B16A16_SFLOAT),
+            motion: image("gb_motion", MOTION_FORMAT),
+            depth: image("depth", vk::Format::D32_SFLOAT),
+            extent,
+        }
+    }
+}
+
 /// Format of [`GBuffer::motion`].
 pub const MOTION_FORMAT: vk::Format = vk::Format::R16G16_SFLOAT;
 
@@ -273,20 +293,7 @@ pub fn gbuffer(
     extent: [u32; 2],
     sampler: vk::Sampler,
 ) -> GBuffer {
-    let [w, h] = extent;
-    let image =
-        |rg: &mut RenderGraph, name, format| rg.create_image(name, ImageDesc::new_2d(format, w, h));
-    let mut g = GBuffer {
-        position: image(rg, "gb_position", vk::Format::R32G32B32A32_SFLOAT),
-        normal: image(rg, "gb_normal", vk::Format::R16G16B16A16_SFLOAT),
-        albedo: image(rg, "gb_albedo", vk::Format::R8G8B8A8_UNORM),
-        material: image(rg, "gb_material", vk::Format::R8G8B8A8_UNORM),
-        emissive: image(rg, "gb_emissive", vk::Format::R16G16B16A16_SFLOAT),
-        geometric_normal: image(rg, "gb_geometric_normal", vk::Format::R16G16B16A16_SFLOAT),
-        motion: image(rg, "gb_motion", MOTION_FORMAT),
-        depth: image(rg, "depth", vk::Format::D32_SFLOAT),
-        extent,
-    };
+    let mut g = GBuffer::create(rg, extent);
     let pipeline = scene_pipeline(
         &shaders::GBUFFER_VERT_MOTION,
         Some(&shaders::GBUFFER_FRAG),

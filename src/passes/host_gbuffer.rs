@@ -3,8 +3,8 @@
 //! (`crate::embed`) imports the host's images and calls [`host_gbuffer`]; the emissive and
 //! hardware-depth images of a shine G-buffer are not read by any GI pass and stay unwritten.
 
-use super::gbuffer::{GBuffer, MOTION_FORMAT};
-use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
+use super::gbuffer::GBuffer;
+use crate::graph::{Buffer, Handle, Image, RenderGraph, vk};
 use crate::shaders;
 
 /// The per-frame constants of `shaders/host_gbuffer.comp` (std430, 304 bytes).
@@ -60,23 +60,8 @@ pub fn host_gbuffer(
     sampler: vk::Sampler,
 ) -> GBuffer {
     let [w, h] = extent;
-    let image =
-        |rg: &mut RenderGraph, name, format| rg.create_image(name, ImageDesc::new_2d(format, w, h));
-    let mut g = GBuffer {
-        position: image(rg, "gb_position", vk::Format::R32G32B32A32_SFLOAT),
-        normal: image(rg, "gb_normal", vk::Format::R16G16B16A16_SFLOAT),
-        albedo: image(rg, "gb_albedo", vk::Format::R8G8B8A8_UNORM),
-        material: image(rg, "gb_material", vk::Format::R8G8B8A8_UNORM),
-        emissive: image(
-            rg,
-            "gb_emissive (not written)",
-            vk::Format::R16G16B16A16_SFLOAT,
-        ),
-        geometric_normal: image(rg, "gb_geometric_normal", vk::Format::R16G16B16A16_SFLOAT),
-        motion: image(rg, "gb_motion", MOTION_FORMAT),
-        depth: image(rg, "depth (not written)", vk::Format::D32_SFLOAT),
-        extent,
-    };
+    // Emission and hardware depth stay unwritten: no GI pass reads them.
+    let mut g = GBuffer::create(rg, extent);
     rg.compute("host gbuffer", &shaders::HOST_GBUFFER_COMP)
         .read("host_depth", &host.depth)
         .read("host_normal", &host.normal)

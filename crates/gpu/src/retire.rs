@@ -6,9 +6,10 @@
 //! submitted or abandoned); [`Device::retire`] polls the fences of submissions in flight,
 //! advances the completed serial and destroys what is old enough.
 //!
-//! Only submissions made through [`Device::submit`] are known here. A host that records shine
-//! work into its own command buffers must keep shine objects alive until that work completes
-//! (the render graph's executor does this for its own resources).
+//! Submissions made through [`Device::submit`] are known here. A host that records shine work
+//! into its own command buffers announces each of its frames with
+//! [`Device::begin_host_frame`] and promises which have completed; from then on a dropped
+//! object is also tagged with the host frame, and waits for that frame too.
 
 use crate::commands::Context;
 use crate::device::{Device, lock};
@@ -233,10 +234,14 @@ impl Device {
     /// has completed on the GPU. From the first call on, objects shine drops are destroyed
     /// only once the host frame they were dropped in has completed by that promise (and any
     /// submission of shine's own made before the drop), here or at a later call, or when the
-    /// device goes. Neither waits nor submits. Frame numbers must not decrease.
+    /// device goes. Neither waits nor submits. The host passes its own frame counter to every
+    /// caller on the device; a number below the highest seen counts as the highest.
     pub fn begin_host_frame(&self, frame: u64, frames_in_flight: u32) {
         let ready = {
             let mut tracker = lock(&self.inner.tracker);
+            // The clock never goes back: a lower number (a second caller counting from 0)
+            // counts as the highest seen, so nothing is released early.
+            let frame = tracker.host_frame.map_or(frame, |f| f.max(frame));
             tracker.host_frame = Some(frame);
             tracker.host_completed = frame.checked_sub(u64::from(frames_in_flight.max(1)));
             tracker.ready_host_garbage()

@@ -128,8 +128,21 @@ impl TimestampPool {
         Ok(())
     }
 
-    /// Reads every closed scope. Call only after the submission has completed.
+    /// Reads every closed scope, waiting for the GPU to write them. Call only after the
+    /// submission has completed.
     pub fn read(&self) -> Result<Vec<ScopeTiming>> {
+        self.read_with(vk::QueryResultFlags::WAIT)
+            .map(Option::unwrap_or_default)
+    }
+
+    /// Reads every closed scope without waiting: `None` when the GPU has not written all of
+    /// them yet (their work is still in flight). For readers on a host's record path, which
+    /// must never block.
+    pub fn try_read(&self) -> Result<Option<Vec<ScopeTiming>>> {
+        self.read_with(vk::QueryResultFlags::empty())
+    }
+
+    fn read_with(&self, wait: vk::QueryResultFlags) -> Result<Option<Vec<ScopeTiming>>> {
         if !self.open.is_empty() {
             return Err(Error::InvalidUsage(format!(
                 "{} timestamp scope(s) were never ended",
@@ -138,30 +151,35 @@ impl TimestampPool {
         }
         let count = self.names.len();
         if count == 0 {
-            return Ok(Vec::new());
+            return Ok(Some(Vec::new()));
         }
         let mut ticks = vec![0u64; count * 2];
-        // SAFETY: every query in the range was written by a completed submission.
-        unsafe {
+        // SAFETY: every query in the range was reset and written by a submitted recording.
+        let read = unsafe {
             self.raw_device.get_query_pool_results(
                 self.pool,
                 0,
                 &mut ticks,
-                vk::QueryResultFlags::TYPE_64 | vk::QueryResultFlags::WAIT,
+                vk::QueryResultFlags::TYPE_64 | wait,
             )
+        };
+        match read {
+            Ok(()) => {}
+            Err(vk::Result::NOT_READY) if wait.is_empty() => return Ok(None),
+            Err(e) => return Err(Error::vk("reading timestamps", e)),
         }
-        .ctx("reading timestamps")?;
         let origin = ticks[0];
-        Ok(self
-            .names
-            .iter()
-            .enumerate()
-            .map(|(i, name)| ScopeTiming {
-                name: name.clone(),
-                begin_ns: ticks_to_ns(ticks[2 * i], origin, self.valid_bits, self.period_ns),
-                end_ns: ticks_to_ns(ticks[2 * i + 1], origin, self.valid_bits, self.period_ns),
-            })
-            .collect())
+        Ok(Some(
+            self.names
+                .iter()
+                .enumerate()
+                .map(|(i, name)| ScopeTiming {
+                    name: name.clone(),
+                    begin_ns: ticks_to_ns(ticks[2 * i], origin, self.valid_bits, self.period_ns),
+                    end_ns: ticks_to_ns(ticks[2 * i + 1], origin, self.valid_bits, self.period_ns),
+                })
+                .collect(),
+        ))
     }
 }
 

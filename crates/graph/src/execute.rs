@@ -32,8 +32,8 @@ struct FrameSlot {
 ///
 /// The caller owns the command buffers and their submission (so a host engine can embed the
 /// graph). Contract: before `execute` records frame `f`, the submission of frame
-/// `f - frames_in_flight` has completed; [`Executor::timings`] is called only once the frames it
-/// reads have completed. Frame `f` records with slot `f % frames_in_flight`: its own transient
+/// `f - frames_in_flight` has completed; [`Executor::timings`] reports only frames that have
+/// completed (it never waits). Frame `f` records with slot `f % frames_in_flight`: its own transient
 /// resources, descriptor sets and timestamps, so frames in flight share none of them.
 pub struct Executor {
     device: Device,
@@ -160,7 +160,9 @@ impl Executor {
         let objects = self.objects.table(&plan, set, &graph.externals)?;
 
         let slot = &mut self.slots[slot_index];
-        self.timings.extend(slot.timestamps.take()?);
+        // The slot's previous frame has completed (the contract); its timings are read without
+        // waiting.
+        self.timings.extend(slot.timestamps.take_before_reuse()?);
         slot.descriptors.reset()?;
         if let Some(cb) = cb {
             slot.timestamps.pool.reset(cb);
@@ -225,8 +227,9 @@ impl Executor {
         Ok((plan, host_timings))
     }
 
-    /// Per-pass GPU times of every executed frame not reported yet, oldest first. Call only
-    /// once those frames' submissions have completed.
+    /// Per-pass GPU times of every executed frame not reported yet whose timestamps the GPU
+    /// has written, oldest first; never waits (a frame still in flight is reported by a later
+    /// call).
     pub fn timings(&mut self) -> Result<Vec<PassTiming>, ExecuteError> {
         let mut unread: Vec<&mut SlotTimestamps> = self
             .slots
@@ -236,7 +239,11 @@ impl Executor {
             .collect();
         unread.sort_by_key(|t| t.unread());
         for timestamps in unread {
-            self.timings.extend(timestamps.take()?);
+            match timestamps.try_take()? {
+                Some(timings) => self.timings.extend(timings),
+                // Keep frames in order: the later ones wait for this one.
+                None => break,
+            }
         }
         Ok(std::mem::take(&mut self.timings))
     }

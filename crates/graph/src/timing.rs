@@ -46,22 +46,39 @@ impl SlotTimestamps {
         self.unread
     }
 
-    /// The pass timings of the unread frame (none when there is none). That frame must have
-    /// completed; it counts as read afterwards, even when reading fails.
-    pub fn take(&mut self) -> Result<Vec<PassTiming>, shine_gpu::Error> {
-        let Some(frame) = self.unread.take() else {
-            return Ok(Vec::new());
+    /// The pass timings of the unread frame, read without waiting: `None` while the GPU has
+    /// not written them all (the frame is still in flight; it stays unread), an empty list when
+    /// no frame is unread.
+    pub fn try_take(&mut self) -> Result<Option<Vec<PassTiming>>, shine_gpu::Error> {
+        let Some(frame) = self.unread else {
+            return Ok(Some(Vec::new()));
         };
-        Ok(self
-            .pool
-            .read()?
-            .into_iter()
-            .map(|t| PassTiming {
-                name: t.name,
-                begin_ns: t.begin_ns,
-                end_ns: t.end_ns,
-                frame,
-            })
-            .collect())
+        let read = self.pool.try_read();
+        if matches!(read, Ok(None)) {
+            return Ok(None);
+        }
+        // Read (or unreadable): it counts as read either way.
+        self.unread = None;
+        Ok(read?.map(|timings| {
+            timings
+                .into_iter()
+                .map(|t| PassTiming {
+                    name: t.name,
+                    begin_ns: t.begin_ns,
+                    end_ns: t.end_ns,
+                    frame,
+                })
+                .collect()
+        }))
+    }
+
+    /// The pass timings of the unread frame before the slot is recorded again (none when there
+    /// is none), without waiting. That frame has completed (the [`crate::Executor`] contract);
+    /// timings the GPU has not written are dropped rather than waited for. It counts as read
+    /// afterwards, even when reading fails.
+    pub fn take_before_reuse(&mut self) -> Result<Vec<PassTiming>, shine_gpu::Error> {
+        let taken = self.try_take();
+        self.unread = None;
+        Ok(taken?.unwrap_or_default())
     }
 }

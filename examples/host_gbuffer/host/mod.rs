@@ -222,7 +222,8 @@ impl HostDevice {
             device: self.device.clone(),
             queue_family_index: self.family,
             queue: self.queue,
-            debug_utils: false,
+            // The host's instance enables VK_EXT_debug_utils: shine names and labels its work.
+            debug_utils: true,
             enabled: shine::gpu::EnabledFeatures::required(),
             allocator: share_allocator.then(|| self.allocator()),
         }
