@@ -66,6 +66,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                     material: color(&targets.material),
                     material_channels: MaterialChannels::default(),
                     motion: None,
+                    environment: None,
                     diffuse: targets
                         .gi
                         .lend(ExternalState::UNDEFINED, host::copy_source()),

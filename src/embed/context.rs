@@ -4,9 +4,11 @@ use super::inputs::GiDispatch;
 use crate::frame::RenderError;
 use crate::frame::memory::MemoryReport;
 use crate::frame::params::FrameParams;
+use crate::frame::renderer::HostSide;
 use crate::frame::renderer::{HostTarget, Renderer};
 use crate::gpu_scene::FrameUpdate;
 use crate::gpu_scene::upload_ring::UploadRing;
+use crate::passes::environment_sh;
 use crate::passes::host_gbuffer::{self, HostFrame, HostImages};
 use crate::settings::Settings;
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
@@ -183,6 +185,7 @@ impl GiContext {
         let display = self.display;
         let constants = dispatch.host_frame(display);
         let camera = dispatch.camera.view_for(display);
+        let proxy_bands = self.params.proxy.map(|p| p.pass.bands);
         let (frame_constants, ring, sampler) =
             (&self.frame_constants, &mut self.ring, self.nearest.raw());
         self.renderer.record_indirect(
@@ -205,8 +208,26 @@ impl GiContext {
                     motion: dispatch.motion.map(|m| import(rg, "host motion", &m.image)),
                 };
                 let g = host_gbuffer::host_gbuffer(rg, &host, &frame, display, sampler);
-                let output = import_output(rg, &dispatch.diffuse);
-                Ok((g, output))
+                // Only the proxies read an environment.
+                let environment = match (dispatch.environment, proxy_bands) {
+                    (Some(env), Some(bands)) => {
+                        let map = import(rg, "host environment", &env.image);
+                        Some(environment_sh::environment_sh(
+                            rg,
+                            &map,
+                            env.image.extent,
+                            env.intensity,
+                            bands,
+                            sampler,
+                        )?)
+                    }
+                    _ => None,
+                };
+                Ok(HostSide {
+                    g,
+                    output: import_output(rg, &dispatch.diffuse),
+                    environment,
+                })
             },
         )?;
         self.last_frame = Some(dispatch.frame_index);

@@ -165,6 +165,19 @@ pub struct HostMotion {
     pub scale: [f32; 2],
 }
 
+/// The host's environment map: an equirectangular radiance image (any size; linear RGB, a
+/// float format; u = atan2(d.x, −d.z)/2π + ½ across, v = acos(d.y)/π down, shine-scene's
+/// convention) times `intensity`. Projected to SH on the GPU every dispatch (for a 256×128 map
+/// at 4 bands, about 2 M multiply-adds); it lights the proxy technique in place of the
+/// scene's environment.
+#[derive(Clone, Copy, Debug)]
+pub struct HostEnvironment {
+    /// The image (sampled).
+    pub image: HostTarget,
+    /// Multiplier on its radiance.
+    pub intensity: f32,
+}
+
 /// One frame of a [`super::GiContext`]: what the host recorded before and where the result
 /// goes. Every image is display-sized, 2D, one mip and layer; inputs need `SAMPLED` and are
 /// only read; each carries the state of the host's last use (`before`) and the one the
@@ -194,6 +207,8 @@ pub struct GiDispatch {
     /// Motion vectors; `None`: the camera's motion alone (objects that move reproject
     /// wrongly, and amortised techniques lag on them).
     pub motion: Option<HostMotion>,
+    /// The environment map; `None`: the scene's environment (if any).
+    pub environment: Option<HostEnvironment>,
     /// Output: the diffuse (and, for HVL, glossy) indirect radiance the host adds to its
     /// direct light, RGBA16F (or another float format a blit can write), `TRANSFER_DST`.
     pub diffuse: HostTarget,
@@ -244,6 +259,20 @@ impl GiDispatch {
             .all(|v| v.is_finite())
         {
             return Err(invalid("normal encoding is not finite".into()));
+        }
+        if let Some(env) = &self.environment {
+            if !env.image.usage.contains(vk::ImageUsageFlags::SAMPLED) {
+                return Err(invalid("environment image needs SAMPLED usage".into()));
+            }
+            if env.image.extent.contains(&0) {
+                return Err(invalid("environment image is empty".into()));
+            }
+            if !(env.intensity.is_finite() && env.intensity >= 0.0) {
+                return Err(invalid(format!(
+                    "environment intensity {} is not a finite number ≥ 0",
+                    env.intensity
+                )));
+            }
         }
         check_extent("diffuse", &self.diffuse, display)?;
         if !self

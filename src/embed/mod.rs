@@ -8,5 +8,6 @@ mod inputs;
 pub use crate::frame::memory::MemoryReport;
 pub use context::{GiBudgets, GiContext, GiContextDesc};
 pub use inputs::{
-    DepthConvention, GiCamera, GiDispatch, HostMotion, MaterialChannels, NormalEncoding,
+    DepthConvention, GiCamera, GiDispatch, HostEnvironment, HostMotion, MaterialChannels,
+    NormalEncoding,
 };

@@ -4,6 +4,7 @@ use crate::capture::image_io::ImageIoError;
 use crate::gpu_scene::SceneUploadError;
 use crate::passes::aaf::AafError;
 use crate::passes::brdf_tables::BrdfTablesError;
+use crate::passes::environment_sh::EnvironmentShError;
 use crate::passes::gi_add::GiAddError;
 use crate::passes::hvl::HvlError;
 use crate::passes::igi::IgiError;
@@ -43,6 +44,9 @@ pub enum RenderError {
     /// The AAF passes refused their parameters.
     #[error(transparent)]
     Aaf(#[from] AafError),
+    /// A host's environment map could not be projected.
+    #[error(transparent)]
+    EnvironmentSh(#[from] EnvironmentShError),
     /// The BRDF SH tables could not be built or uploaded.
     #[error(transparent)]
     BrdfTables(#[from] BrdfTablesError),

@@ -123,6 +123,30 @@ impl ProxyTechnique {
         self.tables.clear();
     }
 
+    /// The scene environment's SH at `bands` bands in `rg`: imported, or projected on the CPU
+    /// and uploaded by this frame (once per band count).
+    fn environment_sh(
+        &mut self,
+        rg: &mut RenderGraph,
+        bands: u32,
+    ) -> Result<Handle<shine_graph::Buffer>, RenderError> {
+        if let Some((_, buffer)) = self.environments.iter().find(|(b, _)| *b == bands) {
+            return Ok(rg.import_gpu_buffer(buffer, BUFFER_READ, BUFFER_READ));
+        }
+        let environment = self.environment.as_ref().ok_or(ProxyError::NoEnvironment)?;
+        let sh = EnvironmentSh::project(environment, bands as usize).map_err(ProxyError::from)?;
+        let data = sh.gpu_data();
+        let buffer = table_buffer(&self.device, "proxy environment sh", &data)?;
+        let handle = self.ring.upload_once(
+            rg,
+            "proxy environment sh",
+            &buffer,
+            bytemuck::cast_slice(&data),
+        )?;
+        self.environments.push((bands, buffer));
+        Ok(handle)
+    }
+
     /// The proxies for `fit_count` (0: the scene's own) in their nodes' space.
     fn local_proxies(&self, fit_count: u32) -> Vec<(usize, ProxySphere, Vec3)> {
         let mut out = Vec::new();
@@ -141,33 +165,21 @@ impl ProxyTechnique {
     }
 
     /// Uploads what `setup` needs (tables once per distinct setup; the proxies, placed by
-    /// the frame's node matrices `world`, every frame) and imports it into `rg`.
+    /// the frame's node matrices `world`, every frame) and imports it into `rg`. The
+    /// environment's SH is `environment` when given (a host's map projected this frame),
+    /// else the scene's, projected on the CPU once per band count.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
         setup: &ProxySetup,
         world: &[Mat4],
+        environment: Option<Handle<shine_graph::Buffer>>,
     ) -> Result<PreparedProxy<'_>, RenderError> {
         let bands = setup.pass.bands;
-        let environment = self.environment.as_ref().ok_or(ProxyError::NoEnvironment)?;
-        let (environment_index, uploaded_environment) =
-            match self.environments.iter().position(|(b, _)| *b == bands) {
-                Some(i) => (i, None),
-                None => {
-                    let sh = EnvironmentSh::project(environment, bands as usize)
-                        .map_err(ProxyError::from)?;
-                    let data = sh.gpu_data();
-                    let buffer = table_buffer(&self.device, "proxy environment sh", &data)?;
-                    let handle = self.ring.upload_once(
-                        rg,
-                        "proxy environment sh",
-                        &buffer,
-                        bytemuck::cast_slice(&data),
-                    )?;
-                    self.environments.push((bands, buffer));
-                    (self.environments.len() - 1, Some(handle))
-                }
-            };
+        let environment = match environment {
+            Some(host) => host,
+            None => self.environment_sh(rg, bands)?,
+        };
         let key = (
             bands,
             setup.shadow_expansion.to_bits(),
@@ -219,13 +231,7 @@ impl ProxyTechnique {
             count: proxies.count,
             tables: uploaded_tables
                 .unwrap_or_else(|| rg.import_gpu_buffer(table_buffer, BUFFER_READ, BUFFER_READ)),
-            environment: uploaded_environment.unwrap_or_else(|| {
-                rg.import_gpu_buffer(
-                    &self.environments[environment_index].1,
-                    BUFFER_READ,
-                    BUFFER_READ,
-                )
-            }),
+            environment,
         };
         Ok(PreparedProxy {
             params: setup.pass,

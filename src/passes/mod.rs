@@ -6,6 +6,7 @@ pub mod aaf;
 pub mod brdf_tables;
 pub mod composite;
 pub mod direct;
+pub mod environment_sh;
 pub mod gbuffer;
 pub mod gi_add;
 pub mod history;

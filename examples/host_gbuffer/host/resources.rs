@@ -258,3 +258,83 @@ fn f16_to_f32(h: u16) -> f32 {
         e => (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
     }
 }
+
+impl HostImage {
+    /// Fills an RGBA32F image (made with `TRANSFER_DST`) with `texels` through a staging
+    /// buffer (the host's own submission, waited for), leaving it in
+    /// `SHADER_READ_ONLY_OPTIMAL`.
+    pub fn upload_rgba32f(
+        &self,
+        host: &HostDevice,
+        texels: &[[f32; 4]],
+    ) -> Result<(), Box<dyn Error>> {
+        let bytes: &[u8] = bytemuck::cast_slice(texels);
+        let mut staging = HostBuffer::new(
+            host,
+            "host upload",
+            bytes.len() as u64,
+            vk::BufferUsageFlags::TRANSFER_SRC,
+            MemoryLocation::CpuToGpu,
+        )?;
+        staging.bytes()[..bytes.len()].copy_from_slice(bytes);
+        let cb = host.begin()?;
+        let to = |old, new, src_stage, src_access, dst_stage, dst_access| {
+            vk::ImageMemoryBarrier2::default()
+                .src_stage_mask(src_stage)
+                .src_access_mask(src_access)
+                .dst_stage_mask(dst_stage)
+                .dst_access_mask(dst_access)
+                .old_layout(old)
+                .new_layout(new)
+                .image(self.image)
+                .subresource_range(range(vk::ImageAspectFlags::COLOR))
+        };
+        let [w, h] = self.extent;
+        // SAFETY: handles of the host's device; the submission is waited for below.
+        unsafe {
+            host.device.cmd_pipeline_barrier2(
+                cb,
+                &vk::DependencyInfo::default().image_memory_barriers(&[to(
+                    vk::ImageLayout::UNDEFINED,
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    vk::PipelineStageFlags2::NONE,
+                    vk::AccessFlags2::NONE,
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                )]),
+            );
+            host.device.cmd_copy_buffer_to_image(
+                cb,
+                staging.buffer,
+                self.image,
+                vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                &[vk::BufferImageCopy::default()
+                    .image_subresource(vk::ImageSubresourceLayers {
+                        aspect_mask: vk::ImageAspectFlags::COLOR,
+                        mip_level: 0,
+                        base_array_layer: 0,
+                        layer_count: 1,
+                    })
+                    .image_extent(vk::Extent3D {
+                        width: w,
+                        height: h,
+                        depth: 1,
+                    })],
+            );
+            host.device.cmd_pipeline_barrier2(
+                cb,
+                &vk::DependencyInfo::default().image_memory_barriers(&[to(
+                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                    vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
+                    vk::PipelineStageFlags2::COPY,
+                    vk::AccessFlags2::TRANSFER_WRITE,
+                    vk::PipelineStageFlags2::ALL_COMMANDS,
+                    vk::AccessFlags2::MEMORY_READ,
+                )]),
+            );
+        }
+        host.submit_and_wait(cb)?;
+        staging.destroy(host);
+        Ok(())
+    }
+}

@@ -88,7 +88,7 @@ impl Renderer {
             p.shadow,
             self.nearest.raw(),
         );
-        let indirect = self.declare_indirect(rg, p, &handles, &g, &camera)?;
+        let indirect = self.declare_indirect(rg, p, &handles, &g, &camera, None)?;
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
         let (first, second) = match (p.component, indirect.as_ref()) {
             (Component::Full, indirect) => (&direct, indirect),
@@ -121,8 +121,10 @@ impl Renderer {
     /// The indirect light of the surfaces in `g`, seen from `camera`: each technique of `p`
     /// prepares its persistent state, then the primary light's RSM, the receiver-resolution
     /// techniques (HVL, proxies) and their upsample, and the full-resolution ones (IGI, AAF)
-    /// are declared and summed. Returns full-resolution outgoing indirect radiance (RGBA16F),
-    /// or `None` when `p` has no technique.
+    /// are declared and summed. The proxies are lit by `environment` (an SH buffer, laid out
+    /// as `EnvironmentSh::gpu_data`) when given, else by the scene's environment. Returns
+    /// full-resolution outgoing indirect radiance (RGBA16F), or `None` when `p` has no
+    /// technique.
     pub(super) fn declare_indirect(
         &mut self,
         rg: &mut RenderGraph,
@@ -130,6 +132,7 @@ impl Renderer {
         handles: &SceneHandles,
         g: &GBuffer,
         camera: &View,
+        environment: Option<Handle<shine_graph::Buffer>>,
     ) -> Result<Option<Handle<Image>>, RenderError> {
         let textures = self.texture_sampler(p);
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
@@ -144,7 +147,11 @@ impl Renderer {
         let proxy = p
             .proxy
             .as_ref()
-            .map(|setup| scene.proxy.prepare(rg, setup, &frame.pose.world))
+            .map(|setup| {
+                scene
+                    .proxy
+                    .prepare(rg, setup, &frame.pose.world, environment)
+            })
             .transpose()?;
         let light_count = light_count(frame)?;
 

@@ -6,12 +6,20 @@ use crate::frame::error::RenderError;
 use crate::frame::params::FrameParams;
 use crate::passes::gbuffer::{GBuffer, View};
 use shine_gpu::vk;
-use shine_graph::{Handle, Image, RenderGraph};
+use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
-/// Declares the host's side of a frame into its graph: the G-buffer converted from the host's
-/// images and the host's output image, imported.
-pub(crate) type DeclareHost<'a> =
-    dyn FnMut(&mut RenderGraph) -> Result<(GBuffer, Handle<Image>), RenderError> + 'a;
+/// The host's side of a frame, declared into its graph.
+pub(crate) struct HostSide {
+    /// The G-buffer converted from the host's images.
+    pub g: GBuffer,
+    /// The host's output image, imported.
+    pub output: Handle<Image>,
+    /// The host's environment map projected to SH, when it gave one.
+    pub environment: Option<Handle<Buffer>>,
+}
+
+/// Declares the host's side of a frame into its graph.
+pub(crate) type DeclareHost<'a> = dyn FnMut(&mut RenderGraph) -> Result<HostSide, RenderError> + 'a;
 
 impl Renderer {
     /// Records into `cb`, as the host's frame `frame_index`, the scene's updates, `host`'s G-buffer conversion, the techniques of
@@ -53,8 +61,12 @@ impl Renderer {
     ) -> Result<(), RenderError> {
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
         let handles = scene.gpu.declare(rg)?;
-        let (g, mut output) = host(rg)?;
-        match self.declare_indirect(rg, p, &handles, &g, camera)? {
+        let HostSide {
+            g,
+            mut output,
+            environment,
+        } = host(rg)?;
+        match self.declare_indirect(rg, p, &handles, &g, camera, environment)? {
             Some(indirect) => {
                 rg.blit_image("gi to host", &indirect, &mut output, vk::Filter::NEAREST);
             }

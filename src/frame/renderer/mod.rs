@@ -7,6 +7,8 @@
 mod compose;
 mod host;
 
+pub(crate) use host::HostSide;
+
 use super::aaf::AafTechnique;
 use super::error::RenderError;
 use super::hvl::HvlTechnique;
