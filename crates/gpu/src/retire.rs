@@ -111,7 +111,8 @@ pub(crate) struct Tracker {
     pub in_flight: VecDeque<(u64, vk::Fence)>,
     garbage: Vec<(u64, Garbage)>,
     /// Dropped while a recording was open: stamped with a serial once none is.
-    held: Vec<Garbage>,
+    /// With the host frame that was being recorded at the drop, if any.
+    held: Vec<(Option<u64>, Garbage)>,
     /// Contexts ready for reuse.
     pub free_contexts: Vec<Context>,
     /// Contexts of submissions dropped without waiting, with their serial.
@@ -136,8 +137,12 @@ impl Tracker {
         self.recording = self.recording.saturating_sub(1);
         if self.recording == 0 {
             let serial = self.submitted;
-            let held = std::mem::take(&mut self.held);
-            self.garbage.extend(held.into_iter().map(|g| (serial, g)));
+            for (host_frame, g) in std::mem::take(&mut self.held) {
+                match host_frame {
+                    Some(frame) => self.host_garbage.push((frame, serial, g)),
+                    None => self.garbage.push((serial, g)),
+                }
+            }
         }
     }
 }
@@ -149,7 +154,7 @@ impl Tracker {
             .garbage
             .drain(..)
             .map(|(_, g)| g)
-            .chain(self.held.drain(..))
+            .chain(self.held.drain(..).map(|(_, g)| g))
             .chain(self.host_garbage.drain(..).map(|(_, _, g)| g));
         for g in garbage {
             g.destroy(device, allocator);
@@ -181,17 +186,17 @@ impl Device {
     /// Hands an object over for destruction once the GPU can no longer be using it.
     pub(crate) fn defer(&self, garbage: Garbage) {
         let mut tracker = lock(&self.inner.tracker);
-        if let Some(frame) = tracker.host_frame {
+        if tracker.recording > 0 {
+            // An open recording may use it; its serial is known only once it is submitted.
+            let host_frame = tracker.host_frame;
+            tracker.held.push((host_frame, garbage));
+        } else if let Some(frame) = tracker.host_frame {
             // The host's submissions of frames up to `frame` may use it.
             let serial = tracker.submitted;
             tracker.host_garbage.push((frame, serial, garbage));
-        } else if tracker.recording > 0 {
-            // An open recording may use it; its serial is known only once it is submitted.
-            tracker.held.push(garbage);
         } else if tracker.completed == tracker.submitted {
             drop(tracker);
-            let freed = garbage.destroy(&self.inner.raw, &mut self.allocator());
-            self.freed(tally([freed]));
+            self.destroy_now(vec![garbage]);
         } else {
             let serial = tracker.submitted;
             tracker.garbage.push((serial, garbage));
@@ -210,6 +215,22 @@ impl Device {
         self.defer(Garbage::Image(image, view, None));
     }
 
+    /// Destroys `ready` (objects the GPU is done with) and counts the memory freed.
+    fn destroy_now(&self, ready: Vec<Garbage>) {
+        if ready.is_empty() {
+            return;
+        }
+        let mut allocator = self.allocator();
+        let freed = tally(
+            ready
+                .into_iter()
+                .map(|g| g.destroy(&self.inner.raw, &mut allocator))
+                .collect::<Vec<_>>(),
+        );
+        drop(allocator);
+        self.freed(freed);
+    }
+
     /// Bytes of device memory held by objects dropped but not yet destroyed.
     pub fn pending_destruction_bytes(&self) -> u64 {
         let tracker = lock(&self.inner.tracker);
@@ -217,7 +238,7 @@ impl Device {
             .garbage
             .iter()
             .map(|(_, g)| g)
-            .chain(&tracker.held)
+            .chain(tracker.held.iter().map(|(_, g)| g))
             .chain(tracker.host_garbage.iter().map(|(_, _, g)| g))
             .map(Garbage::bytes)
             .sum()
@@ -246,17 +267,7 @@ impl Device {
             tracker.host_completed = frame.checked_sub(u64::from(frames_in_flight.max(1)));
             tracker.ready_host_garbage()
         };
-        if !ready.is_empty() {
-            let mut allocator = self.allocator();
-            let freed = tally(
-                ready
-                    .into_iter()
-                    .map(|g| g.destroy(&self.inner.raw, &mut allocator))
-                    .collect::<Vec<_>>(),
-            );
-            drop(allocator);
-            self.freed(freed);
-        }
+        self.destroy_now(ready);
     }
 
     /// Polls submissions in flight and destroys or recycles what they no longer use.
@@ -292,17 +303,7 @@ impl Device {
             .free_contexts
             .extend(free.into_iter().map(|(_, c)| c));
         drop(tracker);
-        if !ready.is_empty() {
-            let mut allocator = self.allocator();
-            let freed = tally(
-                ready
-                    .into_iter()
-                    .map(|g| g.destroy(&self.inner.raw, &mut allocator))
-                    .collect::<Vec<_>>(),
-            );
-            drop(allocator);
-            self.freed(freed);
-        }
+        self.destroy_now(ready);
         Ok(())
     }
 }

@@ -4,7 +4,8 @@
 //! pipeline (dynamic rendering) with its own direct light. `examples/host_gbuffer/main.rs` and
 //! `tests/embedding.rs` drive it.
 
-#![allow(dead_code)] // The example and the tests each use a part.
+// Two examples (host_gbuffer, embed) and tests/embedding.rs each use a part of this host.
+#![allow(dead_code, unused_imports)]
 
 mod raster;
 mod resources;
