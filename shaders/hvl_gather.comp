@@ -201,7 +201,7 @@ void main() {
             continue;
         }
         vec3 wj = v / dist;
-        float a = hvl_sphere_half_angle(dist, r);
+        float a = hvl_cap_half_angle(dist, r);
         float g = hvl_geometric_factor(wj, hvl_normal, n, r, a);
         if (!(g > 0.0)) {
             continue;

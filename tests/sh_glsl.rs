@@ -4,10 +4,10 @@
 //! 2, 3, 4 and 6 bands (the basis alone is checked to 8 bands by tests/sh_eval.rs), run by `shaders/tests/sh_glsl.comp` on the Vulkan device.
 //!
 //! Case layout (floats): dir.xyz, cos a, Phong n, window width, HVL radius, HVL half-angle,
-//! HVL normal.xyz, 0, receiver normal.xyz, 0, f[n²], g[n²]. Results, in order: basis(dir),
-//! cap ZH, cap SH around dir, dot(f, g), f at dir, clamped-cosine ZH, Phong ZH,
-//! convolve(f, Phong), sinc-windowed cap ZH, HVL geometric factor, then for ≤ 4 bands
-//! product(f, g) and exp_hyb(f).
+//! HVL normal.xyz, HVL distance, receiver normal.xyz, 0, f[n²], g[n²]. Results, in order:
+//! basis(dir), cap ZH, cap SH around dir, dot(f, g), f at dir, clamped-cosine ZH, Phong ZH,
+//! convolve(f, Phong), sinc-windowed cap ZH, HVL geometric factor, HVL cap half-angle, then
+//! for ≤ 4 bands product(f, g) and exp_hyb(f).
 
 mod common;
 
@@ -55,6 +55,8 @@ struct Case {
     radius: f32,
     half_angle: f32,
     hvl_normal: Vec3,
+    /// Receiver-to-HVL-centre distance of the cap half-angle (inside and outside the HVL).
+    hvl_distance: f32,
     receiver_normal: Vec3,
     f: Vec<f32>,
     g: Vec<f32>,
@@ -74,7 +76,7 @@ impl Case {
             self.hvl_normal.x,
             self.hvl_normal.y,
             self.hvl_normal.z,
-            0.0,
+            self.hvl_distance,
             self.receiver_normal.x,
             self.receiver_normal.y,
             self.receiver_normal.z,
@@ -122,6 +124,7 @@ fn cases(bands: usize, rng: &mut Rng) -> Vec<Case> {
                 radius: rng.range(0.05, 1.0),
                 half_angle: rng.range(0.0, 1.2),
                 hvl_normal: rng.direction(),
+                hvl_distance: rng.range(0.0, 2.0),
                 receiver_normal: rng.direction(),
                 f,
                 g,
@@ -187,6 +190,9 @@ fn expected(
     .expect("geometric factor");
     // f32 acos in the shader: ~2e-4 relative (measured), so 1e-3.
     put(&[g], 1e-3, "hvl geometric factor");
+    let a = hvl::cap_half_angle(case.hvl_distance, case.radius).expect("cap half-angle");
+    // f32 asin in the shader: 1.4e-4 measured, so 1e-3 as for the geometric factor.
+    put(&[a], 1e-3, "hvl cap half-angle");
     if bands <= 4 {
         put(
             &tensor.product(&case.f, &case.g).expect("product"),

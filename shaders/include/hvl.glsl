@@ -23,14 +23,6 @@ struct Hvl {
     float emission[8];
 };
 
-// shine_sh::zonal::sphere_half_angle: asin(r / d), pi when the point is inside the sphere
-float hvl_sphere_half_angle(float distance, float radius) {
-    if (distance <= radius) {
-        return SH_PI;
-    }
-    return asin(radius / distance);
-}
-
 // shine::reference::hvl::zh_eval: a ZH vector (about axis a) evaluated at direction b,
 // cos_angle = a . b: sum_l zh_l sqrt((2l+1)/(4 pi)) P_l(cos_angle), first `bands` bands.
 float hvl_zh_eval(float zh[8], int bands, float cos_angle) {

@@ -372,6 +372,15 @@ float hvl_hemisphere_cap_fraction(float cos_angle, float a) {
     return smoothstep(0.0, 1.0, (upper - clamp(theta, lower, upper)) / (2.0 * a));
 }
 
+// shine_sh::hvl::cap_half_angle: asin(r / d) outside the HVL, pi - (pi/2) d / r inside
+// (continuous at d = r and at the centre; see the Rust docs), radius > 0
+float hvl_cap_half_angle(float distance, float radius) {
+    if (distance >= radius) {
+        return asin(radius / distance);
+    }
+    return SH_PI - 0.5 * SH_PI * distance / radius;
+}
+
 // shine_sh::hvl::geometric_factor (eq. 21); directions are normalised here, radius > 0
 float hvl_geometric_factor(vec3 to_hvl, vec3 hvl_normal, vec3 receiver_normal, float radius, float half_angle) {
     vec3 w = normalize(to_hvl);

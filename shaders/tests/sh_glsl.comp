@@ -13,9 +13,9 @@ layout(local_size_x = 32) in;
 
 #define IN_STRIDE (16 + 2 * SH_COEFFS)
 #if SH_BANDS <= 4
-#define OUT_STRIDE (5 * SH_COEFFS + 4 * SH_BANDS + 3)
+#define OUT_STRIDE (5 * SH_COEFFS + 4 * SH_BANDS + 4)
 #else
-#define OUT_STRIDE (3 * SH_COEFFS + 4 * SH_BANDS + 3)
+#define OUT_STRIDE (3 * SH_COEFFS + 4 * SH_BANDS + 4)
 #endif
 
 layout(set = 0, binding = 0, std430) readonly buffer Cases {
@@ -50,6 +50,7 @@ void main() {
     float radius = cases.v[b + 6u];
     float half_angle = cases.v[b + 7u];
     vec3 hvl_normal = vec3(cases.v[b + 8u], cases.v[b + 9u], cases.v[b + 10u]);
+    float hvl_distance = cases.v[b + 11u];
     vec3 receiver_normal = vec3(cases.v[b + 12u], cases.v[b + 13u], cases.v[b + 14u]);
     float f[SH_COEFFS];
     float g[SH_COEFFS];
@@ -91,6 +92,7 @@ void main() {
     for (int l = 0; l < SH_BANDS; ++l) put(zh[l]);
 
     put(hvl_geometric_factor(dir, hvl_normal, receiver_normal, radius, half_angle));
+    put(hvl_cap_half_angle(hvl_distance, radius));
 
 #if SH_BANDS <= 4
     float prod[SH_COEFFS];

@@ -50,6 +50,11 @@ pub enum CompareError {
 pub struct Comparison {
     /// Root mean square error (clamped linear values).
     pub rmse: f64,
+    /// RMSE divided by the reference's mean (over pixels and channels): error relative to the
+    /// signal, which PSNR on dim linear images hides (infinite for a black reference).
+    pub relative_rmse: f64,
+    /// Σ image / Σ reference over pixels and channels (1: the same energy).
+    pub energy_ratio: f64,
     /// Peak signal-to-noise ratio in dB (`f64::INFINITY` when identical).
     pub psnr: f64,
     /// Mean structural similarity on luminance.
@@ -98,6 +103,20 @@ pub fn rmse(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError>
         })
         .sum();
     Ok((sum / (3 * n) as f64).sqrt())
+}
+
+/// Sums of `image` and `reference` over pixels and channels (clamped as for the RMSE).
+fn sums(image: &HdrImage, reference: &HdrImage) -> Result<(f64, f64), CompareError> {
+    check(image, reference)?;
+    let n = image.width as usize * image.height as usize;
+    let sum = |i: &HdrImage| {
+        i.texels
+            .iter()
+            .take(n)
+            .map(|t| (0..3).map(|c| clamped(t[c])).sum::<f64>())
+            .sum::<f64>()
+    };
+    Ok((sum(image), sum(reference)))
 }
 
 /// PSNR in dB of `image` against `reference`: `20 log10(L / RMSE)`.
@@ -203,11 +222,16 @@ pub fn flip(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError>
     Ok(f64::from(nv_flip::FlipPool::from_image(&map).mean()))
 }
 
-/// RMSE, PSNR, SSIM and FLIP of `image` against `reference`.
+/// RMSE (absolute and relative to the reference's mean), energy ratio, PSNR, SSIM and FLIP
+/// of `image` against `reference`.
 pub fn compare(image: &HdrImage, reference: &HdrImage) -> Result<Comparison, CompareError> {
     let rmse = rmse(image, reference)?;
+    let (image_sum, reference_sum) = sums(image, reference)?;
+    let values = 3.0 * f64::from(image.width) * f64::from(image.height);
     Ok(Comparison {
         rmse,
+        relative_rmse: rmse / (reference_sum / values),
+        energy_ratio: image_sum / reference_sum,
         psnr: psnr_of_rmse(rmse),
         ssim: ssim(image, reference)?,
         flip: flip(image, reference)?,
@@ -248,6 +272,18 @@ mod tests {
         let c = compare(&a, &b).expect("compare");
         assert!((c.rmse - 0.1).abs() < 1e-6);
         assert!((c.psnr - 20.0).abs() < 1e-4);
+        // The signal: against a reference of mean 0.6, 0.1 is 1/6 of it, and 0.5/0.6 of the
+        // energy is there.
+        assert!(
+            (c.relative_rmse - 0.1 / 0.6).abs() < 1e-6,
+            "{}",
+            c.relative_rmse
+        );
+        assert!(
+            (c.energy_ratio - 0.5 / 0.6).abs() < 1e-6,
+            "{}",
+            c.energy_ratio
+        );
         // Flat images: SSIM is the luminance term (2·0.5·0.6 + C1) / (0.25 + 0.36 + C1).
         let c1 = 1e-4;
         assert!(

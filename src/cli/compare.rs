@@ -33,6 +33,8 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         // JSON has no infinity: identical images report a null PSNR.
         let value = serde_json::json!({
             "rmse": c.rmse,
+            "relative_rmse": c.relative_rmse.is_finite().then_some(c.relative_rmse),
+            "energy_ratio": c.energy_ratio.is_finite().then_some(c.energy_ratio),
             "psnr": c.psnr.is_finite().then_some(c.psnr),
             "ssim": c.ssim,
             "flip": c.flip,
@@ -43,6 +45,8 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     } else {
         println!("metric  value");
         println!("RMSE    {:.6}", c.rmse);
+        println!("RMSE/mean {:.4}", c.relative_rmse);
+        println!("energy  {:.4}", c.energy_ratio);
         println!("PSNR    {:.3} dB", c.psnr);
         println!("SSIM    {:.6}", c.ssim);
         println!("FLIP    {:.6}", c.flip);

@@ -201,17 +201,19 @@ impl GiContext {
                     bytemuck::bytes_of(&constants),
                 )?;
                 let host = HostImages {
-                    depth: import(rg, "host depth", &dispatch.depth),
-                    normal: import(rg, "host normals", &dispatch.normals),
-                    albedo: import(rg, "host albedo", &dispatch.albedo),
-                    material: import(rg, "host material", &dispatch.material),
-                    motion: dispatch.motion.map(|m| import(rg, "host motion", &m.image)),
+                    depth: import(rg, "host depth", &dispatch.depth, true),
+                    normal: import(rg, "host normals", &dispatch.normals, true),
+                    albedo: import(rg, "host albedo", &dispatch.albedo, true),
+                    material: import(rg, "host material", &dispatch.material, true),
+                    motion: dispatch
+                        .motion
+                        .map(|m| import(rg, "host motion", &m.image, true)),
                 };
                 let g = host_gbuffer::host_gbuffer(rg, &host, &frame, display, sampler);
                 // Only the proxies read an environment.
                 let environment = match (dispatch.environment, proxy_bands) {
                     (Some(env), Some(bands)) => {
-                        let map = import(rg, "host environment", &env.image);
+                        let map = import(rg, "host environment", &env.image, true);
                         Some(environment_sh::environment_sh(
                             rg,
                             &map,
@@ -225,7 +227,7 @@ impl GiContext {
                 };
                 Ok(HostSide {
                     g,
-                    output: import_output(rg, &dispatch.diffuse),
+                    output: import(rg, "host diffuse gi", &dispatch.diffuse, false),
                     environment,
                 })
             },
@@ -271,8 +273,8 @@ fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, R
     Ok(params)
 }
 
-/// A host input image, read only.
-fn import(rg: &mut RenderGraph, name: &str, image: &HostTarget) -> Handle<Image> {
+/// A host image: an input (`read_only`) or the output.
+fn import(rg: &mut RenderGraph, name: &str, image: &HostTarget, read_only: bool) -> Handle<Image> {
     rg.import_vk_image(
         name,
         ImageDesc::new_2d(image.format, image.extent[0], image.extent[1]),
@@ -280,23 +282,7 @@ fn import(rg: &mut RenderGraph, name: &str, image: &HostTarget) -> Handle<Image>
             initial: image.before,
             final_state: image.after,
             usage: image.usage,
-            read_only: true,
-        },
-        image.image,
-        image.view,
-    )
-}
-
-/// The host's output image.
-fn import_output(rg: &mut RenderGraph, image: &HostTarget) -> Handle<Image> {
-    rg.import_vk_image(
-        "host diffuse gi",
-        ImageDesc::new_2d(image.format, image.extent[0], image.extent[1]),
-        ImageImport {
-            initial: image.before,
-            final_state: image.after,
-            usage: image.usage,
-            read_only: false,
+            read_only,
         },
         image.image,
         image.view,

@@ -9,11 +9,13 @@
 
 use glam::{DVec3, Vec3, Vec4};
 use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
-use shine_sh::hvl::{HvlNeighbour, geometric_factor, radius_r1, radius_r2, radius_r2_orthographic};
+use shine_sh::hvl::{
+    HvlNeighbour, cap_half_angle, geometric_factor, radius_r1, radius_r2, radius_r2_orthographic,
+};
 use shine_sh::kernels::clamped_cosine_zh;
 use shine_sh::legendre::legendre_all;
 use shine_sh::quadrature::SphereQuadrature;
-use shine_sh::zonal::{cap_sh, cap_zh, sphere_half_angle};
+use shine_sh::zonal::{cap_sh, cap_zh};
 
 use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::{
@@ -289,7 +291,7 @@ pub fn hvl_incoming(hvl: &Hvl, x: Vec3, n: Vec3, emission: Emission) -> Option<(
         return None;
     }
     let wj = v / dist;
-    let a = sphere_half_angle(dist, r).ok()?;
+    let a = cap_half_angle(dist, r).ok()?;
     let hvl_n = Vec4::from(hvl.normal_distance).truncate();
     let g = geometric_factor(wj, hvl_n, n, r, a).ok()?;
     if g.is_nan() || g <= 0.0 {
@@ -459,6 +461,61 @@ mod tests {
         let full = shine_sh::dot(&fa, &gb).unwrap();
         assert!((zh_dot(&f, &g, a.dot(b)) - full).abs() < 1e-5);
         assert!((zh_eval(&f, a.dot(b)) - evaluate(&fa, b).unwrap()).abs() < 1e-5);
+    }
+
+    /// A receiver crossing an HVL's rim (d = r) sees no jump, in both gather paths: the
+    /// light at d = r(1 ± 10⁻⁵) agrees to 1 %, for receivers facing the centre and tilted
+    /// 60° from it (where a full-sphere cap inside made it jump by 2/(1 + cos 60°) = 1.33).
+    /// Outside, the cap closes as asin(r/d), √(2ε) from π/2 at d = r(1 + ε): continuous but
+    /// steep, hence the small ε.
+    #[test]
+    fn the_gather_is_continuous_across_an_hvls_rim() {
+        let bands = 3;
+        let brdf = GatherBrdf::build(bands, HemisphereSampling::default()).unwrap();
+        let r = 0.4;
+        let hvl = Hvl {
+            position_radius: [0.0, 0.0, 0.0, r],
+            normal_distance: [0.0, 1.0, 0.0, 2.0],
+            flux: [1.0, 1.0, 1.0, 1.0],
+            emission: {
+                let mut e = [0.0; 8];
+                let zh = sender_emission_zh(EMISSION_MAX_BANDS).unwrap();
+                e[..zh.len()].copy_from_slice(&zh);
+                e
+            },
+        };
+        // Receivers straight above the HVL (facing away from its surface normal would send
+        // nothing), their normals towards the centre or tilted by 60°.
+        let to_centre = Vec3::NEG_Y;
+        let tilted = Vec3::new(60f32.to_radians().sin(), -60f32.to_radians().cos(), 0.0);
+        for path in [GatherPath::Full, GatherPath::Zonal] {
+            let params = HvlParams {
+                path,
+                conv_bands: bands,
+                ..HvlParams::default()
+            };
+            for normal in [to_centre, tilted] {
+                let light = |d: f32| {
+                    let receiver = Receiver {
+                        position: Vec3::new(0.0, d, 0.0),
+                        normal,
+                        albedo: Vec3::splat(0.5),
+                        metallic: 0.0,
+                        roughness: 1.0,
+                    };
+                    let camera = receiver.position + normal * 2.0;
+                    shade(&receiver, &[hvl], &brdf, camera, &params, None)
+                        .unwrap()
+                        .x
+                };
+                let (inside, outside) = (light(r * (1.0 - 1e-5)), light(r * (1.0 + 1e-5)));
+                assert!(outside > 0.0, "{path:?}, {normal}: no light");
+                assert!(
+                    (inside / outside - 1.0).abs() < 0.01,
+                    "{path:?}, normal {normal}: {inside} inside vs {outside} outside"
+                );
+            }
+        }
     }
 
     #[test]

@@ -34,6 +34,28 @@ pub fn hemisphere_cap_fraction(cos_angle: f32, a: f32) -> f32 {
     smoothstep((upper - theta.clamp(lower, upper)) / (2.0 * a)) as f32
 }
 
+/// The half-angle `a` of the cap an HVL of radius `r` fills seen from a receiver at distance
+/// `d` from its centre: `asin(r/d)` outside the sphere (the cap of eq. 20–22), and inside it
+/// `π − (π/2)·d/r`, widening linearly from the hemisphere towards the centre at the surface
+/// to the whole sphere at the centre.
+///
+/// **Deviation:** the paper does not say what a receiver inside an HVL sees. Taking the whole
+/// sphere there (every direction meets the sphere's surface) makes the gathered light jump by
+/// `2/(1 + cos θ)` at `d = r` (θ between the receiver's normal and the direction to the
+/// centre): a visible seam at every HVL's rim. The ramp is continuous at `d = r` (asin 1 =
+/// π/2) and at the centre (the whole sphere, the same for every direction to the centre), and
+/// changes nothing for a receiver facing the centre (its clamped cosine sees πL either way).
+pub fn cap_half_angle(distance: f32, radius: f32) -> Result<f32> {
+    let d = check_range("distance", f64::from(distance), 0.0, f64::MAX, "≥ 0")?;
+    let r = check_range("radius", f64::from(radius), 1e-30, f64::MAX, "> 0")?;
+    let half_pi = std::f64::consts::FRAC_PI_2;
+    Ok(if d >= r {
+        (r / d).asin() as f32
+    } else {
+        (std::f64::consts::PI - half_pi * d / r) as f32
+    })
+}
+
 /// Paper 003 eq. 21: `G_j(-ω_j) = max(0, n_j · -ω_j) H(n_x, ω_j) / (π r_j²)`.
 ///
 /// * `to_hvl`: direction from the receiver `x` to the HVL centre (`ω_j`, normalised here),
@@ -150,6 +172,22 @@ mod tests {
     use super::*;
     use crate::quadrature::SphereQuadrature;
     use glam::DVec3;
+
+    /// The cap half-angle is asin(r/d) outside, π/2 on the rim from both sides, π at the
+    /// centre, and falls monotonically with distance.
+    #[test]
+    fn cap_half_angle_is_continuous_at_the_rim() {
+        let r = 0.7;
+        let a = |d: f32| cap_half_angle(d, r).unwrap();
+        assert!((a(2.0 * r) - std::f32::consts::FRAC_PI_6).abs() < 1e-6);
+        assert!((a(r) - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+        assert!((a(r * (1.0 - 1e-4)) - a(r * (1.0 + 1e-4))).abs() < 0.02);
+        assert!((a(0.0) - std::f32::consts::PI).abs() < 1e-6);
+        let samples: Vec<f32> = (0..=400).map(|i| a(i as f32 * 0.01)).collect();
+        assert!(samples.windows(2).all(|w| w[1] <= w[0]));
+        assert!(cap_half_angle(1.0, 0.0).is_err());
+        assert!(cap_half_angle(-1.0, 0.5).is_err());
+    }
 
     /// Exact fraction of a cap (half-angle `a` around direction at angle `theta` from the normal)
     /// that lies above the horizon, by quadrature over the cap.
