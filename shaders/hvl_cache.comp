@@ -5,7 +5,7 @@
 // M = K*K). Each cell gives one HVL: its position and normal are those of the cell's valid texel
 // nearest the cell centre (first in row-major order on a tie), its flux is the sum of the flux
 // of every valid texel of the cell (so the light's reflected power is conserved for any M), its
-// emission is the sender's F' (Lambert: cap ZH of the hemisphere / pi, eq. 20). Radius r2
+// emission is the sender's F' (Lambert: 1/pi in every direction, band 0 only, eq. 20). Radius r2
 // (eq. 24-26; for an orthographic RSM sqrt(2) W / sqrt(M)) here; with r1 the radius is left 0
 // for the `r1` stage. A cell without a valid texel is an empty HVL (flux.a = 0, radius 0): the
 // gather skips it. The distance d_j to the light is Euclidean (perspective) or along the
@@ -139,11 +139,10 @@ void main() {
     hvls.h[index].position_radius = position_radius;
     hvls.h[index].normal_distance = normal_distance;
     hvls.h[index].flux = flux_valid;
-    // eq. 20: F' of the Lambert sender (albedo in the flux) = hemisphere cap ZH / pi
-    float zh[SH_BANDS];
-    sh_cap_zh(0.0, zh);
+    // eq. 20: F' of the Lambert sender (albedo in the flux, cosine in G) is 1/pi in every
+    // direction: band 0 only, sqrt(4 pi) / pi (shine::reference::hvl::sender_emission_zh)
     for (int l = 0; l < 8; ++l) {
-        hvls.h[index].emission[l] = l < HVL_EMISSION_MAX_BANDS ? emission_scale * zh[l] / SH_PI : 0.0;
+        hvls.h[index].emission[l] = l == 0 ? emission_scale * SH_SQRT_4PI / SH_PI : 0.0;
     }
 #else
     vec4 position_radius = source.h[index].position_radius;

@@ -8,7 +8,7 @@
 //! rotated ZH vectors, the O(n) zonal path). Everything else calls shine-sh.
 
 use glam::{DVec3, Vec3, Vec4};
-use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
+use shine_sh::brdf_table::BrdfModel;
 use shine_sh::hvl::{
     HvlNeighbour, cap_half_angle, geometric_factor, radius_r1, radius_r2, radius_r2_orthographic,
 };
@@ -112,17 +112,25 @@ impl Receiver {
     }
 }
 
-/// ZH coefficients (about the HVL normal) of the Lambert sender's `F'` (eq. 20), taken from the
-/// shine-sh BRDF table of Lambert with albedo 1 (every θ_o row is the same): `bands` ≤ 5.
+/// ZH coefficients (about the HVL normal) of the Lambert sender's `F'` (eq. 20): the BRDF
+/// without its cosine, `1/π` in every direction (the albedo is in the flux, the cosine and the
+/// back hemisphere are in `G`, eq. 21), so band 0 only, `√(4π)/π`, as the paper says of
+/// isotropic HVLs ("only use band 0 coefficient"); `bands` ≤ 5 coefficients, the rest 0.
+///
+/// shine first projected the hemisphere-cap indicator over `π` instead (zero behind the
+/// sender): that emits `1/(2π)` with one band and, with three, a lobe of `1.25/π` along the
+/// normal and `0.5/π` at grazing angles, while `G` already applies the cosine.
 pub fn sender_emission_zh(bands: usize) -> Result<Vec<f32>, HvlError> {
-    // A polynomial in cos θ of degree < 2·16 and trigonometric terms of order < 16: exact.
-    let sampling = HemisphereSampling {
-        n_theta: 16,
-        n_phi: 16,
-    };
-    let table = BrdfTable::build_with(BrdfModel::Lambert { albedo: 1.0 }, bands, sampling)?;
-    let row = &table.f_prime()[..bands * bands];
-    Ok((0..bands).map(|l| row[shine_sh::index(l, 0)]).collect())
+    if !(1..=EMISSION_MAX_BANDS).contains(&bands) {
+        return Err(HvlError::OutOfRange {
+            name: "emission bands",
+            value: bands as f64,
+            expected: format!("1..={EMISSION_MAX_BANDS}"),
+        });
+    }
+    let mut zh = vec![0.0; bands];
+    zh[0] = (4.0 * std::f32::consts::PI).sqrt() / std::f32::consts::PI;
+    Ok(zh)
 }
 
 /// `Σ_l zh_l √((2l+1)/4π) P_l(cos_angle)`: the ZH vector `zh` about axis `a`, rotated to `a`
@@ -471,7 +479,8 @@ mod tests {
     #[test]
     fn the_gather_is_continuous_across_an_hvls_rim() {
         let bands = 3;
-        let brdf = GatherBrdf::build(bands, HemisphereSampling::default()).unwrap();
+        let brdf =
+            GatherBrdf::build(bands, shine_sh::brdf_table::HemisphereSampling::default()).unwrap();
         let r = 0.4;
         let hvl = Hvl {
             position_radius: [0.0, 0.0, 0.0, r],
@@ -518,12 +527,22 @@ mod tests {
         }
     }
 
+    /// The Lambert sender's `F'` reconstructs to `1/π` in every direction at every band count
+    /// (band 0 only, eq. 20), so with `G`'s cosine an HVL emits its flux like a Lambert
+    /// surface.
     #[test]
-    fn lambert_sender_emission_is_the_hemisphere_cap_over_pi() {
-        let zh = sender_emission_zh(EMISSION_MAX_BANDS).unwrap();
-        let cap = cap_zh(std::f32::consts::FRAC_PI_2, EMISSION_MAX_BANDS).unwrap();
-        for (e, c) in zh.iter().zip(&cap) {
-            assert!((e - c / std::f32::consts::PI).abs() < 1e-6, "{e} vs {c}");
+    fn lambert_sender_emission_is_isotropic() {
+        for bands in 1..=EMISSION_MAX_BANDS {
+            let zh = sender_emission_zh(bands).unwrap();
+            for cos in [-1.0, -0.3, 0.0, 0.5, 1.0] {
+                let e = zh_eval(&zh, cos);
+                assert!(
+                    (e - std::f32::consts::FRAC_1_PI).abs() < 1e-6,
+                    "{bands}, {cos}: {e}"
+                );
+            }
         }
+        assert!(sender_emission_zh(0).is_err());
+        assert!(sender_emission_zh(EMISSION_MAX_BANDS + 1).is_err());
     }
 }

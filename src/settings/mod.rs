@@ -183,7 +183,9 @@ pub struct HvlSettings {
     /// default 5.
     pub convolution_bands: u32,
     /// SH bands of each HVL's emission function. Range 1..=5 and at most
-    /// `convolution_bands`, default 3.
+    /// `convolution_bands`, default 3 (the paper's). Every sender is Lambert today, whose
+    /// emission is isotropic and needs band 0 only (paper 003 eq. 20): more bands change
+    /// nothing until glossy senders exist.
     pub emission_bands: u32,
     /// Shadow rays through the scene's BVH from every receiver to every HVL (shine's
     /// extension: paper 003's HVLs are unshadowed). Default false.
