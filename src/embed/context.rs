@@ -5,14 +5,14 @@ use crate::frame::RenderError;
 use crate::frame::memory::MemoryReport;
 use crate::frame::params::FrameParams;
 use crate::frame::renderer::HostSide;
-use crate::frame::renderer::{HostTarget, Renderer};
+use crate::frame::renderer::Renderer;
 use crate::gpu_scene::FrameUpdate;
 use crate::gpu_scene::upload_ring::UploadRing;
 use crate::passes::environment_sh;
 use crate::passes::host_gbuffer::{self, HostFrame, HostImages};
 use crate::settings::Settings;
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
-use shine_graph::{Handle, Image, ImageDesc, ImageImport, PassTiming, RenderGraph};
+use shine_gpu::{Buffer, Device, Sampler, vk};
+use shine_graph::{PassTiming, RenderGraph};
 use shine_scene::Scene;
 
 /// How a [`GiContext`] is made: fixed for its life (make a new context to change them).
@@ -100,15 +100,10 @@ impl GiContext {
             budgets: desc.budgets,
             params: frame_params(&desc.settings, desc.display)?,
             settings: desc.settings.clone(),
-            frame_constants: Buffer::new(
+            frame_constants: Buffer::storage_for_uploads(
                 device,
-                &BufferDesc {
-                    name: "host frame",
-                    size: std::mem::size_of::<HostFrame>() as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                        | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
+                "host frame",
+                std::mem::size_of::<HostFrame>() as u64,
             )?,
             ring: UploadRing::new(device),
             nearest: Sampler::new(
@@ -201,19 +196,19 @@ impl GiContext {
                     bytemuck::bytes_of(&constants),
                 )?;
                 let host = HostImages {
-                    depth: import(rg, "host depth", &dispatch.depth, true),
-                    normal: import(rg, "host normals", &dispatch.normals, true),
-                    albedo: import(rg, "host albedo", &dispatch.albedo, true),
-                    material: import(rg, "host material", &dispatch.material, true),
+                    depth: dispatch.depth.import(rg, "host depth", true),
+                    normal: dispatch.normals.import(rg, "host normals", true),
+                    albedo: dispatch.albedo.import(rg, "host albedo", true),
+                    material: dispatch.material.import(rg, "host material", true),
                     motion: dispatch
                         .motion
-                        .map(|m| import(rg, "host motion", &m.image, true)),
+                        .map(|m| m.image.import(rg, "host motion", true)),
                 };
                 let g = host_gbuffer::host_gbuffer(rg, &host, &frame, display, sampler);
                 // Only the proxies read an environment.
                 let environment = match (dispatch.environment, proxy_bands) {
                     (Some(env), Some(bands)) => {
-                        let map = import(rg, "host environment", &env.image, true);
+                        let map = env.image.import(rg, "host environment", true);
                         Some(environment_sh::environment_sh(
                             rg,
                             &map,
@@ -227,7 +222,7 @@ impl GiContext {
                 };
                 Ok(HostSide {
                     g,
-                    output: import(rg, "host diffuse gi", &dispatch.diffuse, false),
+                    output: dispatch.diffuse.import(rg, "host diffuse gi", false),
                     environment,
                 })
             },
@@ -271,20 +266,4 @@ fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, R
     let mut params = FrameParams::from_settings(&settings);
     params.component = crate::passes::composite::Component::Indirect;
     Ok(params)
-}
-
-/// A host image: an input (`read_only`) or the output.
-fn import(rg: &mut RenderGraph, name: &str, image: &HostTarget, read_only: bool) -> Handle<Image> {
-    rg.import_vk_image(
-        name,
-        ImageDesc::new_2d(image.format, image.extent[0], image.extent[1]),
-        ImageImport {
-            initial: image.before,
-            final_state: image.after,
-            usage: image.usage,
-            read_only,
-        },
-        image.image,
-        image.view,
-    )
 }

@@ -3,7 +3,7 @@
 //! the scene's previous vertices, `GpuScene::prev_vertices`).
 
 use glam::Mat4;
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_gpu::{Buffer, Device};
 use shine_graph::{Handle, RenderGraph};
 
 use super::error::RenderError;
@@ -23,15 +23,10 @@ impl MotionState {
     pub fn new(device: &Device) -> Result<Self, RenderError> {
         Ok(Self {
             previous: None,
-            buffer: Buffer::new(
+            buffer: Buffer::storage_for_uploads(
                 device,
-                &BufferDesc {
-                    name: "motion view",
-                    size: std::mem::size_of::<MotionView>() as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                        | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
+                "motion view",
+                std::mem::size_of::<MotionView>() as u64,
             )?,
             ring: UploadRing::new(device),
         })

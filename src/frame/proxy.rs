@@ -8,7 +8,7 @@
 //! objects, so `k` = 2, 8, 32 gives 8, 32, 128 proxies (the profiling cases of issue 8).
 
 use glam::{Mat4, Vec3};
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_gpu::{Buffer, Device};
 use shine_graph::{Handle, Image, RenderGraph};
 use shine_scene::environment::Environment;
 use shine_scene::proxies::{self, ProxySphere};
@@ -136,7 +136,11 @@ impl ProxyTechnique {
         let environment = self.environment.as_ref().ok_or(ProxyError::NoEnvironment)?;
         let sh = EnvironmentSh::project(environment, bands as usize).map_err(ProxyError::from)?;
         let data = sh.gpu_data();
-        let buffer = table_buffer(&self.device, "proxy environment sh", &data)?;
+        let buffer = Buffer::storage_for_uploads(
+            &self.device,
+            "proxy environment sh",
+            std::mem::size_of_val(data.as_slice()) as u64,
+        )?;
         let handle = self.ring.upload_once(
             rg,
             "proxy environment sh",
@@ -195,7 +199,11 @@ impl ProxyTechnique {
                 let tables =
                     ProxyTables::build(bands, setup.shadow_expansion, setup.indirect_expansion)?;
                 let data = tables.gpu_data();
-                let buffer = table_buffer(&self.device, "proxy tables", &data)?;
+                let buffer = Buffer::storage_for_uploads(
+                    &self.device,
+                    "proxy tables",
+                    std::mem::size_of_val(data.as_slice()) as u64,
+                )?;
                 let handle = self.ring.upload_once(
                     rg,
                     "proxy tables",
@@ -249,14 +257,10 @@ impl ProxyTechnique {
             .ok_or(ProxyError::TooMany(local.len()))?;
         // A storage buffer cannot be empty: room for one record even without proxies (the
         // passes read `count` records; the proxies are uploaded every frame).
-        let buffer = Buffer::new(
+        let buffer = Buffer::storage_for_uploads(
             &self.device,
-            &BufferDesc {
-                name: "proxies",
-                size: (local.len().max(1) * std::mem::size_of::<GpuProxy>()) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuOnly,
-            },
+            "proxies",
+            (local.len().max(1) * std::mem::size_of::<GpuProxy>()) as u64,
         )?;
         Ok(ProxyBuffer {
             fit_count,
@@ -280,17 +284,4 @@ impl PreparedProxy<'_> {
         let out = proxy::proxy_shade(rg, receivers, &sums, &self.inputs, self.tables, params)?;
         Ok(out.radiance)
     }
-}
-
-/// A device storage buffer for a table of `data`, written by a one-off upload.
-fn table_buffer(device: &Device, name: &str, data: &[f32]) -> Result<Buffer, shine_gpu::Error> {
-    Buffer::new(
-        device,
-        &BufferDesc {
-            name,
-            size: std::mem::size_of_val(data) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-            location: MemoryLocation::GpuOnly,
-        },
-    )
 }

@@ -2,7 +2,7 @@
 //! the scene and the tile size are unchanged, and rewritten every frame (lights move) through
 //! a staging ring.
 
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_gpu::{Buffer, Device};
 use shine_graph::RenderGraph;
 
 use super::error::RenderError;
@@ -38,18 +38,7 @@ impl ShadowState {
         if let Some(state) = cached.filter(|s| s.key == key) {
             return Ok(Self { layout, ..state });
         }
-        let records = |name, bytes: usize| {
-            Buffer::new(
-                device,
-                &BufferDesc {
-                    name,
-                    size: bytes.max(16) as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                        | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
-        };
+        let records = |name, bytes: usize| Buffer::storage_for_uploads(device, name, bytes as u64);
         let views = records(
             "shadow views",
             std::mem::size_of_val(layout.view_records().as_slice()),

@@ -7,7 +7,7 @@
 use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::upload_ring::UploadRing;
 use glam::Vec3;
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_gpu::{Buffer, Device};
 use shine_graph::{Handle, RenderGraph};
 use shine_sh::ShError;
 use shine_sh::brdf_table::{BrdfModel, BrdfTable, HemisphereSampling};
@@ -166,14 +166,10 @@ impl BrdfTables {
         }
         let tables = GatherBrdf::build(bands, HemisphereSampling::default())?;
         let data = tables.gpu_data();
-        let buffer = Buffer::new(
+        let buffer = Buffer::storage_for_uploads(
             &self.device,
-            &BufferDesc {
-                name: "brdf tables",
-                size: std::mem::size_of_val(data.as_slice()) as u64,
-                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
-                location: MemoryLocation::GpuOnly,
-            },
+            "brdf tables",
+            std::mem::size_of_val(data.as_slice()) as u64,
         )?;
         let handle =
             self.ring

@@ -112,6 +112,21 @@ impl Buffer {
         )
     }
 
+    /// A device-local storage buffer named `name` of `size` bytes (at least 16) that transfers
+    /// write: the destination of uploads recorded into a frame (tables uploaded once, records
+    /// rewritten every frame), where [`Buffer::storage_with_data`] would submit and wait.
+    pub fn storage_for_uploads(device: &Device, name: &str, size: u64) -> Result<Self> {
+        Self::new(
+            device,
+            &BufferDesc {
+                name,
+                size: size.max(16),
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
+                location: MemoryLocation::GpuOnly,
+            },
+        )
+    }
+
     /// The Vulkan handle.
     pub fn raw(&self) -> vk::Buffer {
         self.raw

@@ -220,18 +220,7 @@ pub fn read_rgba16f(
             image.image,
             vk::ImageLayout::TRANSFER_SRC_OPTIMAL,
             buffer.buffer,
-            &[vk::BufferImageCopy::default()
-                .image_subresource(vk::ImageSubresourceLayers {
-                    aspect_mask: vk::ImageAspectFlags::COLOR,
-                    mip_level: 0,
-                    base_array_layer: 0,
-                    layer_count: 1,
-                })
-                .image_extent(vk::Extent3D {
-                    width: w,
-                    height: h,
-                    depth: 1,
-                })],
+            &[whole_copy(image.extent)],
         );
     }
     host.submit_and_wait(cb)?;
@@ -244,6 +233,22 @@ pub fn read_rgba16f(
         .collect();
     buffer.destroy(host);
     Ok(texels)
+}
+
+/// A buffer ↔ image copy of a whole one-mip, one-layer colour image of `extent`, texels packed.
+fn whole_copy([width, height]: [u32; 2]) -> vk::BufferImageCopy {
+    vk::BufferImageCopy::default()
+        .image_subresource(vk::ImageSubresourceLayers {
+            aspect_mask: vk::ImageAspectFlags::COLOR,
+            mip_level: 0,
+            base_array_layer: 0,
+            layer_count: 1,
+        })
+        .image_extent(vk::Extent3D {
+            width,
+            height,
+            depth: 1,
+        })
 }
 
 /// IEEE half to single precision.
@@ -289,7 +294,6 @@ impl HostImage {
                 .image(self.image)
                 .subresource_range(range(vk::ImageAspectFlags::COLOR))
         };
-        let [w, h] = self.extent;
         // SAFETY: handles of the host's device; the submission is waited for below.
         unsafe {
             host.device.cmd_pipeline_barrier2(
@@ -308,18 +312,7 @@ impl HostImage {
                 staging.buffer,
                 self.image,
                 vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                &[vk::BufferImageCopy::default()
-                    .image_subresource(vk::ImageSubresourceLayers {
-                        aspect_mask: vk::ImageAspectFlags::COLOR,
-                        mip_level: 0,
-                        base_array_layer: 0,
-                        layer_count: 1,
-                    })
-                    .image_extent(vk::Extent3D {
-                        width: w,
-                        height: h,
-                        depth: 1,
-                    })],
+                &[whole_copy(self.extent)],
             );
             host.device.cmd_pipeline_barrier2(
                 cb,

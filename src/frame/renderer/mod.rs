@@ -24,7 +24,9 @@ use crate::passes::composite;
 use crate::profile::report::PassClock;
 use crate::settings::Settings;
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, Sampler, vk};
-use shine_graph::{Executor, ExternalState, ImageDesc, ImageImport, PassTiming, RenderGraph};
+use shine_graph::{
+    Executor, ExternalState, Handle, Image, ImageDesc, ImageImport, PassTiming, RenderGraph,
+};
 use shine_scene::Scene;
 
 /// A linear or nearest sampler without mips, addressing u and v as given.
@@ -100,6 +102,30 @@ pub struct HostTarget {
     pub before: ExternalState,
     /// Layout, stage and access of the host's next use: the frame leaves it so.
     pub after: ExternalState,
+}
+
+impl HostTarget {
+    /// The image in a frame's graph as `name`, entering in `before` and left in `after`;
+    /// `read_only` for the host's inputs.
+    pub(crate) fn import(
+        &self,
+        rg: &mut RenderGraph,
+        name: &str,
+        read_only: bool,
+    ) -> Handle<Image> {
+        rg.import_vk_image(
+            name,
+            ImageDesc::new_2d(self.format, self.extent[0], self.extent[1]),
+            ImageImport {
+                initial: self.before,
+                final_state: self.after,
+                usage: self.usage,
+                read_only,
+            },
+            self.image,
+            self.view,
+        )
+    }
 }
 
 /// Renders scenes on a [`Device`]: the scene's resources, the techniques' persistent state, and
@@ -367,18 +393,7 @@ impl Renderer {
         self.begin_host_frame(frame_index);
         let mut rg = self.executor.begin_frame();
         let frame = self.declare_frame(&mut rg, &FrameParams::from_settings(&settings))?;
-        let mut host = rg.import_vk_image(
-            "host target",
-            ImageDesc::new_2d(target.format, width, height),
-            ImageImport {
-                initial: target.before,
-                final_state: target.after,
-                usage: target.usage,
-                read_only: false,
-            },
-            target.image,
-            target.view,
-        );
+        let mut host = target.import(&mut rg, "host target", false);
         // The tonemapped image for a UNORM/sRGB target, the HDR one for a float target.
         let source = if is_float(target.format) {
             frame.hdr
