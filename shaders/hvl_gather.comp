@@ -56,6 +56,9 @@
 //! variant zonal_c10_vis HVL_ZONAL=1 SH_BANDS=10 HVL_VISIBILITY=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
+// Every loop inside the loop over HVLs unrolled: see SH_UNROLL in sh.glsl.
+#define SH_LOOP_ATTRIBUTES 1
 #include "sh.glsl"
 #include "brdf.glsl"
 #include "hvl.glsl"
@@ -218,7 +221,7 @@ void main() {
         }
 #endif
         float emission[8];
-        for (int l = 0; l < 8; ++l) {
+        SH_UNROLL for (int l = 0; l < 8; ++l) {
             emission[l] = hvls.h[j].emission[l];
         }
         float e = max(0.0, hvl_zh_eval(emission, int(push.emission_bands), dot(normalize(hvl_normal), -wj)));

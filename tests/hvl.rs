@@ -15,7 +15,7 @@ use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::hvl::{
-    CONV_BANDS, CachePush, GatherPath, GatherPush, Hvl, HvlError, HvlParams, RadiusHeuristic,
+    CONV_BANDS, CachePush, GatherPath, GatherPush, Hvl, MAX_HVLS, HvlError, HvlParams, RadiusHeuristic,
     gather_variants, hvl_cache, hvl_gather,
 };
 use shine::passes::receivers::Receivers;
@@ -808,5 +808,40 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
         zero.iter().all(|v| *v == Vec4::ZERO),
         "zero flux lit something: {e0}"
     );
+    assert_clean(&device);
+}
+
+/// llvmpipe ends every loop of an invocation after 65 535 iterations in all (docs/pitfalls.md):
+/// a gather whose per-HVL work held loops stopped after a few hundred to a couple of thousand
+/// HVLs and silently dropped the rest. One lit HVL behind 9 999 unlit ones must light the
+/// receivers exactly as it does alone, in each path.
+#[test]
+fn gather_reaches_the_last_of_max_hvls() {
+    let device = device();
+    let rsm = synthetic_rsm(1.0);
+    let receivers = synthetic_receivers();
+    let lit = reference::build_cache(&rsm, &params(GatherPath::Full, 5, 3)).unwrap()[20];
+    let mut unlit = lit;
+    unlit.flux = [0.0, 0.0, 0.0, 1.0];
+    let mut many = vec![unlit; MAX_HVLS as usize - 1];
+    many.push(lit);
+    for (path, conv, emission) in [(GatherPath::Full, 5, 3), (GatherPath::Zonal, 5, 3)] {
+        let brdf = tables(conv, [12, 24]);
+        let alone = HvlParams {
+            count: 1,
+            ..params(path, conv, emission)
+        };
+        let crowd = HvlParams {
+            count: MAX_HVLS,
+            ..alone
+        };
+        let one = gpu_gather(&device, &receivers, &[lit], &brdf, CAMERA, &alone, None);
+        let last = gpu_gather(&device, &receivers, &many, &brdf, CAMERA, &crowd, None);
+        let peak = one.iter().fold(0.0f32, |m, v| m.max(v.max_element()));
+        assert!(peak > 0.0, "{path:?}: the lone HVL lights nothing");
+        for (i, (a, b)) in one.iter().zip(&last).enumerate() {
+            assert_eq!(a, b, "{path:?} receiver {i}: alone {a} vs last of {MAX_HVLS} {b}");
+        }
+    }
     assert_clean(&device);
 }

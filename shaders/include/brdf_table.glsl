@@ -17,7 +17,7 @@ void brdf_table_row(int table, float theta_o, out float f[SH_COEFFS]) {
     int i1 = min(i0 + 1, BRDF_TABLE_THETA_SAMPLES - 1);
     float t = x - float(i0);
     int base = table * BRDF_TABLE_THETA_SAMPLES * SH_COEFFS;
-    for (int k = 0; k < SH_COEFFS; ++k) {
+    SH_UNROLL for (int k = 0; k < SH_COEFFS; ++k) {
         f[k] = brdf.f[base + i0 * SH_COEFFS + k] * (1.0 - t) + brdf.f[base + i1 * SH_COEFFS + k] * t;
     }
 }
@@ -35,7 +35,7 @@ void brdf_table_glossy_row(float roughness, vec2 nodes, uint tables, float theta
     float f1[SH_COEFFS];
     brdf_table_row(1 + k0, theta_o, f0);
     brdf_table_row(1 + k1, theta_o, f1);
-    for (int k = 0; k < SH_COEFFS; ++k) {
+    SH_UNROLL for (int k = 0; k < SH_COEFFS; ++k) {
         f[k] = f0[k] * (1.0 - t) + f1[k] * t;
     }
 }

@@ -11,6 +11,9 @@
 // Most emission bands an HVL record stores (paper 003 §3: 0-5 bands for the emission).
 #define HVL_EMISSION_MAX_BANDS 5
 
+// Emission bands a gather can reconstruct: at most HVL_EMISSION_MAX_BANDS and SH_BANDS.
+#define HVL_EMISSION_LOOP (SH_BANDS < HVL_EMISSION_MAX_BANDS ? SH_BANDS : HVL_EMISSION_MAX_BANDS)
+
 // One HVL of the cache, std430, 80 bytes: shine::passes::hvl::Hvl.
 struct Hvl {
     // xyz: world position y_j of the HVL centre; w: radius r_j (scaled), 0 for an empty cell
@@ -29,8 +32,11 @@ float hvl_zh_eval(float zh[8], int bands, float cos_angle) {
     float p[SH_BANDS + 1];
     sh_legendre_all(clamp(cos_angle, -1.0, 1.0), p);
     float s = 0.0;
-    for (int l = 0; l < bands; ++l) {
-        s += zh[l] * sqrt(float(2 * l + 1) / (4.0 * SH_PI)) * p[l];
+    // A constant trip count (unrolled under SH_LOOP_ATTRIBUTES), `bands` masks it.
+    SH_UNROLL for (int l = 0; l < HVL_EMISSION_LOOP; ++l) {
+        if (l < bands) {
+            s += zh[l] * sqrt(float(2 * l + 1) / (4.0 * SH_PI)) * p[l];
+        }
     }
     return s;
 }
@@ -41,7 +47,7 @@ float hvl_zh_dot(float f[SH_BANDS], float g[SH_BANDS], float cos_angle) {
     float p[SH_BANDS + 1];
     sh_legendre_all(clamp(cos_angle, -1.0, 1.0), p);
     float s = 0.0;
-    for (int l = 0; l < SH_BANDS; ++l) {
+    SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
         s += f[l] * g[l] * p[l];
     }
     return s;

@@ -21,13 +21,18 @@
 #endif
 #define SH_COEFFS (SH_BANDS * SH_BANDS)
 
-// Loops over the product tensor stay loops when the including shader enables
-// GL_EXT_control_flow_attributes and defines SH_LOOP_ATTRIBUTES (unrolled, 600-1500 tensor
-// entries make lavapipe compile for minutes).
+// With GL_EXT_control_flow_attributes enabled and SH_LOOP_ATTRIBUTES defined by the including
+// shader, loops over the product tensor stay loops (unrolled, 600-1500 tensor entries make
+// lavapipe compile for minutes), and the short loops over bands and coefficients of the basis,
+// caps, rotation and dot product are unrolled: llvmpipe ends every loop of an invocation after
+// 65535 iterations in all (LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop), so a loop over
+// thousands of lights may hold no loop of its own (docs/pitfalls.md).
 #ifdef SH_LOOP_ATTRIBUTES
 #define SH_DONT_UNROLL [[dont_unroll]]
+#define SH_UNROLL [[unroll]]
 #else
 #define SH_DONT_UNROLL
+#define SH_UNROLL
 #endif
 
 const float SH_PI = 3.14159265358979323846;
@@ -44,7 +49,7 @@ void sh_basis(vec3 d, out float y[SH_COEFFS]) {
     float cm = 1.0;
     float sm = 0.0;
     float qmm = 0.28209479177387814;
-    for (int m = 0; m < SH_BANDS; ++m) {
+    SH_UNROLL for (int m = 0; m < SH_BANDS; ++m) {
         if (m > 0) {
             qmm *= -sqrt(float(2 * m + 1) / float(2 * m));
             float c = cm * d.x - sm * d.y;
@@ -54,7 +59,11 @@ void sh_basis(vec3 d, out float y[SH_COEFFS]) {
         float mf = float(m);
         float q_prev2 = 0.0;
         float q_prev = qmm;
-        for (int l = m; l < SH_BANDS; ++l) {
+        // From l = 0 with a test, not from l = m: a constant trip count lets both loops unroll.
+        SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+            if (l < m) {
+                continue;
+            }
             float q;
             if (l == m) {
                 q = qmm;
@@ -84,7 +93,7 @@ void sh_basis(vec3 d, out float y[SH_COEFFS]) {
 // shine_sh::dot
 float sh_dot(float a[SH_COEFFS], float b[SH_COEFFS]) {
     float s = 0.0;
-    for (int i = 0; i < SH_COEFFS; ++i) {
+    SH_UNROLL for (int i = 0; i < SH_COEFFS; ++i) {
         s += a[i] * b[i];
     }
     return s;
@@ -105,7 +114,7 @@ float sh_evaluate(float c[SH_COEFFS], vec3 d) {
 void sh_legendre_all(float x, out float p[SH_BANDS + 1]) {
     p[0] = 1.0;
     p[1] = x;
-    for (int l = 1; l < SH_BANDS; ++l) {
+    SH_UNROLL for (int l = 1; l < SH_BANDS; ++l) {
         float lf = float(l);
         p[l + 1] = ((2.0 * lf + 1.0) * x * p[l] - lf * p[l - 1]) / (lf + 1.0);
     }
@@ -124,7 +133,7 @@ void sh_cap_zh(float cos_a, out float zh[SH_BANDS]) {
     sh_legendre_all(alpha, p);
     float sqrt_pi = sqrt(SH_PI);
     zh[0] = sqrt_pi * (1.0 - alpha);
-    for (int l = 1; l < SH_BANDS; ++l) {
+    SH_UNROLL for (int l = 1; l < SH_BANDS; ++l) {
         zh[l] = sqrt_pi / sqrt(float(2 * l + 1)) * (p[l - 1] - p[l + 1]);
     }
 }
@@ -132,11 +141,10 @@ void sh_cap_zh(float cos_a, out float zh[SH_BANDS]) {
 // shine_sh::zonal::rotate_zh given the basis y = sh_basis(d) already evaluated (several ZH
 // vectors rotated to the same direction share one basis evaluation)
 void sh_rotate_zh_basis(float zh[SH_BANDS], float y[SH_COEFFS], out float c[SH_COEFFS]) {
-    for (int l = 0; l < SH_BANDS; ++l) {
-        float k = sh_zh_factor(l) * zh[l];
-        for (int i = l * l; i < (l + 1) * (l + 1); ++i) {
-            c[i] = k * y[i];
-        }
+    // One flat loop of constant trip count (unrollable), l = floor(sqrt(i)) per coefficient.
+    SH_UNROLL for (int i = 0; i < SH_COEFFS; ++i) {
+        int l = int(sqrt(float(i) + 0.5));
+        c[i] = sh_zh_factor(l) * zh[l] * y[i];
     }
 }
 
