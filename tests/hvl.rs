@@ -15,8 +15,8 @@ use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::hvl::{
-    CONV_BANDS, CachePush, GatherPath, GatherPush, Hvl, MAX_HVLS, HvlError, HvlParams, RadiusHeuristic,
-    gather_variants, hvl_cache, hvl_gather,
+    CONV_BANDS, CachePush, Distribution, GatherPath, GatherPush, Hvl, HvlError, HvlParams,
+    MAX_HVLS, RadiusHeuristic, gather_variants, hvl_cache, hvl_gather,
 };
 use shine::passes::receivers::Receivers;
 use shine::passes::rsm::{Rsm, RsmProjection};
@@ -151,6 +151,7 @@ const CAMERA: Vec3 = Vec3::new(2.0, 1.5, 2.5);
 fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
     HvlParams {
         count: 64,
+        distribution: Distribution::Grid,
         radius: RadiusHeuristic::R2,
         radius_scale: 1.5,
         conv_bands,
@@ -380,7 +381,12 @@ fn records_and_push_constants_match_the_shaders() {
         .expect("struct Hvl in hvl_gather.comp");
     assert_eq!(hvl as usize, std::mem::size_of::<Hvl>());
     assert_eq!(std::mem::size_of::<Hvl>(), 80);
-    for shader in [&shaders::HVL_CACHE_COMP_BUILD, &shaders::HVL_CACHE_COMP_R1] {
+    for shader in [
+        &shaders::HVL_CACHE_COMP_BUILD,
+        &shaders::HVL_CACHE_COMP_R1,
+        &shaders::HVL_FLUX_COMP_ROWS,
+        &shaders::HVL_FLUX_COMP_BUILD,
+    ] {
         assert_eq!(
             shader.push_constant_size as usize,
             std::mem::size_of::<CachePush>()
@@ -440,6 +446,12 @@ fn bad_parameters_are_errors() {
     assert_eq!(gather_variants().len(), 40);
     let zero = HvlParams { count: 0, ..ok };
     assert!(zero.validate_gather().is_err());
+    let flux_r1 = HvlParams {
+        distribution: Distribution::Flux,
+        radius: RadiusHeuristic::R1,
+        ..ok
+    };
+    assert_eq!(flux_r1.validate_cache(16), Err(HvlError::R1NeedsGrid));
 }
 
 /// hvl_cache on the GPU against `build_cache`, both radius heuristics, on the synthetic RSM.
@@ -508,6 +520,86 @@ fn cache_matches_the_cpu_reference() {
                 );
             }
         }
+    }
+    assert_clean(&device);
+}
+
+/// The flux distribution on the GPU against `build_flux_cache`: the same texels (positions and
+/// normals exactly), fluxes and radii to float rounding (the GPU's `tan` and division: 1e-4).
+/// Every HVL carries Φ/M of the flux weight, and the tilted quadrant, which reflects a known
+/// share of the weight, holds that share of the HVLs to within the pattern's stratification.
+#[test]
+fn flux_cache_matches_the_cpu_reference() {
+    let device = device();
+    let perspective = synthetic_rsm(1.0);
+    let orthographic = RsmData {
+        light_position: Vec3::new(0.0, 5.0, 0.0),
+        projection: RsmProjection::Orthographic { width: 4.0 },
+        ..perspective.clone()
+    };
+    let weight = |f: Vec4| f.x + f.y + f.z;
+    let tilted = |n: Vec3| n.distance(Vec3::Y) > 1e-3;
+    for (rsm, count) in [(&perspective, 64), (&perspective, 100), (&orthographic, 70)] {
+        let p = HvlParams {
+            count,
+            distribution: Distribution::Flux,
+            ..params(GatherPath::Full, 5, 3)
+        };
+        let cpu = reference::build_cache(rsm, &p).unwrap();
+        let gpu = gpu_cache(&device, rsm, &p);
+        assert_eq!((cpu.len(), gpu.len()), (count as usize, count as usize));
+        let total: f32 = rsm
+            .position
+            .iter()
+            .zip(&rsm.flux)
+            .filter(|(p, _)| p.w != 0.0)
+            .map(|(_, f)| weight(*f))
+            .sum();
+        let mut tilted_weight = 0.0;
+        for (p, f) in rsm.position.iter().zip(&rsm.normal).zip(&rsm.flux) {
+            if p.0.w != 0.0 && tilted(p.1.truncate()) {
+                tilted_weight += weight(*f);
+            }
+        }
+        for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+            assert!(c.is_valid(), "{count}: HVL {i} empty");
+            assert_eq!(
+                &g.position_radius[..3],
+                &c.position_radius[..3],
+                "{count}: HVL {i} on another texel"
+            );
+            let share = weight(Vec4::from(c.flux));
+            assert!(
+                close(share, total / count as f32, 1e-4, 0.0),
+                "{count}: HVL {i} weight {share}"
+            );
+            for (gv, cv) in [(g.flux, c.flux), (g.position_radius, c.position_radius)] {
+                for k in 0..4 {
+                    assert!(
+                        close(gv[k], cv[k], 1e-4, 1e-7),
+                        "{count} HVL {i}: {g:?} vs {c:?}"
+                    );
+                }
+            }
+            for k in 0..4 {
+                assert!(close(
+                    g.normal_distance[k],
+                    c.normal_distance[k],
+                    1e-5,
+                    1e-6
+                ));
+            }
+            assert_eq!(g.emission, c.emission);
+        }
+        let on_tilted = cpu
+            .iter()
+            .filter(|h| tilted(Vec4::from(h.normal_distance).truncate()))
+            .count() as f32;
+        let expected = count as f32 * tilted_weight / total;
+        assert!(
+            (on_tilted - expected).abs() <= 2.0,
+            "{count}: {on_tilted} HVLs on the tilted quadrant, expected {expected}"
+        );
     }
     assert_clean(&device);
 }
@@ -840,7 +932,10 @@ fn gather_reaches_the_last_of_max_hvls() {
         let peak = one.iter().fold(0.0f32, |m, v| m.max(v.max_element()));
         assert!(peak > 0.0, "{path:?}: the lone HVL lights nothing");
         for (i, (a, b)) in one.iter().zip(&last).enumerate() {
-            assert_eq!(a, b, "{path:?} receiver {i}: alone {a} vs last of {MAX_HVLS} {b}");
+            assert_eq!(
+                a, b,
+                "{path:?} receiver {i}: alone {a} vs last of {MAX_HVLS} {b}"
+            );
         }
     }
     assert_clean(&device);

@@ -133,3 +133,11 @@ fn hvl_resolve_constants_match_the_shader() {
     );
     assert_eq!(glsl_float(file, "RESOLVE_NORMAL_COS"), RESOLVE_NORMAL_COS);
 }
+
+#[test]
+fn hvl_incidence_clamp_matches_the_shader() {
+    assert_eq!(
+        glsl_float("include/sh.glsl", "HVL_MIN_INCIDENCE_COS"),
+        shine_sh::hvl::MIN_INCIDENCE_COS
+    );
+}

@@ -408,6 +408,31 @@ float hvl_radius_r2_orthographic(float width, float hvl_count) {
     return 1.41421356237309505 * width / sqrt(hvl_count);
 }
 
+// shine_sh::hvl::MIN_INCIDENCE_COS
+const float HVL_MIN_INCIDENCE_COS = 0.1;
+
+// shine_sh::hvl::rsm_texel_area: world area of one texel's patch of an S*S RSM, perspective
+// (2 tan(fov/2) / S)^2 cos^3(alpha) d^2 or orthographic (W / S)^2 (extent: fov or W), over
+// max(cos_incidence, HVL_MIN_INCIDENCE_COS)
+float hvl_rsm_texel_area(bool orthographic, float extent, float size, float light_distance, float cos_axis, float cos_incidence) {
+    float perpendicular;
+    if (orthographic) {
+        perpendicular = (extent / size) * (extent / size);
+    } else {
+        float side = 2.0 * tan(0.5 * extent) / size;
+        float c = clamp(cos_axis, 0.0, 1.0);
+        perpendicular = side * side * c * c * c * light_distance * light_distance;
+    }
+    return perpendicular / max(cos_incidence, HVL_MIN_INCIDENCE_COS);
+}
+
+// shine_sh::hvl::radius_spacing: sqrt(2) sqrt(A total / (M w)), r2 from the local spacing of
+// HVLs placed with density proportional to the reflected flux
+float hvl_radius_spacing(float texel_area, float texel_weight, float total_weight, float hvl_count) {
+    float spacing_squared = texel_area * total_weight / (max(hvl_count, 1.0) * texel_weight);
+    return 1.41421356237309505 * sqrt(spacing_squared);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Paper 002 (sphere proxies)
 // ---------------------------------------------------------------------------------------------

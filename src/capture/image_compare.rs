@@ -40,6 +40,9 @@ pub enum CompareError {
     /// The images are smaller than the SSIM window.
     #[error("images of {0}×{1} are smaller than the {SSIM_WINDOW}×{SSIM_WINDOW} SSIM window")]
     TooSmall(u32, u32),
+    /// A region grid of this many tiles per side does not fit the image.
+    #[error("a {0}×{0} region grid does not fit {1}×{2} images (1 to the smaller side)")]
+    Grid(u32, u32, u32),
     /// An image holds fewer texels than its size says.
     #[error("an image holds {0} texels, its size needs {1}")]
     Truncated(usize, usize),
@@ -63,7 +66,8 @@ pub struct Comparison {
     pub flip: f64,
 }
 
-fn check(a: &HdrImage, b: &HdrImage) -> Result<(), CompareError> {
+/// Checks that two images can be compared: the same size, every texel present.
+pub(crate) fn check(a: &HdrImage, b: &HdrImage) -> Result<(), CompareError> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err(CompareError::SizeMismatch(
             a.width, a.height, b.width, b.height,
@@ -78,7 +82,8 @@ fn check(a: &HdrImage, b: &HdrImage) -> Result<(), CompareError> {
     Ok(())
 }
 
-fn clamped(v: f32) -> f64 {
+/// A channel as the metrics see it: clamped to the dynamic range, NaN as 0.
+pub(crate) fn clamped(v: f32) -> f64 {
     // NaN maps to 0 (clamp would keep it).
     if v.is_nan() {
         0.0

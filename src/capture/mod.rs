@@ -3,5 +3,6 @@
 
 pub mod image_compare;
 pub mod image_io;
+pub mod regions;
 pub mod sequence;
 pub mod tonemap;

@@ -77,6 +77,7 @@ impl FrameParams {
             mipmaps: settings.texture.mipmaps,
             hvl: gi.contains(GiTechnique::Hvl).then_some(HvlParams {
                 count: h.count,
+                distribution: h.distribution,
                 radius: h.radius,
                 radius_scale: h.radius_scale,
                 conv_bands: h.convolution_bands,

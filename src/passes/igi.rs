@@ -314,6 +314,7 @@ pub fn vpls(
     params.validate()?;
     let cache = HvlParams {
         count: params.vpl_count,
+        distribution: hvl::Distribution::Grid,
         radius: hvl::RadiusHeuristic::R2,
         radius_scale: 1.0,
         conv_bands: 3,

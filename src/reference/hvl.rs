@@ -19,7 +19,7 @@ use shine_sh::zonal::{cap_sh, cap_zh};
 
 use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::{
-    EMISSION_MAX_BANDS, GatherPath, Hvl, HvlError, HvlParams, RadiusHeuristic,
+    Distribution, EMISSION_MAX_BANDS, GatherPath, Hvl, HvlError, HvlParams, RadiusHeuristic,
 };
 use crate::passes::rsm::RsmProjection;
 
@@ -158,7 +158,8 @@ pub fn zh_dot(f: &[f32], g: &[f32], cos_angle: f32) -> f32 {
         .sum::<f64>() as f32
 }
 
-/// The HVL cache built from `rsm` as `hvl_cache` does (see [`crate::passes::hvl`]).
+/// The HVL cache built from `rsm` as `hvl_cache` does (see [`crate::passes::hvl`]), on the
+/// grid or by flux ([`super::hvl_flux`]).
 pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlError> {
     let grid = params.validate_cache(rsm.size)?;
     let s = rsm.size;
@@ -169,6 +170,9 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
             actual: format!("{} texels", rsm.position.len()),
             expected: format!("{texels} texels in each image"),
         });
+    }
+    if params.distribution == Distribution::Flux {
+        return super::hvl_flux::build_flux_cache(rsm, params);
     }
     let count = params.count;
     let r2 = |d: f32| match rsm.projection {

@@ -15,6 +15,7 @@
 
 pub mod aaf;
 pub mod hvl;
+pub mod hvl_flux;
 pub mod igi;
 pub mod proxy;
 pub mod resolve;

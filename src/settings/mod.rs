@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 use crate::capture::tonemap::Tonemap;
 use crate::passes::aaf::AafParams;
 use crate::passes::composite::{Component, CompositeParams};
-use crate::passes::hvl::{GatherPath, HvlParams, RadiusHeuristic};
+use crate::passes::hvl::{Distribution, GatherPath, HvlParams, RadiusHeuristic};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
 use crate::passes::proxy::{DEFAULT_ORDER, ExpMethod, INDIRECT_BANDS, paper_expansion};
 use crate::passes::upsample::{DEPTH_SIGMA, NORMAL_POWER_N};
@@ -174,6 +174,10 @@ pub struct HvlSettings {
     /// Number M of HVLs distributed from the RSM (any count: the RSM is cut into M cells).
     /// Range 64..=10000 and at most `rsm.size²`, default 400 (paper 003 fig. 10).
     pub count: u32,
+    /// Where the HVLs are placed on the RSM: `grid` (paper 003 §5.2: cells uniform in the
+    /// RSM's image) or `flux` (texels drawn in proportion to the flux they reflect, radii from
+    /// the local spacing; needs `radius = "r2"`). Default `grid`.
+    pub distribution: Distribution,
     /// Radius heuristic: `r1` (eq. 23) or `r2` (eq. 24–26). Default `r2`.
     pub radius: RadiusHeuristic,
     /// User factor k scaling every radius (paper 003 §5.3: good between 1 and 2).
@@ -355,6 +359,7 @@ impl Default for HvlSettings {
         let h = HvlParams::default();
         Self {
             count: h.count,
+            distribution: h.distribution,
             radius: h.radius,
             radius_scale: h.radius_scale,
             convolution_bands: h.conv_bands,

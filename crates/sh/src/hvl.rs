@@ -167,6 +167,75 @@ pub fn radius_r2_orthographic(width: f32, hvl_count: u32) -> Result<f32> {
     Ok((std::f64::consts::SQRT_2 * f64::from(width) / f64::from(hvl_count).sqrt()) as f32)
 }
 
+/// Smallest cosine of incidence [`rsm_texel_area`] divides by: a texel lit at grazing
+/// incidence (beyond about 84°) counts as lit at 84°, so its patch and the radius taken from
+/// it stay finite.
+pub const MIN_INCIDENCE_COS: f32 = 0.1;
+
+/// How an RSM was projected, as [`rsm_texel_area`] needs it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum RsmFootprint {
+    /// A perspective RSM of square field of view `fov` (radians).
+    Perspective {
+        /// Field of view λ.
+        fov: f32,
+    },
+    /// An orthographic RSM `width` metres across.
+    Orthographic {
+        /// Width W.
+        width: f32,
+    },
+}
+
+/// World area of the surface patch one texel of an `size`² RSM covers.
+///
+/// - Perspective: the texel's solid angle `(2 tan(λ/2) / S)² cos³α` (α from the view's axis,
+///   `cos_axis`) times `d²` (`light_distance`).
+/// - Orthographic: `(W / S)²`.
+///
+/// Both are divided by the obliquity `max(cos θ_i, MIN_INCIDENCE_COS)`, θ_i being the angle
+/// between the surface normal and the direction to the light. The RSM's flux is the power
+/// through the texel, so flux / area is the reflected exitance. Shine's extension, for
+/// [`radius_spacing`]; the GLSL twin is `hvl_rsm_texel_area` in `sh.glsl`.
+pub fn rsm_texel_area(
+    footprint: RsmFootprint,
+    size: u32,
+    light_distance: f32,
+    cos_axis: f32,
+    cos_incidence: f32,
+) -> f32 {
+    let s = size.max(1) as f32;
+    let perpendicular = match footprint {
+        RsmFootprint::Perspective { fov } => {
+            let side = 2.0 * (0.5 * fov).tan() / s;
+            let c = cos_axis.clamp(0.0, 1.0);
+            side * side * c * c * c * light_distance * light_distance
+        }
+        RsmFootprint::Orthographic { width } => (width / s) * (width / s),
+    };
+    perpendicular / cos_incidence.max(MIN_INCIDENCE_COS)
+}
+
+/// The r2 heuristic (eq. 24–25) generalised to HVLs placed with density proportional to the
+/// reflected flux: `√2 s`, where `s = √(A Φ / (M w))` is the local spacing.
+///
+/// - M HVLs share the total flux weight Φ (`total_weight`) equally, one per Φ/M of flux.
+/// - On a texel of area A (`texel_area`) and flux weight w (`texel_weight`), that puts one
+///   HVL on every `A Φ / (M w)` of surface.
+/// - √2 s is the diagonal spacing, as γ = √2 λ / √M of eq. 24 is for a regular grid.
+///
+/// The user scale k multiplies the result. Shine's extension: paper 003 spreads HVLs
+/// uniformly over the RSM. GLSL twin: `hvl_radius_spacing` in `sh.glsl`.
+pub fn radius_spacing(
+    texel_area: f32,
+    texel_weight: f32,
+    total_weight: f32,
+    hvl_count: u32,
+) -> f32 {
+    let spacing_squared = texel_area * total_weight / (hvl_count.max(1) as f32 * texel_weight);
+    std::f32::consts::SQRT_2 * spacing_squared.sqrt()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -252,5 +321,34 @@ mod tests {
             assert!((exact - approx).abs() < 0.01, "M={m}: {exact} vs {approx}");
         }
         assert!(diagonal_angle(1.0, 0).is_err());
+    }
+
+    /// Uniform flux over an RSM facing a plane: the spacing radius is r2 (eq. 24–26) for a
+    /// narrow perspective RSM and √2 W / √M for an orthographic one; a patch lit at 60° is
+    /// twice as large, and grazing light stops at MIN_INCIDENCE_COS.
+    #[test]
+    fn spacing_radius_of_uniform_flux_is_r2() {
+        let (size, m, d) = (512u32, 400u32, 2.0f32);
+        let texels = (size * size) as f32;
+        let fov = 0.3f32;
+        let area = rsm_texel_area(RsmFootprint::Perspective { fov }, size, d, 1.0, 1.0);
+        let r = radius_spacing(area, 0.5, 0.5 * texels, m);
+        let r2 = radius_r2(d, fov, m).unwrap();
+        assert!((r / r2 - 1.0).abs() < 0.01, "{r} vs r2 {r2}");
+        let width = 4.0f32;
+        let ortho = RsmFootprint::Orthographic { width };
+        let area = rsm_texel_area(ortho, size, d, 1.0, 1.0);
+        let r = radius_spacing(area, 0.5, 0.5 * texels, m);
+        let expected = radius_r2_orthographic(width, m).unwrap();
+        assert!((r / expected - 1.0).abs() < 1e-5, "{r} vs {expected}");
+        let tilted = rsm_texel_area(ortho, size, d, 1.0, 0.5);
+        assert!((tilted / area - 2.0).abs() < 1e-5);
+        let grazing = rsm_texel_area(ortho, size, d, 1.0, 0.0);
+        assert!((grazing / area - 1.0 / MIN_INCIDENCE_COS).abs() < 1e-3);
+        // Off the axis a perspective texel shrinks as cos³α.
+        let fov = RsmFootprint::Perspective { fov: 1.0 };
+        let on_axis = rsm_texel_area(fov, size, d, 1.0, 1.0);
+        let off_axis = rsm_texel_area(fov, size, d, 0.5, 1.0);
+        assert!((off_axis / on_axis - 0.125).abs() < 1e-6);
     }
 }

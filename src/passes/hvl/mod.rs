@@ -160,6 +160,20 @@ crate::choice::named_choice! {
 }
 
 crate::choice::named_choice! {
+    /// Where the cache places its M HVLs on the RSM (paper 003 §5.2).
+    pub enum Distribution ("HVL distribution") {
+        /// The paper's: M cells uniform in the RSM's image plane ([`HvlGrid`]), one HVL per
+        /// cell at its valid texel nearest the centre, carrying the cell's summed flux.
+        Grid = "grid",
+        /// Shine's: M texels drawn in proportion to their reflected flux by a fixed
+        /// low-discrepancy pattern (`shaders/hvl_flux.comp`), each HVL carrying Φ/M of the flux
+        /// from its own texel's position and normal, with the r2 radius taken from the local
+        /// spacing ([`shine_sh::hvl::radius_spacing`]).
+        Flux = "flux",
+    }
+}
+
+crate::choice::named_choice! {
     /// Which SH convolution the HVL gather uses (paper 003 §4.3 and §6).
     pub enum GatherPath ("HVL gather path") {
         /// Full SH convolution, O(n²) in the band count n: any BRDF.
@@ -175,6 +189,8 @@ pub struct HvlParams {
     /// Number of HVLs M. The cache needs 64 ≤ M ≤ 10 000 and M ≤ S² (S the RSM side); the
     /// gather takes any 1 ≤ M ≤ 10 000 records.
     pub count: u32,
+    /// Where the HVLs are placed on the RSM.
+    pub distribution: Distribution,
     /// Radius heuristic.
     pub radius: RadiusHeuristic,
     /// User scale k of the radii, in [`RADIUS_SCALE`] (paper 003 §5.3: 1–2).
@@ -194,11 +210,12 @@ pub struct HvlParams {
 }
 
 impl Default for HvlParams {
-    /// Paper 003's choices: 400 HVLs (fig. 10), r2 radii scaled by 1.5 (§5.3: 1–2), 5
-    /// convolution and 3 emission bands, the full path, unshadowed.
+    /// Paper 003's choices: 400 HVLs (fig. 10) on the grid of §5.2, r2 radii scaled by 1.5
+    /// (§5.3: 1–2), 5 convolution and 3 emission bands, the full path, unshadowed.
     fn default() -> Self {
         Self {
             count: 400,
+            distribution: Distribution::Grid,
             radius: RadiusHeuristic::R2,
             radius_scale: 1.5,
             conv_bands: 5,
@@ -256,6 +273,12 @@ pub enum HvlError {
         /// What it should be.
         expected: String,
     },
+    /// The r1 heuristic was asked for with the flux distribution, which has no cache
+    /// neighbourhood to take it from.
+    #[error(
+        "the HVL radius heuristic r1 needs hvl.distribution = \"grid\" (its neighbours are cells of the grid); use r2 with \"flux\""
+    )]
+    R1NeedsGrid,
     /// HVL visibility was asked for without the scene's BVH.
     #[error("HVL visibility needs the scene's BVH buffers")]
     NoBvh,
@@ -331,6 +354,9 @@ impl HvlParams {
                 count: self.count,
                 rsm_size,
             })?;
+        if self.distribution == Distribution::Flux && self.radius == RadiusHeuristic::R1 {
+            return Err(HvlError::R1NeedsGrid);
+        }
         if !RADIUS_SCALE.contains(&self.radius_scale) {
             return Err(HvlError::OutOfRange {
                 name: "radius_scale",
@@ -420,9 +446,11 @@ pub fn cache_bytes(count: u32) -> u64 {
     u64::from(count) * std::mem::size_of::<Hvl>() as u64
 }
 
-/// Adds the `hvl_cache` pass(es): the RSM → `params.count` [`Hvl`] records (in the cell order
-/// of [`HvlGrid`]) in a new transient buffer, returned. With [`RadiusHeuristic::R1`] a second
-/// dispatch computes the radii from the first one's records.
+/// Adds the `hvl_cache` pass(es): the RSM → `params.count` [`Hvl`] records in a new transient
+/// buffer, returned. On the grid, the records follow the cell order of [`HvlGrid`], and with
+/// [`RadiusHeuristic::R1`] a second dispatch computes the radii from the first one's records.
+/// With [`Distribution::Flux`], `hvl_flux_rows` first sums the flux of each RSM row into a
+/// table of cumulative sums that the cache pass samples.
 pub fn hvl_cache(
     rg: &mut RenderGraph,
     rsm: &Rsm,
@@ -446,6 +474,25 @@ pub fn hvl_cache(
     );
     let desc = BufferDesc::new(cache_bytes(params.count));
     let mut built = rg.create_buffer("hvl_cache", desc);
+    if params.distribution == Distribution::Flux {
+        let cdf_bytes = 4 * u64::from(rsm.size) * (u64::from(rsm.size) + 1);
+        let mut cdf = rg.create_buffer("hvl_flux_cdf", BufferDesc::new(cdf_bytes));
+        rg.compute("hvl_flux_rows", &shaders::HVL_FLUX_COMP_ROWS)
+            .read("rsm_position", &rsm.position)
+            .read("rsm_flux", &rsm.flux)
+            .write("cdf", &mut cdf)
+            .push(&push)
+            .dispatch([rsm.size, 1, 1]);
+        rg.compute("hvl_cache", &shaders::HVL_FLUX_COMP_BUILD)
+            .read("rsm_position", &rsm.position)
+            .read("rsm_normal", &rsm.normal)
+            .read("rsm_flux", &rsm.flux)
+            .read("cdf", &cdf)
+            .write("hvls", &mut built)
+            .push(&push)
+            .dispatch([params.count, 1, 1]);
+        return Ok(built);
+    }
     rg.compute("hvl_cache", &shaders::HVL_CACHE_COMP_BUILD)
         .read("rsm_position", &rsm.position)
         .read("rsm_normal", &rsm.normal)

@@ -1,0 +1,159 @@
+//! Where an image differs from its reference: the metrics of `shine compare` per tile of an
+//! N×N grid, and a heatmap of the signed error.
+//!
+//! One number for a whole image hides a floor at 0.75× of the truth behind a ceiling at
+//! 1.25×. The grid keeps them apart without knowing the scene. In the cornell box at 4×4, the
+//! top row is mostly ceiling, the bottom row floor, and the outer columns the side walls. The
+//! heatmap shows the rest.
+
+use crate::capture::image_compare::{CompareError, check, clamped};
+use crate::capture::image_io::{HdrImage, LdrImage};
+
+/// The metrics of one tile of the grid.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Region {
+    /// Tile column, 0 at the left.
+    pub column: u32,
+    /// Tile row, 0 at the top.
+    pub row: u32,
+    /// Mean of the reference over the tile's pixels and channels.
+    pub reference_mean: f64,
+    /// Σ image / Σ reference over the tile (NaN for a black reference tile).
+    pub energy_ratio: f64,
+    /// RMSE over the tile divided by the reference's mean there.
+    pub relative_rmse: f64,
+}
+
+/// The metrics of each tile of an `n`×`n` grid over the images, rows top to bottom. Tile
+/// edges fall at `⌊i · size / n⌋`; `n` must be at least 1 and at most the smaller side.
+pub fn region_grid(
+    image: &HdrImage,
+    reference: &HdrImage,
+    n: u32,
+) -> Result<Vec<Region>, CompareError> {
+    check(image, reference)?;
+    if n == 0 || n > image.width.min(image.height) {
+        return Err(CompareError::Grid(n, image.width, image.height));
+    }
+    let edge = |i: u32, size: u32| (u64::from(i) * u64::from(size) / u64::from(n)) as u32;
+    let mut regions = Vec::with_capacity((n * n) as usize);
+    for row in 0..n {
+        for column in 0..n {
+            let (mut sum_image, mut sum_reference, mut squared, mut values) = (0.0, 0.0, 0.0, 0.0);
+            for y in edge(row, image.height)..edge(row + 1, image.height) {
+                for x in edge(column, image.width)..edge(column + 1, image.width) {
+                    let i = (y * image.width + x) as usize;
+                    for c in 0..3 {
+                        let (a, b) = (clamped(image.texels[i][c]), clamped(reference.texels[i][c]));
+                        sum_image += a;
+                        sum_reference += b;
+                        squared += (a - b) * (a - b);
+                        values += 1.0;
+                    }
+                }
+            }
+            let reference_mean = sum_reference / values;
+            regions.push(Region {
+                column,
+                row,
+                reference_mean,
+                energy_ratio: sum_image / sum_reference,
+                relative_rmse: (squared / values).sqrt() / reference_mean,
+            });
+        }
+    }
+    Ok(regions)
+}
+
+/// Signed error at which the heatmap saturates, relative to the reference's mean.
+pub const HEATMAP_RANGE: f64 = 1.0;
+
+/// The signed error `(image − reference) / mean(reference)` per pixel, on the mean of the
+/// three channels, as a diverging map: white where equal, red where the image is brighter,
+/// blue where darker, saturating at ±[`HEATMAP_RANGE`].
+pub fn error_heatmap(image: &HdrImage, reference: &HdrImage) -> Result<LdrImage, CompareError> {
+    check(image, reference)?;
+    let n = (image.width * image.height) as usize;
+    let mean = |t: &[f32; 4]| (0..3).map(|c| clamped(t[c])).sum::<f64>() / 3.0;
+    let reference_mean = reference.texels[..n].iter().map(mean).sum::<f64>() / n as f64;
+    let scale = if reference_mean > 0.0 {
+        1.0 / (reference_mean * HEATMAP_RANGE)
+    } else {
+        0.0
+    };
+    let texels = image.texels[..n]
+        .iter()
+        .zip(&reference.texels[..n])
+        .map(|(a, b)| {
+            let e = ((mean(a) - mean(b)) * scale).clamp(-1.0, 1.0);
+            let fade = (255.0 * (1.0 - e.abs())).round() as u8;
+            if e >= 0.0 {
+                [255, fade, fade, 255]
+            } else {
+                [fade, fade, 255, 255]
+            }
+        })
+        .collect();
+    Ok(LdrImage {
+        width: image.width,
+        height: image.height,
+        texels,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> HdrImage {
+        HdrImage {
+            width,
+            height,
+            texels: (0..height)
+                .flat_map(|y| (0..width).map(move |x| (x, y)))
+                .map(|(x, y)| {
+                    let v = f(x, y);
+                    [v, v, v, 1.0]
+                })
+                .collect(),
+        }
+    }
+
+    /// An image twice as bright on its left half: the left tiles report energy 2 and relative
+    /// RMSE 1, the right ones 1 and 0; the heatmap is red on the left and white on the right.
+    #[test]
+    fn tiles_keep_halves_apart() {
+        let reference = image(8, 6, |_, _| 0.25);
+        let test = image(8, 6, |x, _| if x < 4 { 0.5 } else { 0.25 });
+        let regions = region_grid(&test, &reference, 2).unwrap();
+        assert_eq!(regions.len(), 4);
+        for r in &regions {
+            let (energy, error) = if r.column == 0 {
+                (2.0, 1.0)
+            } else {
+                (1.0, 0.0)
+            };
+            assert!((r.energy_ratio - energy).abs() < 1e-12, "{r:?}");
+            assert!((r.relative_rmse - error).abs() < 1e-12, "{r:?}");
+            assert!((r.reference_mean - 0.25).abs() < 1e-12);
+        }
+        let map = error_heatmap(&test, &reference).unwrap();
+        assert_eq!(map.texels[0], [255, 0, 0, 255]);
+        assert_eq!(map.texels[7], [255, 255, 255, 255]);
+        let darker = error_heatmap(&reference, &test).unwrap();
+        assert_eq!(darker.texels[0][2], 255);
+        assert!(darker.texels[0][0] < 255);
+    }
+
+    #[test]
+    fn bad_grids_are_errors() {
+        let a = image(8, 6, |_, _| 0.25);
+        assert_eq!(region_grid(&a, &a, 0), Err(CompareError::Grid(0, 8, 6)));
+        assert_eq!(region_grid(&a, &a, 7), Err(CompareError::Grid(7, 8, 6)));
+        let b = image(6, 6, |_, _| 0.25);
+        assert!(matches!(
+            region_grid(&a, &b, 2),
+            Err(CompareError::SizeMismatch(..))
+        ));
+    }
+}
