@@ -87,7 +87,7 @@ void main() {
 // row's total), reaches it: a texel of positive weight either way.
 uint find_column(uint y, float target, float row_total) {
     uint s = push.rsm_size;
-    bool at_total = !(target < row_total);
+    bool at_total = target >= row_total;
     uint lo = 0u;
     uint hi = s - 1u;
     while (lo < hi) {

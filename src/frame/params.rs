@@ -89,6 +89,7 @@ impl FrameParams {
             igi: gi.contains(GiTechnique::Igi).then_some(IgiParams {
                 pattern: [i.n, i.m],
                 vpl_count: i.vpl_count,
+                distribution: i.distribution,
                 sh_order: i.sh_order,
                 filter_radius: i.filter_radius,
                 mode: i.filter,

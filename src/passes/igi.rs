@@ -5,6 +5,8 @@
 //!    pass ([`super::hvl::hvl_cache`], r2 radii unused): each cell is one Lambertian VPL at its
 //!    texel nearest the centre, with the cell's summed reflected flux Φ_j, radiant intensity
 //!    `I(ω) = Φ_j max(0, n_j·ω)/π`.
+//!    With `distribution = flux` (shine's, [`hvl::Distribution::Flux`]) the M VPLs are RSM
+//!    texels drawn in proportion to their reflected flux instead, each carrying Φ/M.
 //! 2. **Interleaved sets** (§2.3): pixel p of an n×m tile uses set `s = (x mod n) + n (y mod m)`,
 //!    the VPLs of global index `i ≡ s (mod nm)`, `i < M`. Index i names RSM cell
 //!    `i·stride mod M` ([`permutation_stride`]: stride coprime with M near M(√5−1)/2): without
@@ -122,6 +124,8 @@ pub struct IgiParams {
     pub pattern: [u32; 2],
     /// VPL count M (64..=10 000, at most the RSM's texel count).
     pub vpl_count: u32,
+    /// Where the VPLs are placed on the RSM (the HVL cache's distributions).
+    pub distribution: hvl::Distribution,
     /// SH order (bands) 2..=4 of the SH mode.
     pub sh_order: u32,
     /// Filter window size k in pattern tiles: k n × k m pixels around the pixel (0..=4; 0: no
@@ -144,6 +148,7 @@ impl Default for IgiParams {
         Self {
             pattern: [4, 4],
             vpl_count: 256,
+            distribution: hvl::Distribution::Flux,
             sh_order: 3,
             filter_radius: 1,
             mode: FilterMode::Sh,
@@ -314,7 +319,7 @@ pub fn vpls(
     params.validate()?;
     let cache = HvlParams {
         count: params.vpl_count,
-        distribution: hvl::Distribution::Grid,
+        distribution: params.distribution,
         radius: hvl::RadiusHeuristic::R2,
         radius_scale: 1.0,
         conv_bands: 3,

@@ -49,7 +49,7 @@ pub fn sample_texel(cdf: &[f32], size: u32, m: u32, count: u32) -> Option<(u32, 
     let s = size as usize;
     let rows = &cdf[s * s..];
     let total = rows.iter().fold(0.0f32, |a, &b| a + b);
-    if !(total > 0.0) {
+    if total.is_nan() || total <= 0.0 {
         return None;
     }
     let goal = (2 * m + 1) as f32 * total;
@@ -65,7 +65,7 @@ pub fn sample_texel(cdf: &[f32], size: u32, m: u32, count: u32) -> Option<(u32, 
     }
     let row_total = rows[y];
     let target = radical_inverse(m) * row_total;
-    let at_total = !(target < row_total);
+    let at_total = target >= row_total;
     let row = &cdf[y * s..(y + 1) * s];
     let (mut lo, mut hi) = (0usize, s - 1);
     while lo < hi {

@@ -176,7 +176,7 @@ pub struct HvlSettings {
     pub count: u32,
     /// Where the HVLs are placed on the RSM: `grid` (paper 003 §5.2: cells uniform in the
     /// RSM's image) or `flux` (texels drawn in proportion to the flux they reflect, radii from
-    /// the local spacing; needs `radius = "r2"`). Default `grid`.
+    /// the local spacing; needs `radius = "r2"`). Default `flux`.
     pub distribution: Distribution,
     /// Radius heuristic: `r1` (eq. 23) or `r2` (eq. 24–26). Default `r2`.
     pub radius: RadiusHeuristic,
@@ -263,6 +263,10 @@ pub struct IgiSettings {
     /// Number of VPLs taken from the RSM (cut into exactly this many cells), shared out over
     /// the n·m sets. Range 64..=10000 and at most `rsm.size²`, default 256.
     pub vpl_count: u32,
+    /// Where the VPLs are placed on the RSM: `grid` (cells uniform in the RSM's image) or
+    /// `flux` (texels drawn in proportion to their reflected flux), as `hvl.distribution`.
+    /// Default `flux`.
+    pub distribution: Distribution,
     /// SH order (bands) of the per-pixel incident radiance: 2, 3 or 4 (4, 9 or 16
     /// coefficients). Default 3 (paper 000 §3.1).
     pub sh_order: u32,
@@ -294,6 +298,7 @@ impl Default for IgiSettings {
             n: p.pattern[0],
             m: p.pattern[1],
             vpl_count: p.vpl_count,
+            distribution: p.distribution,
             sh_order: p.sh_order,
             filter_radius: p.filter_radius,
             filter: p.mode,
@@ -411,7 +416,7 @@ mod tests {
     #[test]
     fn every_out_of_range_field_is_named() {
         type Edit = fn(&mut Settings);
-        let cases: [(&str, &str, Edit); 28] = [
+        let cases: [(&str, &str, Edit); 29] = [
             ("proxy.sh_order", "7", |s| s.proxy.sh_order = 7),
             ("proxy.expansion", "1.0", |s| s.proxy.expansion = 1.0),
             ("proxy.indirect_expansion", "NaN", |s| {
@@ -446,6 +451,7 @@ mod tests {
                 s.hvl.convolution_bands = 100
             }),
             ("hvl.emission_bands", "0", |s| s.hvl.emission_bands = 0),
+            ("hvl.radius", "r1", |s| s.hvl.radius = RadiusHeuristic::R1),
             ("rsm.size", "8", |s| s.rsm.size = 8),
             ("shadow.size", "32", |s| s.shadow.size = 32),
             ("shadow.filter_radius", "-1.0", |s| {
@@ -498,6 +504,7 @@ mod tests {
             },
             hvl: HvlSettings {
                 radius: RadiusHeuristic::R1,
+                distribution: Distribution::Grid,
                 gather: GatherPath::Zonal,
                 ..HvlSettings::default()
             },

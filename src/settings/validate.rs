@@ -96,6 +96,15 @@ impl Settings {
                 ),
             });
         }
+        if self.hvl.radius == hvl::RadiusHeuristic::R1
+            && self.hvl.distribution == hvl::Distribution::Flux
+        {
+            return Err(SettingsError::OutOfRange {
+                field: "hvl.radius",
+                value: "r1".to_owned(),
+                allowed: "r2 with hvl.distribution = \"flux\" (r1 takes its neighbours from the grid: set hvl.distribution = \"grid\")".to_owned(),
+            });
+        }
         check("shadow.size", self.shadow.size, &shadows::TILE_SIZE)?;
         check(
             "shadow.filter_radius",
