@@ -53,7 +53,12 @@ fn bytes_f32(texels: &[Vec4]) -> Vec<u8> {
 /// tilted patch, five empty texels (one whole 2×2 cell of the 64-HVL grid), and colourful
 /// fluxes; `flux_scale` multiplies every flux.
 fn synthetic_rsm(flux_scale: f32) -> RsmData {
-    let s = RSM_SIZE;
+    synthetic_rsm_sized(RSM_SIZE, flux_scale)
+}
+
+/// The synthetic RSM at side `s` (at least 16: the empty texels and the tilted quadrant sit at
+/// fixed texel indices).
+fn synthetic_rsm_sized(s: u32, flux_scale: f32) -> RsmData {
     let mut rsm = RsmData {
         size: s,
         position: Vec::new(),
@@ -342,7 +347,12 @@ fn gpu_gather(
 
 /// Runs the cache alone and returns its records.
 fn gpu_cache(device: &Device, rsm: &RsmData, params: &HvlParams) -> Vec<Hvl> {
-    let images = RsmImages::new(device, rsm);
+    gpu_cache_faces(device, std::slice::from_ref(rsm), params)
+}
+
+/// hvl_cache on the GPU over several RSM faces.
+fn gpu_cache_faces(device: &Device, faces: &[RsmData], params: &HvlParams) -> Vec<Hvl> {
+    let images: Vec<RsmImages> = faces.iter().map(|f| RsmImages::new(device, f)).collect();
     let readback = transfer_storage(
         device,
         "hvl_readback",
@@ -351,8 +361,12 @@ fn gpu_cache(device: &Device, rsm: &RsmData, params: &HvlParams) -> Vec<Hvl> {
     );
     let mut executor = Executor::new(device, 1).unwrap();
     let mut rg = executor.begin_frame();
-    let rsm_handles = images.import(&mut rg, rsm);
-    let hvls = hvl_cache(&mut rg, &rsm_handles, params).unwrap();
+    let handles: Vec<Rsm> = images
+        .iter()
+        .zip(faces)
+        .map(|(i, f)| i.import(&mut rg, f))
+        .collect();
+    let hvls = hvl_cache(&mut rg, &handles, params).unwrap();
     let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
     rg.copy_buffer("read_hvls", &hvls, &mut out);
     common::run_graph(device, &mut executor, rg);
@@ -599,6 +613,83 @@ fn flux_cache_matches_the_cpu_reference() {
         assert!(
             (on_tilted - expected).abs() <= 2.0,
             "{count}: {on_tilted} HVLs on the tilted quadrant, expected {expected}"
+        );
+    }
+    assert_clean(&device);
+}
+
+/// The flux distribution over three faces of different sides and projections (a spot's, a
+/// directional light's, a dim cube face's), as the frame draws every light's bounce: GPU and
+/// CPU pick the same texels, and each face gets the share of the M HVLs that its flux weight
+/// holds of the total (the budget split by flux), to within the pattern's stratification.
+#[test]
+fn flux_cache_splits_the_budget_between_faces() {
+    let device = device();
+    let spot = synthetic_rsm(1.0);
+    let sun = RsmData {
+        light_position: Vec3::new(0.0, 5.0, 0.0),
+        projection: RsmProjection::Orthographic { width: 4.0 },
+        ..synthetic_rsm_sized(24, 3.0)
+    };
+    let dim = RsmData {
+        light_position: Vec3::new(0.5, 2.0, 0.0),
+        ..synthetic_rsm_sized(20, 0.2)
+    };
+    let faces = [spot, sun, dim];
+    let weight = |f: &RsmData| -> f32 {
+        f.position
+            .iter()
+            .zip(&f.flux)
+            .filter(|(p, _)| p.w != 0.0)
+            .map(|(_, f)| f.x + f.y + f.z)
+            .sum()
+    };
+    let weights: Vec<f32> = faces.iter().map(weight).collect();
+    let total: f32 = weights.iter().sum();
+    let count = 250;
+    let p = HvlParams {
+        count,
+        distribution: Distribution::Flux,
+        ..params(GatherPath::Full, 5, 3)
+    };
+    let cpu = shine::reference::hvl_flux::build_flux_cache(&faces, &p).unwrap();
+    let gpu = gpu_cache_faces(&device, &faces, &p);
+    assert_eq!((cpu.len(), gpu.len()), (count as usize, count as usize));
+    for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+        assert!(c.is_valid(), "HVL {i} empty");
+        assert_eq!(&g.position_radius[..3], &c.position_radius[..3], "HVL {i}");
+        for k in 0..4 {
+            assert!(
+                close(g.flux[k], c.flux[k], 1e-4, 1e-7),
+                "HVL {i}: {g:?} vs {c:?}"
+            );
+            assert!(close(
+                g.position_radius[k],
+                c.position_radius[k],
+                1e-4,
+                1e-7
+            ));
+            assert!(close(
+                g.normal_distance[k],
+                c.normal_distance[k],
+                1e-5,
+                1e-6
+            ));
+        }
+    }
+    // The face each HVL was drawn from, as the CPU twin draws it (the GPU matched it above).
+    let cdf = shine::reference::hvl_flux::running_sums(&faces);
+    let mut per_face = [0.0f32; 3];
+    for m in 0..count {
+        let (face, _, _) =
+            shine::reference::hvl_flux::sample_texel(&faces, &cdf, m, count).unwrap();
+        per_face[face] += 1.0;
+    }
+    for (f, (&n, &w)) in per_face.iter().zip(&weights).enumerate() {
+        let expected = count as f32 * w / total;
+        assert!(
+            (n - expected).abs() <= 2.0,
+            "face {f}: {n} HVLs, expected {expected} ({per_face:?})"
         );
     }
     assert_clean(&device);
@@ -883,7 +974,7 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
         let rsm_handles = rsm_images.import(&mut rg, &rsm);
         let recv = recv_images.import(&mut rg, RECV);
         let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
-        let hvls = hvl_cache(&mut rg, &rsm_handles, &p).unwrap();
+        let hvls = hvl_cache(&mut rg, &[rsm_handles], &p).unwrap();
         let indirect =
             hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, None, CAMERA, &p, 0).unwrap();
         read_indirect(&mut rg, &indirect, &readback);

@@ -37,8 +37,9 @@ pub struct PreparedHvl {
 pub struct HvlInputs<'a> {
     /// The receiver buffer the gather shades.
     pub receivers: &'a Receivers,
-    /// The primary light's RSM the HVLs are cut from.
-    pub rsm: &'a Rsm,
+    /// The RSM faces the HVLs are drawn from, the primary light's first (the grid uses that
+    /// one only).
+    pub rsm: &'a [Rsm],
     /// The scene's BVH this frame (read only with `hvl.visibility`).
     pub bvh: &'a TraceBuffers,
     /// The camera position (the gather's view direction).

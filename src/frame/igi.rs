@@ -29,8 +29,9 @@ pub struct PreparedIgi {
 pub struct IgiInputs<'a> {
     /// The full-resolution G-buffer (the interleaving needs the pixel grid).
     pub gbuffer: &'a GBuffer,
-    /// The primary light's RSM the VPLs are cut from.
-    pub rsm: &'a Rsm,
+    /// The RSM faces the VPLs are drawn from, the primary light's first (the grid uses that
+    /// one only).
+    pub rsm: &'a [Rsm],
     /// The scene's BVH for the VPL shadow rays.
     pub bvh: &'a TraceBuffers,
     /// The camera position.

@@ -309,11 +309,11 @@ pub fn pixel_set(x: u32, y: u32, pattern: [u32; 2]) -> u32 {
     x % pattern[0] + pattern[0] * (y % pattern[1])
 }
 
-/// Adds the VPL construction: the HVL cache pass with `params.vpl_count` cells over `rsm`
-/// (records in the layout of [`hvl::Hvl`]; radius and emission unused).
+/// Adds the VPL construction: the HVL cache pass with `params.vpl_count` VPLs over the RSM
+/// faces `rsm` (records in the layout of [`hvl::Hvl`]; radius and emission unused).
 pub fn vpls(
     rg: &mut RenderGraph,
-    rsm: &Rsm,
+    rsm: &[Rsm],
     params: &IgiParams,
 ) -> Result<Handle<Buffer>, IgiError> {
     params.validate()?;
@@ -446,12 +446,12 @@ pub fn sh_filter(
     Ok(indirect)
 }
 
-/// The three IGI passes in a row: VPLs from `rsm`, `vpl_sh`, `sh_filter`; returns `indirect`.
-/// `brdf`: as for [`sh_filter`].
+/// The three IGI passes in a row: VPLs from the RSM faces `rsm` (the primary light's first),
+/// `vpl_sh`, `sh_filter`; returns `indirect`. `brdf`: as for [`sh_filter`].
 pub fn igi(
     rg: &mut RenderGraph,
     g: &GBuffer,
-    rsm: &Rsm,
+    rsm: &[Rsm],
     bvh: &TraceBuffers,
     brdf: Option<&Handle<Buffer>>,
     camera: Vec3,

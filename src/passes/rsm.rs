@@ -5,10 +5,12 @@
 use glam::Vec3;
 use shine_graph::{ColorLoad, DepthLoad, Handle, Image, ImageDesc, RenderGraph};
 
-use super::gbuffer::{View, scene_pipeline};
+use super::gbuffer::{View, light_view, scene_pipeline};
+use super::shadows::{CUBE_FACES, cube_face};
 use crate::gpu::vk;
-use crate::gpu_scene::SceneHandles;
+use crate::gpu_scene::{FrameState, SceneHandles};
 use crate::shaders;
+use shine_scene::LightKind;
 
 /// Default RSM side: 512² texels serve 400 HVLs with room to spare.
 pub const DEFAULT_SIZE: u32 = 512;
@@ -50,8 +52,9 @@ pub enum RsmProjection {
     },
 }
 
-/// Rasterises the scene from the primary light (perspective or orthographic) into a new `size`²
-/// reflective shadow map (docs/frame.md).
+/// Rasterises the scene from light `light` through `view` (perspective or orthographic) into a
+/// new `size`² reflective shadow map (docs/frame.md); its pass and images are named after
+/// `label` (`rsm`: the primary light's).
 pub fn rsm(
     rg: &mut RenderGraph,
     scene: &SceneHandles,
@@ -59,15 +62,19 @@ pub fn rsm(
     light: u32,
     size: u32,
     sampler: vk::Sampler,
+    label: &str,
 ) -> Rsm {
-    let image = |rg: &mut RenderGraph, name, format| {
-        rg.create_image(name, ImageDesc::new_2d(format, size, size))
+    let image = |rg: &mut RenderGraph, name: &str, format| {
+        rg.create_image(
+            &format!("{label}_{name}"),
+            ImageDesc::new_2d(format, size, size),
+        )
     };
-    let mut depth = image(rg, "rsm_depth", vk::Format::D32_SFLOAT);
+    let mut depth = image(rg, "depth", vk::Format::D32_SFLOAT);
     let mut r = Rsm {
-        position: image(rg, "rsm_position", vk::Format::R32G32B32A32_SFLOAT),
-        normal: image(rg, "rsm_normal", vk::Format::R16G16B16A16_SFLOAT),
-        flux: image(rg, "rsm_flux", vk::Format::R32G32B32A32_SFLOAT),
+        position: image(rg, "position", vk::Format::R32G32B32A32_SFLOAT),
+        normal: image(rg, "normal", vk::Format::R16G16B16A16_SFLOAT),
+        flux: image(rg, "flux", vk::Format::R32G32B32A32_SFLOAT),
         light_position: view.eye,
         light_direction: view.forward(),
         projection: if view.orthographic {
@@ -87,7 +94,7 @@ pub fn rsm(
         ],
         None,
     );
-    rg.raster("rsm", pipeline)
+    rg.raster(label, pipeline)
         .color(&mut r.position, ColorLoad::Clear([0.0; 4]))
         .color(&mut r.normal, ColorLoad::Clear([0.0; 4]))
         .color(&mut r.flux, ColorLoad::Clear([0.0; 4]))
@@ -102,4 +109,46 @@ pub fn rsm(
         .push(&view.constants(Some((size, light))))
         .draw_indexed(scene.index_count, 1);
     r
+}
+
+/// The views whose RSMs feed the flux distribution: every light of `frame`, the primary light
+/// (`primary`) first. A spot or directional light has one face of side `size`, as the
+/// primary's RSM. A point light has six cube faces of exactly 90° and side `size / 2` (at
+/// least [`SIZE`]'s minimum): they tile the sphere without overlap, so no flux is counted twice,
+/// and the six hold 1.5× the texels of one spot's RSM. Each entry: light index, pass label
+/// (`rsm` for the primary light, `rsm light I` for light I, a cube face's axis after it),
+/// view, side.
+pub fn face_views(frame: &FrameState, primary: usize, size: u32) -> Vec<(u32, String, View, u32)> {
+    let mut order: Vec<usize> = (0..frame.lights.len()).collect();
+    if primary < order.len() {
+        order.remove(primary);
+        order.insert(0, primary);
+    }
+    let cube_side = (size / 2).max(*SIZE.start());
+    let mut faces = Vec::new();
+    for i in order {
+        let light = &frame.lights[i];
+        // The primary light's passes keep the name `rsm` (profiles, docs/frame.md).
+        let label = if i == primary {
+            "rsm".to_owned()
+        } else {
+            format!("rsm light {i}")
+        };
+        match light.light_kind() {
+            Some(LightKind::Point) => {
+                let eye = Vec3::from(light.position);
+                for (axis, up, name) in CUBE_FACES {
+                    let view = cube_face(frame, eye, axis, up, 1.0);
+                    faces.push((i as u32, format!("{label} {name}"), view, cube_side));
+                }
+            }
+            Some(_) => {
+                if let Some(view) = light_view(frame, i) {
+                    faces.push((i as u32, label.clone(), view, size));
+                }
+            }
+            None => {}
+        }
+    }
+    faces
 }

@@ -236,7 +236,13 @@ impl ShadowLayout {
 
 /// One cube face of a point light at `eye` looking along `axis`: a square frustum whose
 /// half-angle tangent is `tan_half` (1 = exactly 90°), reaching past the scene's far side.
-fn cube_face(frame: &FrameState, eye: Vec3, axis: Vec3, up: Vec3, tan_half: f32) -> View {
+pub(crate) fn cube_face(
+    frame: &FrameState,
+    eye: Vec3,
+    axis: Vec3,
+    up: Vec3,
+    tan_half: f32,
+) -> View {
     let (lo, hi) = frame.bounds;
     let center = (lo + hi) * 0.5;
     let radius = ((hi - lo).length() * 0.5).max(1e-3);

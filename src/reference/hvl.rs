@@ -172,7 +172,7 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
         });
     }
     if params.distribution == Distribution::Flux {
-        return super::hvl_flux::build_flux_cache(rsm, params);
+        return super::hvl_flux::build_flux_cache(std::slice::from_ref(rsm), params);
     }
     let count = params.count;
     let r2 = |d: f32| match rsm.projection {

@@ -13,6 +13,7 @@ use crate::gpu_scene::{SAMPLED_READ, SceneHandles};
 use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
+use crate::passes::hvl::Distribution;
 use crate::passes::{direct, history, receivers, rsm, upsample};
 use shine_graph::{Handle, Image, RenderGraph};
 
@@ -155,18 +156,26 @@ impl Renderer {
             .transpose()?;
         let light_count = light_count(frame)?;
 
-        // HVL and IGI bounce the primary light (the first spot or directional light) off its
-        // RSM; without one they add nothing.
-        let primary = scene
-            .gpu
-            .primary_light()
-            .and_then(|i| Some((i as u32, gbuffer::light_view(frame, i)?)));
-        let rsm = match primary {
-            Some((light, view)) if hvl.is_some() || igi.is_some() => {
-                Some(rsm::rsm(rg, handles, view, light, p.rsm_size, textures))
-            }
-            _ => None,
+        // HVL and IGI bounce light off RSM faces: placed by flux, every light's (the primary
+        // light's first); on the paper's grid, the primary light's only (the first spot or
+        // directional light). Without a light they add nothing.
+        let every_light = p.hvl.is_some_and(|h| h.distribution == Distribution::Flux)
+            || p.igi.is_some_and(|i| i.distribution == Distribution::Flux);
+        let faces: Vec<(u32, String, View, u32)> = match scene.gpu.primary_light() {
+            Some(_) if hvl.is_none() && igi.is_none() => Vec::new(),
+            Some(i) if every_light => rsm::face_views(frame, i, p.rsm_size),
+            Some(i) => gbuffer::light_view(frame, i)
+                .map(|view| vec![(i as u32, "rsm".to_owned(), view, p.rsm_size)])
+                .unwrap_or_default(),
+            None => Vec::new(),
         };
+        let rsm_faces: Vec<rsm::Rsm> = faces
+            .into_iter()
+            .map(|(light, label, view, size)| {
+                rsm::rsm(rg, handles, view, light, size, textures, &label)
+            })
+            .collect();
+        let rsm = (!rsm_faces.is_empty()).then_some(rsm_faces.as_slice());
         // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
         // upsample; `hvl,proxy` sums both at receiver resolution first.
         let recv = if hvl.is_some() || proxy.is_some() {
@@ -178,7 +187,7 @@ impl Renderer {
             // No primary light: the HVL passes (and their history) are not in this frame.
             self.hvl.reset();
         }
-        let hvl_low = match (hvl, &rsm, &recv) {
+        let hvl_low = match (hvl, rsm, &recv) {
             (Some(hvl), Some(rsm), Some(receivers)) => Some(hvl.declare(
                 rg,
                 &HvlInputs {
@@ -204,7 +213,7 @@ impl Renderer {
             _ => None,
         };
         // IGI runs at full resolution (its interleaving needs the pixel grid).
-        let igi_full = match (igi, &rsm) {
+        let igi_full = match (igi, rsm) {
             (Some(igi), Some(rsm)) => Some(igi.declare(
                 rg,
                 &IgiInputs {

@@ -78,6 +78,7 @@ use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::passes::rsm::{Rsm, RsmProjection};
 use crate::shaders;
 
+pub mod flux;
 mod gather;
 mod grid;
 pub mod resolve;
@@ -288,6 +289,9 @@ pub enum HvlError {
         "the HVL radius heuristic r1 needs hvl.distribution = \"grid\" (its neighbours are cells of the grid); use r2 with \"flux\""
     )]
     R1NeedsGrid,
+    /// The cache was given no RSM face.
+    #[error("the HVL cache needs at least one RSM face")]
+    NoFaces,
     /// HVL visibility was asked for without the scene's BVH.
     #[error("HVL visibility needs the scene's BVH buffers")]
     NoBvh,
@@ -422,7 +426,7 @@ fn check_extent(
 }
 
 /// `(λ or W, 1 for orthographic)`, the shader's encoding of an RSM projection.
-fn encode_projection(projection: RsmProjection) -> (f32, f32) {
+pub(crate) fn encode_projection(projection: RsmProjection) -> (f32, f32) {
     match projection {
         RsmProjection::Perspective { fov } => (fov, 0.0),
         RsmProjection::Orthographic { width } => (width, 1.0),
@@ -455,25 +459,29 @@ pub fn cache_bytes(count: u32) -> u64 {
     u64::from(count) * std::mem::size_of::<Hvl>() as u64
 }
 
-/// Adds the `hvl_cache` pass(es): the RSM → `params.count` [`Hvl`] records in a new transient
-/// buffer, returned. On the grid, the records follow the cell order of [`HvlGrid`], and with
+/// Adds the `hvl_cache` pass(es): RSM faces → `params.count` [`Hvl`] records in a new
+/// transient buffer, returned. On the grid (paper 003), only the first face counts (the
+/// primary light's RSM): the records follow the cell order of [`HvlGrid`], and with
 /// [`RadiusHeuristic::R1`] a second dispatch computes the radii from the first one's records.
-/// With [`Distribution::Flux`], `hvl_flux_rows` first sums the flux of each RSM row into a
-/// table of cumulative sums that the cache pass samples.
+/// With [`Distribution::Flux`], the HVLs are drawn over every face, so the budget is split
+/// between the lights by the flux they reflect ([`flux`]).
 pub fn hvl_cache(
     rg: &mut RenderGraph,
-    rsm: &Rsm,
+    faces: &[Rsm],
     params: &HvlParams,
 ) -> Result<Handle<Buffer>, HvlError> {
+    let rsm = faces.first().ok_or(HvlError::NoFaces)?;
     let grid = params.validate_cache(rsm.size)?;
-    for (name, image) in [
-        ("rsm_position", &rsm.position),
-        ("rsm_normal", &rsm.normal),
-        ("rsm_flux", &rsm.flux),
-    ] {
-        check_extent(name, image, [rsm.size, rsm.size])?;
+    for face in faces {
+        for (name, image) in [
+            ("rsm_position", &face.position),
+            ("rsm_normal", &face.normal),
+            ("rsm_flux", &face.flux),
+        ] {
+            check_extent(name, image, [face.size, face.size])?;
+        }
+        validate_projection(face.projection)?;
     }
-    validate_projection(rsm.projection)?;
     let push = cache_push(
         rsm.light_position,
         rsm.light_direction,
@@ -484,22 +492,7 @@ pub fn hvl_cache(
     let desc = BufferDesc::new(cache_bytes(params.count));
     let mut built = rg.create_buffer("hvl_cache", desc);
     if params.distribution == Distribution::Flux {
-        let cdf_bytes = 4 * u64::from(rsm.size) * (u64::from(rsm.size) + 1);
-        let mut cdf = rg.create_buffer("hvl_flux_cdf", BufferDesc::new(cdf_bytes));
-        rg.compute("hvl_flux_rows", &shaders::HVL_FLUX_COMP_ROWS)
-            .read("rsm_position", &rsm.position)
-            .read("rsm_flux", &rsm.flux)
-            .write("cdf", &mut cdf)
-            .push(&push)
-            .dispatch([rsm.size, 1, 1]);
-        rg.compute("hvl_cache", &shaders::HVL_FLUX_COMP_BUILD)
-            .read("rsm_position", &rsm.position)
-            .read("rsm_normal", &rsm.normal)
-            .read("rsm_flux", &rsm.flux)
-            .read("cdf", &cdf)
-            .write("hvls", &mut built)
-            .push(&push)
-            .dispatch([params.count, 1, 1]);
+        flux::flux_cache(rg, faces, params, &mut built)?;
         return Ok(built);
     }
     rg.compute("hvl_cache", &shaders::HVL_CACHE_COMP_BUILD)
