@@ -118,6 +118,11 @@ layout(push_constant) uniform Push {
     // cell; HVL_REGATHER_SLICE: only the receivers marked by alpha -1 in `indirect`
     // (amortised frames, src/passes/hvl/resolve.rs)
     uint slice;
+    // width of the sinc window on the light's SH bands (paper 003 §4.2), 0: none
+    float window_width;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } push;
 
 // Receivers closer than this to an HVL centre get nothing from it (metres).
@@ -189,6 +194,11 @@ void main() {
     float cc[SH_BANDS];
     sh_clamped_cosine_zh(cc);
 #endif
+    // The window's factor per band (1 without a window), applied to each HVL's cap.
+    float win[SH_BANDS];
+    SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+        win[l] = push.window_width > 0.0 ? sh_window_sinc(l, push.window_width) : 1.0;
+    }
     vec3 sum = vec3(0.0);
     for (uint j = 0u; j < push.hvl_count; ++j) {
         // Field by field: naga cannot read the OpCopyLogical of a whole-struct load.
@@ -230,10 +240,16 @@ void main() {
 #ifdef HVL_FULL
         float cap[SH_COEFFS];
         sh_cap(normalize(vec3(dot(wj, t), dot(wj, b), dot(wj, n))), cos_a, cap);
+        SH_UNROLL for (int i = 0; i < SH_COEFFS; ++i) {
+            cap[i] *= win[int(sqrt(float(i) + 0.5))];
+        }
         sum += max(vec3(0.0), lj * (kd * sh_dot(cap, f_lambert) + ks * sh_dot(cap, f_glossy)));
 #else
         float cap[SH_BANDS];
         sh_cap_zh(cos_a, cap);
+        SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+            cap[l] *= win[l];
+        }
         sum += max(vec3(0.0), lj * kd * (hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
 #endif
     }

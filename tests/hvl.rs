@@ -16,7 +16,7 @@ use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::hvl::{
     CONV_BANDS, CachePush, Distribution, GatherPath, GatherPush, Hvl, HvlError, HvlParams,
-    MAX_HVLS, RadiusHeuristic, gather_variants, hvl_cache, hvl_gather,
+    MAX_HVLS, RadiusHeuristic, Window, gather_variants, hvl_cache, hvl_gather,
 };
 use shine::passes::receivers::Receivers;
 use shine::passes::rsm::{Rsm, RsmProjection};
@@ -157,6 +157,7 @@ fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
     HvlParams {
         count: 64,
         distribution: Distribution::Grid,
+        window: Window::None,
         radius: RadiusHeuristic::R2,
         radius_scale: 1.5,
         conv_bands,
@@ -708,15 +709,19 @@ fn gather_matches_the_cpu_reference() {
     // Some of the variants: a lavapipe compile of the 9- and 10-band variants costs seconds
     // each (the 9-band ones are checked against the quadrature below).
     let variants = [
-        (GatherPath::Full, 2, 1),
-        (GatherPath::Full, 3, 3),
-        (GatherPath::Full, 5, 5),
-        (GatherPath::Full, 6, 4),
-        (GatherPath::Zonal, 1, 1),
-        (GatherPath::Zonal, 5, 3),
+        (GatherPath::Full, 2, 1, Window::None),
+        (GatherPath::Full, 3, 3, Window::None),
+        (GatherPath::Full, 5, 5, Window::None),
+        (GatherPath::Full, 5, 3, Window::Sinc),
+        (GatherPath::Full, 6, 4, Window::None),
+        (GatherPath::Zonal, 1, 1, Window::None),
+        (GatherPath::Zonal, 5, 3, Window::Sinc),
     ];
-    for (path, conv, emission) in variants {
-        let p = params(path, conv, emission);
+    for (path, conv, emission, window) in variants {
+        let p = HvlParams {
+            window,
+            ..params(path, conv, emission)
+        };
         let brdf = tables(conv, [12, 24]);
         let cpu = reference::gather(&receivers, &hvls, &brdf, CAMERA, &p, None).unwrap();
         let gpu = gpu_gather(&device, &receivers, &hvls, &brdf, CAMERA, &p, None);
@@ -731,9 +736,27 @@ fn gather_matches_the_cpu_reference() {
             for k in 0..4 {
                 assert!(
                     close(g[k], c[k], 2e-3, 1e-3 * peak),
-                    "{path:?} c{conv} e{emission} pixel {i}: GPU {g} vs CPU {c}"
+                    "{path:?} c{conv} e{emission} {window:?} pixel {i}: GPU {g} vs CPU {c}"
                 );
             }
+        }
+        if window == Window::Sinc {
+            // The window changes the light: the same gather without it differs.
+            let plain = HvlParams {
+                window: Window::None,
+                ..p
+            };
+            let unwindowed =
+                reference::gather(&receivers, &hvls, &brdf, CAMERA, &plain, None).unwrap();
+            let changed = cpu
+                .iter()
+                .zip(&unwindowed)
+                .filter(|(a, b)| (**a - **b).abs().max_element() > 0.01 * peak)
+                .count();
+            assert!(
+                changed > 50,
+                "{path:?} c{conv}: the window changed {changed} pixels"
+            );
         }
     }
     assert_clean(&device);

@@ -83,6 +83,7 @@ impl FrameParams {
                 conv_bands: h.convolution_bands,
                 emission_bands: h.emission_bands,
                 path: h.gather,
+                window: h.window,
                 visibility: h.visibility,
                 slices: h.slices,
             }),

@@ -325,6 +325,7 @@ pub fn vpls(
         conv_bands: 3,
         emission_bands: 1,
         path: hvl::GatherPath::Zonal,
+        window: hvl::Window::None,
         visibility: false,
         slices: 1,
     };

@@ -339,6 +339,16 @@ pub fn shade(
         _ => false,
     };
     let emission = Emission::Sh(params.emission_bands as usize);
+    // The window's factor per band (hvl_gather.comp's `win`).
+    let window = shine_sh::kernels::Window::Sinc {
+        width: bands as f32,
+    };
+    let win: Vec<f32> = (0..bands)
+        .map(|l| match params.window {
+            crate::passes::hvl::Window::None => Ok(1.0),
+            crate::passes::hvl::Window::Sinc => window.factor(l).map(|f| f as f32),
+        })
+        .collect::<Result<_, _>>()?;
     let (x, n) = (receiver.position, receiver.normal.normalize());
     let (kd, ks) = receiver.weights(camera);
     let mut sum = Vec3::ZERO;
@@ -357,7 +367,10 @@ pub fn shade(
                     continue;
                 }
                 let local = Vec3::new(wj.dot(t), wj.dot(b), wj.dot(n)).normalize();
-                let cap = cap_sh(local, a, bands)?;
+                let mut cap = cap_sh(local, a, bands)?;
+                for (i, c) in cap.iter_mut().enumerate() {
+                    *c *= win[i.isqrt()];
+                }
                 let diffuse = shine_sh::dot(&cap, &f_lambert)?;
                 let glossy = shine_sh::dot(&cap, &f_glossy)?;
                 sum += (lj * (kd * diffuse + ks * glossy)).max(Vec3::ZERO);
@@ -375,7 +388,10 @@ pub fn shade(
                 if hidden(hvl, x, n) {
                     continue;
                 }
-                let cap = cap_zh(a, bands)?;
+                let mut cap = cap_zh(a, bands)?;
+                for (c, w) in cap.iter_mut().zip(&win) {
+                    *c *= w;
+                }
                 sum += (lj * kd * zh_dot(&cap, &cc, n.dot(wj))).max(Vec3::ZERO);
             }
         }

@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 use crate::capture::tonemap::Tonemap;
 use crate::passes::aaf::AafParams;
 use crate::passes::composite::{Component, CompositeParams};
-use crate::passes::hvl::{Distribution, GatherPath, HvlParams, RadiusHeuristic};
+use crate::passes::hvl::{Distribution, GatherPath, HvlParams, RadiusHeuristic, Window};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
 use crate::passes::proxy::{DEFAULT_ORDER, ExpMethod, INDIRECT_BANDS, paper_expansion};
 use crate::passes::upsample::{DEPTH_SIGMA, NORMAL_POWER_N};
@@ -197,6 +197,9 @@ pub struct HvlSettings {
     /// Gather path: `full` (any BRDF, O(n²)) or `zonal` (symmetric lobes, O(n)).
     /// Default `full`.
     pub gather: GatherPath,
+    /// Window on each HVL's SH bands against ringing: `none` or `sinc` (paper 003 §4.2,
+    /// Sloan's sinc of width `convolution_bands`). Default `none`.
+    pub window: Window,
     /// Receivers per gather refresh (paper 001): 1 gathers every receiver every frame; 4
     /// gathers one receiver per 2×2 cell per frame and reprojects the others from the
     /// previous frames (`hvl_resolve`). Default 1.
@@ -371,6 +374,7 @@ impl Default for HvlSettings {
             emission_bands: h.emission_bands,
             visibility: h.visibility,
             gather: h.path,
+            window: h.window,
             slices: h.slices,
         }
     }

@@ -3,7 +3,9 @@
 
 use glam::Vec3;
 
-use super::{GatherPath, GatherPush, HvlError, HvlParams, cache_bytes, check_extent, resolve};
+use super::{
+    GatherPath, GatherPush, HvlError, HvlParams, Window, cache_bytes, check_extent, resolve,
+};
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::brdf_tables::{
@@ -138,6 +140,11 @@ fn record_gather(
         roughness_nodes: [GLOSSY_ROUGHNESS_MIN, glossy_roughness_step()],
         glossy_tables: GLOSSY_TABLES,
         slice,
+        window_width: match params.window {
+            Window::None => 0.0,
+            Window::Sinc => params.conv_bands as f32,
+        },
+        pad: [0; 3],
     };
     let (name, threads) = match slice {
         0 => ("hvl_gather", [w, h, 1]),

@@ -135,7 +135,7 @@ pub struct CachePush {
     pub pad: [f32; 3],
 }
 
-/// Push constants of `shaders/hvl_gather.comp`, 48 bytes.
+/// Push constants of `shaders/hvl_gather.comp`, 64 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GatherPush {
@@ -155,6 +155,11 @@ pub struct GatherPush {
     /// 0: every receiver; 1 + k: one receiver per 2×2 cell, at offset (k & 1, k >> 1)
     /// ([`resolve::slice_of_frame`]).
     pub slice: u32,
+    /// Width of the sinc window on the light's SH bands (the convolution's band count), 0 for
+    /// none.
+    pub window_width: f32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 crate::choice::named_choice! {
@@ -178,6 +183,17 @@ crate::choice::named_choice! {
         /// from its own texel's position and normal, with the r2 radius taken from the local
         /// spacing ([`shine_sh::hvl::radius_spacing`]).
         Flux = "flux",
+    }
+}
+
+crate::choice::named_choice! {
+    /// The window on the gathered light's SH bands against ringing (paper 003 §4.2).
+    pub enum Window ("HVL SH window") {
+        /// No window: the bands as projected (each HVL's contribution clamped at 0).
+        None = "none",
+        /// Sloan's sinc window, `sin(π l / n) / (π l / n)` on band l of n
+        /// ([`shine_sh::kernels::Window::Sinc`] of width n).
+        Sinc = "sinc",
     }
 }
 
@@ -209,6 +225,8 @@ pub struct HvlParams {
     pub emission_bands: u32,
     /// Full or zonal convolution.
     pub path: GatherPath,
+    /// Window on the SH bands of each HVL's light.
+    pub window: Window,
     /// Shadow rays from each receiver to each HVL through the scene's BVH (not in paper 003,
     /// whose HVLs are unshadowed).
     pub visibility: bool,
@@ -231,6 +249,7 @@ impl Default for HvlParams {
             conv_bands: 5,
             emission_bands: 3,
             path: GatherPath::Full,
+            window: Window::None,
             visibility: false,
             slices: 1,
         }
