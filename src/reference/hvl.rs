@@ -346,7 +346,7 @@ pub fn shade(
     let win: Vec<f32> = (0..bands)
         .map(|l| match params.window {
             crate::passes::hvl::Window::None => Ok(1.0),
-            crate::passes::hvl::Window::Sinc => window.factor(l).map(|f| f as f32),
+            crate::passes::hvl::Window::Sinc => window.factor(l),
         })
         .collect::<Result<_, _>>()?;
     let (x, n) = (receiver.position, receiver.normal.normalize());
