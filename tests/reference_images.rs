@@ -88,8 +88,9 @@ fn raster_direct_light_matches_the_path_traced_direct_light() {
 #[test]
 fn indirect_light_against_the_path_traced_reference() {
     let reference = reference(1, 64);
-    // (technique, largest relative RMSE, energy range); measured on lavapipe: see below.
-    let cases = [("hvl", 0.62, 0.92..=1.06), ("igi", 0.70, 0.78..=1.05)];
+    // (technique, largest relative RMSE, energy range). Measured on lavapipe against this
+    // 64-spp reference: HVL 0.536 / 1.120 (its own surplus, docs/quality.md), IGI 0.547 / 0.966.
+    let cases = [("hvl", 0.62, 1.0..=1.2), ("igi", 0.62, 0.9..=1.05)];
     for (name, worst, energy) in cases {
         let gi = GiTechniques::from_str(name).expect("technique");
         let image = raster_with(Component::Indirect, gi);

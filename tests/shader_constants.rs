@@ -141,3 +141,17 @@ fn hvl_incidence_clamp_matches_the_shader() {
         shine_sh::hvl::MIN_INCIDENCE_COS
     );
 }
+
+#[test]
+fn diffuse_fresnel_fit_matches_the_shader() {
+    use shine::passes::brdf_tables::{DIFFUSE_FRESNEL_POWER, DIFFUSE_FRESNEL_SCALE};
+    let file = "include/brdf.glsl";
+    assert_eq!(
+        glsl_float(file, "BRDF_DIFFUSE_FRESNEL_SCALE"),
+        DIFFUSE_FRESNEL_SCALE
+    );
+    assert_eq!(
+        glsl_float(file, "BRDF_DIFFUSE_FRESNEL_POWER"),
+        DIFFUSE_FRESNEL_POWER
+    );
+}

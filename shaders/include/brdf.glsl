@@ -105,14 +105,21 @@ vec3 brdf_sample(vec3 n, vec3 v, float p_specular, float roughness, vec3 xi) {
     return sample_cosine(n, xi.xy);
 }
 
-// Diffuse and specular weights of the metallic-roughness material for indirect light (HVL and
-// IGI), shine::passes::brdf_tables::indirect_weights:
-// Schlick's Fresnel at the mirror direction (v . h = n . v), kd = (1 - F)(1 - metallic) albedo
-// (the direct pass's diffuse), ks = F.
+// shine::passes::brdf_tables::DIFFUSE_FRESNEL_SCALE, DIFFUSE_FRESNEL_POWER
+const float BRDF_DIFFUSE_FRESNEL_SCALE = 0.0279;
+const float BRDF_DIFFUSE_FRESNEL_POWER = 2.55;
+
+// Diffuse and specular weights of the metallic-roughness material for indirect light (HVL, IGI,
+// AAF), shine::passes::brdf_tables::indirect_weights: ks = Schlick's Fresnel at the mirror
+// direction (v . h = n . v); kd = (1 - F_d)(1 - metallic) albedo with F_d the direct pass's
+// F(v . h) averaged over a cosine-distributed hemisphere of light directions
+// (brdf_tables::diffuse_fresnel_factor, a fit).
 void brdf_indirect_weights(vec3 albedo, float metallic, float n_dot_v, out vec3 kd, out vec3 ks) {
     vec3 f0 = mix(vec3(0.04), albedo, metallic);
-    ks = f0 + (1.0 - f0) * pow(1.0 - clamp(n_dot_v, 0.0, 1.0), 5.0);
-    kd = (1.0 - ks) * (1.0 - metallic) * albedo;
+    float grazing = 1.0 - clamp(n_dot_v, 0.0, 1.0);
+    ks = f0 + (1.0 - f0) * pow(grazing, 5.0);
+    vec3 f_diffuse = f0 + (1.0 - f0) * (BRDF_DIFFUSE_FRESNEL_SCALE * pow(grazing, BRDF_DIFFUSE_FRESNEL_POWER));
+    kd = (1.0 - f_diffuse) * (1.0 - metallic) * albedo;
 }
 
 // shine::passes::brdf_tables::table_fresnel_weight (an n.v approximation: the tables' Fresnel varies
