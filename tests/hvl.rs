@@ -539,6 +539,52 @@ fn cache_matches_the_cpu_reference() {
     assert_clean(&device);
 }
 
+/// The flux weight r + g + b summed over the valid texels of `rsm`.
+fn flux_weight(rsm: &RsmData) -> f32 {
+    rsm.position
+        .iter()
+        .zip(&rsm.flux)
+        .filter(|(p, _)| p.w != 0.0)
+        .map(|(_, f)| f.x + f.y + f.z)
+        .sum()
+}
+
+/// A flux cache from the GPU against its CPU twin: the same texels (positions exactly), every
+/// HVL valid and carrying `total_weight / M` of the weight, fluxes and radii to 1e-4 (the
+/// GPU's `tan` and division), normals and distances to 1e-5, the same emission.
+fn assert_same_flux_cache(gpu: &[Hvl], cpu: &[Hvl], total_weight: f32, label: &str) {
+    assert_eq!(gpu.len(), cpu.len(), "{label}");
+    let share = total_weight / cpu.len() as f32;
+    for (i, (g, c)) in gpu.iter().zip(cpu).enumerate() {
+        assert!(c.is_valid(), "{label}: HVL {i} empty");
+        assert_eq!(
+            &g.position_radius[..3],
+            &c.position_radius[..3],
+            "{label}: HVL {i} on another texel"
+        );
+        let weight = c.flux[0] + c.flux[1] + c.flux[2];
+        assert!(
+            close(weight, share, 1e-4, 0.0),
+            "{label}: HVL {i} weight {weight}"
+        );
+        for k in 0..4 {
+            assert!(
+                close(g.flux[k], c.flux[k], 1e-4, 1e-7),
+                "{label}: HVL {i}: {g:?} vs {c:?}"
+            );
+            assert!(
+                close(g.position_radius[k], c.position_radius[k], 1e-4, 1e-7),
+                "{label}: HVL {i}: {g:?} vs {c:?}"
+            );
+            assert!(
+                close(g.normal_distance[k], c.normal_distance[k], 1e-5, 1e-6),
+                "{label}: HVL {i}: {g:?} vs {c:?}"
+            );
+        }
+        assert_eq!(g.emission, c.emission, "{label}: HVL {i}");
+    }
+}
+
 /// The flux distribution on the GPU against `build_flux_cache`: the same texels (positions and
 /// normals exactly), fluxes and radii to float rounding (the GPU's `tan` and division: 1e-4).
 /// Every HVL carries Φ/M of the flux weight, and the tilted quadrant, which reflects a known
@@ -563,49 +609,14 @@ fn flux_cache_matches_the_cpu_reference() {
         let cpu = reference::build_cache(rsm, &p).unwrap();
         let gpu = gpu_cache(&device, rsm, &p);
         assert_eq!((cpu.len(), gpu.len()), (count as usize, count as usize));
-        let total: f32 = rsm
-            .position
-            .iter()
-            .zip(&rsm.flux)
-            .filter(|(p, _)| p.w != 0.0)
-            .map(|(_, f)| weight(*f))
-            .sum();
+        let total = flux_weight(rsm);
         let mut tilted_weight = 0.0;
         for (p, f) in rsm.position.iter().zip(&rsm.normal).zip(&rsm.flux) {
             if p.0.w != 0.0 && tilted(p.1.truncate()) {
                 tilted_weight += weight(*f);
             }
         }
-        for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
-            assert!(c.is_valid(), "{count}: HVL {i} empty");
-            assert_eq!(
-                &g.position_radius[..3],
-                &c.position_radius[..3],
-                "{count}: HVL {i} on another texel"
-            );
-            let share = weight(Vec4::from(c.flux));
-            assert!(
-                close(share, total / count as f32, 1e-4, 0.0),
-                "{count}: HVL {i} weight {share}"
-            );
-            for (gv, cv) in [(g.flux, c.flux), (g.position_radius, c.position_radius)] {
-                for k in 0..4 {
-                    assert!(
-                        close(gv[k], cv[k], 1e-4, 1e-7),
-                        "{count} HVL {i}: {g:?} vs {c:?}"
-                    );
-                }
-            }
-            for k in 0..4 {
-                assert!(close(
-                    g.normal_distance[k],
-                    c.normal_distance[k],
-                    1e-5,
-                    1e-6
-                ));
-            }
-            assert_eq!(g.emission, c.emission);
-        }
+        assert_same_flux_cache(&gpu, &cpu, total, &format!("{count} HVLs"));
         let on_tilted = cpu
             .iter()
             .filter(|h| tilted(Vec4::from(h.normal_distance).truncate()))
@@ -637,15 +648,7 @@ fn flux_cache_splits_the_budget_between_faces() {
         ..synthetic_rsm_sized(20, 0.2)
     };
     let faces = [spot, sun, dim];
-    let weight = |f: &RsmData| -> f32 {
-        f.position
-            .iter()
-            .zip(&f.flux)
-            .filter(|(p, _)| p.w != 0.0)
-            .map(|(_, f)| f.x + f.y + f.z)
-            .sum()
-    };
-    let weights: Vec<f32> = faces.iter().map(weight).collect();
+    let weights: Vec<f32> = faces.iter().map(flux_weight).collect();
     let total: f32 = weights.iter().sum();
     let count = 250;
     let p = HvlParams {
@@ -656,28 +659,7 @@ fn flux_cache_splits_the_budget_between_faces() {
     let cpu = shine::reference::hvl_flux::build_flux_cache(&faces, &p).unwrap();
     let gpu = gpu_cache_faces(&device, &faces, &p);
     assert_eq!((cpu.len(), gpu.len()), (count as usize, count as usize));
-    for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
-        assert!(c.is_valid(), "HVL {i} empty");
-        assert_eq!(&g.position_radius[..3], &c.position_radius[..3], "HVL {i}");
-        for k in 0..4 {
-            assert!(
-                close(g.flux[k], c.flux[k], 1e-4, 1e-7),
-                "HVL {i}: {g:?} vs {c:?}"
-            );
-            assert!(close(
-                g.position_radius[k],
-                c.position_radius[k],
-                1e-4,
-                1e-7
-            ));
-            assert!(close(
-                g.normal_distance[k],
-                c.normal_distance[k],
-                1e-5,
-                1e-6
-            ));
-        }
-    }
+    assert_same_flux_cache(&gpu, &cpu, total, "three faces");
     // The face each HVL was drawn from, as the CPU twin draws it (the GPU matched it above).
     let cdf = shine::reference::hvl_flux::running_sums(&faces);
     let mut per_face = [0.0f32; 3];

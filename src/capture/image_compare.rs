@@ -247,19 +247,7 @@ pub fn compare(image: &HdrImage, reference: &HdrImage) -> Result<Comparison, Com
 mod tests {
     use super::*;
 
-    fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> HdrImage {
-        HdrImage {
-            width,
-            height,
-            texels: (0..height)
-                .flat_map(|y| (0..width).map(move |x| (x, y)))
-                .map(|(x, y)| {
-                    let v = f(x, y);
-                    [v, v, v, 1.0]
-                })
-                .collect(),
-        }
-    }
+    use crate::capture::image_io::grey_image as image;
 
     #[test]
     fn identical_images_are_perfect() {

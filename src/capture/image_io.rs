@@ -303,6 +303,22 @@ pub fn write_frame(path: &Path, ldr: &LdrImage, hdr: &HdrImage) -> Result<(), Im
     }
 }
 
+/// A grey test image: every pixel's rgb is `f(x, y)`, alpha 1 (the image tests' input).
+#[cfg(test)]
+pub(crate) fn grey_image(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> HdrImage {
+    HdrImage {
+        width,
+        height,
+        texels: (0..height)
+            .flat_map(|y| (0..width).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let v = f(x, y);
+                [v, v, v, 1.0]
+            })
+            .collect(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -105,19 +105,7 @@ pub fn error_heatmap(image: &HdrImage, reference: &HdrImage) -> Result<LdrImage,
 mod tests {
     use super::*;
 
-    fn image(width: u32, height: u32, f: impl Fn(u32, u32) -> f32) -> HdrImage {
-        HdrImage {
-            width,
-            height,
-            texels: (0..height)
-                .flat_map(|y| (0..width).map(move |x| (x, y)))
-                .map(|(x, y)| {
-                    let v = f(x, y);
-                    [v, v, v, 1.0]
-                })
-                .collect(),
-        }
-    }
+    use crate::capture::image_io::grey_image as image;
 
     /// An image twice as bright on its left half: the left tiles report energy 2 and relative
     /// RMSE 1, the right ones 1 and 0; the heatmap is red on the left and white on the right.

@@ -273,11 +273,14 @@ impl TemporalReport {
                 colour.filled(),
             )))?;
             if labels {
-                chart.draw_series(std::iter::once(Text::new(
-                    format!("{} (flicker {:.3})", m.label, m.flicker),
-                    (m.ms_per_frame, m.relative_rmse),
-                    ("sans-serif", 14).into_font(),
-                )))?;
+                // Offset in pixels to the right of the marker, so the text never covers it.
+                let label = EmptyElement::at((m.ms_per_frame, m.relative_rmse))
+                    + Text::new(
+                        format!("{} (flicker {:.3})", m.label, m.flicker),
+                        (10, -7),
+                        ("sans-serif", 14).into_font(),
+                    );
+                chart.draw_series(std::iter::once(label))?;
             }
         }
         root.present()?;
