@@ -120,7 +120,8 @@ layout(push_constant) uniform Push {
     uint slice;
     // width of the sinc window on the light's SH bands (paper 003 §4.2), 0: none
     float window_width;
-    uint pad0;
+    // 1: the disc's near-field falloff (hvl_disc_falloff); 0: the paper's sphere
+    uint disc_falloff;
     uint pad1;
     uint pad2;
 } push;
@@ -235,6 +236,9 @@ void main() {
             emission[l] = hvls.h[j].emission[l];
         }
         float e = max(0.0, hvl_zh_eval(emission, int(push.emission_bands), dot(normalize(hvl_normal), -wj)));
+        if (push.disc_falloff != 0u) {
+            e *= hvl_disc_falloff(dist, r);
+        }
         vec3 lj = hvls.h[j].flux.rgb * (e * g);
         float cos_a = cos(a);
 #ifdef HVL_FULL

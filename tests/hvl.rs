@@ -15,7 +15,7 @@ use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::hvl::{
-    CONV_BANDS, CachePush, Distribution, GatherPath, GatherPush, Hvl, HvlError, HvlParams,
+    CONV_BANDS, CachePush, Distribution, Falloff, GatherPath, GatherPush, Hvl, HvlError, HvlParams,
     MAX_HVLS, RadiusHeuristic, Window, gather_variants, hvl_cache, hvl_gather,
 };
 use shine::passes::receivers::Receivers;
@@ -158,6 +158,7 @@ fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
         count: 64,
         distribution: Distribution::Grid,
         window: Window::None,
+        falloff: Falloff::Sphere,
         radius: RadiusHeuristic::R2,
         radius_scale: 1.5,
         conv_bands,
@@ -690,18 +691,21 @@ fn gather_matches_the_cpu_reference() {
     let hvls = reference::build_cache(&rsm, &params(GatherPath::Full, 5, 3)).unwrap();
     // Some of the variants: a lavapipe compile of the 9- and 10-band variants costs seconds
     // each (the 9-band ones are checked against the quadrature below).
+    let (none, sphere) = (Window::None, Falloff::Sphere);
     let variants = [
-        (GatherPath::Full, 2, 1, Window::None),
-        (GatherPath::Full, 3, 3, Window::None),
-        (GatherPath::Full, 5, 5, Window::None),
-        (GatherPath::Full, 5, 3, Window::Sinc),
-        (GatherPath::Full, 6, 4, Window::None),
-        (GatherPath::Zonal, 1, 1, Window::None),
-        (GatherPath::Zonal, 5, 3, Window::Sinc),
+        (GatherPath::Full, 2, 1, none, sphere),
+        (GatherPath::Full, 3, 3, none, sphere),
+        (GatherPath::Full, 5, 5, none, sphere),
+        (GatherPath::Full, 5, 3, Window::Sinc, sphere),
+        (GatherPath::Full, 5, 3, none, Falloff::Disc),
+        (GatherPath::Full, 6, 4, none, sphere),
+        (GatherPath::Zonal, 1, 1, none, sphere),
+        (GatherPath::Zonal, 5, 3, Window::Sinc, Falloff::Disc),
     ];
-    for (path, conv, emission, window) in variants {
+    for (path, conv, emission, window, falloff) in variants {
         let p = HvlParams {
             window,
+            falloff,
             ..params(path, conv, emission)
         };
         let brdf = tables(conv, [12, 24]);
@@ -718,26 +722,32 @@ fn gather_matches_the_cpu_reference() {
             for k in 0..4 {
                 assert!(
                     close(g[k], c[k], 2e-3, 1e-3 * peak),
-                    "{path:?} c{conv} e{emission} {window:?} pixel {i}: GPU {g} vs CPU {c}"
+                    "{path:?} c{conv} e{emission} {window:?} {falloff:?} pixel {i}: GPU {g} vs CPU {c}"
                 );
             }
         }
-        if window == Window::Sinc {
-            // The window changes the light: the same gather without it differs.
-            let plain = HvlParams {
+        // The window and the disc falloff each change the light: the same gather without
+        // the one in use differs.
+        let without = [
+            (window == Window::Sinc).then_some(HvlParams {
                 window: Window::None,
                 ..p
-            };
-            let unwindowed =
-                reference::gather(&receivers, &hvls, &brdf, CAMERA, &plain, None).unwrap();
+            }),
+            (falloff == Falloff::Disc).then_some(HvlParams {
+                falloff: Falloff::Sphere,
+                ..p
+            }),
+        ];
+        for plain in without.into_iter().flatten() {
+            let other = reference::gather(&receivers, &hvls, &brdf, CAMERA, &plain, None).unwrap();
             let changed = cpu
                 .iter()
-                .zip(&unwindowed)
+                .zip(&other)
                 .filter(|(a, b)| (**a - **b).abs().max_element() > 0.01 * peak)
                 .count();
             assert!(
                 changed > 50,
-                "{path:?} c{conv}: the window changed {changed} pixels"
+                "{path:?} c{conv}: {plain:?} changed {changed} pixels"
             );
         }
     }
@@ -929,9 +939,18 @@ fn single_hvl_against_numerical_integration() {
                 camera,
                 glossy,
                 Emission::Sh(emission as usize),
+                p.falloff,
                 [96, 192],
             );
-            let exact = integrate_hvl(&hvl, &receiver, camera, glossy, Emission::Exact, [96, 192]);
+            let exact = integrate_hvl(
+                &hvl,
+                &receiver,
+                camera,
+                glossy,
+                Emission::Exact,
+                p.falloff,
+                [96, 192],
+            );
             assert!(exact.max_element() > 0.0, "receiver {i} gets no light");
             let err = |r: Vec3| (g.truncate() - r).abs().max_element() / r.max_element();
             worst_conv = worst_conv.max(err(sh));

@@ -408,6 +408,14 @@ float hvl_radius_r2_orthographic(float width, float hvl_count) {
     return 1.41421356237309505 * width / sqrt(hvl_count);
 }
 
+// shine_sh::hvl::disc_falloff: what a disc of area pi r^2 sends over what the HVL's sphere sends,
+// d^2 / (d^2 + r^2) outside, r^2 / (d^2 + r^2) inside (1/2 at d = r from both sides)
+float hvl_disc_falloff(float distance, float radius) {
+    float d2 = distance * distance;
+    float r2 = radius * radius;
+    return distance >= radius ? d2 / (d2 + r2) : r2 / (d2 + r2);
+}
+
 // shine_sh::hvl::MIN_INCIDENCE_COS
 const float HVL_MIN_INCIDENCE_COS = 0.1;
 

@@ -84,6 +84,7 @@ impl FrameParams {
                 emission_bands: h.emission_bands,
                 path: h.gather,
                 window: h.window,
+                falloff: h.falloff,
                 visibility: h.visibility,
                 slices: h.slices,
             }),

@@ -326,6 +326,7 @@ pub fn vpls(
         emission_bands: 1,
         path: hvl::GatherPath::Zonal,
         window: hvl::Window::None,
+        falloff: hvl::Falloff::Sphere,
         visibility: false,
         slices: 1,
     };

@@ -10,7 +10,8 @@
 use glam::{DVec3, Vec3, Vec4};
 use shine_sh::brdf_table::BrdfModel;
 use shine_sh::hvl::{
-    HvlNeighbour, cap_half_angle, geometric_factor, radius_r1, radius_r2, radius_r2_orthographic,
+    HvlNeighbour, cap_half_angle, disc_falloff, geometric_factor, radius_r1, radius_r2,
+    radius_r2_orthographic,
 };
 use shine_sh::kernels::clamped_cosine_zh;
 use shine_sh::legendre::legendre_all;
@@ -19,7 +20,8 @@ use shine_sh::zonal::{cap_sh, cap_zh};
 
 use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::{
-    Distribution, EMISSION_MAX_BANDS, GatherPath, Hvl, HvlError, HvlParams, RadiusHeuristic,
+    Distribution, EMISSION_MAX_BANDS, Falloff, GatherPath, Hvl, HvlError, HvlParams,
+    RadiusHeuristic,
 };
 use crate::passes::rsm::RsmProjection;
 
@@ -290,9 +292,16 @@ pub enum Emission {
     Sh(usize),
 }
 
-/// What one HVL sends to a receiver: the incoming radiance `L_j(x, ω_j)` (eq. 20–22), the unit
-/// direction `ω_j` and the half-angle `a`; `None` when it sends nothing.
-pub fn hvl_incoming(hvl: &Hvl, x: Vec3, n: Vec3, emission: Emission) -> Option<(Vec3, Vec3, f32)> {
+/// What one HVL sends to a receiver: the incoming radiance `L_j(x, ω_j)` (eq. 20–22, times the
+/// disc's near-field factor with [`Falloff::Disc`]), the unit direction `ω_j` and the
+/// half-angle `a`; `None` when it sends nothing.
+pub fn hvl_incoming(
+    hvl: &Hvl,
+    x: Vec3,
+    n: Vec3,
+    emission: Emission,
+    falloff: Falloff,
+) -> Option<(Vec3, Vec3, f32)> {
     let r = hvl.position_radius[3];
     if r.is_nan() || r <= 0.0 {
         return None;
@@ -309,10 +318,13 @@ pub fn hvl_incoming(hvl: &Hvl, x: Vec3, n: Vec3, emission: Emission) -> Option<(
     if g.is_nan() || g <= 0.0 {
         return None;
     }
-    let e = match emission {
+    let mut e = match emission {
         Emission::Exact => std::f32::consts::FRAC_1_PI,
         Emission::Sh(bands) => zh_eval(&hvl.emission[..bands], hvl_n.normalize().dot(-wj)).max(0.0),
     };
+    if falloff == Falloff::Disc {
+        e *= disc_falloff(dist, r);
+    }
     Some((Vec4::from(hvl.flux).truncate() * (e * g), wj, a))
 }
 
@@ -360,7 +372,7 @@ pub fn shade(
             let f_lambert = brdf.lambert.lookup_f(theta_o);
             let f_glossy = brdf.glossy_f(receiver.roughness, theta_o);
             for hvl in hvls {
-                let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
+                let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission, params.falloff) else {
                     continue;
                 };
                 if hidden(hvl, x, n) {
@@ -382,7 +394,7 @@ pub fn shade(
                 .map(|c| c / std::f32::consts::PI)
                 .collect();
             for hvl in hvls {
-                let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
+                let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission, params.falloff) else {
                     continue;
                 };
                 if hidden(hvl, x, n) {
@@ -441,10 +453,11 @@ pub fn integrate_hvl(
     camera: Vec3,
     glossy: BrdfModel,
     emission: Emission,
+    falloff: Falloff,
     nodes: [usize; 2],
 ) -> Vec3 {
     let (x, n) = (receiver.position, receiver.normal.normalize());
-    let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission) else {
+    let Some((lj, wj, a)) = hvl_incoming(hvl, x, n, emission, falloff) else {
         return Vec3::ZERO;
     };
     let Some((t, b, _)) = receiver_frame(n, (camera - x).normalize()) else {

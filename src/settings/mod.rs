@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 use crate::capture::tonemap::Tonemap;
 use crate::passes::aaf::AafParams;
 use crate::passes::composite::{Component, CompositeParams};
-use crate::passes::hvl::{Distribution, GatherPath, HvlParams, RadiusHeuristic, Window};
+use crate::passes::hvl::{Distribution, Falloff, GatherPath, HvlParams, RadiusHeuristic, Window};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
 use crate::passes::proxy::{DEFAULT_ORDER, ExpMethod, INDIRECT_BANDS, paper_expansion};
 use crate::passes::upsample::{DEPTH_SIGMA, NORMAL_POWER_N};
@@ -200,6 +200,10 @@ pub struct HvlSettings {
     /// Window on each HVL's SH bands against ringing: `none` or `sinc` (paper 003 §4.2,
     /// Sloan's sinc of width `convolution_bands`). Default `none`.
     pub window: Window,
+    /// Near-field falloff of each HVL: `sphere` (paper 003 eq. 20–22: the point-light
+    /// irradiance up to the sphere's surface) or `disc` (a Lambertian disc of the same area:
+    /// half of that at the rim). Default `sphere`.
+    pub falloff: Falloff,
     /// Receivers per gather refresh (paper 001): 1 gathers every receiver every frame; 4
     /// gathers one receiver per 2×2 cell per frame and reprojects the others from the
     /// previous frames (`hvl_resolve`). Default 1.
@@ -375,6 +379,7 @@ impl Default for HvlSettings {
             visibility: h.visibility,
             gather: h.path,
             window: h.window,
+            falloff: h.falloff,
             slices: h.slices,
         }
     }

@@ -167,6 +167,28 @@ pub fn radius_r2_orthographic(width: f32, hvl_count: u32) -> Result<f32> {
     Ok((std::f64::consts::SQRT_2 * f64::from(width) / f64::from(hvl_count).sqrt()) as f32)
 }
 
+/// The near-field correction of an HVL of radius `r` seen from distance `d` (shine's, not in
+/// paper 003): the ratio of what a Lambertian disc of area πr² sends to what eq. 20–22's
+/// sphere sends.
+/// - Outside the sphere (d ≥ r), the sphere's cap gives the point-light irradiance `Φ/(π d²)`
+///   up to its surface, twice the disc's on-axis `Φ/(π (r² + d²))` at d = r. The factor is
+///   `d²/(d² + r²)`.
+/// - Inside, the cap is the whole sphere, about `Φ/(π r²)`. The factor is `r²/(d² + r²)`:
+///   1 at the centre.
+///
+/// The two forms meet at 1/2 at d = r, and the factor tends to 1 far away. It brings HVL's
+/// energy on the cornell box from 1.12 to 1.02 of the truth, but darkens the animated scene
+/// (docs/quality.md), so `hvl.falloff` defaults to the sphere. GLSL twin `hvl_disc_falloff`
+/// in `sh.glsl`.
+pub fn disc_falloff(distance: f32, radius: f32) -> f32 {
+    let (d2, r2) = (distance * distance, radius * radius);
+    if distance >= radius {
+        d2 / (d2 + r2)
+    } else {
+        r2 / (d2 + r2)
+    }
+}
+
 /// Smallest cosine of incidence [`rsm_texel_area`] divides by: a texel lit at grazing
 /// incidence (beyond about 84°) counts as lit at 84°, so its patch and the radius taken from
 /// it stay finite.
@@ -350,5 +372,17 @@ mod tests {
         let on_axis = rsm_texel_area(fov, size, d, 1.0, 1.0);
         let off_axis = rsm_texel_area(fov, size, d, 0.5, 1.0);
         assert!((off_axis / on_axis - 0.125).abs() < 1e-6);
+    }
+
+    /// Continuous at the rim (1/2 from both sides), 1 at the centre, towards 1 far away.
+    #[test]
+    fn disc_falloff_is_continuous() {
+        let r = 0.3;
+        assert!((disc_falloff(r * (1.0 - 1e-6), r) - 0.5).abs() < 1e-5);
+        assert!((disc_falloff(r, r) - 0.5).abs() < 1e-6);
+        assert_eq!(disc_falloff(0.0, r), 1.0);
+        assert!(disc_falloff(100.0 * r, r) > 0.9999);
+        // d = 2r: the disc's Φ/(π 5r²) over the sphere's Φ/(π 4r²).
+        assert!((disc_falloff(2.0 * r, r) - 0.8).abs() < 1e-6);
     }
 }

@@ -4,7 +4,8 @@
 use glam::Vec3;
 
 use super::{
-    GatherPath, GatherPush, HvlError, HvlParams, Window, cache_bytes, check_extent, resolve,
+    Falloff, GatherPath, GatherPush, HvlError, HvlParams, Window, cache_bytes, check_extent,
+    resolve,
 };
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
@@ -144,7 +145,8 @@ fn record_gather(
             Window::None => 0.0,
             Window::Sinc => params.conv_bands as f32,
         },
-        pad: [0; 3],
+        disc_falloff: u32::from(params.falloff == Falloff::Disc),
+        pad: [0; 2],
     };
     let (name, threads) = match slice {
         0 => ("hvl_gather", [w, h, 1]),

@@ -158,8 +158,10 @@ pub struct GatherPush {
     /// Width of the sinc window on the light's SH bands (the convolution's band count), 0 for
     /// none.
     pub window_width: f32,
+    /// 1: [`Falloff::Disc`]; 0: the paper's sphere.
+    pub disc_falloff: u32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: [u32; 2],
 }
 
 crate::choice::named_choice! {
@@ -183,6 +185,17 @@ crate::choice::named_choice! {
         /// from its own texel's position and normal, with the r2 radius taken from the local
         /// spacing ([`shine_sh::hvl::radius_spacing`]).
         Flux = "flux",
+    }
+}
+
+crate::choice::named_choice! {
+    /// How an HVL's light falls off near it (`hvl.falloff`).
+    pub enum Falloff ("HVL falloff") {
+        /// Paper 003's sphere (eq. 20–22): the point-light irradiance up to its surface.
+        Sphere = "sphere",
+        /// A Lambertian disc of the same area ([`shine_sh::hvl::disc_falloff`]): half the
+        /// sphere's at its rim, the same far away.
+        Disc = "disc",
     }
 }
 
@@ -227,6 +240,8 @@ pub struct HvlParams {
     pub path: GatherPath,
     /// Window on the SH bands of each HVL's light.
     pub window: Window,
+    /// Near-field falloff of each HVL.
+    pub falloff: Falloff,
     /// Shadow rays from each receiver to each HVL through the scene's BVH (not in paper 003,
     /// whose HVLs are unshadowed).
     pub visibility: bool,
@@ -237,9 +252,9 @@ pub struct HvlParams {
 
 impl Default for HvlParams {
     /// Paper 003's choices but one: 400 HVLs (fig. 10), r2 radii scaled by 1.5 (§5.3: 1–2),
-    /// 5 convolution and 3 emission bands, the full path, unshadowed; placed by flux rather
-    /// than on the paper's grid (relative RMSE of the cornell box's indirect light 0.64 → 0.34,
-    /// docs/quality.md).
+    /// 5 convolution and 3 emission bands, the full path, the sphere's falloff, unshadowed;
+    /// placed by flux rather than on the paper's grid (relative RMSE of the cornell box's
+    /// indirect light 0.64 → 0.34, docs/quality.md).
     fn default() -> Self {
         Self {
             count: 400,
@@ -250,6 +265,7 @@ impl Default for HvlParams {
             emission_bands: 3,
             path: GatherPath::Full,
             window: Window::None,
+            falloff: Falloff::Sphere,
             visibility: false,
             slices: 1,
         }
