@@ -381,7 +381,7 @@ mod tests {
         assert!((disc_falloff(r * (1.0 - 1e-6), r) - 0.5).abs() < 1e-5);
         assert!((disc_falloff(r, r) - 0.5).abs() < 1e-6);
         assert_eq!(disc_falloff(0.0, r), 1.0);
-        assert!(disc_falloff(100.0 * r, r) > 0.9999);
+        assert!(disc_falloff(1000.0 * r, r) > 0.9999);
         // d = 2r: the disc's Φ/(π 5r²) over the sphere's Φ/(π 4r²).
         assert!((disc_falloff(2.0 * r, r) - 0.8).abs() < 1e-6);
     }
