@@ -10,10 +10,11 @@
 //     the xz half-plane), F rows of the BRDF SH tables interpolated at theta_o (eq. 18), the
 //     glossy row blended between the two GGX tables around the receiver's roughness;
 //   zonal path (O(n)): L_j * kd * sum_l cap_l (cc_l / pi) P_l(n . omega_j) (Lambert only).
-// kd, ks: brdf_indirect_weights (Schlick F at n.v; ks over the tables' own dielectric F). Each
-// HVL's contribution is clamped
-// at 0 per channel (band-limited ringing must not go negative in the RGBA16F output; the
-// paper's sinc window is not applied). CPU twin: shine::reference::hvl.
+// kd, ks: brdf_indirect_weights (kd with the hemisphere-averaged Fresnel, ks with Schlick's F at
+// n.v over the tables' own dielectric F). Each HVL's contribution is clamped at 0 per channel
+// (band-limited ringing must not go negative in the RGBA16F output); the paper's sinc window
+// (push.window_width) and the disc falloff (push.disc_falloff) are options. CPU twin:
+// shine::reference::hvl.
 //! variant full_c1 HVL_FULL=1 SH_BANDS=1
 //! variant full_c2 HVL_FULL=1 SH_BANDS=2
 //! variant full_c3 HVL_FULL=1 SH_BANDS=3

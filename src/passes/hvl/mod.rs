@@ -41,7 +41,10 @@
 //!   one BVH shadow ray per receiver and HVL, to the HVL's centre lifted off its surface
 //!   (shine's extension; measured against the path tracer in the issue notes).
 //! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
-//!   never makes `indirect` negative; the paper's sinc window (§4.2) is not applied.
+//!   never makes `indirect` negative. The paper's sinc window (§4.2) is [`Window::Sinc`], off
+//!   by default: it costs 5–7% of the energy for no visible ringing (docs/quality.md).
+//! * **Near field.** [`Falloff::Disc`] scales each HVL's light to what a disc of the same area
+//!   sends ([`shine_sh::hvl::disc_falloff`]); off by default (measured in docs/quality.md).
 //! * **Receiver BRDF.** `kd` times Lambert and `ks` times GGX (its tables hold the dielectric
 //!   Fresnel of η = 1.5; [`table_fresnel_weight`] swaps it for the material's, approximately,
 //!   at n·v) at the receiver's roughness, with the weights of [`indirect_weights`]: the paper
