@@ -139,10 +139,8 @@ void main() {
     hvls.h[index].position_radius = position_radius;
     hvls.h[index].normal_distance = normal_distance;
     hvls.h[index].flux = flux_valid;
-    // eq. 20: F' of the Lambert sender (albedo in the flux, cosine in G) is 1/pi in every
-    // direction: band 0 only, sqrt(4 pi) / pi (shine::reference::hvl::sender_emission_zh)
     for (int l = 0; l < 8; ++l) {
-        hvls.h[index].emission[l] = l == 0 ? emission_scale * SH_SQRT_4PI / SH_PI : 0.0;
+        hvls.h[index].emission[l] = emission_scale * hvl_sender_emission(l);
     }
 #else
     vec4 position_radius = source.h[index].position_radius;

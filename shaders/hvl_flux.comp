@@ -133,10 +133,8 @@ void write_hvl(uint m, vec4 position_radius, vec4 normal_distance, vec4 flux_val
     hvls.h[m].position_radius = position_radius;
     hvls.h[m].normal_distance = normal_distance;
     hvls.h[m].flux = flux_valid;
-    // eq. 20: F' of the Lambert sender is 1/pi in every direction, band 0 only
-    // (shine::reference::hvl::sender_emission_zh)
     for (int l = 0; l < 8; ++l) {
-        hvls.h[m].emission[l] = l == 0 ? emission_scale * SH_SQRT_4PI / SH_PI : 0.0;
+        hvls.h[m].emission[l] = emission_scale * hvl_sender_emission(l);
     }
 }
 

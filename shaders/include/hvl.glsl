@@ -26,6 +26,12 @@ struct Hvl {
     float emission[8];
 };
 
+// shine::reference::hvl::sender_emission_zh: ZH coefficient l of the Lambert sender's F'
+// (paper 003 eq. 20; albedo in the flux, cosine in G): 1/pi in every direction, band 0 only.
+float hvl_sender_emission(int l) {
+    return l == 0 ? SH_SQRT_4PI / SH_PI : 0.0;
+}
+
 // shine::reference::hvl::zh_eval: a ZH vector (about axis a) evaluated at direction b,
 // cos_angle = a . b: sum_l zh_l sqrt((2l+1)/(4 pi)) P_l(cos_angle), first `bands` bands.
 float hvl_zh_eval(float zh[8], int bands, float cos_angle) {

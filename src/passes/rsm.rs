@@ -111,14 +111,41 @@ pub fn rsm(
     r
 }
 
-/// The views whose RSMs feed the flux distribution: every light of `frame`, the primary light
+/// One RSM face to render: which light, through which view, at which side.
+#[derive(Debug, Clone)]
+pub struct FaceView {
+    /// Index of the light in the scene.
+    pub light: u32,
+    /// Name of its pass and prefix of its images: `rsm` for the primary light, `rsm light I`
+    /// for light I, a cube face's axis after it.
+    pub label: String,
+    /// The light's view.
+    pub view: View,
+    /// Side of the face in texels.
+    pub size: u32,
+}
+
+impl FaceView {
+    /// Rasterises this face ([`rsm`]).
+    pub fn render(&self, rg: &mut RenderGraph, scene: &SceneHandles, sampler: vk::Sampler) -> Rsm {
+        rsm(
+            rg,
+            scene,
+            self.view,
+            self.light,
+            self.size,
+            sampler,
+            &self.label,
+        )
+    }
+}
+
+/// The faces whose RSMs feed the flux distribution: every light of `frame`, the primary light
 /// (`primary`) first. A spot or directional light has one face of side `size`, as the
 /// primary's RSM. A point light has six cube faces of exactly 90° and side `size / 2` (at
 /// least [`SIZE`]'s minimum): they tile the sphere without overlap, so no flux is counted twice,
-/// and the six hold 1.5× the texels of one spot's RSM. Each entry: light index, pass label
-/// (`rsm` for the primary light, `rsm light I` for light I, a cube face's axis after it),
-/// view, side.
-pub fn face_views(frame: &FrameState, primary: usize, size: u32) -> Vec<(u32, String, View, u32)> {
+/// and the six hold 1.5× the texels of one spot's RSM.
+pub fn face_views(frame: &FrameState, primary: usize, size: u32) -> Vec<FaceView> {
     let mut order: Vec<usize> = (0..frame.lights.len()).collect();
     if primary < order.len() {
         order.remove(primary);
@@ -139,12 +166,22 @@ pub fn face_views(frame: &FrameState, primary: usize, size: u32) -> Vec<(u32, St
                 let eye = Vec3::from(light.position);
                 for (axis, up, name) in CUBE_FACES {
                     let view = cube_face(frame, eye, axis, up, 1.0);
-                    faces.push((i as u32, format!("{label} {name}"), view, cube_side));
+                    faces.push(FaceView {
+                        light: i as u32,
+                        label: format!("{label} {name}"),
+                        view,
+                        size: cube_side,
+                    });
                 }
             }
             Some(_) => {
                 if let Some(view) = light_view(frame, i) {
-                    faces.push((i as u32, label.clone(), view, size));
+                    faces.push(FaceView {
+                        light: i as u32,
+                        label: label.clone(),
+                        view,
+                        size,
+                    });
                 }
             }
             None => {}

@@ -122,6 +122,19 @@ pub fn build_flux_cache(faces: &[RsmData], params: &HvlParams) -> Result<Vec<Hvl
     let mut emission = [0.0f32; 8];
     emission[..EMISSION_MAX_BANDS].copy_from_slice(&sender_emission_zh(EMISSION_MAX_BANDS)?);
     let count = params.count;
+    // Per face: its footprint, whether it is orthographic, its unit axis.
+    let geometry: Vec<(RsmFootprint, bool, Vec3)> = faces
+        .iter()
+        .map(|face| match face.projection {
+            RsmProjection::Perspective { fov } => (RsmFootprint::Perspective { fov }, false),
+            RsmProjection::Orthographic { width } => (RsmFootprint::Orthographic { width }, true),
+        })
+        .zip(faces)
+        .map(|((footprint, ortho), face)| {
+            let axis = face.light_direction.normalize_or(Vec3::NEG_Y);
+            (footprint, ortho, axis)
+        })
+        .collect();
     let hvls = (0..count)
         .map(|m| match sample_texel(faces, &cdf, m, count) {
             None => Hvl {
@@ -133,12 +146,7 @@ pub fn build_flux_cache(faces: &[RsmData], params: &HvlParams) -> Result<Vec<Hvl
             Some((f, x, y)) => {
                 let face = &faces[f];
                 let s = face.size;
-                let footprint = match face.projection {
-                    RsmProjection::Perspective { fov } => RsmFootprint::Perspective { fov },
-                    RsmProjection::Orthographic { width } => RsmFootprint::Orthographic { width },
-                };
-                let ortho = matches!(face.projection, RsmProjection::Orthographic { .. });
-                let axis = face.light_direction.normalize_or(Vec3::NEG_Y);
+                let (footprint, ortho, axis) = geometry[f];
                 let t = (y * s + x) as usize;
                 let w = texel_weight(face, t);
                 let p = face.position[t].truncate();

@@ -161,19 +161,24 @@ impl Renderer {
         // directional light). Without a light they add nothing.
         let every_light = p.hvl.is_some_and(|h| h.distribution == Distribution::Flux)
             || p.igi.is_some_and(|i| i.distribution == Distribution::Flux);
-        let faces: Vec<(u32, String, View, u32)> = match scene.gpu.primary_light() {
+        let faces: Vec<rsm::FaceView> = match scene.gpu.primary_light() {
             Some(_) if hvl.is_none() && igi.is_none() => Vec::new(),
             Some(i) if every_light => rsm::face_views(frame, i, p.rsm_size),
             Some(i) => gbuffer::light_view(frame, i)
-                .map(|view| vec![(i as u32, "rsm".to_owned(), view, p.rsm_size)])
+                .map(|view| {
+                    vec![rsm::FaceView {
+                        light: i as u32,
+                        label: "rsm".to_owned(),
+                        view,
+                        size: p.rsm_size,
+                    }]
+                })
                 .unwrap_or_default(),
             None => Vec::new(),
         };
         let rsm_faces: Vec<rsm::Rsm> = faces
-            .into_iter()
-            .map(|(light, label, view, size)| {
-                rsm::rsm(rg, handles, view, light, size, textures, &label)
-            })
+            .iter()
+            .map(|face| face.render(rg, handles, textures))
             .collect();
         let rsm = (!rsm_faces.is_empty()).then_some(rsm_faces.as_slice());
         // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one

@@ -520,6 +520,12 @@ pub fn hvl_cache(
         }
         validate_projection(face.projection)?;
     }
+    let desc = BufferDesc::new(cache_bytes(params.count));
+    let mut built = rg.create_buffer("hvl_cache", desc);
+    if params.distribution == Distribution::Flux {
+        flux::flux_cache(rg, faces, params, &mut built)?;
+        return Ok(built);
+    }
     let push = cache_push(
         rsm.light_position,
         rsm.light_direction,
@@ -527,12 +533,6 @@ pub fn hvl_cache(
         grid,
         params,
     );
-    let desc = BufferDesc::new(cache_bytes(params.count));
-    let mut built = rg.create_buffer("hvl_cache", desc);
-    if params.distribution == Distribution::Flux {
-        flux::flux_cache(rg, faces, params, &mut built)?;
-        return Ok(built);
-    }
     rg.compute("hvl_cache", &shaders::HVL_CACHE_COMP_BUILD)
         .read("rsm_position", &rsm.position)
         .read("rsm_normal", &rsm.normal)
