@@ -1,6 +1,6 @@
-//! `shine study aaf` as a user runs it: a tiny study (32×32, a 32-spp truth, three spp levels,
-//! two μ) whose JSON report has every field, finite, and whose pictures are written; and bad
-//! input (exit status 1, a message, no panic).
+//! `shine study aaf` and `shine study temporal` as a user runs them: tiny studies whose JSON
+//! reports have every field, finite, and whose pictures are written; and bad input (exit
+//! status 1, a message, no panic).
 
 mod common;
 
@@ -171,4 +171,84 @@ fn study_refuses_bad_input_cleanly() {
     fails_cleanly(&study(&["--repeats", "0"]), "at least 1");
     // Nothing was written by a refused study.
     assert_eq!(std::fs::read_dir(&dir).expect("read dir").count(), 0);
+}
+
+/// `shine study temporal` on a tiny sequence: every number of the JSON report is finite, a
+/// mode without history flickers exactly as its cold frames do (nothing carries over), and
+/// the plots and flicker maps are written.
+#[test]
+fn tiny_temporal_study_reports_flicker_and_writes_the_pictures() {
+    let dir = scratch("cli_study_temporal");
+    let out = shine(&[
+        "study",
+        "temporal",
+        "builtin:animated",
+        "--frames",
+        "4",
+        "--warmup",
+        "1",
+        "--width",
+        "16",
+        "--height",
+        "16",
+        "--truth-spp",
+        "4",
+        "--mode",
+        "hvl=gi=hvl",
+        "--mode",
+        "igi cold=gi=igi;history.frames=1",
+        "--format",
+        "json",
+        "--out",
+        dir.to_str().expect("utf-8 path"),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let report: Value = serde_json::from_slice(&out.stdout).expect("study prints JSON");
+    assert_eq!(report["extent"], serde_json::json!([16, 16]));
+    assert!(finite(&report, "/truth_flicker") > 0.0);
+    finite(&report, "/truth_still_flicker");
+    for k in 0..2 {
+        for field in [
+            "ms_per_frame",
+            "relative_rmse",
+            "flicker",
+            "still_flicker",
+            "last_rmse",
+            "cold_flicker",
+            "cold_still_flicker",
+            "cold_last_rmse",
+        ] {
+            let v = finite(&report, &format!("/modes/{k}/{field}"));
+            assert!(v >= 0.0, "modes[{k}].{field} = {v}");
+        }
+        assert_eq!(
+            report["modes"][k]["flicker_by_frame"]
+                .as_array()
+                .map(Vec::len),
+            Some(2)
+        );
+    }
+    let (flicker, cold) = (
+        finite(&report, "/modes/1/flicker"),
+        finite(&report, "/modes/1/cold_flicker"),
+    );
+    assert!(
+        (flicker - cold).abs() <= 1e-4 * cold,
+        "{flicker} against {cold}"
+    );
+    for (name, size) in [
+        ("plot.png", None),
+        ("flicker-by-frame.png", None),
+        ("flicker-truth.png", Some((256, 264))),
+        ("flicker-hvl.png", Some((256, 264))),
+        ("flicker-igi_cold.png", Some((256, 264))),
+        ("still.png", Some((256, 264))),
+    ] {
+        let path = dir.join(name);
+        let image = shine::capture::image_io::read_png(&path)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        if let Some((w, h)) = size {
+            assert_eq!((image.width, image.height), (w, h), "{name}");
+        }
+    }
 }

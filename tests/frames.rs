@@ -23,6 +23,9 @@ fn settings(gi: &str) -> Settings {
     };
     s.set("gi", gi).expect("gi");
     s.set("shadow.size", "128").expect("shadow size");
+    // No history: a sequence's frame then owes nothing to the frames before it, which is what
+    // these tests compare (tests/accumulate.rs covers the history).
+    s.set("history.frames", "1").expect("history");
     s
 }
 

@@ -135,6 +135,15 @@ fn hvl_resolve_constants_match_the_shader() {
 }
 
 #[test]
+fn accumulate_constant_matches_the_shader() {
+    use shine::passes::accumulate::ACCUMULATE_MIN_WEIGHT;
+    assert_eq!(
+        glsl_float("include/accumulate.glsl", "ACCUMULATE_MIN_WEIGHT"),
+        ACCUMULATE_MIN_WEIGHT
+    );
+}
+
+#[test]
 fn hvl_incidence_clamp_matches_the_shader() {
     assert_eq!(
         glsl_float("include/sh.glsl", "HVL_MIN_INCIDENCE_COS"),

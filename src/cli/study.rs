@@ -25,7 +25,8 @@ enum Study {
     /// and AAF at several μ; the samples and time uniform sampling needs for AAF's error.
     Aaf(AafStudyArgs),
     /// GI modes in motion (paper 001): cost per frame, error against a path-traced truth of
-    /// every frame, and flicker, on an animated sequence; plot.png beside the report.
+    /// every frame, and flicker, on an animated sequence, as a sequence and cold; plots and
+    /// per-pixel flicker maps beside the report.
     Temporal(TemporalStudyArgs),
 }
 
@@ -59,7 +60,8 @@ pub struct TemporalStudyArgs {
     /// default: `hvl=gi=hvl` and `hvl/4=gi=hvl;hvl.slices=4`.
     #[arg(long = "mode")]
     modes: Vec<String>,
-    /// Output folder for plot.png (default: out/study-temporal-SCENE).
+    /// Output folder for plot.png, flicker-by-frame.png and flicker-LABEL.png (default:
+    /// out/study-temporal-SCENE).
     #[arg(long)]
     out: Option<PathBuf>,
     /// Report format on stdout: table or json.
@@ -182,12 +184,14 @@ fn run_temporal(args: &TemporalStudyArgs) -> Result<(), CliError> {
     let mut bars = Bars::default();
     let report = temporal::run(&device, &scene, &args.scene, &config, &modes, &mut bars)?;
     std::fs::create_dir_all(&out)?;
-    report.plot(&out.join("plot.png"))?;
+    let written = report.write_pictures(&out)?;
     match format {
         StudyFormat::Json => println!("{}", serde_json::to_string_pretty(&report)?),
         StudyFormat::Table => print!("{}", report.table()),
     }
-    eprintln!("wrote {}", out.join("plot.png").display());
+    for path in written {
+        eprintln!("wrote {}", path.display());
+    }
     Ok(())
 }
 

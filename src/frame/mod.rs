@@ -8,6 +8,7 @@
 //! declare with. `Renderer::declare_frame` composes them in one place.
 
 pub mod aaf;
+pub mod accumulate;
 pub mod error;
 pub mod hvl;
 pub mod igi;

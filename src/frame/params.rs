@@ -3,6 +3,7 @@
 //! the frame reads the settings.
 
 use crate::passes::aaf::AafParams;
+use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{Component, CompositeParams};
 use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParams};
 use crate::passes::hvl::HvlParams;
@@ -37,6 +38,9 @@ pub struct FrameParams {
     pub aaf: Option<AafParams>,
     /// The joint bilateral upsample of the receiver-resolution light.
     pub upsample: UpsampleParams,
+    /// The indirect light's accumulation over frames, when it has a history longer than one
+    /// frame.
+    pub history: Option<AccumulateParams>,
     /// Exposure and tonemap of the composite.
     pub composite: CompositeParams,
     /// Which part of the radiance the frame shows.
@@ -138,6 +142,10 @@ impl FrameParams {
                 normal_power: settings.upsample.normal_power,
                 ..UpsampleParams::default()
             },
+            history: (settings.history.frames > 1).then_some(AccumulateParams {
+                max_frames: settings.history.frames,
+                clip: settings.history.clip,
+            }),
             composite: CompositeParams {
                 exposure: settings.output.exposure,
                 tonemap: settings.output.tonemap,

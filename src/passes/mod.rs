@@ -3,6 +3,7 @@
 //! the same computation for its GPU test where one exists.
 
 pub mod aaf;
+pub mod accumulate;
 pub mod brdf_tables;
 pub mod composite;
 pub mod direct;

@@ -14,6 +14,7 @@
 //! ```
 
 pub mod aaf;
+pub mod accumulate;
 pub mod hvl;
 pub mod hvl_flux;
 pub mod igi;

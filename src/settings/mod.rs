@@ -38,6 +38,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::capture::tonemap::Tonemap;
 use crate::passes::aaf::AafParams;
+use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{Component, CompositeParams};
 use crate::passes::hvl::{Distribution, Falloff, GatherPath, HvlParams, RadiusHeuristic, Window};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
@@ -82,6 +83,33 @@ pub struct Settings {
     pub proxy: ProxySettings,
     /// Axis-aligned filtering of path-traced indirect light (paper 004).
     pub aaf: AafSettings,
+    /// The indirect light accumulated over the frames of a sequence (issue 23).
+    pub history: HistorySettings,
+}
+
+/// `[history]`: the indirect light accumulated over frames (`src/passes/accumulate.rs`):
+/// reprojected with the motion vectors, rejected on disocclusion, clipped to the current
+/// neighbourhood. A single still frame is unchanged (it has no history).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct HistorySettings {
+    /// Longest history n in frames: each frame blends in at least 1/n of its own light
+    /// (1: no accumulation). Range 1..=256, default 8.
+    pub frames: u32,
+    /// Half-width of the clip box in standard deviations of the current 3×3 neighbourhood
+    /// (0: history not clipped). Range 0.0..=16.0, default 3.0.
+    pub clip: f32,
+}
+
+impl Default for HistorySettings {
+    /// The defaults of the accumulate pass ([`AccumulateParams::default`]).
+    fn default() -> Self {
+        let a = AccumulateParams::default();
+        Self {
+            frames: a.max_frames,
+            clip: a.clip,
+        }
+    }
 }
 
 /// `[aaf]`: axis-aligned filtering of path-traced indirect light (paper 004,
@@ -335,6 +363,7 @@ impl Default for Settings {
             igi: IgiSettings::default(),
             proxy: ProxySettings::default(),
             aaf: AafSettings::default(),
+            history: HistorySettings::default(),
         }
     }
 }

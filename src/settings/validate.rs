@@ -7,7 +7,7 @@ use std::ops::RangeInclusive;
 use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
-use crate::passes::{aaf, hvl, igi, proxy, receivers, rsm, shadows, upsample};
+use crate::passes::{aaf, accumulate, hvl, igi, proxy, receivers, rsm, shadows, upsample};
 
 /// Output sides in pixels.
 pub const EXTENT: RangeInclusive<u32> = 1..=16384;
@@ -137,6 +137,12 @@ impl Settings {
         check("proxy.fit_count", self.proxy.fit_count, &proxy::FIT_COUNT)?;
         self.validate_igi()?;
         self.validate_aaf()?;
+        check(
+            "history.frames",
+            self.history.frames,
+            &accumulate::MAX_FRAMES_RANGE,
+        )?;
+        check("history.clip", self.history.clip, &accumulate::CLIP_RANGE)?;
         Ok(())
     }
 

@@ -16,6 +16,7 @@ pub mod plot;
 pub mod report;
 pub mod runner;
 pub mod temporal;
+pub mod temporal_plot;
 
 use crate::capture::image_io::ImageIoError;
 use crate::frame::RenderError;

@@ -1,23 +1,21 @@
-//! `shine study temporal`: GI modes judged in motion (issue 18). On an animated sequence,
-//! for each mode (a label and settings), the cost per frame, the error of every frame against
-//! a path-traced truth of that frame, and the flicker: the RMS of the second temporal
-//! difference of the frames over their mean. The truth is a fixed-seed, unjittered path-traced
-//! sequence (emissive surfaces lighting nothing, as the raster GI), whose own flicker is
-//! reported as the yardstick. A plot of cost against error, each point labelled with its
-//! flicker, is written as PNG.
+//! `shine study temporal`: GI modes judged in motion (issues 18 and 23). On an animated
+//! sequence, for each mode (a label and settings), the cost per frame, the error of every
+//! frame against a path-traced truth of that frame, and the flicker: the RMS of the second
+//! temporal difference of the frames over their mean. The truth is a fixed-seed, unjittered
+//! path-traced sequence (emissive surfaces lighting nothing, as the raster GI), whose own
+//! flicker is reported as the yardstick. Each mode is rendered twice: as a sequence (one
+//! renderer, its history kept from frame to frame) and cold (every frame a fresh scene at its
+//! time, no history), so that what history buys and what it costs in accuracy show side by
+//! side. Plots and per-pixel flicker maps are written by [`TemporalReport::write_pictures`].
 
-use std::path::Path;
 use std::time::Instant;
 
-use plotters::backend::RGBPixel;
-use plotters::prelude::*;
 use serde::Serialize;
 use shine_scene::Scene;
 
 use super::metrics;
-use super::plot::font;
 use super::{Progress, StudyError};
-use crate::capture::image_io::{HdrImage, LdrImage, write_png};
+use crate::capture::image_io::HdrImage;
 use crate::frame::renderer::Renderer;
 use crate::gpu::Device;
 use crate::gpu_scene::FrameUpdate;
@@ -53,12 +51,29 @@ pub struct TemporalConfig {
 pub struct ModeResult {
     /// The mode's label.
     pub label: String,
-    /// Median wall time of a frame (submission to readback), ms.
+    /// Median wall time of a frame of the sequence (submission to readback), ms.
     pub ms_per_frame: f64,
-    /// Mean over frames of the relative RMSE against the truth frame.
+    /// Mean over the sequence's frames of the relative RMSE against the truth frame.
     pub relative_rmse: f64,
-    /// RMS of the second temporal difference over the mean of the frames.
+    /// RMS of the second temporal difference over the mean of the sequence's frames.
     pub flicker: f64,
+    /// Flicker where the truth holds still: over the pixels of [`TemporalReport::still`].
+    pub still_flicker: f64,
+    /// Relative RMSE of the sequence's last frame.
+    pub last_rmse: f64,
+    /// Flicker of the cold frames (each rendered from a fresh scene at its time).
+    pub cold_flicker: f64,
+    /// Flicker of the cold frames where the truth holds still.
+    pub cold_still_flicker: f64,
+    /// Relative RMSE of the last cold frame (what the sequence's last frame is judged by).
+    pub cold_last_rmse: f64,
+    /// The sequence's flicker at each inner frame k (1..frames-1): RMS over pixels of
+    /// I(k+1) - 2 I(k) + I(k-1) over the mean of the frames.
+    pub flicker_by_frame: Vec<f64>,
+    /// Per-pixel flicker of the sequence (row-major): RMS over frames of the second
+    /// difference, over the mean of the frames.
+    #[serde(skip)]
+    pub flicker_map: Vec<f32>,
 }
 
 /// The study's report.
@@ -70,8 +85,22 @@ pub struct TemporalReport {
     pub frames: u32,
     /// Frames rendered before them, not measured.
     pub warmup: u32,
+    /// Width and height of the frames.
+    pub extent: [u32; 2],
     /// Flicker of the path-traced truth (the yardstick).
     pub truth_flicker: f64,
+    /// Where the truth holds still: the pixels whose per-pixel truth flicker is at most its
+    /// median (moving objects and their shadows are out; surfaces only a moving light
+    /// changes are in). Row-major.
+    #[serde(skip)]
+    pub still: Vec<bool>,
+    /// The truth's flicker over [`TemporalReport::still`].
+    pub truth_still_flicker: f64,
+    /// The truth's flicker at each inner frame.
+    pub truth_flicker_by_frame: Vec<f64>,
+    /// Per-pixel flicker of the truth.
+    #[serde(skip)]
+    pub truth_flicker_map: Vec<f32>,
     /// One result per mode.
     pub modes: Vec<ModeResult>,
 }
@@ -85,18 +114,8 @@ fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
     metrics::image_error(&rgb(a), &rgb(b), &mask).map_or(0.0, |e| e.relative_rmse)
 }
 
-/// RMS of the second temporal difference `I[k+1] - 2 I[k] + I[k-1]` over the mean of the
-/// frames (rgb); 0 for fewer than 3 frames.
-pub fn flicker(frames: &[HdrImage]) -> f64 {
-    let (mut se, mut n) = (0.0f64, 0usize);
-    for w in frames.windows(3) {
-        for ((a, b), c) in w[0].texels.iter().zip(&w[1].texels).zip(&w[2].texels) {
-            for k in 0..3 {
-                se += f64::from(c[k] - 2.0 * b[k] + a[k]).powi(2);
-                n += 1;
-            }
-        }
-    }
+/// Mean of the frames' rgb channels (at least 1e-12).
+fn frames_mean(frames: &[HdrImage]) -> f64 {
     let (mut sum, mut m) = (0.0f64, 0usize);
     for f in frames {
         for t in &f.texels {
@@ -104,10 +123,92 @@ pub fn flicker(frames: &[HdrImage]) -> f64 {
             m += 3;
         }
     }
+    (sum / m.max(1) as f64).max(1e-12)
+}
+
+/// Squared second temporal difference `I[k+1] - 2 I[k] + I[k-1]` of every pixel (summed over
+/// rgb) at each inner frame k.
+fn second_differences(frames: &[HdrImage]) -> Vec<Vec<f64>> {
+    frames
+        .windows(3)
+        .map(|w| {
+            w[0].texels
+                .iter()
+                .zip(&w[1].texels)
+                .zip(&w[2].texels)
+                .map(|((a, b), c)| {
+                    (0..3)
+                        .map(|k| f64::from(c[k] - 2.0 * b[k] + a[k]).powi(2))
+                        .sum()
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// RMS of the second temporal difference `I[k+1] - 2 I[k] + I[k-1]` over the mean of the
+/// frames (rgb); 0 for fewer than 3 frames.
+pub fn flicker(frames: &[HdrImage]) -> f64 {
+    let d = second_differences(frames);
+    let n: usize = d.iter().map(|f| 3 * f.len()).sum();
     if n == 0 {
         return 0.0;
     }
-    (se / n as f64).sqrt() / (sum / m.max(1) as f64).max(1e-12)
+    let se: f64 = d.iter().flatten().sum();
+    (se / n as f64).sqrt() / frames_mean(frames)
+}
+
+/// [`flicker`] over the pixels where `mask` holds (RMS and mean both over them).
+pub fn flicker_masked(frames: &[HdrImage], mask: &[bool]) -> f64 {
+    let d = second_differences(frames);
+    let (mut se, mut n) = (0.0f64, 0usize);
+    for f in &d {
+        for (v, _) in f.iter().zip(mask).filter(|(_, m)| **m) {
+            se += v;
+            n += 3;
+        }
+    }
+    let (mut sum, mut m) = (0.0f64, 0usize);
+    for f in frames {
+        for (t, _) in f.texels.iter().zip(mask).filter(|(_, m)| **m) {
+            sum += f64::from(t[0] + t[1] + t[2]);
+            m += 3;
+        }
+    }
+    if n == 0 || m == 0 {
+        return 0.0;
+    }
+    (se / n as f64).sqrt() / (sum / m as f64).max(1e-12)
+}
+
+/// The pixels whose value in `map` is at most its (lower) median: the calmer half.
+pub fn calm_half(map: &[f32]) -> Vec<bool> {
+    let mut sorted = map.to_vec();
+    sorted.sort_by(f32::total_cmp);
+    let median = sorted
+        .get(sorted.len().saturating_sub(1) / 2)
+        .copied()
+        .unwrap_or(0.0);
+    map.iter().map(|v| *v <= median).collect()
+}
+
+/// [`flicker`] at each inner frame, and per pixel (row-major), both over the mean of all the
+/// frames.
+pub fn flicker_parts(frames: &[HdrImage]) -> (Vec<f64>, Vec<f32>) {
+    let d = second_differences(frames);
+    let mean = frames_mean(frames);
+    let by_frame = d
+        .iter()
+        .map(|f| (f.iter().sum::<f64>() / (3 * f.len().max(1)) as f64).sqrt() / mean)
+        .collect();
+    let pixels = d.first().map_or(0, Vec::len);
+    let map = (0..pixels)
+        .map(|i| {
+            let se: f64 = d.iter().map(|f| f[i]).sum();
+            ((se / (3 * d.len()) as f64).sqrt() / mean) as f32
+        })
+        .collect();
+    (by_frame, map)
 }
 
 /// Runs the study: the truth sequence, then every mode's.
@@ -149,9 +250,11 @@ pub fn run(
         truth.push(tracer.read()?.full);
         progress.advance(1, "path tracing");
     }
+    let (truth_flicker_by_frame, truth_flicker_map) = flicker_parts(&truth);
+    let still = calm_half(&truth_flicker_map);
     let mut results = Vec::new();
     for mode in modes {
-        progress.stage(&mode.label, u64::from(config.frames));
+        progress.stage(&mode.label, 2 * u64::from(config.frames));
         let mut renderer = Renderer::new(device)?;
         renderer.set_scene(scene, config.time)?;
         for k in 0..config.warmup {
@@ -167,6 +270,13 @@ pub fn run(
             images.push(frame.hdr);
             progress.advance(1, &mode.label);
         }
+        // Cold: every frame from a fresh scene at its time, so nothing carries over.
+        let mut cold = Vec::new();
+        for &t in &times {
+            renderer.set_scene(scene, t)?;
+            cold.push(renderer.render(&mode.settings)?.hdr);
+            progress.advance(1, &format!("{} (cold)", mode.label));
+        }
         ms.sort_by(f64::total_cmp);
         let error = images
             .iter()
@@ -174,11 +284,23 @@ pub fn run(
             .map(|(a, b)| relative_rmse(a, b))
             .sum::<f64>()
             / images.len() as f64;
+        let last = |frames: &[HdrImage]| match (frames.last(), truth.last()) {
+            (Some(a), Some(b)) => relative_rmse(a, b),
+            _ => 0.0,
+        };
+        let (flicker_by_frame, flicker_map) = flicker_parts(&images);
         results.push(ModeResult {
             label: mode.label.clone(),
             ms_per_frame: ms[ms.len() / 2],
             relative_rmse: error,
             flicker: flicker(&images),
+            still_flicker: flicker_masked(&images, &still),
+            last_rmse: last(&images),
+            cold_flicker: flicker(&cold),
+            cold_still_flicker: flicker_masked(&cold, &still),
+            cold_last_rmse: last(&cold),
+            flicker_by_frame,
+            flicker_map,
         });
     }
     progress.finish();
@@ -186,104 +308,49 @@ pub fn run(
         scene: name.to_owned(),
         frames: config.frames,
         warmup: config.warmup,
+        extent: [first.settings.width, first.settings.height],
         truth_flicker: flicker(&truth),
+        truth_still_flicker: flicker_masked(&truth, &still),
+        still,
+        truth_flicker_by_frame,
+        truth_flicker_map,
         modes: results,
     })
 }
 
-impl TemporalReport {
-    /// The report as a table.
-    pub fn table(&self) -> String {
-        let mut out = format!(
-            "{} over {} frames after {} of warm-up; flicker of the path-traced truth {:.4}\n{:<28} {:>12} {:>14} {:>10}\n",
-            self.scene,
-            self.frames,
-            self.warmup,
-            self.truth_flicker,
-            "mode",
-            "ms/frame",
-            "rel. RMSE",
-            "flicker"
-        );
-        for m in &self.modes {
-            out.push_str(&format!(
-                "{:<28} {:>12.1} {:>14.4} {:>10.4}\n",
-                m.label, m.ms_per_frame, m.relative_rmse, m.flicker
-            ));
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2×1 image of one grey level per pixel.
+    fn frame(a: f32, b: f32) -> HdrImage {
+        HdrImage {
+            width: 2,
+            height: 1,
+            texels: vec![[a, a, a, 1.0], [b, b, b, 1.0]],
         }
-        out
     }
 
-    /// Draws cost (x) against error (y), each mode a point labelled with its flicker, into
-    /// `path` (PNG).
-    pub fn plot(&self, path: &Path) -> Result<(), StudyError> {
-        let (w, h) = (720u32, 480u32);
-        let mut rgb = vec![255u8; (w * h * 3) as usize];
-        self.draw(&mut rgb, (w, h))
-            .map_err(|e| StudyError::Plot(format!("{}: {e}", path.display())))?;
-        let texels = rgb
-            .chunks_exact(3)
-            .map(|p| [p[0], p[1], p[2], 255])
+    #[test]
+    fn a_steady_change_does_not_flicker_and_a_pop_does() {
+        let ramp: Vec<HdrImage> = (0..5).map(|k| frame(1.0 + k as f32, 2.0)).collect();
+        assert_eq!(flicker(&ramp), 0.0);
+        // Pixel 0 pops to 3 at frame 2 of five frames at 1: second differences 2, -4, 2 there.
+        let pop: Vec<HdrImage> = [1.0, 1.0, 3.0, 1.0, 1.0]
+            .iter()
+            .map(|&a| frame(a, 1.0))
             .collect();
-        Ok(write_png(
-            path,
-            &LdrImage {
-                width: w,
-                height: h,
-                texels,
-            },
-        )?)
-    }
-
-    fn draw(&self, rgb: &mut [u8], size: (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
-        let root =
-            BitMapBackend::<RGBPixel>::with_buffer_and_format(rgb, size)?.into_drawing_area();
-        root.fill(&WHITE)?;
-        let max_ms = self
-            .modes
-            .iter()
-            .map(|m| m.ms_per_frame)
-            .fold(1e-3, f64::max)
-            * 1.2;
-        let max_err = self
-            .modes
-            .iter()
-            .map(|m| m.relative_rmse)
-            .fold(1e-3, f64::max)
-            * 1.2;
-        let mut builder = ChartBuilder::on(&root);
-        builder.margin(16);
-        let labels = font().is_some();
-        if labels {
-            builder.x_label_area_size(40).y_label_area_size(56);
-        }
-        let mut chart = builder.build_cartesian_2d(0.0..max_ms, 0.0..max_err)?;
-        let mut mesh = chart.configure_mesh();
-        if labels {
-            mesh.x_desc("ms per frame").y_desc("relative RMSE vs truth");
-        } else {
-            mesh.disable_x_axis().disable_y_axis();
-        }
-        mesh.draw()?;
-        for (i, m) in self.modes.iter().enumerate() {
-            let colour = Palette99::pick(i).to_rgba();
-            chart.draw_series(std::iter::once(Circle::new(
-                (m.ms_per_frame, m.relative_rmse),
-                6,
-                colour.filled(),
-            )))?;
-            if labels {
-                // Offset in pixels to the right of the marker, so the text never covers it.
-                let label = EmptyElement::at((m.ms_per_frame, m.relative_rmse))
-                    + Text::new(
-                        format!("{} (flicker {:.3})", m.label, m.flicker),
-                        (10, -7),
-                        ("sans-serif", 14).into_font(),
-                    );
-                chart.draw_series(std::iter::once(label))?;
-            }
-        }
-        root.present()?;
-        Ok(())
+        let mean = (7.0 + 5.0) / 10.0;
+        let expected = ((4.0 + 16.0 + 4.0) / 6.0f64).sqrt() / mean;
+        assert!((flicker(&pop) - expected).abs() < 1e-9, "{}", flicker(&pop));
+        let (by_frame, map) = flicker_parts(&pop);
+        assert_eq!(by_frame.len(), 3);
+        assert!((by_frame[1] - (16.0f64 / 2.0).sqrt() / mean).abs() < 1e-9);
+        assert_eq!(map[1], 0.0);
+        // Over the still pixel alone, nothing flickers; over both, as everywhere.
+        let still = calm_half(&map);
+        assert_eq!(still, vec![false, true]);
+        assert_eq!(flicker_masked(&pop, &still), 0.0);
+        assert!((flicker_masked(&pop, &[true, true]) - flicker(&pop)).abs() < 1e-12);
     }
 }

@@ -40,6 +40,7 @@ impl Renderer {
             scene.gpu.forget_previous();
         }
         self.motion.reset();
+        self.accumulate.reset();
         self.hvl.forget_uploads();
         self.igi.forget_uploads();
         if let Some(scene) = self.scene.as_mut() {
@@ -70,8 +71,9 @@ impl Renderer {
         let unjittered = gbuffer::unjittered_camera_view(frame, width, height).view_proj();
         let motion_view = self.motion.declare(rg, unjittered, p.extent)?;
         let g = gbuffer::gbuffer(rg, &handles, &camera, &motion_view, p.extent, textures);
-        // Kept for the next frame (its previous normal and depth); nothing reads it yet.
-        history::gbuffer_history(rg, &g);
+        // Kept for the next frame (its previous normal and depth); the previous frame's is
+        // the accumulation's disocclusion test.
+        let geometry_then = history::gbuffer_history(rg, &g);
         let light_count = light_count(&scene.gpu.state)?;
         let atlas = shadows.declare(rg, &handles)?;
         let background = direct::Background {
@@ -90,6 +92,7 @@ impl Renderer {
             self.nearest.raw(),
         );
         let indirect = self.declare_indirect(rg, p, &handles, &g, &camera, None)?;
+        let indirect = self.accumulate_indirect(rg, p, indirect, &g, |_| geometry_then)?;
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
         let (first, second) = match (p.component, indirect.as_ref()) {
             (Component::Full, indirect) => (&direct, indirect),
@@ -108,6 +111,31 @@ impl Renderer {
             p.extent,
             &p.composite,
         ))
+    }
+
+    /// `indirect` (on the surfaces of `g`) accumulated over frames when `p` asks for a
+    /// history (issue 23; `geometry_then` declares or returns the previous frame's `gbuffer
+    /// history`, asked for only then); the history is forgotten on a frame without one or
+    /// without indirect light.
+    pub(super) fn accumulate_indirect(
+        &mut self,
+        rg: &mut RenderGraph,
+        p: &FrameParams,
+        indirect: Option<Handle<Image>>,
+        g: &GBuffer,
+        geometry_then: impl FnOnce(&mut RenderGraph) -> Handle<Image>,
+    ) -> Result<Option<Handle<Image>>, RenderError> {
+        match (indirect, p.history) {
+            (Some(light), Some(params)) => {
+                let then = geometry_then(rg);
+                let prepared = self.accumulate.prepare(rg, params, p.extent);
+                Ok(Some(prepared.declare(rg, &light, g, &then)?))
+            }
+            (light, _) => {
+                self.accumulate.reset();
+                Ok(light)
+            }
+        }
     }
 
     /// The scene textures' sampler of `p`: trilinear, or level 0 without mipmaps.

@@ -5,6 +5,7 @@ use super::Renderer;
 use crate::frame::error::RenderError;
 use crate::frame::params::FrameParams;
 use crate::passes::gbuffer::{GBuffer, View};
+use crate::passes::history;
 use shine_gpu::vk;
 use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
@@ -66,7 +67,12 @@ impl Renderer {
             mut output,
             environment,
         } = host(rg)?;
-        match self.declare_indirect(rg, p, &handles, &g, camera, environment)? {
+        let indirect = self.declare_indirect(rg, p, &handles, &g, camera, environment)?;
+        // With a history (issue 23), the host's G-buffer is kept for the next frame's
+        // disocclusion test.
+        let indirect =
+            self.accumulate_indirect(rg, p, indirect, &g, |rg| history::gbuffer_history(rg, &g))?;
+        match indirect {
             Some(indirect) => {
                 rg.blit_image("gi to host", &indirect, &mut output, vk::Filter::NEAREST);
             }

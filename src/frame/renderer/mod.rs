@@ -10,6 +10,7 @@ mod host;
 pub(crate) use host::HostSide;
 
 use super::aaf::AafTechnique;
+use super::accumulate::AccumulateTechnique;
 use super::error::RenderError;
 use super::hvl::HvlTechnique;
 use super::igi::IgiTechnique;
@@ -155,6 +156,8 @@ pub struct Renderer {
     aaf: AafTechnique,
     /// The previous frame's camera, for motion vectors.
     motion: MotionState,
+    /// The indirect light's history (issue 23).
+    accumulate: AccumulateTechnique,
     /// Readback buffers of [`Renderer::render`].
     readback: Option<Readback>,
 }
@@ -232,6 +235,7 @@ impl Renderer {
             igi: IgiTechnique::new(device),
             aaf: AafTechnique,
             motion: MotionState::new(device)?,
+            accumulate: AccumulateTechnique::default(),
             readback: None,
         })
     }
@@ -254,6 +258,7 @@ impl Renderer {
         self.shadows = None;
         self.motion.reset();
         self.hvl.reset();
+        self.accumulate.reset();
         Ok(())
     }
 

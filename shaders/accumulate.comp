@@ -1,0 +1,121 @@
+// `accumulate` (issue 23, "history"; src/passes/accumulate.rs): the frame's indirect light
+// accumulated over frames. Each pixel's history is reprojected with the G-buffer's motion
+// vectors (a bilinear footprint whose taps count only where they show the pixel's surface:
+// `resolve_same_surface`, the amortised HVL's disocclusion test), clipped to the current 3×3
+// neighbourhood's mean ± clip·σ per channel (variance clipping, as TAA does; the box widened to
+// hold the pixel's own light, so a static image keeps its history), and blended with
+// weight 1/n, where n is the history's length (alpha), capped at `max_frames`: an exponential
+// history that converges where nothing changes, restarts where the surface was not visible
+// (n = 1) and follows at once where the light leaves the clip box. CPU twin:
+// shine::reference::accumulate::accumulate_cpu.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+#include "accumulate.glsl"
+#include "hvl_resolve.glsl"
+
+// This frame's indirect light.
+layout(set = 0, binding = 0, rgba16f) readonly uniform image2D current;
+// World position, w: linear depth (0 on the background).
+layout(set = 0, binding = 1, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D gb_normal;
+// uv now minus uv then.
+layout(set = 0, binding = 3, rg16f) readonly uniform image2D gb_motion;
+// The previous frame's (normal, linear depth): `gbuffer history`.
+layout(set = 0, binding = 4, rgba32f) readonly uniform image2D history_geometry;
+// The previous frame's accumulated light; alpha: its history length.
+layout(set = 0, binding = 5, rgba16f) readonly uniform image2D history_light;
+// This frame's accumulated light (next frame's history).
+layout(set = 0, binding = 6, rgba16f) uniform image2D accumulated;
+
+// shine::passes::accumulate::AccumulatePush
+layout(push_constant) uniform Push {
+    uvec2 extent;
+    // 1 when the history holds the previous frame
+    uint has_history;
+    // longest history n: the blend weight never falls below 1/max_frames
+    float max_frames;
+    // half-width of the clip box in standard deviations (0: no clipping)
+    float clip;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+} push;
+
+// Whether p is inside the image.
+bool inside(ivec2 p) {
+    return all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, ivec2(push.extent)));
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (!inside(p)) {
+        return;
+    }
+    vec3 light = imageLoad(current, p).rgb;
+    float depth = imageLoad(gb_position, p).w;
+    if (depth == 0.0 || push.has_history == 0u) {
+        imageStore(accumulated, p, vec4(light, depth == 0.0 ? 0.0 : 1.0));
+        return;
+    }
+    vec3 n = normalize(imageLoad(gb_normal, p).xyz);
+
+    // The history: bilinear over the taps that show this surface.
+    vec2 uv = (vec2(p) + 0.5) / vec2(push.extent);
+    vec2 then_px = (uv - imageLoad(gb_motion, p).xy) * vec2(push.extent) - 0.5;
+    ivec2 base = ivec2(floor(then_px));
+    vec2 f = then_px - vec2(base);
+    vec4 history = vec4(0.0);
+    float weight = 0.0;
+    for (int j = 0; j < 2; ++j) {
+        for (int i = 0; i < 2; ++i) {
+            ivec2 q = base + ivec2(i, j);
+            if (!inside(q)) {
+                continue;
+            }
+            vec4 g = imageLoad(history_geometry, q);
+            if (!resolve_same_surface(depth, n, g.w, g.xyz)) {
+                continue;
+            }
+            float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
+            history += w * imageLoad(history_light, q);
+            weight += w;
+        }
+    }
+    if (weight < ACCUMULATE_MIN_WEIGHT) {
+        // Disoccluded: the history restarts here.
+        imageStore(accumulated, p, vec4(light, 1.0));
+        return;
+    }
+    history /= weight;
+
+    if (push.clip > 0.0) {
+        // Mean and standard deviation of the current light over the 3×3 neighbourhood's
+        // foreground pixels.
+        vec3 sum = vec3(0.0);
+        vec3 sum2 = vec3(0.0);
+        float count = 0.0;
+        for (int y = -1; y <= 1; ++y) {
+            for (int x = -1; x <= 1; ++x) {
+                ivec2 q = p + ivec2(x, y);
+                if (!inside(q) || imageLoad(gb_position, q).w == 0.0) {
+                    continue;
+                }
+                vec3 c = imageLoad(current, q).rgb;
+                sum += c;
+                sum2 += c * c;
+                count += 1.0;
+            }
+        }
+        vec3 mean = sum / count;
+        vec3 sigma = sqrt(max(sum2 / count - mean * mean, vec3(0.0)));
+        // The box always holds the pixel's own light: where nothing changes, history is kept.
+        vec3 lo = min(light, mean - push.clip * sigma);
+        vec3 hi = max(light, mean + push.clip * sigma);
+        history.rgb = clamp(history.rgb, lo, hi);
+    }
+    float frames = min(history.a + 1.0, push.max_frames);
+    imageStore(accumulated, p, vec4(mix(history.rgb, light, 1.0 / frames), frames));
+}

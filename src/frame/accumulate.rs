@@ -1,0 +1,72 @@
+//! The indirect light's history as the frame uses it (issue 23): which frame last accumulated
+//! into it, so that a frame blends only with the one just before it at the same size
+//! (`accumulate`, `src/passes/accumulate.rs`).
+
+use shine_graph::{Handle, Image, RenderGraph};
+
+use super::error::RenderError;
+use crate::passes::accumulate::{self, AccumulateParams};
+use crate::passes::gbuffer::GBuffer;
+
+/// The accumulation's persistent state: the frame number and extent of the last frame that
+/// wrote the history.
+#[derive(Default)]
+pub struct AccumulateTechnique {
+    last: Option<(u64, [u32; 2])>,
+}
+
+/// An accumulation ready to be declared: its parameters and whether the history holds the
+/// previous frame.
+pub struct PreparedAccumulate {
+    params: AccumulateParams,
+    has_history: bool,
+}
+
+impl AccumulateTechnique {
+    /// Forgets the history (a new scene, a frame without accumulation, a dropped frame).
+    pub fn reset(&mut self) {
+        self.last = None;
+    }
+
+    /// This frame's accumulation at `extent`: it has history when the previous frame
+    /// accumulated at the same extent.
+    pub fn prepare(
+        &mut self,
+        rg: &RenderGraph,
+        params: AccumulateParams,
+        extent: [u32; 2],
+    ) -> PreparedAccumulate {
+        let frame = rg.frame();
+        let has_history = self.last == Some((frame.wrapping_sub(1), extent));
+        self.last = Some((frame, extent));
+        PreparedAccumulate {
+            params,
+            has_history,
+        }
+    }
+}
+
+impl PreparedAccumulate {
+    /// Adds `accumulate` over `current` (this frame's indirect light on the surfaces of `g`;
+    /// `history_geometry` is the previous frame's `gbuffer history`); returns the accumulated
+    /// light.
+    pub fn declare(
+        self,
+        rg: &mut RenderGraph,
+        current: &Handle<Image>,
+        g: &GBuffer,
+        history_geometry: &Handle<Image>,
+    ) -> Result<Handle<Image>, RenderError> {
+        let mut history = accumulate::accumulate_history(rg, g.extent);
+        accumulate::accumulate(
+            rg,
+            current,
+            g,
+            history_geometry,
+            &mut history,
+            &self.params,
+            self.has_history,
+        )
+        .map_err(|e| RenderError::Invalid(e.to_string()))
+    }
+}

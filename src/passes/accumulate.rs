@@ -1,0 +1,124 @@
+//! `accumulate`: the frame's indirect light accumulated over frames (issue 23, "history"), for
+//! every GI technique alike. Each pixel's history is reprojected with the G-buffer's motion
+//! vectors, bilinearly over the taps that show the pixel's surface (the amortised HVL's
+//! disocclusion test, [`crate::passes::hvl::resolve::same_surface`]), clipped to the current
+//! 3×3 neighbourhood's mean ± [`AccumulateParams::clip`] standard deviations per channel
+//! (variance clipping, as TAA clips colour history; the box widened to hold the pixel's own
+//! light, so that a static image keeps its history where a peak lies outside mean ± σ), and
+//! blended with weight 1/n, n the
+//! history's length capped at [`AccumulateParams::max_frames`].
+//!
+//! Decisions: the clip box is per RGB channel rather than in YCoCg (indirect light is smooth and
+//! chroma ghosts were not seen); background pixels are left out of the neighbourhood (their
+//! indirect light is 0); the history length lives in the image's alpha, so a disocclusion
+//! restarts at n = 1 and converges as fast as the first frames. Shader:
+//! `shaders/accumulate.comp`; CPU twin: [`crate::reference::accumulate::accumulate_cpu`].
+
+use std::ops::RangeInclusive;
+
+use super::OutOfRange;
+use super::gbuffer::GBuffer;
+use crate::graph::{Handle, History, Image, ImageDesc, RenderGraph, vk};
+use crate::shaders;
+
+/// Smallest bilinear weight of the history taps that show a pixel's surface; below it the
+/// history is rejected (`ACCUMULATE_MIN_WEIGHT` in shaders/include/accumulate.glsl).
+pub const ACCUMULATE_MIN_WEIGHT: f32 = 0.01;
+
+/// Default longest history: blend weight 1/8 once converged (about 8 frames of lag and of
+/// noise averaging).
+pub const DEFAULT_MAX_FRAMES: u32 = 8;
+/// Allowed longest history (1: no accumulation).
+pub const MAX_FRAMES_RANGE: RangeInclusive<u32> = 1..=256;
+/// Default half-width of the clip box in standard deviations of the current neighbourhood.
+/// Colour TAA uses about 1 (Salvi 2016: 0.75–1.25); GI is noisier: on `builtin:animated`, IGI's
+/// flicker where the truth holds still is 3.9× the truth's at 1, 3.2× at 2, 2.8× at 3 and 1.4×
+/// unclipped, at the same error (docs/quality.md).
+pub const DEFAULT_CLIP: f32 = 3.0;
+/// Allowed clip half-widths (0: the history is not clipped).
+pub const CLIP_RANGE: RangeInclusive<f32> = 0.0..=16.0;
+
+/// How the indirect light is accumulated.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AccumulateParams {
+    /// Longest history n: the blend weight of the current frame never falls below 1/n.
+    pub max_frames: u32,
+    /// Half-width of the clip box in standard deviations (0: no clipping).
+    pub clip: f32,
+}
+
+impl Default for AccumulateParams {
+    fn default() -> Self {
+        Self {
+            max_frames: DEFAULT_MAX_FRAMES,
+            clip: DEFAULT_CLIP,
+        }
+    }
+}
+
+impl AccumulateParams {
+    /// Checks both parameters against their ranges.
+    pub fn validate(&self) -> Result<(), OutOfRange> {
+        super::check_range("history.frames", self.max_frames, &MAX_FRAMES_RANGE)?;
+        super::check_range("history.clip", self.clip, &CLIP_RANGE)
+    }
+}
+
+/// Push constants of `shaders/accumulate.comp` (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct AccumulatePush {
+    /// Image size.
+    pub extent: [u32; 2],
+    /// 1 when the history holds the previous frame.
+    pub has_history: u32,
+    /// Longest history n.
+    pub max_frames: f32,
+    /// Clip half-width in standard deviations.
+    pub clip: f32,
+    /// Padding.
+    pub pad: [u32; 3],
+}
+
+/// Format of the accumulated light: rgb radiance, alpha the history length.
+pub const ACCUMULATED_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
+
+/// The accumulated light's ping-pong pair for frames of `extent`.
+pub fn accumulate_history(rg: &mut RenderGraph, extent: [u32; 2]) -> History<Image> {
+    let desc = ImageDesc::new_2d(ACCUMULATED_FORMAT, extent[0], extent[1]);
+    rg.history_image("accumulated indirect", desc)
+}
+
+/// Adds `accumulate`: `current` (this frame's indirect light on the surfaces of `g`) blended
+/// into the reprojected history (`history.previous`, valid when `has_history`; its geometry is
+/// `history_geometry`, the previous frame's `gbuffer history`). Writes `history.current` and
+/// returns it.
+pub fn accumulate(
+    rg: &mut RenderGraph,
+    current: &Handle<Image>,
+    g: &GBuffer,
+    history_geometry: &Handle<Image>,
+    history: &mut History<Image>,
+    params: &AccumulateParams,
+    has_history: bool,
+) -> Result<Handle<Image>, OutOfRange> {
+    params.validate()?;
+    let push = AccumulatePush {
+        extent: g.extent,
+        has_history: u32::from(has_history),
+        max_frames: params.max_frames as f32,
+        clip: params.clip,
+        pad: [0; 3],
+    };
+    rg.compute("accumulate", &shaders::ACCUMULATE_COMP)
+        .read("current", current)
+        .read("gb_position", &g.position)
+        .read("gb_normal", &g.normal)
+        .read("gb_motion", &g.motion)
+        .read("history_geometry", history_geometry)
+        .read("history_light", &history.previous)
+        .write("accumulated", &mut history.current)
+        .push(&push)
+        .dispatch([g.extent[0], g.extent[1], 1]);
+    Ok(history.current)
+}

@@ -1,0 +1,306 @@
+//! The indirect light's history (issue 23; src/passes/accumulate.rs): `accumulate` against its
+//! CPU twin (reprojection, disocclusion, variance clip, blend), history rejected on a
+//! disocclusion, and a static scene accumulated over frames against its single frame.
+
+mod common;
+
+use common::{bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
+use glam::{Vec2, Vec3, Vec4};
+use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
+use shine::passes::accumulate::{AccumulateParams, accumulate};
+use shine::passes::gbuffer::GBuffer;
+use shine::reference::accumulate::{AccumulateInputs, accumulate_cpu};
+use shine::{Renderer, Settings};
+use shine_scene::Scene;
+
+/// A deterministic pseudo-random number in [0, 1).
+struct Rng(u32);
+
+impl Rng {
+    fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        (self.0 >> 8) as f32 / (1u32 << 24) as f32
+    }
+}
+
+/// Runs `accumulate` on the GPU over `inp` (as uploaded: f16 values where the images are f16)
+/// and returns the accumulated light.
+fn accumulate_gpu(
+    device: &shine::gpu::Device,
+    inp: &AccumulateInputs<'_>,
+    params: &AccumulateParams,
+) -> Vec<Vec4> {
+    let [w, h] = inp.extent;
+    let rgba16 = vk::Format::R16G16B16A16_SFLOAT;
+    let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
+    let current: Vec<Vec4> = inp.current.iter().map(|c| c.extend(0.0)).collect();
+    let current = storage_image_with(device, "current", rgba16, inp.extent, &bytes_f16(&current));
+    let position = storage_image_with(
+        device,
+        "gb_position",
+        rgba32,
+        inp.extent,
+        bytemuck::cast_slice(inp.position),
+    );
+    let normals: Vec<Vec4> = inp.normal.iter().map(|n| n.extend(0.0)).collect();
+    let normal = storage_image_with(
+        device,
+        "gb_normal",
+        rgba16,
+        inp.extent,
+        &bytes_f16(&normals),
+    );
+    let motion_bytes: Vec<u8> = inp
+        .motion
+        .iter()
+        .flat_map(|m| [f32_to_f16(m.x), f32_to_f16(m.y)])
+        .flat_map(u16::to_le_bytes)
+        .collect();
+    let motion = storage_image_with(
+        device,
+        "gb_motion",
+        vk::Format::R16G16_SFLOAT,
+        inp.extent,
+        &motion_bytes,
+    );
+    let geometry = storage_image_with(
+        device,
+        "history geometry",
+        rgba32,
+        inp.extent,
+        bytemuck::cast_slice(inp.history_geometry),
+    );
+    let light = storage_image_with(
+        device,
+        "history light",
+        rgba16,
+        inp.extent,
+        &bytes_f16(inp.history_light),
+    );
+    let out = common::transfer_storage(device, "out", u64::from(w * h) * 8, None);
+    let mut executor = Executor::new(device, 1).expect("executor");
+    let mut rg = executor.begin_frame();
+    let import = |rg: &mut RenderGraph, image| {
+        rg.import_gpu_image(image, uploaded_state(), ExternalState::UNDEFINED)
+    };
+    let g = GBuffer {
+        position: import(&mut rg, &position),
+        normal: import(&mut rg, &normal),
+        albedo: import(&mut rg, &current),
+        material: import(&mut rg, &current),
+        emissive: import(&mut rg, &current),
+        geometric_normal: import(&mut rg, &normal),
+        motion: import(&mut rg, &motion),
+        depth: import(&mut rg, &position),
+        extent: inp.extent,
+    };
+    let current_handle = import(&mut rg, &current);
+    let geometry_handle = import(&mut rg, &geometry);
+    let mut history = History {
+        previous: import(&mut rg, &light),
+        current: rg.create_image("accumulated", shine::graph::ImageDesc::new_2d(rgba16, w, h)),
+    };
+    let accumulated = accumulate(
+        &mut rg,
+        &current_handle,
+        &g,
+        &geometry_handle,
+        &mut history,
+        params,
+        inp.has_history,
+    )
+    .expect("accumulate");
+    let mut out_handle =
+        rg.import_gpu_buffer(&out, ExternalState::UNDEFINED, common::read_by_copy());
+    rg.copy_image_to_buffer("read accumulated", &accumulated, &mut out_handle);
+    common::run_graph(device, &mut executor, rg);
+    common::decode_rgba16f(&device.read_buffer(&out).expect("read"))
+}
+
+/// The GPU pass equals its CPU twin with history kept, moved between texels (bilinear), partly
+/// and wholly rejected (other depth or normal, off screen), clipped and not, and without
+/// history.
+#[test]
+fn accumulate_matches_the_cpu_twin() {
+    let device = common::device();
+    let extent = [13u32, 11];
+    let n = (extent[0] * extent[1]) as usize;
+    let mut rng = Rng(77);
+    let mut position = Vec::new();
+    let mut normal = Vec::new();
+    for _ in 0..n {
+        let background = rng.next() < 0.1;
+        let depth = 1.0 + 4.0 * rng.next();
+        position.push(Vec4::new(
+            0.0,
+            0.0,
+            0.0,
+            if background { 0.0 } else { depth },
+        ));
+        normal.push(
+            q16(Vec3::new(rng.next() - 0.5, rng.next() - 0.5, 1.0)
+                .normalize()
+                .extend(0.0))
+            .truncate(),
+        );
+    }
+    let current: Vec<Vec3> = (0..n)
+        .map(|_| q16(Vec4::new(rng.next(), rng.next(), rng.next(), 0.0)).truncate())
+        .collect();
+    let history_light: Vec<Vec4> = (0..n)
+        .map(|_| {
+            q16(Vec4::new(
+                2.0 * rng.next(),
+                rng.next(),
+                rng.next(),
+                (8.0 * rng.next()).floor(),
+            ))
+        })
+        .collect();
+    // History geometry: mostly the pixel's own, sometimes another depth or normal.
+    let history_geometry: Vec<Vec4> = (0..n)
+        .map(|i| {
+            let r = rng.next();
+            let (nn, d) = (normal[i], position[i].w);
+            if r < 0.7 {
+                nn.extend(d)
+            } else if r < 0.85 {
+                nn.extend(d * 1.5)
+            } else {
+                (-nn).extend(d)
+            }
+        })
+        .collect();
+    // Motion: none, sub-texel, or several texels (some off screen).
+    let motion: Vec<Vec2> = (0..n)
+        .map(|_| match rng.next() {
+            r if r < 0.3 => Vec2::ZERO,
+            r if r < 0.7 => (Vec2::new(rng.next(), rng.next()) - 0.5) * 0.15,
+            _ => (Vec2::new(rng.next(), rng.next()) - 0.5) * 0.8,
+        })
+        .map(|m| Vec2::new(f16_to_f32(f32_to_f16(m.x)), f16_to_f32(f32_to_f16(m.y))))
+        .collect();
+    let mut restarted = 0;
+    for (has_history, max_frames, clip) in [(true, 8, 1.0), (true, 4, 0.0), (false, 8, 1.0)] {
+        let inputs = AccumulateInputs {
+            extent,
+            current: &current,
+            position: &position,
+            normal: &normal,
+            motion: &motion,
+            history_geometry: &history_geometry,
+            history_light: &history_light,
+            has_history,
+        };
+        let params = AccumulateParams { max_frames, clip };
+        let cpu = accumulate_cpu(&inputs, &params);
+        let gpu = accumulate_gpu(&device, &inputs, &params);
+        for (i, (c, g)) in cpu.iter().zip(&gpu).enumerate() {
+            assert!(
+                (*c - *g).abs().max_element() <= 4e-3 * c.abs().max_element().max(1.0),
+                "history {has_history}, n {max_frames}, clip {clip}, pixel {i}: cpu {c} gpu {g}"
+            );
+            restarted += usize::from(position[i].w > 0.0 && c.w == 1.0);
+        }
+    }
+    assert!(restarted > n, "restarted {restarted}");
+    common::assert_clean(&device);
+}
+
+/// A pixel whose history shows another surface (depth 1.5× or a flipped normal) restarts from
+/// this frame's light; one that shows its surface blends it in.
+#[test]
+fn disocclusion_rejects_history() {
+    let device = common::device();
+    let extent = [2u32, 2];
+    let position = vec![Vec4::new(0.0, 0.0, 0.0, 2.0); 4];
+    let normal = vec![Vec3::Z; 4];
+    let current = vec![Vec3::new(1.0, 0.5, 0.25); 4];
+    let history_light = vec![Vec4::new(0.0, 0.0, 8.0, 4.0); 4];
+    let motion = vec![Vec2::ZERO; 4];
+    let params = AccumulateParams {
+        max_frames: 8,
+        clip: 0.0,
+    };
+    for (geometry, keeps) in [
+        (Vec4::new(0.0, 0.0, 1.0, 2.0), true),
+        (Vec4::new(0.0, 0.0, 1.0, 3.0), false),
+        (Vec4::new(0.0, 0.0, -1.0, 2.0), false),
+    ] {
+        let history_geometry = vec![geometry; 4];
+        let inputs = AccumulateInputs {
+            extent,
+            current: &current,
+            position: &position,
+            normal: &normal,
+            motion: &motion,
+            history_geometry: &history_geometry,
+            history_light: &history_light,
+            has_history: true,
+        };
+        let gpu = accumulate_gpu(&device, &inputs, &params);
+        let expected = if keeps {
+            // n = 5: a fifth of this frame's light into the history.
+            Vec4::new(0.2, 0.1, 6.45, 5.0)
+        } else {
+            current[0].extend(1.0)
+        };
+        for g in &gpu {
+            assert!(
+                (*g - expected).abs().max_element() <= 4e-3,
+                "history geometry {geometry}: {g} against {expected}"
+            );
+        }
+    }
+    common::assert_clean(&device);
+}
+
+/// A static scene accumulated over frames renders its single frame (every frame's light is
+/// the same, so the blend changes nothing), for HVL and IGI.
+#[test]
+fn a_static_scene_accumulated_converges_to_the_single_frame() {
+    let device = common::device();
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    for gi in ["hvl", "igi"] {
+        let frame = |history: &str, frames: u32| {
+            let mut s = Settings {
+                width: 32,
+                height: 32,
+                ..Settings::default()
+            };
+            s.set("gi", gi).expect("gi");
+            s.set("shadow.size", "128").expect("shadow");
+            s.set("history.frames", history).expect("history");
+            let mut renderer = Renderer::new(&device).expect("renderer");
+            renderer.set_scene(&scene, 0.0).expect("scene");
+            let mut last = None;
+            for _ in 0..frames {
+                last = Some(renderer.render(&s).expect("render"));
+            }
+            last.expect("a frame").hdr
+        };
+        let single = frame(
+            "1",
+            std::env::var("SINGLE_FRAMES").map_or(1, |v| v.parse().unwrap()),
+        );
+        let accumulated = frame("8", 5);
+        let mean: f32 = single
+            .texels
+            .iter()
+            .map(|t| t[0] + t[1] + t[2])
+            .sum::<f32>()
+            / (3 * single.texels.len()) as f32;
+        let rmse = (single
+            .texels
+            .iter()
+            .zip(&accumulated.texels)
+            .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f32>())
+            .sum::<f32>()
+            / (3 * single.texels.len()) as f32)
+            .sqrt();
+        assert!(rmse / mean <= 2e-3, "{gi}: relative RMSE {}", rmse / mean);
+    }
+    common::assert_clean(&device);
+}
