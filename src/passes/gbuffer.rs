@@ -144,10 +144,39 @@ fn jittered_camera_view(frame: &FrameState, width: u32, height: u32, [jx, jy]: [
     view
 }
 
+/// Steps per octave of a directional light's box radius: the radius is rounded up to a
+/// multiple of 2^⌊log₂ r⌋ / RADIUS_STEPS (at most 1/16 larger than the scene's).
+pub const RADIUS_STEPS: f32 = 16.0;
+
+/// A directional light's orthographic box around a sphere (`center`, `radius`) for a map
+/// `side` texels wide, made texel-stable as cascaded shadow maps stabilise theirs (issue 23):
+/// the radius is rounded up to [`RADIUS_STEPS`] per octave and grown by one texel, and the
+/// centre snapped, in the light's image plane (axis `dir`, `up`), to whole texels of the map.
+/// Scene bounds that change a little (a moving object, a morph) then shift the map by whole
+/// texels or not at all, instead of sliding every texel by a fraction, and the sphere stays
+/// inside. Returns the box's centre and half-width.
+pub fn stable_box(center: Vec3, radius: f32, dir: Vec3, up: Vec3, side: u32) -> (Vec3, f32) {
+    let step = 2f32.powf(radius.log2().floor()) / RADIUS_STEPS;
+    let rounded = (radius / step).ceil() * step;
+    let side = side.max(2) as f32;
+    // Half a texel of snap on either side: one texel of margin (2r' / side = texel).
+    let radius = rounded * side / (side - 2.0);
+    let texel = 2.0 * radius / side;
+    let to_light = Mat4::look_to_rh(Vec3::ZERO, dir, up);
+    let local = to_light.transform_point3(center);
+    let snapped = Vec3::new(
+        (local.x / texel).round() * texel,
+        (local.y / texel).round() * texel,
+        local.z,
+    );
+    (to_light.inverse().transform_point3(snapped), radius)
+}
+
 /// The primary light's view (the RSM and shadow map): a perspective frustum along a spot
 /// light's axis covering its outer cone, an orthographic box around the scene for a
-/// directional light, or a frustum from a point light towards the scene's centre.
-pub fn light_view(frame: &FrameState, light_index: usize) -> Option<View> {
+/// directional light (texel-stable for a map `side` texels wide: [`stable_box`]), or a frustum
+/// from a point light towards the scene's centre.
+pub fn light_view(frame: &FrameState, light_index: usize, side: u32) -> Option<View> {
     let light = frame.lights.get(light_index)?;
     let (lo, hi) = frame.bounds;
     let center = (lo + hi) * 0.5;
@@ -156,6 +185,7 @@ pub fn light_view(frame: &FrameState, light_index: usize) -> Option<View> {
     match light.light_kind()? {
         LightKind::Directional => {
             let dir = Vec3::from(light.direction).normalize_or(Vec3::NEG_Y);
+            let (center, radius) = stable_box(center, radius, dir, up_for(dir), side);
             let eye = center - dir * radius * 2.0;
             Some(View {
                 view: Mat4::look_to_rh(eye, dir, up_for(dir)),
@@ -328,4 +358,65 @@ pub fn gbuffer(
         .push(&view.constants(None))
         .draw_indexed(scene.index_count, 1);
     g
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec2;
+
+    /// Where `p` falls in texels of a `side`-wide map of the box (`center`, `radius`) seen along
+    /// `dir`.
+    fn texel_of(p: Vec3, (center, radius): (Vec3, f32), dir: Vec3, up: Vec3, side: f32) -> Vec2 {
+        let local = Mat4::look_to_rh(Vec3::ZERO, dir, up).transform_point3(p - center);
+        (Vec2::new(local.x, local.y) + radius) / (2.0 * radius) * side
+    }
+
+    /// Bounds that grow or move by a little (up to 2 mm in a 10 m scene) move a fixed world
+    /// point by a whole number of texels of the map the box is made for, at every side, and
+    /// its fraction within the texel stays; unsnapped, it slides by fractions.
+    #[test]
+    fn a_directional_box_moves_by_whole_texels() {
+        let dir = Vec3::new(0.3, -1.0, 0.2).normalize();
+        let up = Vec3::Y;
+        let point = Vec3::new(1.234, 0.5, -2.345);
+        let (c0, r0) = (Vec3::new(0.1, 1.5, -0.2), 4.9);
+        let base = |side| stable_box(c0, r0, dir, up, side);
+        let mut slid = 0.0f32;
+        for k in 1..20 {
+            let d = k as f32 * 1e-4;
+            let (c, r) = (c0 + Vec3::new(d, -0.5 * d, 0.7 * d), r0 + 0.3 * d);
+            for side in [256, 2048, 16384] {
+                let moved = stable_box(c, r, dir, up, side);
+                assert_eq!(moved.1, base(side).1, "radius {r}");
+                let a = texel_of(point, base(side), dir, up, side as f32);
+                let b = texel_of(point, moved, dir, up, side as f32);
+                let shift = b - a;
+                assert!(
+                    (shift - shift.round()).abs().max_element() < 0.02,
+                    "side {side}, step {k}: shift {shift}"
+                );
+                let unsnapped = texel_of(point, (c, r), dir, up, side as f32)
+                    - texel_of(point, (c0, r0), dir, up, side as f32);
+                slid = slid.max((unsnapped - unsnapped.round()).abs().max_element());
+            }
+        }
+        // The test can tell: without the snap the point slides by fractions of a texel.
+        assert!(slid > 0.1, "unsnapped slide {slid}");
+    }
+
+    /// The box still holds the scene's sphere: its half-width is at least the sphere's radius
+    /// plus the centre's snap, and at most 1/16 and a texel larger.
+    #[test]
+    fn a_stable_box_holds_the_scene() {
+        for side in [16u32, 256, 4096] {
+            for r in [0.01f32, 0.7, 1.0, 3.3, 250.0] {
+                let c = Vec3::new(r * 0.3, -r, 2.0 * r);
+                let (center, radius) = stable_box(c, r, Vec3::NEG_Y, Vec3::Z, side);
+                assert!(radius >= r + center.distance(c), "side {side}, r {r}");
+                let most = r * (1.0 + 1.0 / RADIUS_STEPS) * side as f32 / (side as f32 - 2.0);
+                assert!(radius <= most * 1.0001, "side {side}, r {r}: {radius}");
+            }
+        }
+    }
 }

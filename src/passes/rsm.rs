@@ -175,7 +175,7 @@ pub fn face_views(frame: &FrameState, primary: usize, size: u32) -> Vec<FaceView
                 }
             }
             Some(_) => {
-                if let Some(view) = light_view(frame, i) {
+                if let Some(view) = light_view(frame, i, size) {
                     faces.push(FaceView {
                         light: i as u32,
                         label: label.clone(),

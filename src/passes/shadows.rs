@@ -151,7 +151,7 @@ impl ShadowLayout {
                     }
                 }
                 Some(_) => {
-                    if let Some(view) = light_view(frame, i) {
+                    if let Some(view) = light_view(frame, i, side) {
                         views.push((index, format!("shadow light {i}"), view));
                     }
                 }

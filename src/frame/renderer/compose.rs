@@ -192,7 +192,7 @@ impl Renderer {
         let faces: Vec<rsm::FaceView> = match scene.gpu.primary_light() {
             Some(_) if hvl.is_none() && igi.is_none() => Vec::new(),
             Some(i) if every_light => rsm::face_views(frame, i, p.rsm_size),
-            Some(i) => gbuffer::light_view(frame, i)
+            Some(i) => gbuffer::light_view(frame, i, p.rsm_size)
                 .map(|view| {
                     vec![rsm::FaceView {
                         light: i as u32,
