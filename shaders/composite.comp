@@ -1,5 +1,7 @@
 // Composite (docs/frame.md, "Direct light and composition"): direct + indirect_full radiance,
 // times exposure, into the linear HDR frame, and tonemapped + sRGB-encoded into the LDR frame.
+// With supersampling (ssaa = N > 1) the inputs are N times the output's size and each output
+// pixel is the box average of its N×N input pixels, before exposure and tonemapping.
 //! variant with_indirect INDIRECT=1
 //! variant direct_only INDIRECT=0
 #version 460
@@ -17,9 +19,16 @@ layout(set = 0, binding = 3, rgba8) uniform writeonly image2D ldr;
 
 // CompositePush in src/passes/composite.rs.
 layout(push_constant) uniform Push {
+    // output size
     uvec2 extent;
     float exposure;
     uint op;
+    // input pixels per output pixel along each axis
+    uint ssaa;
+    // 1 / ssaa², the box filter's weight
+    float inv_samples;
+    uint pad0;
+    uint pad1;
 } push;
 
 void main() {
@@ -28,11 +37,18 @@ void main() {
         return;
     }
     ivec2 p = ivec2(pixel);
-    vec3 radiance = imageLoad(direct, p).rgb;
+    vec3 radiance = vec3(0.0);
+    for (uint j = 0u; j < push.ssaa; ++j) {
+        for (uint i = 0u; i < push.ssaa; ++i) {
+            ivec2 q = p * int(push.ssaa) + ivec2(i, j);
+            vec3 sample_radiance = imageLoad(direct, q).rgb;
 #if INDIRECT
-    radiance += imageLoad(indirect_full, p).rgb;
+            sample_radiance += imageLoad(indirect_full, q).rgb;
 #endif
-    vec3 exposed = radiance * push.exposure;
+            radiance += sample_radiance;
+        }
+    }
+    vec3 exposed = radiance * push.inv_samples * push.exposure;
     imageStore(hdr, p, vec4(exposed, 1.0));
     imageStore(ldr, p, encode_ldr(push.op, exposed));
 }

@@ -31,6 +31,10 @@ pub struct SettingsArgs {
     /// Linear exposure factor.
     #[arg(long)]
     exposure: Option<f32>,
+    /// Supersampling N (1-4): render at N times the size and box-filter down before
+    /// tonemapping (`output.ssaa`; antialiased captures).
+    #[arg(long)]
+    ssaa: Option<u32>,
     /// Any setting by its TOML key, e.g. `--set hvl.count=2000` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     overrides: Vec<String>,
@@ -92,6 +96,7 @@ impl SettingsArgs {
             ("gi", self.gi.clone()),
             ("output.tonemap", self.tonemap.clone()),
             ("output.exposure", self.exposure.map(|v| v.to_string())),
+            ("output.ssaa", self.ssaa.map(|v| v.to_string())),
         ];
         for (key, value) in flags {
             if let Some(value) = value {

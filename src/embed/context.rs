@@ -265,5 +265,7 @@ fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, R
     }
     let mut params = FrameParams::from_settings(&settings);
     params.component = crate::passes::composite::Component::Indirect;
+    // The technique shades the host's G-buffer at its size: nothing to supersample.
+    params.composite.ssaa = 1;
     Ok(params)
 }

@@ -16,7 +16,8 @@ use crate::settings::{GiTechnique, Settings};
 /// exactly when its parameters are present.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FrameParams {
-    /// Width and height of the frame in pixels.
+    /// Width and height of the output frame in pixels (the passes before the composite run
+    /// at [`FrameParams::render_extent`]).
     pub extent: [u32; 2],
     /// Receiver-buffer downscale s (paper 002 §4.2) of the receiver-resolution techniques.
     pub receiver_scale: u32,
@@ -61,6 +62,22 @@ pub struct ProxySetup {
 }
 
 impl FrameParams {
+    /// The size every pass before the composite renders at: the output's times the
+    /// supersampling factor.
+    pub fn render_extent(&self) -> [u32; 2] {
+        let n = self.composite.ssaa.max(1);
+        [self.extent[0] * n, self.extent[1] * n]
+    }
+
+    /// These parameters as the passes before the composite see them: `extent` is the
+    /// rendered size.
+    pub fn at_render_extent(&self) -> Self {
+        Self {
+            extent: self.render_extent(),
+            ..self.clone()
+        }
+    }
+
     /// The parameters chosen by `settings` (which the caller has validated).
     pub fn from_settings(settings: &Settings) -> Self {
         let gi = &settings.gi;
@@ -149,6 +166,7 @@ impl FrameParams {
             composite: CompositeParams {
                 exposure: settings.output.exposure,
                 tonemap: settings.output.tonemap,
+                ssaa: settings.output.ssaa,
             },
             component: settings.output.component,
         }

@@ -25,14 +25,21 @@ pub struct CompositeParams {
     pub exposure: f32,
     /// Operator of the LDR frame.
     pub tonemap: Tonemap,
+    /// Supersampling N: the inputs are N times the output's size, and each output pixel is the
+    /// box average of N×N of them ([`SSAA`] range).
+    pub ssaa: u32,
 }
 
+/// Supersampling factors: input pixels per output pixel along each axis.
+pub const SSAA: std::ops::RangeInclusive<u32> = 1..=4;
+
 impl Default for CompositeParams {
-    /// Exposure 1 and the Khronos PBR Neutral curve.
+    /// Exposure 1, the Khronos PBR Neutral curve, no supersampling.
     fn default() -> Self {
         Self {
             exposure: 1.0,
             tonemap: Tonemap::PbrNeutral,
+            ssaa: 1,
         }
     }
 }
@@ -50,16 +57,22 @@ crate::choice::named_choice! {
     }
 }
 
-/// The push constants of `composite.comp` (its `Push` block, 16 bytes).
+/// The push constants of `composite.comp` (its `Push` block, 32 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CompositePush {
-    /// Image size in pixels; invocations outside it do nothing.
+    /// Output size in pixels; invocations outside it do nothing.
     pub extent: [u32; 2],
     /// [`CompositeParams::exposure`].
     pub exposure: f32,
     /// [`Tonemap::shader_id`] of the operator.
     pub op: u32,
+    /// [`CompositeParams::ssaa`].
+    pub ssaa: u32,
+    /// 1 / ssaa², the box filter's weight.
+    pub inv_samples: f32,
+    /// Padding.
+    pub pad: [u32; 2],
 }
 
 /// The images the composite writes.
@@ -72,7 +85,8 @@ pub struct CompositeOutputs {
 }
 
 /// Adds the composite pass: reads `direct` and, when given, `indirect` (both [`INPUT_FORMAT`],
-/// `extent`), writes new transient `hdr` and `ldr` images of the same extent.
+/// `extent` × [`CompositeParams::ssaa`]), writes new transient `hdr` and `ldr` images of
+/// `extent`.
 ///
 /// Without `indirect` the frame is direct light only (`--gi none`).
 pub fn composite(
@@ -85,10 +99,14 @@ pub fn composite(
     let [width, height] = extent;
     let mut hdr = rg.create_image("hdr", ImageDesc::new_2d(HDR_FORMAT, width, height));
     let mut ldr = rg.create_image("ldr", ImageDesc::new_2d(LDR_FORMAT, width, height));
+    let ssaa = params.ssaa.max(1);
     let push = CompositePush {
         extent,
         exposure: params.exposure,
         op: params.tonemap.shader_id(),
+        ssaa,
+        inv_samples: 1.0 / (ssaa * ssaa) as f32,
+        pad: [0; 2],
     };
     let shader = match indirect {
         Some(_) => &shaders::COMPOSITE_COMP_WITH_INDIRECT,
@@ -114,11 +132,30 @@ pub fn composite_texel(
     indirect: Option<[f32; 4]>,
     params: &CompositeParams,
 ) -> ([f32; 4], [u8; 4]) {
-    let mut radiance = Vec3::from_slice(&direct[..3]);
-    if let Some(indirect) = indirect {
-        radiance += Vec3::from_slice(&indirect[..3]);
+    composite_block(
+        &[direct],
+        indirect.as_ref().map(std::slice::from_ref),
+        params,
+    )
+}
+
+/// The CPU reference of one supersampled composite texel: its `ssaa`² input texels (row by row,
+/// as the shader visits them) summed, weighted by 1/ssaa², exposed and tonemapped.
+pub fn composite_block(
+    direct: &[[f32; 4]],
+    indirect: Option<&[[f32; 4]]>,
+    params: &CompositeParams,
+) -> ([f32; 4], [u8; 4]) {
+    let mut radiance = Vec3::ZERO;
+    for (k, d) in direct.iter().enumerate() {
+        let mut sample = Vec3::from_slice(&d[..3]);
+        if let Some(indirect) = indirect {
+            sample += Vec3::from_slice(&indirect[k][..3]);
+        }
+        radiance += sample;
     }
-    let exposed = radiance * params.exposure;
+    let ssaa = params.ssaa.max(1);
+    let exposed = radiance * (1.0 / (ssaa * ssaa) as f32) * params.exposure;
     (
         exposed.extend(1.0).to_array(),
         tonemap::encode_ldr(params.tonemap, exposed),
@@ -159,6 +196,7 @@ mod tests {
         let params = CompositeParams {
             exposure: 0.5,
             tonemap: Tonemap::None,
+            ssaa: 1,
         };
         let (hdr, ldr) =
             composite_texel([1.0, 0.25, 0.0, 0.0], Some([1.0, 0.0, 0.5, 0.0]), &params);

@@ -193,6 +193,11 @@ pub struct OutputSettings {
     pub exposure: f32,
     /// Radiance shown: `full`, `direct` or `indirect` (GI only). Default `full`.
     pub component: Component,
+    /// Supersampling N: the frame is rendered at N × width by N × height and each output pixel
+    /// is the box average of N×N of them, before tonemapping (antialiasing for captures; GI
+    /// contexts render at the host's G-buffer size and ignore it). Range 1..=4 with N × width
+    /// and N × height at most 16384, default 1.
+    pub ssaa: u32,
 }
 
 /// `[hvl]`: Harmonics Virtual Lights (paper 003).
@@ -390,6 +395,7 @@ impl Default for OutputSettings {
             tonemap: c.tonemap,
             exposure: c.exposure,
             component: Component::Full,
+            ssaa: c.ssaa,
         }
     }
 }
@@ -539,6 +545,7 @@ mod tests {
                 tonemap: Tonemap::Aces,
                 exposure: 0.1,
                 component: Component::Indirect,
+                ssaa: 2,
             },
             hvl: HvlSettings {
                 radius: RadiusHeuristic::R1,

@@ -7,7 +7,9 @@ use std::ops::RangeInclusive;
 use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
-use crate::passes::{aaf, accumulate, hvl, igi, proxy, receivers, rsm, shadows, upsample};
+use crate::passes::{
+    aaf, accumulate, composite, hvl, igi, proxy, receivers, rsm, shadows, upsample,
+};
 
 /// Output sides in pixels.
 pub const EXTENT: RangeInclusive<u32> = 1..=16384;
@@ -52,6 +54,21 @@ impl Settings {
             });
         }
         check("output.exposure", self.output.exposure, &tonemap::EXPOSURE)?;
+        check("output.ssaa", self.output.ssaa, &composite::SSAA)?;
+        let rendered = |side: u32| side.saturating_mul(self.output.ssaa);
+        if !EXTENT.contains(&rendered(self.width)) || !EXTENT.contains(&rendered(self.height)) {
+            return Err(SettingsError::OutOfRange {
+                field: "output.ssaa",
+                value: self.output.ssaa.to_string(),
+                allowed: format!(
+                    "at most {} for a {}×{} frame (the rendered size, ssaa × width and ssaa × height, must be within {:?})",
+                    EXTENT.end() / self.width.max(self.height).max(1),
+                    self.width,
+                    self.height,
+                    EXTENT
+                ),
+            });
+        }
         check("hvl.count", self.hvl.count, &hvl::CACHE_COUNT)?;
         check(
             "hvl.radius_scale",

@@ -52,8 +52,10 @@ impl Renderer {
     fn declare_passes(
         &mut self,
         rg: &mut RenderGraph,
-        p: &FrameParams,
+        output: &FrameParams,
     ) -> Result<CompositeOutputs, RenderError> {
+        // Every pass before the composite renders at the supersampled size.
+        let p = &output.at_render_extent();
         let textures = self.texture_sampler(p);
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
         let handles = scene.gpu.declare(rg)?;
@@ -108,7 +110,7 @@ impl Renderer {
             rg,
             first,
             second,
-            p.extent,
+            output.extent,
             &p.composite,
         ))
     }
