@@ -6,7 +6,10 @@
 // hold the pixel's own light, so a static image keeps its history), and blended with
 // weight 1/n, where n is the history's length (alpha), capped at `max_frames`: an exponential
 // history that converges where nothing changes, restarts where the surface was not visible
-// (n = 1) and follows at once where the light leaves the clip box. CPU twin:
+// (n = 1) and follows at once where the light leaves the clip box. With `geometry` 0 it is
+// TAA: every pixel counts, the background too, a still pixel keeps history of any surface of
+// its 3×3 neighbourhood (jittered silhouettes), and the blend is in the space x / (1 + luma) so
+// that bright history cannot bleed into dark surfaces. CPU twin:
 // shine::reference::accumulate::accumulate_cpu.
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -20,7 +23,8 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba16f) readonly uniform image2D current;
 // World position, w: linear depth (0 on the background).
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D gb_position;
-layout(set = 0, binding = 2, rgba16f) readonly uniform image2D gb_normal;
+// The geometric normal (what `gbuffer history` keeps).
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D gb_geometric_normal;
 // uv now minus uv then.
 layout(set = 0, binding = 3, rg16f) readonly uniform image2D gb_motion;
 // The previous frame's (normal, linear depth): `gbuffer history`.
@@ -39,7 +43,9 @@ layout(push_constant) uniform Push {
     float max_frames;
     // half-width of the clip box in standard deviations (0: no clipping)
     float clip;
-    uint pad0;
+    // 1: history taps must show the pixel's surface and the background passes through (the
+    // indirect light); 0: colour only, every pixel and tap counts (TAA of the direct light)
+    uint geometry;
     uint pad1;
     uint pad2;
 } push;
@@ -49,22 +55,75 @@ bool inside(ivec2 p) {
     return all(greaterThanEqual(p, ivec2(0))) && all(lessThan(p, ivec2(push.extent)));
 }
 
+// The space TAA blends in: x / (1 + luma(x)) (Karis 2014), so that a bright background's
+// history cannot bleed into a dark object over it, as it does in linear HDR; the indirect
+// light's history blends linear radiance (energy-true). `from_blend` inverts `to_blend`.
+vec3 to_blend(vec3 x) {
+    return push.geometry != 0u ? x : x / (1.0 + dot(x, TAA_LUMA));
+}
+
+vec3 from_blend(vec3 x) {
+    return push.geometry != 0u ? x : x / max(1.0 - dot(x, TAA_LUMA), TAA_MIN_INVERSE);
+}
+
+// TAA's disocclusion test at a pixel: whether history geometry `g` (normal, linear depth; 0:
+// the background) shows the surface the pixel shows now (`depth`, `n`), the background
+// included.
+bool taa_same_surface(float depth, vec3 n, vec4 g) {
+    return g.w == 0.0 ? depth == 0.0 : (depth > 0.0 && resolve_same_surface(depth, n, g.w, g.xyz));
+}
+
+// TAA's test where nothing moves: whether `g` shows a surface some pixel of p's 3×3
+// neighbourhood shows now. A still silhouette pixel, whose jittered samples alternate between
+// two surfaces, keeps its history. (Where things move, only the pixel's own surface counts:
+// the wider test let a thin moving figure's edges, and so most of it, take in the background.)
+bool taa_seen_nearby(ivec2 p, vec4 g) {
+    for (int y = -1; y <= 1; ++y) {
+        for (int x = -1; x <= 1; ++x) {
+            ivec2 q = p + ivec2(x, y);
+            if (inside(q)) {
+                float d = imageLoad(gb_position, q).w;
+                vec3 nq = normalize(imageLoad(gb_geometric_normal, q).xyz);
+                if (taa_same_surface(d, nq, g)) {
+                    return true;
+                }
+            }
+        }
+    }
+    return false;
+}
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (!inside(p)) {
         return;
     }
-    vec3 light = imageLoad(current, p).rgb;
+    vec3 radiance = imageLoad(current, p).rgb;
+    vec3 light = to_blend(radiance);
     float depth = imageLoad(gb_position, p).w;
-    if (depth == 0.0 || push.has_history == 0u) {
-        imageStore(accumulated, p, vec4(light, depth == 0.0 ? 0.0 : 1.0));
+    bool geometry = push.geometry != 0u;
+    bool background = geometry && depth == 0.0;
+    if (background || push.has_history == 0u) {
+        imageStore(accumulated, p, vec4(radiance, background ? 0.0 : 1.0));
         return;
     }
-    vec3 n = normalize(imageLoad(gb_normal, p).xyz);
+    vec3 n = normalize(imageLoad(gb_geometric_normal, p).xyz);
 
     // The history: bilinear over the taps that show this surface.
     vec2 uv = (vec2(p) + 0.5) / vec2(push.extent);
-    vec2 then_px = (uv - imageLoad(gb_motion, p).xy) * vec2(push.extent) - 0.5;
+    vec2 motion = imageLoad(gb_motion, p).xy;
+    vec2 then_px = (uv - motion) * vec2(push.extent) - 0.5;
+    // Still: nothing in the 3×3 neighbourhood moves (a still pixel beside a moving figure must
+    // not take the figure's light into its history: the figure would take it back).
+    bool still = true;
+    for (int y = -1; y <= 1; ++y) {
+        for (int x = -1; x <= 1; ++x) {
+            ivec2 q = p + ivec2(x, y);
+            if (inside(q) && length(imageLoad(gb_motion, q).xy * vec2(push.extent)) >= TAA_STILL_PIXELS) {
+                still = false;
+            }
+        }
+    }
     ivec2 base = ivec2(floor(then_px));
     vec2 f = then_px - vec2(base);
     vec4 history = vec4(0.0);
@@ -76,17 +135,20 @@ void main() {
                 continue;
             }
             vec4 g = imageLoad(history_geometry, q);
-            if (!resolve_same_surface(depth, n, g.w, g.xyz)) {
+            bool valid = geometry ? resolve_same_surface(depth, n, g.w, g.xyz)
+                                  : taa_same_surface(depth, n, g) || (still && taa_seen_nearby(p, g));
+            if (!valid) {
                 continue;
             }
             float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
-            history += w * imageLoad(history_light, q);
+            vec4 h = imageLoad(history_light, q);
+            history += w * vec4(to_blend(h.rgb), h.a);
             weight += w;
         }
     }
     if (weight < ACCUMULATE_MIN_WEIGHT) {
         // Disoccluded: the history restarts here.
-        imageStore(accumulated, p, vec4(light, 1.0));
+        imageStore(accumulated, p, vec4(radiance, 1.0));
         return;
     }
     history /= weight;
@@ -100,10 +162,10 @@ void main() {
         for (int y = -1; y <= 1; ++y) {
             for (int x = -1; x <= 1; ++x) {
                 ivec2 q = p + ivec2(x, y);
-                if (!inside(q) || imageLoad(gb_position, q).w == 0.0) {
+                if (!inside(q) || (geometry && imageLoad(gb_position, q).w == 0.0)) {
                     continue;
                 }
-                vec3 c = imageLoad(current, q).rgb;
+                vec3 c = to_blend(imageLoad(current, q).rgb);
                 sum += c;
                 sum2 += c * c;
                 count += 1.0;
@@ -116,6 +178,9 @@ void main() {
         vec3 hi = max(light, mean + push.clip * sigma);
         history.rgb = clamp(history.rgb, lo, hi);
     }
-    float frames = min(history.a + 1.0, push.max_frames);
-    imageStore(accumulated, p, vec4(mix(history.rgb, light, 1.0 / frames), frames));
+    // A moving pixel under TAA keeps a short history: its jittered edges alternate between
+    // surfaces, and a long history would carry one surface's light onto the other.
+    float longest = geometry || still ? push.max_frames : min(push.max_frames, TAA_MOVING_FRAMES);
+    float frames = min(history.a + 1.0, longest);
+    imageStore(accumulated, p, vec4(from_blend(mix(history.rgb, light, 1.0 / frames)), frames));
 }

@@ -1,6 +1,7 @@
-//! The indirect light's history (issue 23; src/passes/accumulate.rs): `accumulate` against its
-//! CPU twin (reprojection, disocclusion, variance clip, blend), history rejected on a
-//! disocclusion, and a static scene accumulated over frames against its single frame.
+//! Histories (src/passes/accumulate.rs): `accumulate` against its CPU twin (reprojection,
+//! disocclusion, variance clip, blend; the indirect light's geometry-tested mode and TAA's
+//! colour-only mode), history rejected on a disocclusion, and a static scene accumulated over
+//! frames against its single frame.
 
 mod common;
 
@@ -104,6 +105,7 @@ fn accumulate_gpu(
     };
     let accumulated = accumulate(
         &mut rg,
+        "accumulate",
         &current_handle,
         &g,
         &geometry_handle,
@@ -120,8 +122,8 @@ fn accumulate_gpu(
 }
 
 /// The GPU pass equals its CPU twin with history kept, moved between texels (bilinear), partly
-/// and wholly rejected (other depth or normal, off screen), clipped and not, and without
-/// history.
+/// and wholly rejected (other depth or normal, off screen), clipped and not, without history,
+/// and in TAA's mode (blend space, background, still and moving pixels).
 #[test]
 fn accumulate_matches_the_cpu_twin() {
     let device = common::device();
@@ -183,24 +185,35 @@ fn accumulate_matches_the_cpu_twin() {
         .map(|m| Vec2::new(f16_to_f32(f32_to_f16(m.x)), f16_to_f32(f32_to_f16(m.y))))
         .collect();
     let mut restarted = 0;
-    for (has_history, max_frames, clip) in [(true, 8, 1.0), (true, 4, 0.0), (false, 8, 1.0)] {
+    let still = vec![Vec2::ZERO; n];
+    for (has_history, max_frames, clip, geometry, moving) in [
+        (true, 8, 1.0, true, true),
+        (true, 4, 0.0, true, true),
+        (false, 8, 1.0, true, true),
+        (true, 16, 1.0, false, true),
+        (true, 16, 1.0, false, false),
+    ] {
         let inputs = AccumulateInputs {
             extent,
             current: &current,
             position: &position,
             normal: &normal,
-            motion: &motion,
+            motion: if moving { &motion } else { &still },
             history_geometry: &history_geometry,
             history_light: &history_light,
             has_history,
         };
-        let params = AccumulateParams { max_frames, clip };
+        let params = AccumulateParams {
+            max_frames,
+            clip,
+            geometry,
+        };
         let cpu = accumulate_cpu(&inputs, &params);
         let gpu = accumulate_gpu(&device, &inputs, &params);
         for (i, (c, g)) in cpu.iter().zip(&gpu).enumerate() {
             assert!(
                 (*c - *g).abs().max_element() <= 4e-3 * c.abs().max_element().max(1.0),
-                "history {has_history}, n {max_frames}, clip {clip}, pixel {i}: cpu {c} gpu {g}"
+                "history {has_history}, n {max_frames}, clip {clip}, geometry {geometry}, pixel {i}: cpu {c} gpu {g}"
             );
             restarted += usize::from(position[i].w > 0.0 && c.w == 1.0);
         }
@@ -223,6 +236,7 @@ fn disocclusion_rejects_history() {
     let params = AccumulateParams {
         max_frames: 8,
         clip: 0.0,
+        geometry: true,
     };
     for (geometry, keeps) in [
         (Vec4::new(0.0, 0.0, 1.0, 2.0), true),

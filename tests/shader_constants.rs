@@ -136,10 +136,30 @@ fn hvl_resolve_constants_match_the_shader() {
 
 #[test]
 fn accumulate_constant_matches_the_shader() {
-    use shine::passes::accumulate::ACCUMULATE_MIN_WEIGHT;
+    use shine::passes::accumulate::{
+        ACCUMULATE_MIN_WEIGHT, TAA_LUMA, TAA_MIN_INVERSE, TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
+    };
+    let file = "include/accumulate.glsl";
     assert_eq!(
-        glsl_float("include/accumulate.glsl", "ACCUMULATE_MIN_WEIGHT"),
+        glsl_float(file, "ACCUMULATE_MIN_WEIGHT"),
         ACCUMULATE_MIN_WEIGHT
+    );
+    assert_eq!(glsl_float(file, "TAA_MIN_INVERSE"), TAA_MIN_INVERSE);
+    assert_eq!(glsl_float(file, "TAA_STILL_PIXELS"), TAA_STILL_PIXELS);
+    assert_eq!(
+        glsl_float(file, "TAA_MOVING_FRAMES"),
+        TAA_MOVING_FRAMES as f32
+    );
+    let source = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("shaders")
+            .join(file),
+    )
+    .expect("shader source");
+    let [r, g, b] = TAA_LUMA;
+    assert!(
+        source.contains(&format!("const vec3 TAA_LUMA = vec3({r}, {g}, {b});")),
+        "TAA_LUMA differs from {TAA_LUMA:?}"
     );
 }
 

@@ -1,6 +1,6 @@
-//! The indirect light's history as the frame uses it (issue 23): which frame last accumulated
-//! into it, so that a frame blends only with the one just before it at the same size
-//! (`accumulate`, `src/passes/accumulate.rs`).
+//! An image's history as the frame uses it: the indirect light's (issue 23) and the direct
+//! light's under TAA (issue 21). It knows which frame last accumulated into it, so that a frame
+//! blends only with the one just before it at the same size (`src/passes/accumulate.rs`).
 
 use shine_graph::{Handle, Image, RenderGraph};
 
@@ -8,21 +8,34 @@ use super::error::RenderError;
 use crate::passes::accumulate::{self, AccumulateParams};
 use crate::passes::gbuffer::GBuffer;
 
-/// The accumulation's persistent state: the frame number and extent of the last frame that
-/// wrote the history.
-#[derive(Default)]
+/// The accumulation's persistent state: its pass name and history key, and the frame number
+/// and extent of the last frame that wrote the history.
 pub struct AccumulateTechnique {
+    name: &'static str,
+    key: &'static str,
     last: Option<(u64, [u32; 2])>,
 }
 
 /// An accumulation ready to be declared: its parameters and whether the history holds the
 /// previous frame.
 pub struct PreparedAccumulate {
+    name: &'static str,
+    key: &'static str,
     params: AccumulateParams,
     has_history: bool,
 }
 
 impl AccumulateTechnique {
+    /// An accumulation whose pass is `name` and whose history images are `key`; no history
+    /// yet.
+    pub fn new(name: &'static str, key: &'static str) -> Self {
+        Self {
+            name,
+            key,
+            last: None,
+        }
+    }
+
     /// Forgets the history (a new scene, a frame without accumulation, a dropped frame).
     pub fn reset(&mut self) {
         self.last = None;
@@ -40,6 +53,8 @@ impl AccumulateTechnique {
         let has_history = self.last == Some((frame.wrapping_sub(1), extent));
         self.last = Some((frame, extent));
         PreparedAccumulate {
+            name: self.name,
+            key: self.key,
             params,
             has_history,
         }
@@ -57,9 +72,10 @@ impl PreparedAccumulate {
         g: &GBuffer,
         history_geometry: &Handle<Image>,
     ) -> Result<Handle<Image>, RenderError> {
-        let mut history = accumulate::accumulate_history(rg, g.extent);
+        let mut history = accumulate::accumulate_history(rg, self.key, g.extent);
         accumulate::accumulate(
             rg,
+            self.name,
             current,
             g,
             history_geometry,

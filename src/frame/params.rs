@@ -42,6 +42,8 @@ pub struct FrameParams {
     /// The indirect light's accumulation over frames, when it has a history longer than one
     /// frame.
     pub history: Option<AccumulateParams>,
+    /// Temporal antialiasing (camera jitter and the direct light's history), when on.
+    pub taa: Option<AccumulateParams>,
     /// Exposure and tonemap of the composite.
     pub composite: CompositeParams,
     /// Which part of the radiance the frame shows.
@@ -162,7 +164,9 @@ impl FrameParams {
             history: (settings.history.frames > 1).then_some(AccumulateParams {
                 max_frames: settings.history.frames,
                 clip: settings.history.clip,
+                geometry: true,
             }),
+            taa: settings.output.taa.then(AccumulateParams::taa),
             composite: CompositeParams {
                 exposure: settings.output.exposure,
                 tonemap: settings.output.tonemap,

@@ -25,6 +25,25 @@ use crate::shaders;
 /// history is rejected (`ACCUMULATE_MIN_WEIGHT` in shaders/include/accumulate.glsl).
 pub const ACCUMULATE_MIN_WEIGHT: f32 = 0.01;
 
+/// Motion in pixels below which TAA counts a pixel as still: its history may then show any
+/// surface of its 3×3 neighbourhood, so a still silhouette, whose jittered samples alternate
+/// between two surfaces, keeps its history; a moving pixel's must show its own surface
+/// (`TAA_STILL_PIXELS` in shaders/include/accumulate.glsl).
+pub const TAA_STILL_PIXELS: f32 = 0.01;
+
+/// Longest history of a moving pixel under TAA (`TAA_MOVING_FRAMES`): its jittered edges
+/// alternate between surfaces, and a long history carried one surface's light onto the other
+/// (a thin walking figure washed out into the window behind it with 16 frames).
+pub const TAA_MOVING_FRAMES: u32 = 2;
+
+/// Luma weights (Rec. 709) of TAA's blend space x / (1 + luma(x)) (Karis 2014): a bright
+/// background's history cannot bleed into a dark object over it, as it does in linear HDR
+/// (`TAA_LUMA` in shaders/include/accumulate.glsl).
+pub const TAA_LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+/// Smallest 1 − luma of a blend-space value when it is mapped back to radiance
+/// (`TAA_MIN_INVERSE`).
+pub const TAA_MIN_INVERSE: f32 = 1e-4;
+
 /// Default longest history: blend weight 1/8 once converged (about 8 frames of lag and of
 /// noise averaging).
 pub const DEFAULT_MAX_FRAMES: u32 = 8;
@@ -38,22 +57,66 @@ pub const DEFAULT_CLIP: f32 = 3.0;
 /// Allowed clip half-widths (0: the history is not clipped).
 pub const CLIP_RANGE: RangeInclusive<f32> = 0.0..=16.0;
 
-/// How the indirect light is accumulated.
+/// Longest history of temporal antialiasing (TAA of the direct light): 16 jittered frames, the
+/// length of its jitter cycle ([`TAA_JITTER_CYCLE`]) twice over.
+pub const TAA_MAX_FRAMES: u32 = 16;
+/// Clip half-width of TAA in standard deviations (colour TAA's usual γ, Salvi 2016).
+pub const TAA_CLIP: f32 = 1.0;
+/// Frames of TAA's jitter sequence before it repeats.
+pub const TAA_JITTER_CYCLE: u64 = 8;
+
+/// How an image is accumulated over frames.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AccumulateParams {
     /// Longest history n: the blend weight of the current frame never falls below 1/n.
     pub max_frames: u32,
     /// Half-width of the clip box in standard deviations (0: no clipping).
     pub clip: f32,
+    /// The indirect light's history: linear radiance, the background passes through. Without
+    /// it, TAA: the background accumulates too, a still pixel ([`TAA_STILL_PIXELS`]) keeps
+    /// history of any surface of its 3×3 neighbourhood, and the blend is in the space
+    /// x / (1 + luma(x)) ([`TAA_LUMA`]). Both restart where the history shows another surface.
+    pub geometry: bool,
 }
 
 impl Default for AccumulateParams {
+    /// The indirect light's history.
     fn default() -> Self {
         Self {
             max_frames: DEFAULT_MAX_FRAMES,
             clip: DEFAULT_CLIP,
+            geometry: true,
         }
     }
+}
+
+impl AccumulateParams {
+    /// Temporal antialiasing of the direct light.
+    pub fn taa() -> Self {
+        Self {
+            max_frames: TAA_MAX_FRAMES,
+            clip: TAA_CLIP,
+            geometry: false,
+        }
+    }
+}
+
+/// TAA's sub-pixel camera jitter of frame `frame`, in pixels within ±0.5: the Halton (2, 3)
+/// points 1 to [`TAA_JITTER_CYCLE`], centred.
+pub fn taa_jitter(frame: u64) -> [f32; 2] {
+    let index = (frame % TAA_JITTER_CYCLE) as u32 + 1;
+    [halton(index, 2) - 0.5, halton(index, 3) - 0.5]
+}
+
+/// The radical inverse of `index` in `base`.
+fn halton(mut index: u32, base: u32) -> f32 {
+    let (mut value, mut scale) = (0.0f32, 1.0f32);
+    while index > 0 {
+        scale /= base as f32;
+        value += scale * (index % base) as f32;
+        index /= base;
+    }
+    value
 }
 
 impl AccumulateParams {
@@ -76,25 +139,29 @@ pub struct AccumulatePush {
     pub max_frames: f32,
     /// Clip half-width in standard deviations.
     pub clip: f32,
+    /// 1: history must show the pixel's surface ([`AccumulateParams::geometry`]).
+    pub geometry: u32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: [u32; 2],
 }
 
 /// Format of the accumulated light: rgb radiance, alpha the history length.
 pub const ACCUMULATED_FORMAT: vk::Format = vk::Format::R16G16B16A16_SFLOAT;
 
-/// The accumulated light's ping-pong pair for frames of `extent`.
-pub fn accumulate_history(rg: &mut RenderGraph, extent: [u32; 2]) -> History<Image> {
+/// The ping-pong pair of accumulated images `key` for frames of `extent`.
+pub fn accumulate_history(rg: &mut RenderGraph, key: &str, extent: [u32; 2]) -> History<Image> {
     let desc = ImageDesc::new_2d(ACCUMULATED_FORMAT, extent[0], extent[1]);
-    rg.history_image("accumulated indirect", desc)
+    rg.history_image(key, desc)
 }
 
-/// Adds `accumulate`: `current` (this frame's indirect light on the surfaces of `g`) blended
-/// into the reprojected history (`history.previous`, valid when `has_history`; its geometry is
-/// `history_geometry`, the previous frame's `gbuffer history`). Writes `history.current` and
-/// returns it.
+/// Adds the pass `name` (shaders/accumulate.comp): `current` (this frame's light on the
+/// surfaces of `g`) blended into the reprojected history (`history.previous`, valid when
+/// `has_history`; its geometry is `history_geometry`, the previous frame's `gbuffer history`).
+/// Writes `history.current` and returns it.
+#[allow(clippy::too_many_arguments)]
 pub fn accumulate(
     rg: &mut RenderGraph,
+    name: &str,
     current: &Handle<Image>,
     g: &GBuffer,
     history_geometry: &Handle<Image>,
@@ -108,12 +175,13 @@ pub fn accumulate(
         has_history: u32::from(has_history),
         max_frames: params.max_frames as f32,
         clip: params.clip,
-        pad: [0; 3],
+        geometry: u32::from(params.geometry),
+        pad: [0; 2],
     };
-    rg.compute("accumulate", &shaders::ACCUMULATE_COMP)
+    rg.compute(name, &shaders::ACCUMULATE_COMP)
         .read("current", current)
         .read("gb_position", &g.position)
-        .read("gb_normal", &g.normal)
+        .read("gb_geometric_normal", &g.geometric_normal)
         .read("gb_motion", &g.motion)
         .read("history_geometry", history_geometry)
         .read("history_light", &history.previous)

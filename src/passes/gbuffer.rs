@@ -98,8 +98,14 @@ pub fn unjittered_camera_view(frame: &FrameState, width: u32, height: u32) -> Vi
     jittered_camera_view(frame, width, height, [0.0; 2])
 }
 
-/// The camera view offset by `[jx, jy]` pixels.
-fn jittered_camera_view(frame: &FrameState, width: u32, height: u32, [jx, jy]: [f32; 2]) -> View {
+/// The camera view of `frame` offset by `[jx, jy]` pixels (TAA adds its own jitter to the
+/// frame's).
+pub fn jittered_camera_view(
+    frame: &FrameState,
+    width: u32,
+    height: u32,
+    [jx, jy]: [f32; 2],
+) -> View {
     let aspect = width as f32 / height.max(1) as f32;
     let view = frame.camera_world.inverse();
     let eye = frame.camera_world.transform_point3(Vec3::ZERO);

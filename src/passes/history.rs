@@ -1,4 +1,4 @@
-//! `gbuffer history`: the G-buffer's shading normal and linear depth kept across frames in a
+//! `gbuffer history`: the G-buffer's geometric normal and linear depth kept across frames in a
 //! ping-pong pair of temporal images (`RenderGraph::history_image`), so a frame can read the
 //! previous frame's (temporal reuse, disocclusion tests, hosts).
 
@@ -14,7 +14,8 @@ pub struct HistoryPush {
     pub extent: [u32; 2],
 }
 
-/// Format of the history images: normal xyz, linear view depth w.
+/// Format of the history images: geometric normal xyz (the shading normal would change with a
+/// normal map's texel under a jittered sample), linear view depth w.
 pub const HISTORY_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
 
 /// Writes this frame's normal and depth into the history; returns the previous frame's
@@ -24,7 +25,7 @@ pub fn gbuffer_history(rg: &mut RenderGraph, g: &GBuffer) -> Handle<Image> {
     let mut history = rg.history_image("gbuffer history", ImageDesc::new_2d(HISTORY_FORMAT, w, h));
     rg.compute("gbuffer history", &shaders::GBUFFER_HISTORY_COMP)
         .read("gb_position", &g.position)
-        .read("gb_normal", &g.normal)
+        .read("gb_geometric_normal", &g.geometric_normal)
         .write("history", &mut history.current)
         .push(&HistoryPush { extent: [w, h] })
         .dispatch([w, h, 1]);

@@ -3,7 +3,10 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::passes::accumulate::{ACCUMULATE_MIN_WEIGHT, AccumulateParams};
+use crate::passes::accumulate::{
+    ACCUMULATE_MIN_WEIGHT, AccumulateParams, TAA_LUMA, TAA_MIN_INVERSE, TAA_MOVING_FRAMES,
+    TAA_STILL_PIXELS,
+};
 use crate::passes::hvl::resolve::same_surface;
 
 /// The images `accumulate` reads, row-major, all of one extent.
@@ -14,7 +17,7 @@ pub struct AccumulateInputs<'a> {
     pub current: &'a [Vec3],
     /// G-buffer positions (w: linear depth, 0 on the background).
     pub position: &'a [Vec4],
-    /// G-buffer normals.
+    /// G-buffer geometric normals (what `gbuffer history` keeps).
     pub normal: &'a [Vec3],
     /// Motion (uv now minus uv then).
     pub motion: &'a [Vec2],
@@ -26,6 +29,49 @@ pub struct AccumulateInputs<'a> {
     pub has_history: bool,
 }
 
+/// TAA's blend space x / (1 + luma(x)) (`to_blend` in the shader); the indirect light's is
+/// linear.
+fn to_blend(x: Vec3, params: &AccumulateParams) -> Vec3 {
+    if params.geometry {
+        x
+    } else {
+        x / (1.0 + x.dot(Vec3::from(TAA_LUMA)))
+    }
+}
+
+/// The inverse of [`to_blend`] (`from_blend`).
+fn from_blend(x: Vec3, params: &AccumulateParams) -> Vec3 {
+    if params.geometry {
+        x
+    } else {
+        x / (1.0 - x.dot(Vec3::from(TAA_LUMA))).max(TAA_MIN_INVERSE)
+    }
+}
+
+/// TAA's disocclusion test (`taa_same_surface` in the shader): whether history geometry `g`
+/// shows the surface a pixel at `depth` with normal `n` shows now, the background (depth 0)
+/// included.
+fn taa_same_surface(depth: f32, n: Vec3, g: Vec4) -> bool {
+    if g.w == 0.0 {
+        depth == 0.0
+    } else {
+        depth > 0.0 && same_surface(depth, n, g.w, g.truncate())
+    }
+}
+
+/// TAA's test where nothing moves (`taa_seen_nearby`): whether `g` shows a surface some pixel
+/// of (x, y)'s 3×3 neighbourhood shows now.
+fn taa_seen_nearby(inp: &AccumulateInputs<'_>, x: i32, y: i32, g: Vec4) -> bool {
+    let [w, h] = inp.extent;
+    (-1..=1)
+        .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+        .filter(|&(qx, qy)| qx >= 0 && qy >= 0 && qx < w as i32 && qy < h as i32)
+        .any(|(qx, qy)| {
+            let i = (qy * w as i32 + qx) as usize;
+            taa_same_surface(inp.position[i].w, inp.normal[i].normalize(), g)
+        })
+}
+
 /// The accumulated light (alpha: history length), as the pass writes it.
 pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> Vec<Vec4> {
     let [w, h] = inp.extent;
@@ -35,15 +81,22 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
     for y in 0..h as i32 {
         for x in 0..w as i32 {
             let i = at(x, y);
-            let light = inp.current[i];
+            let radiance = inp.current[i];
+            let light = to_blend(radiance, params);
             let depth = inp.position[i].w;
-            if depth == 0.0 || !inp.has_history {
-                out[i] = light.extend(if depth == 0.0 { 0.0 } else { 1.0 });
+            let background = params.geometry && depth == 0.0;
+            if background || !inp.has_history {
+                out[i] = radiance.extend(if background { 0.0 } else { 1.0 });
                 continue;
             }
             let n = inp.normal[i].normalize();
             let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
-            let then = (uv - inp.motion[i]) * Vec2::new(w as f32, h as f32) - 0.5;
+            let size = Vec2::new(w as f32, h as f32);
+            let then = (uv - inp.motion[i]) * size - 0.5;
+            let still = (-1..=1)
+                .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+                .filter(|&(qx, qy)| inside(qx, qy))
+                .all(|(qx, qy)| (inp.motion[at(qx, qy)] * size).length() < TAA_STILL_PIXELS);
             let base = then.floor();
             let f = then - base;
             let (mut history, mut weight) = (Vec4::ZERO, 0.0f32);
@@ -54,17 +107,23 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                         continue;
                     }
                     let g = inp.history_geometry[at(qx, qy)];
-                    if !same_surface(depth, n, g.w, g.truncate()) {
+                    let valid = if params.geometry {
+                        same_surface(depth, n, g.w, g.truncate())
+                    } else {
+                        taa_same_surface(depth, n, g) || (still && taa_seen_nearby(inp, x, y, g))
+                    };
+                    if !valid {
                         continue;
                     }
                     let wx = if k == 0 { 1.0 - f.x } else { f.x };
                     let wy = if j == 0 { 1.0 - f.y } else { f.y };
-                    history += wx * wy * inp.history_light[at(qx, qy)];
+                    let h = inp.history_light[at(qx, qy)];
+                    history += wx * wy * to_blend(h.truncate(), params).extend(h.w);
                     weight += wx * wy;
                 }
             }
             if weight < ACCUMULATE_MIN_WEIGHT {
-                out[i] = light.extend(1.0);
+                out[i] = radiance.extend(1.0);
                 continue;
             }
             history /= weight;
@@ -74,10 +133,11 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                 for dy in -1..=1 {
                     for dx in -1..=1 {
                         let (qx, qy) = (x + dx, y + dy);
-                        if !inside(qx, qy) || inp.position[at(qx, qy)].w == 0.0 {
+                        if !inside(qx, qy) || (params.geometry && inp.position[at(qx, qy)].w == 0.0)
+                        {
                             continue;
                         }
-                        let c = inp.current[at(qx, qy)];
+                        let c = to_blend(inp.current[at(qx, qy)], params);
                         sum += c;
                         sum2 += c * c;
                         count += 1.0;
@@ -90,8 +150,13 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                 let hi = light.max(mean + params.clip * sigma);
                 past = past.clamp(lo, hi);
             }
-            let frames = (history.w + 1.0).min(params.max_frames as f32);
-            out[i] = past.lerp(light, 1.0 / frames).extend(frames);
+            let longest = if params.geometry || still {
+                params.max_frames
+            } else {
+                params.max_frames.min(TAA_MOVING_FRAMES)
+            };
+            let frames = (history.w + 1.0).min(longest as f32);
+            out[i] = from_blend(past.lerp(light, 1.0 / frames), params).extend(frames);
         }
     }
     out

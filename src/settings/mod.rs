@@ -198,6 +198,11 @@ pub struct OutputSettings {
     /// contexts render at the host's G-buffer size and ignore it). Range 1..=4 with N × width
     /// and N × height at most 16384, default 1.
     pub ssaa: u32,
+    /// Temporal antialiasing for sequences and real time: the camera jitters through 8 Halton
+    /// points and the direct light is accumulated over up to 16 frames, reprojected with the
+    /// motion vectors and clipped to the current neighbourhood (the indirect light has its
+    /// own history, `[history]`). A single frame is unchanged. Default false.
+    pub taa: bool,
 }
 
 /// `[hvl]`: Harmonics Virtual Lights (paper 003).
@@ -396,6 +401,7 @@ impl Default for OutputSettings {
             exposure: c.exposure,
             component: Component::Full,
             ssaa: c.ssaa,
+            taa: false,
         }
     }
 }
@@ -546,6 +552,7 @@ mod tests {
                 exposure: 0.1,
                 component: Component::Indirect,
                 ssaa: 2,
+                taa: true,
             },
             hvl: HvlSettings {
                 radius: RadiusHeuristic::R1,

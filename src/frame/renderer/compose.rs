@@ -14,7 +14,7 @@ use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::Distribution;
-use crate::passes::{direct, history, receivers, rsm, upsample};
+use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
 use shine_graph::{Handle, Image, RenderGraph};
 
 impl Renderer {
@@ -41,6 +41,7 @@ impl Renderer {
         }
         self.motion.reset();
         self.accumulate.reset();
+        self.taa.reset();
         self.hvl.forget_uploads();
         self.igi.forget_uploads();
         if let Some(scene) = self.scene.as_mut() {
@@ -69,7 +70,15 @@ impl Renderer {
         )?;
         let shadows = self.shadows.insert(shadows);
         let [width, height] = p.extent;
-        let camera = gbuffer::camera_view(frame, width, height);
+        // TAA: the camera's own jitter plus this frame's point of the Halton cycle.
+        let jitter = match p.taa {
+            Some(_) => {
+                let [jx, jy] = accumulate::taa_jitter(rg.frame());
+                [frame.jitter[0] + jx, frame.jitter[1] + jy]
+            }
+            None => frame.jitter,
+        };
+        let camera = gbuffer::jittered_camera_view(frame, width, height, jitter);
         let unjittered = gbuffer::unjittered_camera_view(frame, width, height).view_proj();
         let motion_view = self.motion.declare(rg, unjittered, p.extent)?;
         let g = gbuffer::gbuffer(rg, &handles, &camera, &motion_view, p.extent, textures);
@@ -93,6 +102,17 @@ impl Renderer {
             p.shadow,
             self.nearest.raw(),
         );
+        let direct = match p.taa {
+            Some(params) => {
+                self.taa
+                    .prepare(rg, params, p.extent)
+                    .declare(rg, &direct, &g, &geometry_then)?
+            }
+            None => {
+                self.taa.reset();
+                direct
+            }
+        };
         let indirect = self.declare_indirect(rg, p, &handles, &g, &camera, None)?;
         let indirect = self.accumulate_indirect(rg, p, indirect, &g, |_| geometry_then)?;
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
@@ -140,12 +160,13 @@ impl Renderer {
         }
     }
 
-    /// The scene textures' sampler of `p`: trilinear, or level 0 without mipmaps.
+    /// The scene textures' sampler of `p`: trilinear (a level finer under TAA), or level 0
+    /// without mipmaps.
     pub(super) fn texture_sampler(&self, p: &FrameParams) -> shine_gpu::vk::Sampler {
-        if p.mipmaps {
-            self.textures.raw()
-        } else {
-            self.textures_level0.raw()
+        match (p.mipmaps, p.taa.is_some()) {
+            (true, false) => self.textures.raw(),
+            (true, true) => self.textures_taa.raw(),
+            (false, _) => self.textures_level0.raw(),
         }
     }
 

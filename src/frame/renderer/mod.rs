@@ -52,9 +52,14 @@ fn sampler(
 /// Anisotropy of the scene textures' sampler where the device allows it.
 const TEXTURE_ANISOTROPY: f32 = 16.0;
 
-/// The scene textures' sampler: trilinear over the mip chain, repeating, anisotropic up to
-/// [`TEXTURE_ANISOTROPY`] where the device has it enabled.
-fn texture_sampler(device: &Device) -> Result<Sampler, shine_gpu::Error> {
+/// Mip LOD bias of the scene textures under TAA: its jittered frames resolve detail a level
+/// finer than one frame can (the usual log2 of the samples per pixel along an axis, about one
+/// level for TAA's 8 to 16 frames).
+const TAA_LOD_BIAS: f32 = -1.0;
+
+/// The scene textures' sampler: trilinear over the mip chain with `lod_bias`, repeating,
+/// anisotropic up to [`TEXTURE_ANISOTROPY`] where the device has it enabled.
+fn texture_sampler(device: &Device, lod_bias: f32) -> Result<Sampler, shine_gpu::Error> {
     let anisotropy = TEXTURE_ANISOTROPY.min(device.info().max_anisotropy);
     Sampler::new(
         device,
@@ -67,6 +72,7 @@ fn texture_sampler(device: &Device) -> Result<Sampler, shine_gpu::Error> {
             .address_mode_w(vk::SamplerAddressMode::REPEAT)
             .anisotropy_enable(anisotropy > 1.0)
             .max_anisotropy(anisotropy.max(1.0))
+            .mip_lod_bias(lod_bias)
             .max_lod(vk::LOD_CLAMP_NONE),
     )
 }
@@ -138,6 +144,8 @@ pub struct Renderer {
     frames_in_flight: usize,
     /// Trilinear, repeating: the scene textures' sampler.
     textures: Sampler,
+    /// The scene textures' sampler under TAA: trilinear, a level finer ([`TAA_LOD_BIAS`]).
+    textures_taa: Sampler,
     /// Bilinear on level 0, repeating: the scene textures' sampler without mipmaps, and at ray
     /// hits.
     textures_level0: Sampler,
@@ -158,6 +166,8 @@ pub struct Renderer {
     motion: MotionState,
     /// The indirect light's history (issue 23).
     accumulate: AccumulateTechnique,
+    /// The direct light's history under TAA (issue 21).
+    taa: AccumulateTechnique,
     /// Readback buffers of [`Renderer::render`].
     readback: Option<Readback>,
 }
@@ -220,7 +230,8 @@ impl Renderer {
             device: device.clone(),
             executor: Executor::new(device, frames_in_flight)?,
             frames_in_flight: frames_in_flight.max(1),
-            textures: texture_sampler(device)?,
+            textures: texture_sampler(device, 0.0)?,
+            textures_taa: texture_sampler(device, TAA_LOD_BIAS)?,
             textures_level0: sampler(device, vk::Filter::LINEAR, A::REPEAT, A::REPEAT)?,
             nearest: sampler(
                 device,
@@ -235,7 +246,8 @@ impl Renderer {
             igi: IgiTechnique::new(device),
             aaf: AafTechnique,
             motion: MotionState::new(device)?,
-            accumulate: AccumulateTechnique::default(),
+            accumulate: AccumulateTechnique::new("accumulate", "accumulated indirect"),
+            taa: AccumulateTechnique::new("taa", "taa direct"),
             readback: None,
         })
     }
@@ -259,6 +271,7 @@ impl Renderer {
         self.motion.reset();
         self.hvl.reset();
         self.accumulate.reset();
+        self.taa.reset();
         Ok(())
     }
 
