@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
+use common::{Rng, bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
 use glam::{Vec2, Vec3, Vec4};
 use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
 use shine::passes::accumulate::{AccumulateParams, accumulate};
@@ -13,18 +13,6 @@ use shine::passes::gbuffer::GBuffer;
 use shine::reference::accumulate::{AccumulateInputs, accumulate_cpu};
 use shine::{Renderer, Settings};
 use shine_scene::Scene;
-
-/// A deterministic pseudo-random number in [0, 1).
-struct Rng(u32);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 17;
-        self.0 ^= self.0 << 5;
-        (self.0 >> 8) as f32 / (1u32 << 24) as f32
-    }
-}
 
 /// Runs `accumulate` on the GPU over `inp` (as uploaded: f16 values where the images are f16)
 /// and returns the accumulated light.
@@ -53,19 +41,7 @@ fn accumulate_gpu(
         inp.extent,
         &bytes_f16(&normals),
     );
-    let motion_bytes: Vec<u8> = inp
-        .motion
-        .iter()
-        .flat_map(|m| [f32_to_f16(m.x), f32_to_f16(m.y)])
-        .flat_map(u16::to_le_bytes)
-        .collect();
-    let motion = storage_image_with(
-        device,
-        "gb_motion",
-        vk::Format::R16G16_SFLOAT,
-        inp.extent,
-        &motion_bytes,
-    );
+    let motion = common::motion_image(device, inp.extent, inp.motion);
     let geometry = storage_image_with(
         device,
         "history geometry",
@@ -300,21 +276,8 @@ fn a_static_scene_accumulated_converges_to_the_single_frame() {
             std::env::var("SINGLE_FRAMES").map_or(1, |v| v.parse().unwrap()),
         );
         let accumulated = frame("8", 5);
-        let mean: f32 = single
-            .texels
-            .iter()
-            .map(|t| t[0] + t[1] + t[2])
-            .sum::<f32>()
-            / (3 * single.texels.len()) as f32;
-        let rmse = (single
-            .texels
-            .iter()
-            .zip(&accumulated.texels)
-            .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f32>())
-            .sum::<f32>()
-            / (3 * single.texels.len()) as f32)
-            .sqrt();
-        assert!(rmse / mean <= 2e-3, "{gi}: relative RMSE {}", rmse / mean);
+        let e = common::relative_rmse(&accumulated, &single);
+        assert!(e <= 2e-3, "{gi}: relative RMSE {e}");
     }
     common::assert_clean(&device);
 }

@@ -4,7 +4,7 @@
 
 mod common;
 
-use common::{bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
+use common::{Rng, bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
 use glam::{Vec2, Vec3, Vec4};
 use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
 use shine::passes::hvl::resolve::{ResolveHistory, hvl_resolve};
@@ -12,18 +12,6 @@ use shine::passes::receivers::Receivers;
 use shine::reference::resolve::{ResolveInputs, resolve_cpu};
 use shine::{Renderer, Settings};
 use shine_scene::Scene;
-
-/// A deterministic pseudo-random number in [0, 1).
-struct Rng(u32);
-
-impl Rng {
-    fn next(&mut self) -> f32 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 17;
-        self.0 ^= self.0 << 5;
-        (self.0 >> 8) as f32 / (1u32 << 24) as f32
-    }
-}
 
 /// Runs `hvl_resolve` on the GPU over `inp` (as uploaded: f16 values where the images are
 /// f16) and returns the resolved light.
@@ -46,19 +34,7 @@ fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4
         &bytes_f16(&normals),
     );
     let fresh = storage_image_with(device, "fresh", rgba16, inp.extent, &bytes_f16(inp.fresh));
-    let motion_bytes: Vec<u8> = inp
-        .motion
-        .iter()
-        .flat_map(|m| [f32_to_f16(m.x), f32_to_f16(m.y)])
-        .flat_map(u16::to_le_bytes)
-        .collect();
-    let motion = storage_image_with(
-        device,
-        "gb_motion",
-        vk::Format::R16G16_SFLOAT,
-        inp.full_extent,
-        &motion_bytes,
-    );
+    let motion = common::motion_image(device, inp.full_extent, inp.motion);
     let light = storage_image_with(
         device,
         "history light",
@@ -284,20 +260,7 @@ fn a_static_scene_amortised_converges_to_the_per_frame_image() {
     };
     let per_frame = frame("1", 1);
     let amortised = frame("4", 6);
-    let mean: f32 = per_frame
-        .texels
-        .iter()
-        .map(|t| t[0] + t[1] + t[2])
-        .sum::<f32>()
-        / (3 * per_frame.texels.len()) as f32;
-    let rmse = (per_frame
-        .texels
-        .iter()
-        .zip(&amortised.texels)
-        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).powi(2)).sum::<f32>())
-        .sum::<f32>()
-        / (3 * per_frame.texels.len()) as f32)
-        .sqrt();
-    assert!(rmse / mean <= 2e-3, "relative RMSE {}", rmse / mean);
+    let e = common::relative_rmse(&amortised, &per_frame);
+    assert!(e <= 2e-3, "relative RMSE {e}");
     common::assert_clean(&device);
 }

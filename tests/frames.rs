@@ -5,12 +5,10 @@
 mod common;
 
 use glam::{Mat4, Vec3};
-use shine::capture::image_io::HdrImage;
 use shine::gpu::vk;
 use shine::gpu_scene::{FrameUpdate, GpuScene, Vertex};
 use shine::graph::{Executor, ExternalState};
 use shine::reference::{PathTracer, ReferenceParams};
-use shine::study::metrics::image_error;
 use shine::{Renderer, Settings};
 use shine_scene::Scene;
 
@@ -27,16 +25,6 @@ fn settings(gi: &str) -> Settings {
     // these tests compare (tests/accumulate.rs covers the history).
     s.set("history.frames", "1").expect("history");
     s
-}
-
-/// RMS of `a - b` over the mean of `b` (all channels).
-fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
-    let rgb =
-        |i: &HdrImage| -> Vec<[f32; 3]> { i.texels.iter().map(|t| [t[0], t[1], t[2]]).collect() };
-    let mask = vec![true; b.texels.len()];
-    image_error(&rgb(a), &rgb(b), &mask)
-        .expect("a lit reference")
-        .relative_rmse
 }
 
 /// Frame k of a sequence (scene uploaded once, then updated) equals a cold render of the scene
@@ -65,7 +53,7 @@ fn sequence_frames_equal_cold_renders() {
             let frame = live.render(&settings).expect("render");
             cold.set_scene(&scene, t).expect("scene");
             let expected = cold.render(&settings).expect("render");
-            let e = relative_rmse(&frame.hdr, &expected.hdr);
+            let e = common::relative_rmse(&frame.hdr, &expected.hdr);
             assert!(e <= 1e-4, "gi {gi}, t {t}: relative RMSE {e:e}");
         }
     }
@@ -74,7 +62,7 @@ fn sequence_frames_equal_cold_renders() {
     let first = live.render(&settings("proxy")).expect("render");
     live.update(&FrameUpdate::at(1.1)).expect("update");
     let later = live.render(&settings("proxy")).expect("render");
-    let moved = relative_rmse(&later.hdr, &first.hdr);
+    let moved = common::relative_rmse(&later.hdr, &first.hdr);
     assert!(moved > 1e-2, "nothing moved: {moved:e}");
     common::assert_clean(&device);
 }
@@ -98,7 +86,7 @@ fn path_tracer_update_matches_cold_start() {
     cold.accumulate(4).expect("accumulate");
     let (a, b) = (moved.read().expect("read"), cold.read().expect("read"));
     assert_eq!(a.samples, 4);
-    let e = relative_rmse(&a.full, &b.full);
+    let e = common::relative_rmse(&a.full, &b.full);
     assert!(e <= 1e-4, "relative RMSE {e:e}");
     common::assert_clean(&device);
 }

@@ -161,10 +161,21 @@ pub fn error_plot(
         error_axis,
         font: font.map(str::to_owned),
     };
-    let [w, h] = size;
+    write_drawing(path, size, |rgb, size| {
+        draw_error_plot(rgb, size, title, curves, marks, &plot)
+    })?;
+    Ok(plot)
+}
+
+/// A drawing on a white `size` canvas (RGB, row-major) written to `path` (PNG): the one way the
+/// studies' plots reach a file.
+pub(crate) fn write_drawing(
+    path: &Path,
+    [w, h]: [u32; 2],
+    draw: impl FnOnce(&mut [u8], [u32; 2]) -> Result<(), Box<dyn std::error::Error>>,
+) -> Result<(), StudyError> {
     let mut rgb = vec![255u8; w as usize * h as usize * 3];
-    draw_error_plot(&mut rgb, size, title, curves, marks, &plot)
-        .map_err(|e| StudyError::Plot(format!("{}: {e}", path.display())))?;
+    draw(&mut rgb, [w, h]).map_err(|e| StudyError::Plot(format!("{}: {e}", path.display())))?;
     let texels = rgb
         .chunks_exact(3)
         .map(|p| [p[0], p[1], p[2], 255])
@@ -177,7 +188,7 @@ pub fn error_plot(
             texels,
         },
     )?;
-    Ok(plot)
+    Ok(())
 }
 
 /// The drawing of [`error_plot`] into an RGB buffer.

@@ -7,9 +7,8 @@ use plotters::backend::RGBPixel;
 use plotters::prelude::*;
 
 use super::StudyError;
-use super::plot::{font, write_map};
+use super::plot::{font, write_drawing, write_map};
 use super::temporal::TemporalReport;
-use crate::capture::image_io::{LdrImage, write_png};
 
 /// A mode's label as part of a file name: letters, digits, `-` and `_` kept, the rest `_`.
 fn file_label(label: &str) -> String {
@@ -24,6 +23,9 @@ fn file_label(label: &str) -> String {
         })
         .collect()
 }
+
+/// Size of the plots in pixels.
+const PLOT_SIZE: [u32; 2] = [720, 480];
 
 /// Width the flicker maps are magnified to at least (pixels), so small study frames can be seen.
 const MAP_WIDTH: u32 = 256;
@@ -135,22 +137,7 @@ impl TemporalReport {
     /// Draws cost (x) against error (y), each mode a point labelled with its flicker, into
     /// `path` (PNG).
     fn plot(&self, path: &Path) -> Result<(), StudyError> {
-        let (w, h) = (720u32, 480u32);
-        let mut rgb = vec![255u8; (w * h * 3) as usize];
-        self.draw(&mut rgb, (w, h))
-            .map_err(|e| StudyError::Plot(format!("{}: {e}", path.display())))?;
-        let texels = rgb
-            .chunks_exact(3)
-            .map(|p| [p[0], p[1], p[2], 255])
-            .collect();
-        Ok(write_png(
-            path,
-            &LdrImage {
-                width: w,
-                height: h,
-                texels,
-            },
-        )?)
+        write_drawing(path, PLOT_SIZE, |rgb, [w, h]| self.draw(rgb, (w, h)))
     }
 
     fn draw(&self, rgb: &mut [u8], size: (u32, u32)) -> Result<(), Box<dyn std::error::Error>> {
@@ -207,22 +194,9 @@ impl TemporalReport {
 
     /// Draws each mode's flicker at every inner frame, and the truth's, into `path` (PNG).
     fn plot_by_frame(&self, path: &Path) -> Result<(), StudyError> {
-        let (w, h) = (720u32, 480u32);
-        let mut rgb = vec![255u8; (w * h * 3) as usize];
-        self.draw_by_frame(&mut rgb, (w, h))
-            .map_err(|e| StudyError::Plot(format!("{}: {e}", path.display())))?;
-        let texels = rgb
-            .chunks_exact(3)
-            .map(|p| [p[0], p[1], p[2], 255])
-            .collect();
-        Ok(write_png(
-            path,
-            &LdrImage {
-                width: w,
-                height: h,
-                texels,
-            },
-        )?)
+        write_drawing(path, PLOT_SIZE, |rgb, [w, h]| {
+            self.draw_by_frame(rgb, (w, h))
+        })
     }
 
     fn draw_by_frame(

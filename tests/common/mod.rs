@@ -256,3 +256,46 @@ pub fn decode_rgba16f(bytes: &[u8]) -> Vec<Vec4> {
         .collect();
     halves.chunks_exact(4).map(Vec4::from_slice).collect()
 }
+
+/// RMS of `a - b` over the mean of `b` (rgb, every pixel): the image tests' relative RMSE.
+pub fn relative_rmse(
+    a: &shine::capture::image_io::HdrImage,
+    b: &shine::capture::image_io::HdrImage,
+) -> f64 {
+    let rgb = |i: &shine::capture::image_io::HdrImage| -> Vec<[f32; 3]> {
+        i.texels.iter().map(|t| [t[0], t[1], t[2]]).collect()
+    };
+    let mask = vec![true; b.texels.len()];
+    shine::study::metrics::image_error(&rgb(a), &rgb(b), &mask)
+        .expect("a lit reference")
+        .relative_rmse
+}
+
+/// A deterministic pseudo-random number generator (xorshift32) for test inputs.
+pub struct Rng(pub u32);
+
+impl Rng {
+    /// The next number in [0, 1).
+    pub fn next(&mut self) -> f32 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 17;
+        self.0 ^= self.0 << 5;
+        (self.0 >> 8) as f32 / (1u32 << 24) as f32
+    }
+}
+
+/// A motion image (`gb_motion`, RG16F) holding `motion`, row-major at `extent`.
+pub fn motion_image(device: &Device, extent: [u32; 2], motion: &[glam::Vec2]) -> shine::gpu::Image {
+    let bytes: Vec<u8> = motion
+        .iter()
+        .flat_map(|m| [f32_to_f16(m.x), f32_to_f16(m.y)])
+        .flat_map(u16::to_le_bytes)
+        .collect();
+    storage_image_with(
+        device,
+        "gb_motion",
+        vk::Format::R16G16_SFLOAT,
+        extent,
+        &bytes,
+    )
+}
