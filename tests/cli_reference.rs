@@ -135,3 +135,63 @@ fn bad_input_fails_cleanly() {
     );
     assert!(!out_path.exists());
 }
+
+/// `shine compare` on PNGs: compared as displayed (the JSON says so, stderr says what it
+/// means), a plain capture against a supersampled one differs at the edges, and both maps
+/// are written at the image's size (the FLIP map black where the images agree).
+#[test]
+fn compare_reads_pngs_as_displayed_and_writes_the_maps() {
+    let dir = scratch("cli_compare_png");
+    let (a, b) = (dir.join("plain.png"), dir.join("ssaa.png"));
+    for (path, ssaa) in [(&a, "1"), (&b, "2")] {
+        let out = shine(&[
+            "render",
+            "builtin:cornell-box",
+            "--width",
+            "24",
+            "--height",
+            "24",
+            "--gi",
+            "none",
+            "--ssaa",
+            ssaa,
+            "-o",
+            path.to_str().unwrap(),
+        ]);
+        assert!(out.status.success(), "{}", text(&out));
+    }
+    let (flip, signed) = (dir.join("flip.png"), dir.join("signed.png"));
+    let out = shine(&[
+        "compare",
+        a.to_str().unwrap(),
+        b.to_str().unwrap(),
+        "--format",
+        "json",
+        "--heatmap",
+        flip.to_str().unwrap(),
+        "--signed-map",
+        signed.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("compared as displayed"));
+    let report: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("compare prints JSON");
+    assert_eq!(report["displayed"], serde_json::json!(true));
+    let flip_mean = report["flip"].as_f64().expect("flip");
+    assert!(flip_mean > 0.0 && flip_mean < 0.5, "FLIP {flip_mean}");
+    for path in [&flip, &signed] {
+        let map = shine::capture::image_io::read_png(path).expect("map");
+        assert_eq!((map.width, map.height), (24, 24));
+    }
+    // The FLIP map of an image against itself is black.
+    let out = shine(&[
+        "compare",
+        a.to_str().unwrap(),
+        a.to_str().unwrap(),
+        "--heatmap",
+        flip.to_str().unwrap(),
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let map = shine::capture::image_io::read_png(&flip).expect("map");
+    assert!(map.texels.iter().all(|t| t[..3].iter().all(|&c| c < 8)));
+}

@@ -18,7 +18,7 @@
 //!   clamped values sRGB-encoded to 8 bits (what a display shows at exposure 1), at the
 //!   binding's default 67 pixels per degree (a 0.7 m viewing distance from a 24" monitor).
 
-use crate::capture::image_io::HdrImage;
+use crate::capture::image_io::{HdrImage, LdrImage};
 
 /// Dynamic range `L` of the clamped values.
 pub const DYNAMIC_RANGE: f64 = 1.0;
@@ -214,8 +214,11 @@ fn srgb8(image: &HdrImage) -> Vec<u8> {
         .collect()
 }
 
-/// Mean LDR-FLIP error of `image` against `reference` (see the module documentation).
-pub fn flip(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError> {
+/// The per-pixel LDR-FLIP error of `image` against `reference` (see the module documentation).
+fn flip_error(
+    image: &HdrImage,
+    reference: &HdrImage,
+) -> Result<nv_flip::FlipImageFloat, CompareError> {
     check(image, reference)?;
     let (w, h) = (image.width, image.height);
     if w == 0 || h == 0 {
@@ -223,8 +226,32 @@ pub fn flip(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError>
     }
     let test = nv_flip::FlipImageRgb8::with_data(w, h, &srgb8(image));
     let reference = nv_flip::FlipImageRgb8::with_data(w, h, &srgb8(reference));
-    let map = nv_flip::flip(reference, test, nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    Ok(nv_flip::flip(
+        reference,
+        test,
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    ))
+}
+
+/// Mean LDR-FLIP error of `image` against `reference` (see the module documentation).
+pub fn flip(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError> {
+    let map = flip_error(image, reference)?;
     Ok(f64::from(nv_flip::FlipPool::from_image(&map).mean()))
+}
+
+/// The per-pixel FLIP error of `image` against `reference` on FLIP's magma colour map (black:
+/// no visible difference, yellow-white: the largest), as FLIP's own tool writes it.
+pub fn flip_map(image: &HdrImage, reference: &HdrImage) -> Result<LdrImage, CompareError> {
+    let map = flip_error(image, reference)?.apply_color_lut(&nv_flip::magma_lut());
+    Ok(LdrImage {
+        width: image.width,
+        height: image.height,
+        texels: map
+            .to_vec()
+            .chunks_exact(3)
+            .map(|p| [p[0], p[1], p[2], 255])
+            .collect(),
+    })
 }
 
 /// RMSE (absolute and relative to the reference's mean), energy ratio, PSNR, SSIM and FLIP

@@ -205,6 +205,22 @@ pub fn read_png(path: &Path) -> Result<LdrImage, ImageIoError> {
     })
 }
 
+/// Reads a PNG as the light it displays: 8-bit sRGB decoded to linear [0, 1] (alpha 1). For
+/// comparing tonemapped images: the values are what a screen shows, not scene radiance.
+pub fn read_png_linear(path: &Path) -> Result<HdrImage, ImageIoError> {
+    let ldr = read_png(path)?;
+    let decode = |v: u8| crate::capture::tonemap::srgb_eotf(f32::from(v) / 255.0);
+    Ok(HdrImage {
+        width: ldr.width,
+        height: ldr.height,
+        texels: ldr
+            .texels
+            .iter()
+            .map(|t| [decode(t[0]), decode(t[1]), decode(t[2]), 1.0])
+            .collect(),
+    })
+}
+
 /// Decodes `path` as `format`, whatever its extension says.
 fn open(path: &Path, format: image::ImageFormat) -> Result<image::DynamicImage, ImageIoError> {
     let read_error = |source| ImageIoError::Read {

@@ -97,6 +97,16 @@ pub fn srgb_oetf(linear: f32) -> f32 {
     }
 }
 
+/// The sRGB EOTF (encoded [0, 1] → linear [0, 1]), the inverse of [`srgb_oetf`]: how a PNG's
+/// 8-bit values are read back as displayed light.
+pub fn srgb_eotf(encoded: f32) -> f32 {
+    if encoded <= 0.040_45 {
+        encoded / 12.92
+    } else {
+        ((encoded + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// Tonemaps exposed linear radiance with `op`: linear, in [0, 1].
 pub fn tonemap(op: Tonemap, exposed: Vec3) -> Vec3 {
     let c = exposed.max(Vec3::ZERO);
@@ -129,6 +139,16 @@ mod tests {
 
     fn close(a: f32, b: f32, tolerance: f32) -> bool {
         (a - b).abs() <= tolerance
+    }
+
+    #[test]
+    fn srgb_eotf_inverts_the_oetf() {
+        for k in 0..=1000 {
+            let x = k as f32 / 1000.0;
+            assert!(close(srgb_eotf(srgb_oetf(x)), x, 1e-5), "{x}");
+        }
+        assert_eq!(srgb_eotf(0.0), 0.0);
+        assert!(close(srgb_eotf(1.0), 1.0, 1e-6));
     }
 
     #[test]

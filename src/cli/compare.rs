@@ -1,19 +1,20 @@
-//! `shine compare`: RMSE, PSNR and SSIM of an image against a reference (both EXR), as a table
-//! or JSON (definitions in `shine::capture::image_compare`); per tile of a grid and as a
-//! heatmap on request (`shine::capture::regions`).
+//! `shine compare`: RMSE, relative RMSE, energy ratio, PSNR, SSIM and FLIP of an image against a
+//! reference (EXR radiance, or PNG as displayed), as a table or JSON (definitions in
+//! `shine::capture::image_compare`); per tile of a grid, as a FLIP map and as a signed error
+//! map on request (`shine::capture::regions`).
 
 use super::CliError;
-use shine::capture::image_compare::compare;
-use shine::capture::image_io::{read_exr, write_png};
+use shine::capture::image_compare::{compare, flip_map};
+use shine::capture::image_io::{HdrImage, read_exr, read_png_linear, write_png};
 use shine::capture::regions::{Region, error_heatmap, region_grid};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Arguments of `shine compare`.
 #[derive(clap::Args, Debug)]
 pub struct CompareArgs {
-    /// The image under test (.exr).
+    /// The image under test: .exr (linear radiance) or .png (8-bit sRGB, compared as displayed).
     image: PathBuf,
-    /// The reference (.exr), e.g. from `shine reference`.
+    /// The reference: .exr (e.g. from `shine reference`) or .png.
     reference: PathBuf,
     /// Report format: table or json.
     #[arg(long, default_value = "table")]
@@ -21,10 +22,28 @@ pub struct CompareArgs {
     /// Also report energy ratio and relative RMSE per tile of an N×N grid (0: none).
     #[arg(long, default_value_t = 0)]
     regions: u32,
+    /// Also write the per-pixel FLIP error as a PNG (FLIP's magma map: black where no
+    /// difference shows, yellow-white where the largest does).
+    #[arg(long)]
+    heatmap: Option<PathBuf>,
     /// Also write the signed error relative to the reference's mean as a PNG (red: brighter,
     /// blue: darker, saturating at ±1).
     #[arg(long)]
-    heatmap: Option<PathBuf>,
+    signed_map: Option<PathBuf>,
+}
+
+/// Reads an image to compare: EXR as radiance, PNG decoded from sRGB to the light it displays.
+/// Returns the image and whether it was a PNG.
+fn read_image(path: &Path) -> Result<(HdrImage, bool), CliError> {
+    let png = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+    let image = if png {
+        read_png_linear(path)
+    } else {
+        read_exr(path)
+    };
+    Ok((image.map_err(|e| format!("{}: {e}", path.display()))?, png))
 }
 
 /// Compares and prints the metrics.
@@ -34,15 +53,27 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         "json" => true,
         other => return Err(format!("unknown format `{other}` (expected table or json)").into()),
     };
-    let read = |path: &PathBuf| read_exr(path).map_err(|e| format!("{}: {e}", path.display()));
-    let image = read(&args.image)?;
-    let reference = read(&args.reference)?;
+    let (image, image_png) = read_image(&args.image)?;
+    let (reference, reference_png) = read_image(&args.reference)?;
+    let displayed = image_png || reference_png;
+    if displayed {
+        // What a PNG comparison means, once, where a person reads it (not in the JSON on stdout).
+        eprintln!(
+            "note: PNG input is compared as displayed (8-bit sRGB decoded to linear [0, 1], after any tonemap): \
+             energy ratio and relative RMSE are those of the displayed images, not of the radiance; \
+             compare EXR files for radiance"
+        );
+    }
     let c = compare(&image, &reference)?;
     let regions = match args.regions {
         0 => Vec::new(),
         n => region_grid(&image, &reference, n)?,
     };
     if let Some(path) = &args.heatmap {
+        write_png(path, &flip_map(&image, &reference)?)
+            .map_err(|e| format!("{}: {e}", path.display()))?;
+    }
+    if let Some(path) = &args.signed_map {
         write_png(path, &error_heatmap(&image, &reference)?)
             .map_err(|e| format!("{}: {e}", path.display()))?;
     }
@@ -55,6 +86,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             "psnr": c.psnr.is_finite().then_some(c.psnr),
             "ssim": c.ssim,
             "flip": c.flip,
+            "displayed": displayed,
             "width": image.width,
             "height": image.height,
             "regions": regions,

@@ -32,7 +32,8 @@ enum Command {
     Profile(profile::ProfileArgs),
     /// Path-traced reference of a scene (linear EXR): direct, indirect or full radiance.
     Reference(reference::ReferenceArgs),
-    /// RMSE, PSNR and SSIM of an EXR image against a reference EXR.
+    /// RMSE, RMSE / mean, energy ratio, PSNR, SSIM and FLIP of an image against a reference
+    /// (EXR radiance or PNG as displayed); per-tile grids, a FLIP map and a signed error map.
     Compare(compare::CompareArgs),
     /// Built-in scenes: list them or export one as .glb.
     Scene(scene::SceneArgs),
