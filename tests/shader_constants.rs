@@ -55,6 +55,7 @@ fn tonemap_ids_match_the_shader() {
         ("TONEMAP_NONE", Tonemap::None),
         ("TONEMAP_ACES", Tonemap::Aces),
         ("TONEMAP_PBR_NEUTRAL", Tonemap::PbrNeutral),
+        ("TONEMAP_AGX", Tonemap::Agx),
     ] {
         assert_eq!(
             glsl_uint("include/tonemap.glsl", name),
@@ -132,6 +133,15 @@ fn hvl_resolve_constants_match_the_shader() {
         RESOLVE_DEPTH_TOLERANCE
     );
     assert_eq!(glsl_float(file, "RESOLVE_NORMAL_COS"), RESOLVE_NORMAL_COS);
+}
+
+#[test]
+fn agx_constants_match_the_shader() {
+    use shine::capture::tonemap::{AGX_GAMMA, AGX_MAX_EV, AGX_MIN_EV};
+    let file = "include/tonemap.glsl";
+    assert_eq!(glsl_float(file, "AGX_MIN_EV"), AGX_MIN_EV);
+    assert_eq!(glsl_float(file, "AGX_MAX_EV"), AGX_MAX_EV);
+    assert_eq!(glsl_float(file, "AGX_GAMMA"), AGX_GAMMA);
 }
 
 #[test]

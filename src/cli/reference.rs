@@ -6,7 +6,7 @@ use super::CliError;
 use super::frame_args::{EnvironmentArgs, load_scene};
 use glam::Vec3;
 use shine::capture::image_io::{LdrImage, OutputFormat, write_exr, write_png};
-use shine::capture::tonemap::{Tonemap, encode_ldr};
+use shine::capture::tonemap::{DEFAULT_TONEMAP, encode_ldr};
 use shine::gpu::{Device, DeviceDesc};
 use shine::reference::{PathTracer, ReferenceParams};
 use std::path::PathBuf;
@@ -114,12 +114,12 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
     };
     match format {
         OutputFormat::Exr => write_exr(&args.output, image)?,
-        // A preview: PBR-neutral tonemapped, sRGB-encoded.
+        // A preview: tonemapped with the default operator, sRGB-encoded.
         OutputFormat::Png => {
             let texels = image
                 .texels
                 .iter()
-                .map(|t| encode_ldr(Tonemap::PbrNeutral, Vec3::new(t[0], t[1], t[2])))
+                .map(|t| encode_ldr(DEFAULT_TONEMAP, Vec3::new(t[0], t[1], t[2])))
                 .collect();
             let ldr = LdrImage {
                 width: image.width,

@@ -34,11 +34,11 @@ pub struct CompositeParams {
 pub const SSAA: std::ops::RangeInclusive<u32> = 1..=4;
 
 impl Default for CompositeParams {
-    /// Exposure 1, the Khronos PBR Neutral curve, no supersampling.
+    /// Exposure 1, the default tonemap ([`tonemap::DEFAULT_TONEMAP`], AgX), no supersampling.
     fn default() -> Self {
         Self {
             exposure: 1.0,
-            tonemap: Tonemap::PbrNeutral,
+            tonemap: tonemap::DEFAULT_TONEMAP,
             ssaa: 1,
         }
     }

@@ -16,7 +16,7 @@ use plotters::prelude::*;
 
 use super::StudyError;
 use crate::capture::image_io::{LdrImage, write_png};
-use crate::capture::tonemap::{Tonemap, encode_ldr};
+use crate::capture::tonemap::{DEFAULT_TONEMAP, encode_ldr};
 
 /// Where a sans-serif TrueType font is usually found (Debian/Ubuntu, Fedora, Arch, macOS,
 /// Windows).
@@ -397,7 +397,8 @@ fn write_with_bar(
     Ok(())
 }
 
-/// Writes linear radiance scaled by `exposure`, PBR-neutral tonemapped and sRGB-encoded.
+/// Writes linear radiance scaled by `exposure`, tonemapped with [`DEFAULT_TONEMAP`] and
+/// sRGB-encoded.
 pub fn write_tonemapped(
     path: &Path,
     extent: [u32; 2],
@@ -406,7 +407,7 @@ pub fn write_tonemapped(
 ) -> Result<(), StudyError> {
     let texels = image
         .iter()
-        .map(|t| encode_ldr(Tonemap::PbrNeutral, Vec3::from_array(*t) * exposure))
+        .map(|t| encode_ldr(DEFAULT_TONEMAP, Vec3::from_array(*t) * exposure))
         .collect();
     write_png(
         path,
