@@ -29,11 +29,13 @@
 
 use glam::Vec3;
 
-/// The operator of captures, previews and the composite unless told otherwise: AgX. On the
-/// cornell box's back wall PBR Neutral's black offset took 33 of 34 sRGB levels of blue
-/// (untonemapped (76, 63, 34) → (68, 53, 5), an olive cast), AgX keeps them ((87, 71, 32));
-/// it lifts mid-tones by about 15% and desaturates the brightest colours (docs/quality.md).
-pub const DEFAULT_TONEMAP: Tonemap = Tonemap::Agx;
+/// The operator of captures, previews and the composite unless told otherwise: PBR Neutral,
+/// which renders base colours true. AgX was tried as the default and not kept: it keeps a dim
+/// channel that PBR Neutral's black offset removes (the cornell box's back wall in sRGB:
+/// untonemapped (76, 63, 34), PBR Neutral (68, 53, 5), AgX (87, 71, 32)), but it turns the
+/// room's red cube pink and its pale blue wall grey ((214, 220, 230) → (187, 189, 193);
+/// docs/quality.md). `--tonemap agx` is one flag away.
+pub const DEFAULT_TONEMAP: Tonemap = Tonemap::PbrNeutral;
 
 /// Linear exposure factors a frame takes (`output.exposure`).
 pub const EXPOSURE: std::ops::RangeInclusive<f32> = 1e-6..=1e6;

@@ -25,7 +25,7 @@ pub struct SettingsArgs {
     /// (`hvl,proxy`), `aaf`.
     #[arg(long)]
     gi: Option<String>,
-    /// Tonemapping: none, aces, pbr-neutral, agx (default).
+    /// Tonemapping: none, aces, pbr-neutral (default), agx.
     #[arg(long)]
     tonemap: Option<String>,
     /// Linear exposure factor.

@@ -34,7 +34,8 @@ pub struct CompositeParams {
 pub const SSAA: std::ops::RangeInclusive<u32> = 1..=4;
 
 impl Default for CompositeParams {
-    /// Exposure 1, the default tonemap ([`tonemap::DEFAULT_TONEMAP`], AgX), no supersampling.
+    /// Exposure 1, the default tonemap ([`tonemap::DEFAULT_TONEMAP`], PBR Neutral), no
+    /// supersampling.
     fn default() -> Self {
         Self {
             exposure: 1.0,

@@ -17,7 +17,7 @@
 //! receiver_scale = 2
 //!
 //! [output]
-//! tonemap = "agx"
+//! tonemap = "pbr-neutral"
 //! exposure = 1.0
 //!
 //! [hvl]
@@ -186,7 +186,7 @@ pub struct ProxySettings {
 #[serde(default, deny_unknown_fields)]
 pub struct OutputSettings {
     /// Tonemap operator of the LDR (PNG) output: `none`, `aces`, `pbr-neutral`, `agx`.
-    /// Default `agx`. EXR output stays linear HDR.
+    /// Default `pbr-neutral`. EXR output stays linear HDR.
     pub tonemap: Tonemap,
     /// Linear factor applied to radiance before tonemapping (and in the EXR).
     /// Range 1e-6..=1e6, default 1.0.
