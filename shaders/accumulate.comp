@@ -1,5 +1,5 @@
 // `accumulate` (issue 23, "history"; src/passes/accumulate.rs): the frame's indirect light
-// accumulated over frames. Each pixel's history is reprojected with the G-buffer's motion
+// (and, as the `taa` pass, its jittered direct light) accumulated over frames. Each pixel's history is reprojected with the G-buffer's motion
 // vectors (a bilinear footprint whose taps count only where they show the pixel's surface:
 // `resolve_same_surface`, the amortised HVL's disocclusion test), clipped to the current 3×3
 // neighbourhood's mean ± clip·σ per channel (variance clipping, as TAA does; the box widened to
@@ -8,7 +8,8 @@
 // history that converges where nothing changes, restarts where the surface was not visible
 // (n = 1) and follows at once where the light leaves the clip box. With `geometry` 0 it is
 // TAA: every pixel counts, the background too, a still pixel keeps history of any surface of
-// its 3×3 neighbourhood (jittered silhouettes), and the blend is in the space x / (1 + luma) so
+// its 3×3 neighbourhood (jittered silhouettes) while a pixel near motion keeps only its own
+// surface's and at most TAA_MOVING_FRAMES, and the blend is in the space x / (1 + luma) so
 // that bright history cannot bleed into dark surfaces. CPU twin:
 // shine::reference::accumulate::accumulate_cpu.
 #version 460
@@ -19,7 +20,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 #include "accumulate.glsl"
 #include "hvl_resolve.glsl"
 
-// This frame's indirect light.
+// This frame's light (indirect; direct under TAA).
 layout(set = 0, binding = 0, rgba16f) readonly uniform image2D current;
 // World position, w: linear depth (0 on the background).
 layout(set = 0, binding = 1, rgba32f) readonly uniform image2D gb_position;
@@ -43,8 +44,9 @@ layout(push_constant) uniform Push {
     float max_frames;
     // half-width of the clip box in standard deviations (0: no clipping)
     float clip;
-    // 1: history taps must show the pixel's surface and the background passes through (the
-    // indirect light); 0: colour only, every pixel and tap counts (TAA of the direct light)
+    // 1: the indirect light's history (linear; the background passes through); 0: TAA of the
+    // direct light (blend space, the background accumulates, still pixels take any nearby
+    // surface's history)
     uint geometry;
     uint pad1;
     uint pad2;

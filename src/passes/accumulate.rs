@@ -1,18 +1,18 @@
 //! `accumulate`: the frame's indirect light accumulated over frames (issue 23, "history"), for
-//! every GI technique alike. Each pixel's history is reprojected with the G-buffer's motion
-//! vectors, bilinearly over the taps that show the pixel's surface (the amortised HVL's
-//! disocclusion test, [`crate::passes::hvl::resolve::same_surface`]), clipped to the current
-//! 3×3 neighbourhood's mean ± [`AccumulateParams::clip`] standard deviations per channel
-//! (variance clipping, as TAA clips colour history; the box widened to hold the pixel's own
-//! light, so that a static image keeps its history where a peak lies outside mean ± σ), and
-//! blended with weight 1/n, n the
-//! history's length capped at [`AccumulateParams::max_frames`].
+//! every GI technique alike; the same pass, in TAA mode ([`AccumulateParams::taa`]), is the direct
+//! light's temporal antialiasing (issue 21). Each pixel's history is reprojected with the
+//! G-buffer's motion vectors, bilinearly over the taps that show the pixel's surface (the amortised
+//! HVL's disocclusion test, [`crate::passes::hvl::resolve::same_surface`]), clipped to the current
+//! 3×3 neighbourhood's mean ± [`AccumulateParams::clip`] standard deviations per channel (variance
+//! clipping, as TAA clips colour history; the box widened to hold the pixel's own light, so that a
+//! static image keeps its history where a peak lies outside mean ± σ), and blended with weight 1/n,
+//! n the history's length capped at [`AccumulateParams::max_frames`].
 //!
 //! Decisions: the clip box is per RGB channel rather than in YCoCg (indirect light is smooth and
 //! chroma ghosts were not seen); background pixels are left out of the neighbourhood (their
-//! indirect light is 0); the history length lives in the image's alpha, so a disocclusion
-//! restarts at n = 1 and converges as fast as the first frames. Shader:
-//! `shaders/accumulate.comp`; CPU twin: [`crate::reference::accumulate::accumulate_cpu`].
+//! indirect light is 0); the history length lives in the image's alpha, so a disocclusion restarts
+//! at n = 1 and converges as fast as the first frames. Shader: `shaders/accumulate.comp`; CPU twin:
+//! [`crate::reference::accumulate::accumulate_cpu`].
 
 use std::ops::RangeInclusive;
 
@@ -139,7 +139,7 @@ pub struct AccumulatePush {
     pub max_frames: f32,
     /// Clip half-width in standard deviations.
     pub clip: f32,
-    /// 1: history must show the pixel's surface ([`AccumulateParams::geometry`]).
+    /// 1: the indirect light's mode, 0: TAA ([`AccumulateParams::geometry`]).
     pub geometry: u32,
     /// Padding.
     pub pad: [u32; 2],
