@@ -115,10 +115,11 @@ void main() {
     vec2 uv = (vec2(p) + 0.5) / vec2(push.extent);
     vec2 motion = imageLoad(gb_motion, p).xy;
     vec2 then_px = (uv - motion) * vec2(push.extent) - 0.5;
-    // Still: nothing in the 3×3 neighbourhood moves (a still pixel beside a moving figure must
-    // not take the figure's light into its history: the figure would take it back).
+    // TAA's "still": nothing in the 3×3 neighbourhood moves (a still pixel beside a moving
+    // figure must not take the figure's light into its history: the figure would take it back).
+    // The indirect light's history never asks, so its loop is skipped.
     bool still = true;
-    for (int y = -1; y <= 1; ++y) {
+    for (int y = -1; y <= 1 && !geometry; ++y) {
         for (int x = -1; x <= 1; ++x) {
             ivec2 q = p + ivec2(x, y);
             if (inside(q) && length(imageLoad(gb_motion, q).xy * vec2(push.extent)) >= TAA_STILL_PIXELS) {

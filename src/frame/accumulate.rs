@@ -41,6 +41,31 @@ impl AccumulateTechnique {
         self.last = None;
     }
 
+    /// `current` (on the surfaces of `g`, at `extent`) accumulated with `params` when the frame
+    /// has both (`geometry_then` declares or returns the previous frame's `gbuffer history`,
+    /// asked for only then); otherwise the history is forgotten and `current` passes through.
+    pub fn apply(
+        &mut self,
+        rg: &mut RenderGraph,
+        params: Option<AccumulateParams>,
+        extent: [u32; 2],
+        current: Option<Handle<Image>>,
+        g: &GBuffer,
+        geometry_then: impl FnOnce(&mut RenderGraph) -> Handle<Image>,
+    ) -> Result<Option<Handle<Image>>, RenderError> {
+        match (current, params) {
+            (Some(light), Some(params)) => {
+                let then = geometry_then(rg);
+                let prepared = self.prepare(rg, params, extent);
+                Ok(Some(prepared.declare(rg, &light, g, &then)?))
+            }
+            (light, _) => {
+                self.reset();
+                Ok(light)
+            }
+        }
+    }
+
     /// This frame's accumulation at `extent`: it has history when the previous frame
     /// accumulated at the same extent.
     pub fn prepare(

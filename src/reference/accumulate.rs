@@ -93,10 +93,11 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
             let uv = Vec2::new((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32);
             let size = Vec2::new(w as f32, h as f32);
             let then = (uv - inp.motion[i]) * size - 0.5;
-            let still = (-1..=1)
-                .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
-                .filter(|&(qx, qy)| inside(qx, qy))
-                .all(|(qx, qy)| (inp.motion[at(qx, qy)] * size).length() < TAA_STILL_PIXELS);
+            let still = !params.geometry
+                && (-1..=1)
+                    .flat_map(|dy| (-1..=1).map(move |dx| (x + dx, y + dy)))
+                    .filter(|&(qx, qy)| inside(qx, qy))
+                    .all(|(qx, qy)| (inp.motion[at(qx, qy)] * size).length() < TAA_STILL_PIXELS);
             let base = then.floor();
             let f = then - base;
             let (mut history, mut weight) = (Vec4::ZERO, 0.0f32);

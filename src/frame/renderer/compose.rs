@@ -102,19 +102,14 @@ impl Renderer {
             p.shadow,
             self.nearest.raw(),
         );
-        let direct = match p.taa {
-            Some(params) => {
-                self.taa
-                    .prepare(rg, params, p.extent)
-                    .declare(rg, &direct, &g, &geometry_then)?
-            }
-            None => {
-                self.taa.reset();
-                direct
-            }
-        };
+        let direct = self
+            .taa
+            .apply(rg, p.taa, p.extent, Some(direct), &g, |_| geometry_then)?
+            .unwrap_or(direct);
         let indirect = self.declare_indirect(rg, p, &handles, &g, &camera, None)?;
-        let indirect = self.accumulate_indirect(rg, p, indirect, &g, |_| geometry_then)?;
+        let indirect = self
+            .accumulate
+            .apply(rg, p.history, p.extent, indirect, &g, |_| geometry_then)?;
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
         let (first, second) = match (p.component, indirect.as_ref()) {
             (Component::Full, indirect) => (&direct, indirect),
@@ -133,31 +128,6 @@ impl Renderer {
             output.extent,
             &p.composite,
         ))
-    }
-
-    /// `indirect` (on the surfaces of `g`) accumulated over frames when `p` asks for a
-    /// history (issue 23; `geometry_then` declares or returns the previous frame's `gbuffer
-    /// history`, asked for only then); the history is forgotten on a frame without one or
-    /// without indirect light.
-    pub(super) fn accumulate_indirect(
-        &mut self,
-        rg: &mut RenderGraph,
-        p: &FrameParams,
-        indirect: Option<Handle<Image>>,
-        g: &GBuffer,
-        geometry_then: impl FnOnce(&mut RenderGraph) -> Handle<Image>,
-    ) -> Result<Option<Handle<Image>>, RenderError> {
-        match (indirect, p.history) {
-            (Some(light), Some(params)) => {
-                let then = geometry_then(rg);
-                let prepared = self.accumulate.prepare(rg, params, p.extent);
-                Ok(Some(prepared.declare(rg, &light, g, &then)?))
-            }
-            (light, _) => {
-                self.accumulate.reset();
-                Ok(light)
-            }
-        }
     }
 
     /// The scene textures' sampler of `p`: trilinear (a level finer under TAA), or level 0

@@ -70,8 +70,11 @@ impl Renderer {
         let indirect = self.declare_indirect(rg, p, &handles, &g, camera, environment)?;
         // With a history (issue 23), the host's G-buffer is kept for the next frame's
         // disocclusion test.
-        let indirect =
-            self.accumulate_indirect(rg, p, indirect, &g, |rg| history::gbuffer_history(rg, &g))?;
+        let indirect = self
+            .accumulate
+            .apply(rg, p.history, p.extent, indirect, &g, |rg| {
+                history::gbuffer_history(rg, &g)
+            })?;
         match indirect {
             Some(indirect) => {
                 rg.blit_image("gi to host", &indirect, &mut output, vk::Filter::NEAREST);
