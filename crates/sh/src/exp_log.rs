@@ -559,16 +559,9 @@ mod tests {
 
     /// Issue 21, item 4: single sphere blockers of 30°–90° (90°: the receiver on the sphere),
     /// 4 bands (paper 002's shadow order). Relative L2 error of exp(log g) against the
-    /// ray-cast visibility g, for the exact exponential and for HYB (what the GPU runs):
-    ///
-    /// | half-angle | 30° | 45° | 60° | 75° | 90° |
-    /// |---|---|---|---|---|---|
-    /// | Ren et al., exact exp | 0.000 | 0.001 | 0.046 | 0.043 | 0.018 |
-    /// | ln of floored eigenvalues, exact exp | 0.000 | 0.001 | 0.048 | 0.046 | 0.019 |
-    /// | Ren et al., HYB | see the printed table |
-    ///
-    /// Up to 45° nothing is clamped and the two agree; beyond, Ren et al.'s formula is the
-    /// closer one at every size.
+    /// ray-cast visibility g, for the exact exponential, HYB (what the GPU runs) and OL; the
+    /// table it prints is in docs/quality.md. Up to 45° nothing is clamped and the two formulas
+    /// agree; beyond, Ren et al.'s is the closer one at every size.
     #[test]
     fn log_of_large_blockers_against_ray_cast_visibility() {
         let bands = 4;
