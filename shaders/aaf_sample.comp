@@ -34,7 +34,7 @@ layout(push_constant) uniform Push {
     uvec4 frame;
     // x: bounces B, y: samples of the first pass, z, w: unused.
     uvec4 config;
-    // xyz: camera position, w: unused.
+    // xyz: camera position, w: the specular pass's roughness limit (0: none).
     vec4 camera;
 } push;
 
@@ -147,7 +147,10 @@ void main() {
         }
         z_min = min(z_min, hit.t);
         z_max = max(z_max, hit.t);
-        vec3 f = brdf_metallic_roughness(n, l, v, albedo, roughness_metallic.y, roughness_metallic.x);
+        vec3 f_d;
+        vec3 f_s;
+        brdf_metallic_roughness_parts(n, l, v, albedo, roughness_metallic.y, roughness_metallic.x, f_d, f_s);
+        vec3 f = f_d + f_s * (1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w));
         vec3 radiance = incident(l, hit, push.config.x) * BRDF_PI * f / w;
         if (!any(isnan(radiance)) && !any(isinf(radiance))) {
             sum.rgb += radiance;

@@ -103,7 +103,7 @@ const float HVL_VISIBILITY_LIFT = 0.01;
 
 // shine::passes::hvl::GatherPush
 layout(push_constant) uniform Push {
-    // xyz: camera position; w unused
+    // xyz: camera position; w: the specular pass's roughness limit (0: none)
     vec4 camera;
     // receiver buffer size
     uvec2 extent;
@@ -174,7 +174,7 @@ void main() {
     vec3 ks;
     brdf_indirect_weights(albedo, metallic, cos_o, kd, ks);
 #ifdef HVL_FULL
-    ks = brdf_table_fresnel_weight(ks, cos_o);
+    ks = brdf_table_fresnel_weight(ks, cos_o) * (1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w));
     if (cos_o <= 0.0) {
         imageStore(indirect, px, vec4(0.0));
         return;

@@ -60,7 +60,7 @@ layout(set = 0, binding = 7, std430) readonly buffer Brdf {
 
 // shine::passes::igi::FilterPush
 layout(push_constant) uniform Push {
-    // xyz: camera position; w unused
+    // xyz: camera position; w: the specular pass's roughness limit (0: none)
     vec4 camera;
     // image size
     uvec2 extent;
@@ -141,6 +141,7 @@ void main() {
     vec3 kd;
     vec3 ks;
     brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
+    ks *= 1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w);
     ks = brdf_table_fresnel_weight(ks, dot(n, wo));
     // A shading normal facing away from the viewer is evaluated at grazing view.
     float cos_o = clamp(dot(n, wo), 1e-4, 1.0);
@@ -171,11 +172,13 @@ void main() {
     vec3 kd;
     vec3 ks;
     brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
+    ks *= 1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w);
     result = kd / IGI_PI * (sum[0] / count) + ks * (sum[1] / count);
 #else
     vec3 kd;
     vec3 ks;
     brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, wo), kd, ks);
+    ks *= 1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w);
     float exponent = igi_phong_exponent(roughness_metallic.x);
     float b_lambert[SH_COEFFS];
     float b_phong[SH_COEFFS];

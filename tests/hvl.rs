@@ -166,6 +166,8 @@ fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
         path,
         visibility: false,
         slices: 1,
+        // the glossy share of the traced specular pass: ties the GLSL fade to the Rust one
+        specular_limit: shine::passes::specular::LIMIT,
     }
 }
 

@@ -360,6 +360,8 @@ fn params(pattern: [u32; 2], order: u32, radius: u32, mode: FilterMode) -> IgiPa
         sh_order: order,
         filter_radius: radius,
         mode,
+        // the glossy share of the traced specular pass: ties the GLSL fade to the Rust one
+        specular_limit: shine::passes::specular::LIMIT,
         ..IgiParams::default()
     }
 }

@@ -12,7 +12,7 @@ use shine::graph::{Executor, ExternalState};
 use shine::reference::{PathTracer, ReferenceImages, ReferenceParams, render_reference};
 use shine_scene::bvh::Ray;
 use shine_scene::environment::Environment;
-use shine_scene::{Camera, Light, Material, Mesh, Node, Primitive, Projection, Scene, Transform};
+use shine_scene::{Light, Material, Scene, Transform};
 
 /// A scene of one mesh (flat-shaded triangles) with one material, a camera and `lights`.
 fn one_mesh_scene(
@@ -22,92 +22,17 @@ fn one_mesh_scene(
     lights: Vec<Light>,
     environment: Option<Environment>,
 ) -> Scene {
-    let mut primitive = Primitive::default();
-    for (i, t) in triangles.iter().enumerate() {
-        let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
-        for v in t {
-            primitive.positions.push(*v);
-            primitive.normals.push(n);
-            primitive.bounds.grow(*v);
-        }
-        primitive
-            .indices
-            .extend([3 * i as u32, 3 * i as u32 + 1, 3 * i as u32 + 2]);
-    }
-    Scene {
-        source: "test".into(),
-        nodes: vec![Node {
-            name: "mesh".into(),
-            parent: None,
-            children: vec![],
-            transform: Transform::default(),
-            mesh: Some(0),
-            camera: None,
-            lights: vec![],
-            skin: None,
-            weights: None,
-        }],
-        roots: vec![0],
-        meshes: vec![Mesh {
-            name: "mesh".into(),
-            primitives: vec![primitive],
-            weights: vec![],
-        }],
-        materials: vec![material],
-        material_names: vec!["material".into()],
+    common::scenes::mesh_scene(
+        &[(triangles.to_vec(), material)],
+        camera,
         lights,
-        cameras: vec![Camera {
-            name: "camera".into(),
-            projection: Projection::Perspective {
-                yfov: 1.0,
-                aspect_ratio: None,
-                znear: 0.01,
-                zfar: None,
-            },
-            world: camera,
-            node: None,
-        }],
         environment,
-        ..Scene::default()
-    }
+    )
 }
 
-/// A UV sphere of radius `r` at the origin: outward-facing (counter-clockwise seen from
-/// outside) or inward-facing.
+/// A UV sphere of radius `r` at the origin.
 fn sphere(r: f32, outward: bool) -> Vec<[Vec3; 3]> {
-    let (rings, segments) = (24, 48);
-    let point = |i: u32, j: u32| {
-        let theta = std::f32::consts::PI * i as f32 / rings as f32;
-        let phi = std::f32::consts::TAU * j as f32 / segments as f32;
-        r * Vec3::new(
-            theta.sin() * phi.cos(),
-            theta.cos(),
-            theta.sin() * phi.sin(),
-        )
-    };
-    let mut out = Vec::new();
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b, c, d) = (
-                point(i, j),
-                point(i + 1, j),
-                point(i + 1, j + 1),
-                point(i, j + 1),
-            );
-            // (a, d, c) and (a, c, b) wind counter-clockwise seen from outside.
-            let mut tris = vec![];
-            if i > 0 {
-                tris.push([a, d, c]);
-            }
-            if i + 1 < rings {
-                tris.push([a, c, b]);
-            }
-            for t in tris {
-                out.push(if outward { t } else { [t[0], t[2], t[1]] });
-            }
-        }
-    }
-    out
+    common::scenes::sphere(Vec3::ZERO, r, outward)
 }
 
 fn lambert(albedo: f32, emissive: f32) -> Material {

@@ -194,3 +194,11 @@ fn diffuse_fresnel_fit_matches_the_shader() {
         DIFFUSE_FRESNEL_POWER
     );
 }
+
+#[test]
+fn specular_fade_matches_the_shader() {
+    assert_eq!(
+        glsl_float("include/brdf.glsl", "SPECULAR_FADE"),
+        shine::passes::specular::FADE
+    );
+}

@@ -17,8 +17,9 @@ float ggx_distribution(float nh, float a) {
     return a2 / (BRDF_PI * d_denom * d_denom);
 }
 
-// f(l, v) for unit n, l, v; `roughness` is perceptual (alpha = roughness^2).
-vec3 brdf_metallic_roughness(vec3 n, vec3 l, vec3 v, vec3 base_color, float metallic, float roughness) {
+// f(l, v) for unit n, l, v as its diffuse (Lambert) and specular (GGX) parts; `roughness` is
+// perceptual (alpha = roughness^2).
+void brdf_metallic_roughness_parts(vec3 n, vec3 l, vec3 v, vec3 base_color, float metallic, float roughness, out vec3 diffuse, out vec3 specular) {
     vec3 h = normalize(l + v);
     float nl = max(dot(n, l), 0.0);
     float nv = max(dot(n, v), 1e-4);
@@ -30,8 +31,30 @@ vec3 brdf_metallic_roughness(vec3 n, vec3 l, vec3 v, vec3 base_color, float meta
     float vis = 0.5 / max(nl * sqrt(nv * nv * (1.0 - a2) + a2) + nv * sqrt(nl * nl * (1.0 - a2) + a2), 1e-6);
     vec3 f0 = mix(vec3(0.04), base_color, metallic);
     vec3 f = f0 + (1.0 - f0) * pow(1.0 - vh, 5.0);
-    vec3 diffuse = (1.0 - f) * (1.0 - metallic) * base_color / BRDF_PI;
-    return diffuse + f * d * vis;
+    diffuse = (1.0 - f) * (1.0 - metallic) * base_color / BRDF_PI;
+    specular = f * d * vis;
+}
+
+// f(l, v) for unit n, l, v; `roughness` is perceptual (alpha = roughness^2).
+vec3 brdf_metallic_roughness(vec3 n, vec3 l, vec3 v, vec3 base_color, float metallic, float roughness) {
+    vec3 diffuse;
+    vec3 specular;
+    brdf_metallic_roughness_parts(n, l, v, base_color, metallic, roughness, diffuse, specular);
+    return diffuse + specular;
+}
+
+// shine::passes::specular::FADE
+const float SPECULAR_FADE = 0.1;
+
+// Share of a receiver's specular lobe that the traced specular pass takes
+// (shine::passes::specular::trace_weight): 1 up to `limit` - SPECULAR_FADE, a smoothstep down to
+// 0 at `limit`; 0 everywhere without the pass (limit <= 0). The SH techniques (HVL, IGI, AAF)
+// scale their glossy term by 1 minus it.
+float specular_trace_weight(float roughness, float limit) {
+    if (limit <= 0.0) {
+        return 0.0;
+    }
+    return 1.0 - smoothstep(limit - SPECULAR_FADE, limit, roughness);
 }
 
 // --- Importance sampling of the BRDF above (path tracer) ---

@@ -44,6 +44,9 @@ pub enum RenderError {
     /// The AAF passes refused their parameters.
     #[error(transparent)]
     Aaf(#[from] AafError),
+    /// The specular pass refused its parameters.
+    #[error(transparent)]
+    Specular(#[from] crate::passes::specular::SpecularError),
     /// A host's environment map could not be projected.
     #[error(transparent)]
     EnvironmentSh(#[from] EnvironmentShError),

@@ -9,6 +9,7 @@ use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParam
 use crate::passes::hvl::HvlParams;
 use crate::passes::igi::IgiParams;
 use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
+use crate::passes::specular::SpecularParams;
 use crate::passes::upsample::UpsampleParams;
 use crate::settings::{GiTechnique, Settings};
 
@@ -37,6 +38,9 @@ pub struct FrameParams {
     pub proxy: Option<ProxySetup>,
     /// Axis-aligned filtering of path-traced indirect light (paper 004), when the frame has it.
     pub aaf: Option<AafParams>,
+    /// Traced specular reflections, when on and the frame has a GI technique (the techniques'
+    /// `specular_limit` is its limit then, else 0).
+    pub specular: Option<SpecularParams>,
     /// The joint bilateral upsample of the receiver-resolution light.
     pub upsample: UpsampleParams,
     /// The indirect light's accumulation over frames, when it has a history longer than one
@@ -86,6 +90,12 @@ impl FrameParams {
         let h = &settings.hvl;
         let i = &settings.igi;
         let p = &settings.proxy;
+        let specular = (settings.specular.enabled && !gi.is_none()).then(|| SpecularParams {
+            samples: settings.specular.samples,
+            limit: settings.specular.limit,
+            ..SpecularParams::default()
+        });
+        let specular_limit = specular.map_or(0.0, |s| s.limit);
         Self {
             extent: [settings.width, settings.height],
             receiver_scale: settings.receiver_scale,
@@ -110,6 +120,7 @@ impl FrameParams {
                 falloff: h.falloff,
                 visibility: h.visibility,
                 slices: h.slices,
+                specular_limit,
             }),
             igi: gi.contains(GiTechnique::Igi).then_some(IgiParams {
                 pattern: [i.n, i.m],
@@ -122,6 +133,7 @@ impl FrameParams {
                 clamp_distance: i.clamp_distance,
                 depth_tolerance: i.depth_tolerance,
                 normal_threshold: i.normal_threshold,
+                specular_limit,
             }),
             proxy: gi.contains(GiTechnique::Proxy).then_some(ProxySetup {
                 pass: ProxyParams {
@@ -153,9 +165,11 @@ impl FrameParams {
                     bounces: a.bounces,
                     adaptive: a.adaptive,
                     filter: a.filter,
+                    specular_limit,
                     ..AafParams::default()
                 }
             }),
+            specular,
             upsample: UpsampleParams {
                 depth_sigma: settings.upsample.depth_epsilon,
                 normal_power: settings.upsample.normal_power,

@@ -98,6 +98,9 @@ pub struct AafParams {
     pub filter: bool,
     /// Seed of the samples' random numbers.
     pub seed: u32,
+    /// Roughness limit of the frame's traced specular pass (0: none): the samples' specular
+    /// BRDF term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    pub specular_limit: f32,
 }
 
 impl Default for AafParams {
@@ -117,6 +120,7 @@ impl Default for AafParams {
             adaptive: true,
             filter: true,
             seed: 0,
+            specular_limit: 0.0,
         }
     }
 }
@@ -181,7 +185,7 @@ pub struct SamplePush {
     pub frame: [u32; 4],
     /// Bounces, samples of the first pass, unused, unused.
     pub config: [u32; 4],
-    /// xyz camera position, w unused.
+    /// xyz camera position, w the specular pass's roughness limit (0: none).
     pub camera: [f32; 4],
 }
 
@@ -263,7 +267,7 @@ pub fn aaf(
     let sample_push = SamplePush {
         frame: [w, h, scene.light_count, params.seed],
         config: [params.bounces, params.first_samples, 0, 0],
-        camera: camera.eye.extend(0.0).to_array(),
+        camera: camera.eye.extend(params.specular_limit).to_array(),
     };
     let mut first = rg.create_buffer("aaf_sums_first", BufferDesc::new(pixels * 16));
     let mut depths = rg.create_buffer("aaf_depths", BufferDesc::new(pixels * 8));

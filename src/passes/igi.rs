@@ -141,6 +141,9 @@ pub struct IgiParams {
     pub depth_tolerance: f32,
     /// Cosine threshold of the geometric-normal test (−1..=1).
     pub normal_threshold: f32,
+    /// Roughness limit of the frame's traced specular pass (0: none): the filter's glossy
+    /// term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    pub specular_limit: f32,
 }
 
 impl Default for IgiParams {
@@ -156,6 +159,7 @@ impl Default for IgiParams {
             clamp_distance: 0.1,
             depth_tolerance: 0.05,
             normal_threshold: 0.9,
+            specular_limit: 0.0,
         }
     }
 }
@@ -182,7 +186,7 @@ pub struct VplShPush {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FilterPush {
-    /// xyz: camera position; w unused.
+    /// xyz: camera position; w: the specular pass's roughness limit (0: none).
     pub camera: [f32; 4],
     /// Image size.
     pub extent: [u32; 2],
@@ -329,6 +333,7 @@ pub fn vpls(
         falloff: hvl::Falloff::Sphere,
         visibility: false,
         slices: 1,
+        specular_limit: 0.0,
     };
     Ok(hvl::hvl_cache(rg, rsm, &cache)?)
 }
@@ -419,7 +424,7 @@ pub fn sh_filter(
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
     let push = FilterPush {
-        camera: camera.extend(0.0).to_array(),
+        camera: camera.extend(params.specular_limit).to_array(),
         extent: g.extent,
         pattern: params.pattern,
         radius: params.filter_radius,

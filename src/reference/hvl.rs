@@ -363,6 +363,9 @@ pub fn shade(
         .collect::<Result<_, _>>()?;
     let (x, n) = (receiver.position, receiver.normal.normalize());
     let (kd, ks) = receiver.weights(camera);
+    // the glossy share the frame's specular pass leaves to the gather
+    let ks = ks
+        * (1.0 - crate::passes::specular::trace_weight(receiver.roughness, params.specular_limit));
     let mut sum = Vec3::ZERO;
     match params.path {
         GatherPath::Full => {

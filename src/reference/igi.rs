@@ -10,6 +10,7 @@ use shine_sh::{ShError, basis, kernels, zonal};
 use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::Hvl;
 use crate::passes::igi::{FilterMode, Glossy, IgiParams, permutation_stride, pixel_set, vpl_cell};
+use crate::passes::specular::trace_weight;
 
 /// `IGI_MIN_DISTANCE` of igi.glsl (metres).
 pub const MIN_DISTANCE: f32 = 1e-4;
@@ -60,19 +61,21 @@ pub fn brdf_sh(n: Vec3, r: Vec3, exponent: f32, bands: usize) -> Result<[Vec<f32
 /// The GGX path of `sh_filter` for one pixel: `sh` (world-frame rgb SH, already filtered)
 /// rotated into the receiver frame of the BRDF SH tables (z = `n`, `wo` in the xz half-plane)
 /// with shine-sh's rotation, dotted with the Lambert and the roughness-blended GGX rows, weighted
-/// by [`indirect_weights`] (the glossy one through [`table_fresnel_weight`]).
+/// by [`indirect_weights`] (the glossy one through [`table_fresnel_weight`] and times
+/// `glossy_share`, the part the frame's specular pass leaves); `material` is the albedo,
+/// roughness and metallic.
 pub fn ggx_resolve(
     sh: &[Vec3],
     n: Vec3,
     wo: Vec3,
-    albedo: Vec3,
-    roughness: f32,
-    metallic: f32,
+    material: (Vec3, f32, f32),
+    glossy_share: f32,
     tables: &GatherBrdf,
 ) -> Result<Vec3, ShError> {
+    let (albedo, roughness, metallic) = material;
     let bands = basis_bands(sh.len());
     let (kd, ks) = indirect_weights(albedo, metallic, n.dot(wo));
-    let ks = table_fresnel_weight(ks, n.dot(wo));
+    let ks = table_fresnel_weight(ks, n.dot(wo)) * glossy_share;
     let cos_o = n.dot(wo).clamp(1e-4, 1.0);
     let mut t = wo - n * n.dot(wo);
     if t.length_squared() < 1e-12 {
@@ -245,7 +248,10 @@ pub fn sh_filter(
         let albedo = g.albedo[p].truncate();
         let (roughness, metallic) = (g.material[p].x, g.material[p].y);
         let wo = (camera - x).normalize();
+        // the glossy share the frame's specular pass leaves to the filter
+        let glossy_share = 1.0 - trace_weight(roughness, params.specular_limit);
         let (kd, ks) = indirect_weights(albedo, metallic, n.dot(wo));
+        let ks = ks * glossy_share;
         let result = match params.mode {
             FilterMode::Irradiance => {
                 kd / std::f32::consts::PI * (sum[0] / count) + ks * (sum[1] / count)
@@ -257,7 +263,14 @@ pub fn sh_filter(
                     expected: "GatherBrdf tables for the GGX path",
                 })?;
                 let filtered: Vec<Vec3> = sum.iter().map(|s| *s / count).collect();
-                ggx_resolve(&filtered, n, wo, albedo, roughness, metallic, tables)?
+                ggx_resolve(
+                    &filtered,
+                    n,
+                    wo,
+                    (albedo, roughness, metallic),
+                    glossy_share,
+                    tables,
+                )?
             }
             FilterMode::Sh => {
                 let [lambert, phong] =
@@ -278,7 +291,7 @@ pub fn sh_filter(
 
 /// Brute-force VPL shading: every valid VPL (all sets, no interleaving, no filter), shadowed,
 /// through the exact BRDF of the irradiance mode: `Σ_j V_j E_j (kd/π max(0, n·ω_j) + ks
-/// phong(r·ω_j))`.
+/// phong(r·ω_j))`, ks times the glossy share the specular pass leaves (`params.specular_limit`).
 pub fn brute_force(
     g: &GBufferData,
     vpls: &[Hvl],
@@ -301,6 +314,7 @@ pub fn brute_force(
             let r = (-wo).reflect(n);
             let exponent = phong_exponent(g.material[p].x);
             let (kd, ks) = indirect_weights(g.albedo[p].truncate(), g.material[p].y, n.dot(wo));
+            let ks = ks * (1.0 - trace_weight(g.material[p].x, params.specular_limit));
             let mut sum = Vec3::ZERO;
             for vpl in &vpls[..params.vpl_count as usize] {
                 let Some((dir, e)) = contribution(vpl, x, ng, params.clamp_distance, 1.0) else {

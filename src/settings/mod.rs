@@ -28,10 +28,12 @@
 mod error;
 mod gi;
 mod io;
+mod specular;
 mod validate;
 
 pub use error::SettingsError;
 pub use gi::{GiTechnique, GiTechniques};
+pub use specular::SpecularSettings;
 pub use validate::{EXTENT, FRAMES, TIME};
 
 use serde::{Deserialize, Serialize};
@@ -85,6 +87,8 @@ pub struct Settings {
     pub aaf: AafSettings,
     /// The indirect light accumulated over the frames of a sequence (issue 23).
     pub history: HistorySettings,
+    /// Traced specular reflections (issue 21).
+    pub specular: SpecularSettings,
 }
 
 /// `[history]`: the indirect light accumulated over frames (`src/passes/accumulate.rs`):
@@ -374,6 +378,7 @@ impl Default for Settings {
             proxy: ProxySettings::default(),
             aaf: AafSettings::default(),
             history: HistorySettings::default(),
+            specular: SpecularSettings::default(),
         }
     }
 }

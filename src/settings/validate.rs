@@ -8,7 +8,7 @@ use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
 use crate::passes::{
-    aaf, accumulate, composite, hvl, igi, proxy, receivers, rsm, shadows, upsample,
+    aaf, accumulate, composite, hvl, igi, proxy, receivers, rsm, shadows, specular, upsample,
 };
 
 /// Output sides in pixels.
@@ -160,6 +160,16 @@ impl Settings {
             &accumulate::MAX_FRAMES_RANGE,
         )?;
         check("history.clip", self.history.clip, &accumulate::CLIP_RANGE)?;
+        check(
+            "specular.samples",
+            self.specular.samples,
+            &specular::SAMPLES_RANGE,
+        )?;
+        check(
+            "specular.limit",
+            self.specular.limit,
+            &specular::LIMIT_RANGE,
+        )?;
         Ok(())
     }
 

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod cli;
+pub mod scenes;
 
 use glam::Vec4;
 use shine::gpu::{

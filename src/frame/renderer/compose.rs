@@ -14,6 +14,7 @@ use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::Distribution;
+use crate::passes::specular::{self, SpecularScene};
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
 use shine_graph::{Handle, Image, RenderGraph};
 
@@ -230,10 +231,7 @@ impl Renderer {
             (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers)?),
             _ => None,
         };
-        let low = match (hvl_low, proxy_low) {
-            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
-            (a, b) => a.or(b),
-        };
+        let low = sum(rg, hvl_low, proxy_low)?;
         let upsampled = match (low, &recv) {
             (Some(low), Some(recv)) => Some(upsample::upsample(rg, &low, recv, g, &p.upsample)?),
             _ => None,
@@ -271,11 +269,44 @@ impl Renderer {
         // `igi,proxy` and `aaf,proxy`: both full-resolution indirect terms summed (settings
         // allow at most one of hvl, igi and aaf).
         let full = igi_full.or(aaf_full);
-        Ok(match (upsampled, full) {
-            (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
-            (a, b) => a.or(b),
-        })
+        let techniques = sum(rg, upsampled, full)?;
+        // The sharp part of the glossy lobes, which the techniques above leave out.
+        let reflections = match p.specular {
+            Some(params) => {
+                let environment =
+                    rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ);
+                Some(specular::specular(
+                    rg,
+                    g,
+                    &SpecularScene {
+                        handles,
+                        bvh: &handles.trace,
+                        light_count,
+                        texture_sampler: self.textures_level0.raw(),
+                        environment: &environment,
+                        environment_sampler: self.environment_sampler.raw(),
+                        environment_lighting: scene.has_environment,
+                    },
+                    camera.eye,
+                    &params,
+                )?)
+            }
+            None => None,
+        };
+        sum(rg, techniques, reflections)
     }
+}
+
+/// `a + b` (`gi_add`) when both are there, else the one that is.
+fn sum(
+    rg: &mut RenderGraph,
+    a: Option<Handle<Image>>,
+    b: Option<Handle<Image>>,
+) -> Result<Option<Handle<Image>>, RenderError> {
+    Ok(match (a, b) {
+        (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
+        (a, b) => a.or(b),
+    })
 }
 
 /// The number of lights of `frame`, as the passes take it.

@@ -178,6 +178,8 @@ struct SceneState {
     gpu: GpuScene,
     /// The environment baked for the background (black without one).
     environment: shine_gpu::Image,
+    /// Whether the scene has an environment (it lights the specular pass's ray hits).
+    has_environment: bool,
     /// Sphere proxies under the environment (paper 002): scene-bound state.
     proxy: ProxyTechnique,
 }
@@ -264,6 +266,7 @@ impl Renderer {
                 &self.device,
                 scene.environment.as_ref(),
             )?,
+            has_environment: scene.environment.is_some(),
             proxy: ProxyTechnique::new(&self.device, scene),
         };
         self.scene = Some(state);

@@ -134,7 +134,7 @@ fn record_gather(
     let (receivers, camera) = (inputs.receivers, inputs.camera);
     let [w, h] = receivers.extent;
     let push = GatherPush {
-        camera: camera.extend(0.0).to_array(),
+        camera: camera.extend(params.specular_limit).to_array(),
         extent: receivers.extent,
         hvl_count: params.count,
         emission_bands: params.emission_bands,

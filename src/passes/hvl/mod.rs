@@ -142,7 +142,7 @@ pub struct CachePush {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GatherPush {
-    /// xyz: camera position; w unused.
+    /// xyz: camera position; w: the specular pass's roughness limit (0: none).
     pub camera: [f32; 4],
     /// Receiver buffer size.
     pub extent: [u32; 2],
@@ -251,6 +251,9 @@ pub struct HvlParams {
     /// Receivers per refresh: 1 gathers every receiver every frame; [`resolve::SLICES`]
     /// gathers one per 2×2 cell and reprojects the rest (paper 001).
     pub slices: u32,
+    /// Roughness limit of the frame's traced specular pass (0: none): the gather's glossy
+    /// term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    pub specular_limit: f32,
 }
 
 impl Default for HvlParams {
@@ -271,6 +274,7 @@ impl Default for HvlParams {
             falloff: Falloff::Sphere,
             visibility: false,
             slices: 1,
+            specular_limit: 0.0,
         }
     }
 }

@@ -1,0 +1,107 @@
+// Traced specular reflections (issue 21, item 3; src/passes/specular.rs): the part of each
+// G-buffer pixel's GGX lobe that is sharper than the SH techniques resolve. Per pixel,
+// `samples` half vectors drawn from D(h)·(n·h) (sample_ggx_half) give directions
+// l = reflect(-v, h) with the solid-angle density D·(n·h)/(4 v·h); a sample adds
+// f_s(l, v)·(n·l)·L(l)/pdf, f_s the GGX term of brdf_metallic_roughness. L(l) is next-event
+// estimation to the punctual lights at the first hit through the BVH (path.glsl), plus, in a
+// scene with an environment, one cosine-sampled ray from the hit that sees it (f·π·L_env when
+// unoccluded), or the environment where the ray escapes: the one-bounce light the path-traced
+// reference sees in a mirror. Emission of the hit surfaces adds nothing (the GI techniques'
+// convention).
+// The mean is weighted by specular_trace_weight(roughness, limit): pixels rougher than the
+// limit keep their SH glossy term and are skipped here. No CPU twin: tests/specular.rs checks
+// the pass against the path tracer.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
+#include "surface.glsl"
+#include "brdf.glsl"
+#define TRACE_NODES_BINDING 7
+#define TRACE_TRIANGLES_BINDING 8
+#define TRACE_TOP_BINDING 17
+#define TRACE_INSTANCES_BINDING 18
+#include "trace.glsl"
+#define ENVIRONMENT_BINDING 19
+#define ENVIRONMENT_SAMPLER_BINDING 20
+#include "environment.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+// shine::passes::specular::SpecularPush (48 bytes).
+layout(push_constant) uniform Push {
+    // x: width, y: height, z: light count, w: seed (varies per frame).
+    uvec4 frame;
+    // xyz: camera position, w: the roughness limit of the pass.
+    vec4 camera;
+    // x: samples per pixel, y: 1 when the environment lights the hits, z, w: unused.
+    uvec4 config;
+} push;
+
+#define PATH_LIGHT_COUNT push.frame.z
+#define PATH_FLAGS 0u
+#include "path.glsl"
+
+layout(set = 0, binding = 9, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 10, rgba16f) readonly uniform image2D gb_normal;
+layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_normal;
+layout(set = 0, binding = 15, rgba8) readonly uniform image2D gb_albedo;
+layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
+layout(set = 0, binding = 12, rgba16f) writeonly uniform image2D specular;
+
+void main() {
+    uvec2 pixel = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(pixel, push.frame.xy))) {
+        return;
+    }
+    ivec2 ixy = ivec2(pixel);
+    vec4 position = imageLoad(gb_position, ixy);
+    vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
+    float share = specular_trace_weight(roughness_metallic.x, push.camera.w);
+    vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
+    vec3 v = normalize(push.camera.xyz - position.xyz);
+    if (position.w == 0.0 || share <= 0.0 || dot(n, v) <= 0.0) {
+        imageStore(specular, ixy, vec4(0.0));
+        return;
+    }
+    vec3 ng = normalize(imageLoad(gb_geometric_normal, ixy).xyz);
+    vec3 origin = trace_offset(position.xyz, ng);
+    vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
+    float a = brdf_alpha(roughness_metallic.x);
+    uint samples = max(push.config.x, 1u);
+    vec3 sum = vec3(0.0);
+    for (uint s = 0u; s < samples; ++s) {
+        rng_state = pcg(pcg(pcg(pixel.x ^ pcg(push.frame.w)) + pixel.y) + s);
+        vec3 h = sample_ggx_half(n, a, vec2(rand(), rand()));
+        vec3 l = reflect(-v, h);
+        float nl = dot(n, l);
+        float vh = dot(v, h);
+        if (nl <= 0.0 || vh <= 0.0 || dot(ng, l) <= 0.0) {
+            continue;
+        }
+        float nh = max(dot(n, h), 1e-6);
+        float pdf = ggx_distribution(nh, a) * nh / (4.0 * vh);
+        vec3 diffuse;
+        vec3 f_s;
+        brdf_metallic_roughness_parts(n, l, v, albedo, roughness_metallic.y, roughness_metallic.x, diffuse, f_s);
+        TraceHit hit;
+        vec3 incoming;
+        if (trace_closest(origin, l, 0.0, PT_FAR, hit)) {
+            Vertex x = shade(hit, l);
+            incoming = punctual_lights(x, -l);
+            if (push.config.y != 0u) {
+                vec3 d = sample_cosine(x.s.normal, vec2(rand(), rand()));
+                if (dot(x.geometric_normal, d) > 0.0
+                    && !trace_occluded(trace_offset(x.position, x.geometric_normal), d, 0.0, PT_FAR)) {
+                    incoming += brdf(x, d, -l) * BRDF_PI * environment_radiance(d);
+                }
+            }
+        } else {
+            incoming = environment_radiance(l);
+        }
+        vec3 radiance = pdf > 0.0 ? f_s * nl * incoming / pdf : vec3(0.0);
+        if (!any(isnan(radiance)) && !any(isinf(radiance))) {
+            sum += radiance;
+        }
+    }
+    imageStore(specular, ixy, vec4(share * sum / float(samples), 0.0));
+}

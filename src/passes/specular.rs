@@ -1,0 +1,187 @@
+//! Traced specular reflections (issue 21, item 3): the `specular` pass
+//! (`shaders/specular.comp`).
+//!
+//! The SH techniques carry a receiver's glossy lobe through band-limited tables (HVL's gather,
+//! IGI's filter) or not at all (the proxies), so a lobe sharper than their band limit comes out
+//! as a blurred average of the scene: the chrome torus of `room` turned grey, the metal torus of
+//! `spheres` black. This pass takes the sharp part of every lobe instead: per G-buffer pixel,
+//! [`SpecularParams::samples`] GGX-sampled reflection rays through the BVH, each seeing
+//! next-event estimation to the punctual lights at its hit or the environment where it escapes
+//! (the one-bounce light of the path-traced reference), weighted by [`trace_weight`] of the
+//! pixel's roughness. The techniques scale their glossy term by `1 − trace_weight`, so each part
+//! of a lobe is counted once: rough lobes stay with the SH tables, sharp ones are traced.
+//!
+//! # Decisions
+//!
+//! * Full resolution (reflections move with the view and change within a pixel); the frame's
+//!   history ([`crate::passes::accumulate`]) averages the noise of successive frames, whose
+//!   seeds differ.
+//! * One bounce: the hit is lit by the punctual lights (shadow rays) and, in a scene with an
+//!   environment, by one cosine-sampled ray towards it; not by its own indirect light or
+//!   emission, as the GI techniques' convention. Rays that escape see the environment.
+//! * [`LIMIT`] (0.5): the HVL gather's GGX tables at 5 bands hold a lobe of roughness 0.5 to
+//!   within a few percent of its energy, while at 0.3 and below they smear it over tens of
+//!   degrees; [`FADE`] (0.1) blends the two over a range of roughness so no seam shows.
+
+use std::ops::RangeInclusive;
+
+use crate::gpu_scene::SceneHandles;
+use crate::gpu_scene::bvh::TraceBuffers;
+use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::gbuffer::GBuffer;
+use crate::shaders;
+
+/// Default roughness limit: lobes rougher than this are left to the SH techniques.
+pub const LIMIT: f32 = 0.5;
+/// Width of the roughness range over which the traced share fades from 1 to 0 (GLSL
+/// `SPECULAR_FADE`).
+pub const FADE: f32 = 0.1;
+/// Roughness limits the settings take.
+pub const LIMIT_RANGE: RangeInclusive<f32> = 0.0..=1.0;
+/// Default reflection rays per pixel and frame.
+pub const SAMPLES: u32 = 2;
+/// Reflection rays per pixel the settings take.
+pub const SAMPLES_RANGE: RangeInclusive<u32> = 1..=256;
+
+/// Parameters of the specular pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SpecularParams {
+    /// Reflection rays per pixel and frame.
+    pub samples: u32,
+    /// Roughness above which the SH techniques keep the whole lobe ([`trace_weight`]).
+    pub limit: f32,
+    /// Seed of the random numbers (the frame index is added to it).
+    pub seed: u32,
+}
+
+impl Default for SpecularParams {
+    fn default() -> Self {
+        Self {
+            samples: SAMPLES,
+            limit: LIMIT,
+            seed: 0,
+        }
+    }
+}
+
+/// What the specular pass refuses.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SpecularError {
+    /// A parameter out of its range.
+    #[error("specular {0}")]
+    OutOfRange(#[from] super::OutOfRange),
+}
+
+impl SpecularParams {
+    /// Checks every parameter against its range.
+    pub fn validate(&self) -> Result<(), SpecularError> {
+        super::check_range("samples", self.samples, &SAMPLES_RANGE)?;
+        super::check_range("limit", self.limit, &LIMIT_RANGE)?;
+        Ok(())
+    }
+}
+
+/// Share of a lobe of perceptual `roughness` that the pass traces, for a roughness `limit`
+/// (0: no pass): 1 up to `limit − FADE`, a smoothstep down to 0 at `limit`. GLSL twin:
+/// `specular_trace_weight` in `shaders/include/brdf.glsl`.
+pub fn trace_weight(roughness: f32, limit: f32) -> f32 {
+    if limit <= 0.0 {
+        return 0.0;
+    }
+    let t = ((roughness - (limit - FADE)) / FADE).clamp(0.0, 1.0);
+    1.0 - t * t * (3.0 - 2.0 * t)
+}
+
+/// Push constants of `shaders/specular.comp` (48 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SpecularPush {
+    /// Width, height, light count, seed.
+    pub frame: [u32; 4],
+    /// xyz camera position, w the roughness limit.
+    pub camera: [f32; 4],
+    /// Samples per pixel, 1 when the environment lights the hits, then unused.
+    pub config: [u32; 4],
+}
+
+/// The scene as the reflection rays see it.
+#[derive(Debug, Clone, Copy)]
+pub struct SpecularScene<'a> {
+    /// The scene's buffers and textures.
+    pub handles: &'a SceneHandles,
+    /// Its BVH.
+    pub bvh: &'a TraceBuffers,
+    /// Lights in the light buffer.
+    pub light_count: u32,
+    /// The sampler of the scene's textures (level 0 at ray hits).
+    pub texture_sampler: vk::Sampler,
+    /// The environment (RGBA32F equirectangular) seen by rays that escape.
+    pub environment: &'a Handle<Image>,
+    /// Its sampler (linear, repeating in u, clamped in v).
+    pub environment_sampler: vk::Sampler,
+    /// The environment also lights the ray hits (one cosine-sampled, shadowed ray each).
+    pub environment_lighting: bool,
+}
+
+/// Adds the `specular` pass over the G-buffer `g` seen from `camera`; returns the reflected
+/// radiance towards the camera (RGBA16F, full resolution, a = 0).
+pub fn specular(
+    rg: &mut RenderGraph,
+    g: &GBuffer,
+    scene: &SpecularScene<'_>,
+    camera: glam::Vec3,
+    params: &SpecularParams,
+) -> Result<Handle<Image>, SpecularError> {
+    params.validate()?;
+    let [w, h] = g.extent;
+    let frame_seed = params.seed.wrapping_add(rg.frame() as u32);
+    let mut out = rg.create_image(
+        "specular",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    let mut pass = rg.compute("specular", &shaders::SPECULAR_COMP);
+    pass.read("materials", &scene.handles.materials)
+        .read("srgb_textures", &scene.handles.srgb_textures)
+        .read("linear_textures", &scene.handles.linear_textures)
+        .sampler("texture_sampler", scene.texture_sampler)
+        .read("vertices", &scene.handles.vertices)
+        .read("indices", &scene.handles.indices)
+        .read("lights", &scene.handles.lights)
+        .read("environment", scene.environment)
+        .sampler("environment_sampler", scene.environment_sampler)
+        .read("gb_position", &g.position)
+        .read("gb_normal", &g.normal)
+        .read("gb_geometric_normal", &g.geometric_normal)
+        .read("gb_albedo", &g.albedo)
+        .read("gb_material", &g.material);
+    scene.bvh.bind(&mut pass);
+    pass.write("specular", &mut out)
+        .push(&SpecularPush {
+            frame: [w, h, scene.light_count, frame_seed],
+            camera: camera.extend(params.limit).to_array(),
+            config: [params.samples, u32::from(scene.environment_lighting), 0, 0],
+        })
+        .dispatch([w, h, 1]);
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trace_weight_fades_over_the_last_tenth_below_the_limit() {
+        assert_eq!(trace_weight(0.05, 0.0), 0.0);
+        assert_eq!(trace_weight(0.3, LIMIT), 1.0);
+        assert_eq!(trace_weight(LIMIT - FADE, LIMIT), 1.0);
+        assert!((trace_weight(LIMIT - 0.5 * FADE, LIMIT) - 0.5).abs() < 1e-6);
+        assert_eq!(trace_weight(LIMIT, LIMIT), 0.0);
+        assert_eq!(trace_weight(0.9, LIMIT), 0.0);
+        let mut last = 1.0;
+        for i in 0..=100 {
+            let w = trace_weight(i as f32 / 100.0, LIMIT);
+            assert!(w <= last && (0.0..=1.0).contains(&w));
+            last = w;
+        }
+    }
+}

@@ -1,0 +1,123 @@
+//! Small scenes built in code for the GPU tests: flat-shaded meshes, one material per part.
+
+use glam::{Mat4, Vec3};
+use shine_scene::environment::Environment;
+use shine_scene::{Camera, Light, Material, Mesh, Node, Primitive, Projection, Scene, Transform};
+
+/// A scene of one mesh whose primitives are `parts` (flat-shaded triangles, each part with its
+/// material), a perspective camera (vertical field of view 1 rad) at `camera`, and `lights`.
+pub fn mesh_scene(
+    parts: &[(Vec<[Vec3; 3]>, Material)],
+    camera: Mat4,
+    lights: Vec<Light>,
+    environment: Option<Environment>,
+) -> Scene {
+    let primitives = parts
+        .iter()
+        .enumerate()
+        .map(|(k, (triangles, _))| {
+            let mut primitive = Primitive {
+                material: k as u32,
+                ..Primitive::default()
+            };
+            for (i, t) in triangles.iter().enumerate() {
+                let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+                for v in t {
+                    primitive.positions.push(*v);
+                    primitive.normals.push(n);
+                    primitive.bounds.grow(*v);
+                }
+                primitive
+                    .indices
+                    .extend([3 * i as u32, 3 * i as u32 + 1, 3 * i as u32 + 2]);
+            }
+            primitive
+        })
+        .collect();
+    Scene {
+        source: "test".into(),
+        nodes: vec![Node {
+            name: "mesh".into(),
+            parent: None,
+            children: vec![],
+            transform: Transform::default(),
+            mesh: Some(0),
+            camera: None,
+            lights: vec![],
+            skin: None,
+            weights: None,
+        }],
+        roots: vec![0],
+        meshes: vec![Mesh {
+            name: "mesh".into(),
+            primitives,
+            weights: vec![],
+        }],
+        materials: parts.iter().map(|(_, m)| *m).collect(),
+        material_names: (0..parts.len()).map(|k| format!("material {k}")).collect(),
+        lights,
+        cameras: vec![Camera {
+            name: "camera".into(),
+            projection: Projection::Perspective {
+                yfov: 1.0,
+                aspect_ratio: None,
+                znear: 0.01,
+                zfar: None,
+            },
+            world: camera,
+            node: None,
+        }],
+        environment,
+        ..Scene::default()
+    }
+}
+
+/// A UV sphere of radius `r` about `centre`: outward-facing (counter-clockwise seen from
+/// outside) or inward-facing.
+pub fn sphere(centre: Vec3, r: f32, outward: bool) -> Vec<[Vec3; 3]> {
+    let (rings, segments) = (24, 48);
+    let point = |i: u32, j: u32| {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+        centre
+            + r * Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                theta.sin() * phi.sin(),
+            )
+    };
+    let mut out = Vec::new();
+    for i in 0..rings {
+        for j in 0..segments {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            // (a, d, c) and (a, c, b) wind counter-clockwise seen from outside.
+            let mut tris = vec![];
+            if i > 0 {
+                tris.push([a, d, c]);
+            }
+            if i + 1 < rings {
+                tris.push([a, c, b]);
+            }
+            for t in tris {
+                out.push(if outward { t } else { [t[0], t[2], t[1]] });
+            }
+        }
+    }
+    out
+}
+
+/// A square of side `2 s` in the plane y = `height`, facing +y.
+pub fn floor(s: f32, height: f32) -> Vec<[Vec3; 3]> {
+    let c = [
+        Vec3::new(-s, height, -s),
+        Vec3::new(-s, height, s),
+        Vec3::new(s, height, s),
+        Vec3::new(s, height, -s),
+    ];
+    vec![[c[0], c[1], c[2]], [c[0], c[2], c[3]]]
+}
