@@ -15,13 +15,15 @@
 //!
 //! * Full resolution (reflections move with the view and change within a pixel); the frame's
 //!   history ([`crate::passes::accumulate`]) averages the noise of successive frames, whose
-//!   seeds differ.
+//!   seeds differ when there is a history ([`SpecularParams::per_frame_seed`]; without one,
+//!   changing noise would only add flicker).
 //! * One bounce: the hit is lit by the punctual lights (shadow rays) and, in a scene with an
 //!   environment, by one cosine-sampled ray towards it; not by its own indirect light or
 //!   emission, as the GI techniques' convention. Rays that escape see the environment.
-//! * [`LIMIT`] (0.5): the HVL gather's GGX tables at 5 bands hold a lobe of roughness 0.5 to
-//!   within a few percent of its energy, while at 0.3 and below they smear it over tens of
-//!   degrees; [`FADE`] (0.1) blends the two over a range of roughness so no seam shows.
+//! * [`LIMIT`] (0.5): on `room` and `spheres` FLIP against the truth barely moves between 0.5
+//!   and 1.0, while at 0.3 the brushed torus of `spheres` (0.35) goes black under the proxies
+//!   again (docs/quality.md); rougher lobes need more rays for the same noise. [`FADE`] (0.1)
+//!   blends the traced and the SH glossy term over a range of roughness so no seam shows.
 
 use std::ops::RangeInclusive;
 
@@ -50,8 +52,11 @@ pub struct SpecularParams {
     pub samples: u32,
     /// Roughness above which the SH techniques keep the whole lobe ([`trace_weight`]).
     pub limit: f32,
-    /// Seed of the random numbers (the frame index is added to it).
+    /// Seed of the random numbers.
     pub seed: u32,
+    /// Add the frame index to the seed, so that a history averages independent rays; off, a
+    /// still scene gives the same image every frame (what a frame without history wants).
+    pub per_frame_seed: bool,
 }
 
 impl Default for SpecularParams {
@@ -60,6 +65,7 @@ impl Default for SpecularParams {
             samples: SAMPLES,
             limit: LIMIT,
             seed: 0,
+            per_frame_seed: false,
         }
     }
 }
@@ -134,7 +140,11 @@ pub fn specular(
 ) -> Result<Handle<Image>, SpecularError> {
     params.validate()?;
     let [w, h] = g.extent;
-    let frame_seed = params.seed.wrapping_add(rg.frame() as u32);
+    let frame_seed = if params.per_frame_seed {
+        params.seed.wrapping_add(rg.frame() as u32)
+    } else {
+        params.seed
+    };
     let mut out = rg.create_image(
         "specular",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
