@@ -107,8 +107,9 @@ fn indirect_light_against_the_path_traced_reference() {
 /// Paper 002's frame (`--gi proxy`: the sky shadowed by the sphere proxies plus their indirect
 /// light) of the `spheres` scene against the path-traced reference of the same scene with the
 /// proxies' real meshes, lit by the same sky, one bounce; both show the sky behind the scene.
-/// Compared where the raster frame is not black: the fully metallic torus (the proxy path
-/// shades Lambert only; its specular environment term is not part of paper 002) is left out.
+/// Compared where the raster frame is not black, which now leaves out almost nothing: the
+/// fully metallic torus, black under paper 002's Lambert receivers, reflects the sky through
+/// the specular pass (issue 21), and is compared with the rest.
 #[test]
 fn spheres_proxy_frame_against_the_path_traced_reference() {
     const SIDE: u32 = 64;
@@ -126,6 +127,8 @@ fn spheres_proxy_frame_against_the_path_traced_reference() {
     settings.shadow.size = 256;
     // The path tracer reads level 0 at each pixel centre: so does the raster here.
     settings.texture.mipmaps = false;
+    // The metal torus's reflections: enough rays that their noise does not hide the bias.
+    settings.specular.samples = 16;
     let frame = renderer.render(&settings).expect("frame").hdr;
     settings.proxy.brute_force = true;
     let brute = renderer.render(&settings).expect("brute-force frame").hdr;
@@ -144,7 +147,7 @@ fn spheres_proxy_frame_against_the_path_traced_reference() {
     let shaded = |t: &[f32; 4]| t[0] + t[1] + t[2] > 0.0;
     let masked = frame.texels.iter().filter(|t| !shaded(t)).count();
     assert!(
-        masked < (SIDE * SIDE / 10) as usize,
+        masked < (SIDE * SIDE / 100) as usize,
         "{masked} of {} pixels are black in the raster frame",
         SIDE * SIDE
     );
@@ -171,8 +174,9 @@ fn spheres_proxy_frame_against_the_path_traced_reference() {
     report("spheres, brute-force proxy frame vs reference", &exact);
     let ratio = sum(&frame) / sum(&reference.full);
     println!("mean ratio {ratio:.3}, {masked} pixels masked");
-    // Measured on lavapipe (64², 256 spp): PSNR 32.4 dB (brute force 32.45), SSIM 0.961,
-    // mean 0.990× the reference, 136 pixels (the torus) masked.
+    // Measured on lavapipe (64², 256 spp): PSNR 31.1 dB (brute force 31.3), SSIM 0.961,
+    // mean 0.992× the reference, 1 pixel masked (before the specular pass: 32.4 dB without the
+    // torus, whose 136 pixels were black).
     assert!(
         splat.psnr > 30.0 && splat.ssim > 0.94,
         "PSNR {} SSIM {}",

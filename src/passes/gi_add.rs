@@ -1,5 +1,5 @@
 //! `gi_add`: the sum of two indirect-light images of one extent (`hvl,proxy` at receiver
-//! resolution, `igi,proxy` at full resolution).
+//! resolution, `igi,proxy` and the specular reflections at full resolution).
 
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
@@ -22,9 +22,11 @@ pub struct GiAddError {
     pub second: [u32; 2],
 }
 
-/// Adds a `gi_add` pass: `first + second` (RGBA16F images of one extent) in a new image.
+/// Adds a pass named `name` (unique in the frame): `first + second` (RGBA16F images of one
+/// extent) in a new image.
 pub fn gi_add(
     rg: &mut RenderGraph,
+    name: &str,
     first: &Handle<Image>,
     second: &Handle<Image>,
 ) -> Result<Handle<Image>, GiAddError> {
@@ -39,7 +41,7 @@ pub fn gi_add(
         "gi_sum",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, a.width, a.height),
     );
-    rg.compute("gi_add", &shaders::GI_ADD_COMP)
+    rg.compute(name, &shaders::GI_ADD_COMP)
         .read("first", first)
         .read("second", second)
         .write("sum", &mut sum)

@@ -231,7 +231,7 @@ impl Renderer {
             (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers)?),
             _ => None,
         };
-        let low = sum(rg, hvl_low, proxy_low)?;
+        let low = sum(rg, "gi_add", hvl_low, proxy_low)?;
         let upsampled = match (low, &recv) {
             (Some(low), Some(recv)) => Some(upsample::upsample(rg, &low, recv, g, &p.upsample)?),
             _ => None,
@@ -269,7 +269,7 @@ impl Renderer {
         // `igi,proxy` and `aaf,proxy`: both full-resolution indirect terms summed (settings
         // allow at most one of hvl, igi and aaf).
         let full = igi_full.or(aaf_full);
-        let techniques = sum(rg, upsampled, full)?;
+        let techniques = sum(rg, "gi_add_full", upsampled, full)?;
         // The sharp part of the glossy lobes, which the techniques above leave out.
         let reflections = match p.specular {
             Some(params) => {
@@ -293,18 +293,19 @@ impl Renderer {
             }
             None => None,
         };
-        sum(rg, techniques, reflections)
+        sum(rg, "specular_add", techniques, reflections)
     }
 }
 
-/// `a + b` (`gi_add`) when both are there, else the one that is.
+/// `a + b` (a `gi_add` pass called `name`) when both are there, else the one that is.
 fn sum(
     rg: &mut RenderGraph,
+    name: &str,
     a: Option<Handle<Image>>,
     b: Option<Handle<Image>>,
 ) -> Result<Option<Handle<Image>>, RenderError> {
     Ok(match (a, b) {
-        (Some(a), Some(b)) => Some(gi_add(rg, &a, &b)?),
+        (Some(a), Some(b)) => Some(gi_add(rg, name, &a, &b)?),
         (a, b) => a.or(b),
     })
 }
