@@ -19,11 +19,13 @@ use glam::{Vec3, Vec4};
 use shine::gpu::{Device, vk};
 use shine::gpu_scene::environment_sh::EnvironmentSh;
 use shine::graph::{Executor, ExternalState, RenderGraph};
+use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::proxy::{
     self, Accumulation, ExpMethod, GpuProxy, ProxyInputs, ProxyParams, ProxyTables,
 };
 use shine::passes::receivers::Receivers;
-use shine::reference::proxy::{ReceiverSample, accumulate_cpu, shade_cpu};
+use shine::reference::proxy::{GlossyView, ReceiverSample, accumulate_cpu, shade_cpu};
+use shine_sh::brdf_table::HemisphereSampling;
 use shine_sh::exp_log::ShExp;
 
 const SIDE: u32 = 24;
@@ -40,10 +42,25 @@ fn receivers() -> Vec<ReceiverSample> {
                 valid: x != SIDE - 1,
                 normal: Vec3::Y,
                 albedo: Vec3::new(0.8, 0.6, 0.4),
-                metallic: 0.0,
+                // every third column metal; roughness exact in the receivers' unorm8, across
+                // the whole range (the specular pass's fade included)
+                metallic: if x % 3 == 0 { 1.0 } else { 0.0 },
+                roughness: ((y * 11) % 256) as f32 / 255.0,
             }
         })
         .collect()
+}
+
+/// Where the receivers are seen from (their glossy lobes).
+const CAMERA: Vec3 = Vec3::new(0.4, 1.5, 2.5);
+
+/// The BRDF SH tables of the glossy receivers (coarse sampling: GPU and CPU read the same).
+fn glossy(bands: u32) -> GatherBrdf {
+    let sampling = HemisphereSampling {
+        n_theta: 12,
+        n_phi: 24,
+    };
+    GatherBrdf::build(bands, sampling).unwrap()
 }
 
 fn proxies() -> Vec<GpuProxy> {
@@ -91,7 +108,7 @@ impl ReceiverImages {
             .collect();
         let material: Vec<u8> = samples
             .iter()
-            .flat_map(|s| unorm(Vec4::new(0.5, s.metallic, 0.0, 0.0)))
+            .flat_map(|s| unorm(Vec4::new(s.roughness, s.metallic, 0.0, 0.0)))
             .collect();
         Self([
             storage_image_with(
@@ -162,6 +179,10 @@ fn run_gpu(
     let proxy_buffer = storage("proxies", bytemuck::cast_slice(list));
     let table_buffer = storage("tables", bytemuck::cast_slice(&tables.gpu_data()));
     let env_buffer = storage("environment", bytemuck::cast_slice(&env.gpu_data()));
+    let brdf_buffer = storage(
+        "brdf",
+        bytemuck::cast_slice(&glossy(params.bands).gpu_data()),
+    );
     let texels = u64::from(SIDE * SIDE);
     let coeffs = u64::from(params.bands * params.bands);
     let readback = |name, bytes| {
@@ -183,9 +204,10 @@ fn run_gpu(
         count: list.len() as u32,
         tables: rg.import_gpu_buffer(&table_buffer, uploaded_state(), ExternalState::UNDEFINED),
         environment: rg.import_gpu_buffer(&env_buffer, uploaded_state(), ExternalState::UNDEFINED),
+        brdf: rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), ExternalState::UNDEFINED),
     };
     let sums = proxy::proxy_accumulate(&mut rg, &recv, &inputs, tables, params).unwrap();
-    let out = proxy::proxy_shade(&mut rg, &recv, &sums, &inputs, tables, params).unwrap();
+    let out = proxy::proxy_shade(&mut rg, &recv, &sums, &inputs, tables, params, CAMERA).unwrap();
     let mut s = rg.import_gpu_buffer(&sums_out, ExternalState::UNDEFINED, read_by_copy());
     rg.copy_buffer("read sums", &sums, &mut s);
     let mut o = rg.import_gpu_buffer(&occ_out, ExternalState::UNDEFINED, read_by_copy());
@@ -220,6 +242,8 @@ fn params(bands: u32, accumulation: Accumulation, exp: ExpMethod) -> ProxyParams
         accumulation,
         exp,
         indirect: true,
+        // the glossy share of the traced specular pass: ties the GLSL fade to the Rust one
+        specular_limit: shine::passes::specular::LIMIT,
     }
 }
 
@@ -238,6 +262,11 @@ fn splat_equals_brute_force_and_cpu() {
     let tables = ProxyTables::build(bands, 15.0, 10.0).unwrap();
     let env = environment(bands);
     let exp = ShExp::new(bands as usize).unwrap();
+    let brdf = glossy(bands);
+    let view = GlossyView {
+        camera: CAMERA,
+        brdf: &brdf,
+    };
     let splat_params = params(bands, Accumulation::Splat, ExpMethod::Hyb);
     let splat = run_gpu(&device, &samples, &list, &tables, &env, &splat_params);
     let brute = run_gpu(
@@ -275,7 +304,7 @@ fn splat_equals_brute_force_and_cpu() {
             );
             worst.0 = worst.0.max((g - c).abs());
         }
-        let (o, rad) = shade_cpu(s, &cpu, &env, &splat_params, &exp).unwrap();
+        let (o, rad) = shade_cpu(s, &cpu, &env, &splat_params, &exp, &view).unwrap();
         let go = &splat.occlusion[i * 16..(i + 1) * 16];
         for (k, (g, c)) in go.iter().zip(&o).enumerate() {
             assert!(close(*g, *c, 1e-3, 1e-4), "receiver {i} O_{k}: {g} vs {c}");
@@ -318,13 +347,18 @@ fn exponentials_and_orders_match_cpu() {
         let tables = ProxyTables::build(bands, 15.0, 10.0).unwrap();
         let env = environment(bands);
         let exp = ShExp::new(bands as usize).unwrap();
+        let brdf = glossy(bands);
+        let view = GlossyView {
+            camera: CAMERA,
+            brdf: &brdf,
+        };
         let p = params(bands, Accumulation::Splat, method);
         let gpu = run_gpu(&device, &samples, &list, &tables, &env, &p);
         let stride = proxy::sums_stride(bands);
         let n2 = (bands * bands) as usize;
         for (i, s) in samples.iter().enumerate().step_by(7) {
             let sums = &gpu.sums[i * stride..(i + 1) * stride];
-            let (o, rad) = shade_cpu(s, sums, &env, &p, &exp).unwrap();
+            let (o, rad) = shade_cpu(s, sums, &env, &p, &exp, &view).unwrap();
             for (k, (g, c)) in gpu.occlusion[i * n2..(i + 1) * n2]
                 .iter()
                 .zip(&o)
@@ -358,6 +392,11 @@ fn brute_force_product_matches_cpu() {
     let tables = ProxyTables::build(bands, 15.0, 10.0).unwrap();
     let env = environment(bands);
     let exp = ShExp::new(bands as usize).unwrap();
+    let brdf = glossy(bands);
+    let view = GlossyView {
+        camera: CAMERA,
+        brdf: &brdf,
+    };
     let p = params(bands, Accumulation::Product, ExpMethod::Hyb);
     let gpu = run_gpu(&device, &samples, &list, &tables, &env, &p);
     assert_clean(&device);
@@ -374,7 +413,7 @@ fn brute_force_product_matches_cpu() {
                 "receiver {i} sum {k}: {g} vs {c}"
             );
         }
-        let (_, rad) = shade_cpu(s, &cpu, &env, &p, &exp).unwrap();
+        let (_, rad) = shade_cpu(s, &cpu, &env, &p, &exp, &view).unwrap();
         for c in 0..3 {
             assert!(
                 close(gpu.radiance[i][c], rad[c], 3e-3, 1e-4),
@@ -395,6 +434,11 @@ fn a_proxy_shadows_the_ground_beside_it() {
     let tables = ProxyTables::build(bands, 15.0, 10.0).unwrap();
     let env = environment(bands);
     let exp = ShExp::new(bands as usize).unwrap();
+    let brdf = glossy(bands);
+    let view = GlossyView {
+        camera: CAMERA,
+        brdf: &brdf,
+    };
     let with_indirect = params(bands, Accumulation::Splat, ExpMethod::Hyb);
     let ball = [GpuProxy::new(
         Vec3::new(0.0, 0.5, 0.0),
@@ -408,9 +452,10 @@ fn a_proxy_shadows_the_ground_beside_it() {
             normal: Vec3::Y,
             albedo: Vec3::ONE,
             metallic: 0.0,
+            roughness: 1.0,
         };
         let sums = accumulate_cpu(&r, proxies, &tables, &env, p, &exp).unwrap();
-        shade_cpu(&r, &sums, &env, p, &exp).unwrap().1
+        shade_cpu(&r, &sums, &env, p, &exp, &view).unwrap().1
     };
     let shade = |x: f32, proxies: &[GpuProxy]| shade_with(x, proxies, &with_indirect);
     let (near, open) = (shade(0.6, &ball), shade(0.6, &[]));

@@ -163,9 +163,9 @@ void sh_cap(vec3 d, float cos_a, out float c[SH_COEFFS]) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// General rotation (Ivanic-Ruedenberg), compiled for SH_BANDS <= 4 only (per-pixel use)
+// General rotation (Ivanic-Ruedenberg), compiled for SH_BANDS <= 6 only (per-pixel use)
 // ---------------------------------------------------------------------------------------------
-#if SH_BANDS <= 4
+#if SH_BANDS <= 6
 
 // Floats of the block-diagonal rotation of SH_BANDS bands: sum over l of (2l+1)^2.
 #define SH_ROT_SIZE (SH_BANDS * (4 * SH_BANDS * SH_BANDS - 1) / 3)

@@ -146,6 +146,7 @@ impl FrameParams {
                     },
                     exp: p.exp,
                     indirect: p.indirect,
+                    specular_limit,
                 },
                 shadow_expansion: if p.expansion > 0.0 {
                     p.expansion

@@ -19,6 +19,7 @@ use super::params::ProxySetup;
 use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::environment_sh::EnvironmentSh;
 use crate::gpu_scene::upload_ring::UploadRing;
+use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::proxy::{
     self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyParams, ProxyTables,
 };
@@ -47,6 +48,8 @@ pub struct ProxyTechnique {
     tables: Vec<(TableKey, ProxyTables, Buffer)>,
     /// Staging of the per-frame proxy uploads.
     ring: UploadRing,
+    /// The BRDF SH tables of the glossy receivers, per band count.
+    brdf: BrdfTables,
 }
 
 /// The proxies of one `fit_count`: in their nodes' space, and their device buffer, rewritten
@@ -101,6 +104,7 @@ impl ProxyTechnique {
             environments: Vec::new(),
             tables: Vec::new(),
             ring: UploadRing::new(device),
+            brdf: BrdfTables::new(device),
         }
     }
 
@@ -113,14 +117,16 @@ impl ProxyTechnique {
             .chain(self.tables.iter().map(|(_, _, b)| b))
             .chain(self.proxies.iter().map(|p| &p.buffer))
             .map(Buffer::allocated_bytes)
-            .sum();
-        (caches, self.ring.allocated_bytes())
+            .sum::<u64>();
+        let (brdf, brdf_staging) = self.brdf.allocated_bytes();
+        (caches + brdf, self.ring.allocated_bytes() + brdf_staging)
     }
 
     /// Forgets the uploaded tables: a frame that may have uploaded them was dropped unrun.
     pub fn forget_uploads(&mut self) {
         self.environments.clear();
         self.tables.clear();
+        self.brdf.clear();
     }
 
     /// The scene environment's SH at `bands` bands in `rg`: imported, or projected on the CPU
@@ -214,6 +220,7 @@ impl ProxyTechnique {
                 (self.tables.len() - 1, Some(handle))
             }
         };
+        let brdf = self.brdf.import(rg, bands)?;
         let proxies = match self.proxies.take() {
             Some(cached) if cached.fit_count == setup.fit_count => cached,
             _ => self.proxy_buffer(setup.fit_count)?,
@@ -240,6 +247,7 @@ impl ProxyTechnique {
             tables: uploaded_tables
                 .unwrap_or_else(|| rg.import_gpu_buffer(table_buffer, BUFFER_READ, BUFFER_READ)),
             environment,
+            brdf,
         };
         Ok(PreparedProxy {
             params: setup.pass,
@@ -272,16 +280,25 @@ impl ProxyTechnique {
 }
 
 impl PreparedProxy<'_> {
-    /// Adds `proxy_tiles`, `proxy_accumulate` and `proxy_shade` over `receivers`; returns
-    /// `proxy_gi` (RGBA16F outgoing radiance at receiver resolution).
+    /// Adds `proxy_tiles`, `proxy_accumulate` and `proxy_shade` over `receivers` seen from
+    /// `camera`; returns `proxy_gi` (RGBA16F outgoing radiance at receiver resolution).
     pub fn declare(
         self,
         rg: &mut RenderGraph,
         receivers: &Receivers,
+        camera: Vec3,
     ) -> Result<Handle<Image>, RenderError> {
         let params = &self.params;
         let sums = proxy::proxy_accumulate(rg, receivers, &self.inputs, self.tables, params)?;
-        let out = proxy::proxy_shade(rg, receivers, &sums, &self.inputs, self.tables, params)?;
+        let out = proxy::proxy_shade(
+            rg,
+            receivers,
+            &sums,
+            &self.inputs,
+            self.tables,
+            params,
+            camera,
+        )?;
         Ok(out.radiance)
     }
 }

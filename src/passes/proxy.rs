@@ -29,8 +29,14 @@
 //! * **Indirect light** is order 3 (the D(θ) fit of eq. 15): `I_i = (ρ_i/π) κ_i V_i`, with the
 //!   proxy's albedo `ρ_i` (base colour of its node's first material) turning the irradiance
 //!   `L̃` on the proxy into exitant radiance (the paper leaves the albedo implicit).
-//! * **Receiver BRDF.** Lambert, `kd = albedo (1 − metallic)`: outgoing radiance
-//!   `kd/π · max(ψ_p, 0)` per channel (band-limited ringing clamped at 0).
+//! * **Receiver BRDF** (shine's extension: paper 002 shades Lambert receivers). The
+//!   metallic-roughness material, as the HVL gather: `kd`, `ks` from `brdf_indirect_weights`
+//!   at n·v; the diffuse part `kd/π · max(ψ_p + ξ_p Σ I_i·H, 0)`, the glossy part
+//!   `ks · max(L · (O_p ∗ F_w), 0)` per channel, with `F_w` the receiver's GGX row of the BRDF
+//!   SH tables ([`GatherBrdf`], at `θ_o` and its roughness) rotated from the receiver frame
+//!   (z = n, ω_o in xz) to the world; `ks` carries the tables' Fresnel weight and
+//!   `1 − trace_weight`, the share the traced specular pass leaves. Band-limited ringing is
+//!   clamped at 0. The proxies' own indirect light reaches the diffuse part only.
 
 use glam::Vec3;
 use shine_sh::ShError;
@@ -41,6 +47,7 @@ use crate::gpu_scene::environment_sh::ORDERS;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
 
+use super::brdf_tables::{GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step};
 use super::receivers::Receivers;
 
 crate::choice::named_choice! {
@@ -140,6 +147,9 @@ pub struct ProxyParams {
     pub exp: ExpMethod,
     /// Whether the proxy indirect light is accumulated.
     pub indirect: bool,
+    /// Roughness limit of the frame's traced specular pass (0: none): the shade pass's glossy
+    /// term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    pub specular_limit: f32,
 }
 
 /// What the proxy passes refuse.
@@ -263,6 +273,7 @@ impl ProxyTables {
             accumulation: Accumulation::Splat,
             exp: ExpMethod::Hyb,
             indirect: true,
+            specular_limit: 0.0,
         }
         .check()?;
         let mut log_occlusion = AlphaTable::log_visibility(bands, TABLE_ENTRIES)?;
@@ -348,14 +359,20 @@ pub const TILE: u32 = 8;
 /// Words of a tile's proxy mask (`MAX_PROXIES / 32`).
 pub const TILE_WORDS: u32 = MAX_PROXIES / 32;
 
-/// Push constants of `shaders/proxy_shade.comp` (16 bytes).
+/// Push constants of `shaders/proxy_shade.comp` (48 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct ShadePush {
+    /// xyz: camera position; w: the specular pass's roughness limit (0: none).
+    pub camera: [f32; 4],
     /// Receiver buffer size.
     pub extent: [u32; 2],
+    /// Roughness of the first glossy table, step between tables.
+    pub roughness_nodes: [f32; 2],
+    /// Number of glossy tables.
+    pub glossy_tables: u32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: [u32; 3],
 }
 
 /// Floats per receiver in the `proxy_sums` buffer: `bands²` (log-occlusion, or occlusion for
@@ -377,6 +394,9 @@ pub struct ProxyInputs {
     ///
     /// [`EnvironmentSh::gpu_data`]: crate::gpu_scene::environment_sh::EnvironmentSh::gpu_data
     pub environment: Handle<Buffer>,
+    /// [`GatherBrdf::gpu_data`] at the parameters' band count: the shade pass's glossy
+    /// receivers.
+    pub brdf: Handle<Buffer>,
 }
 
 /// The outputs of [`proxy_shade`].
@@ -414,6 +434,11 @@ fn check_inputs(
             "environment",
             inputs.environment.desc().size,
             (6 * bands * bands * 4) as u64,
+        ),
+        (
+            "brdf",
+            inputs.brdf.desc().size,
+            GatherBrdf::gpu_bytes(params.bands),
         ),
     ];
     for (name, actual, expected) in sizes {
@@ -510,7 +535,7 @@ pub fn proxy_accumulate(
 }
 
 /// Adds the `proxy_shade` pass over the sums of [`proxy_accumulate`] (`inputs.proxies` is not
-/// read).
+/// read), the receivers seen from `camera` (their glossy lobes).
 pub fn proxy_shade(
     rg: &mut RenderGraph,
     receivers: &Receivers,
@@ -518,7 +543,9 @@ pub fn proxy_shade(
     inputs: &ProxyInputs,
     tables: &ProxyTables,
     params: &ProxyParams,
+    camera: Vec3,
 ) -> Result<ProxyOutputs, ProxyError> {
+    check_inputs(receivers, inputs, tables, params)?;
     let shader = params.shade_shader()?;
     let table_bytes = (tables.gpu_data().len() * 4) as u64;
     if inputs.tables.desc().size != table_bytes {
@@ -545,8 +572,11 @@ pub fn proxy_shade(
     let coeffs = u64::from(params.bands * params.bands);
     let mut occlusion = rg.create_buffer("proxy_occlusion", BufferDesc::new(texels * coeffs * 4));
     let push = ShadePush {
+        camera: camera.extend(params.specular_limit).to_array(),
         extent: receivers.extent,
-        pad: [0; 2],
+        roughness_nodes: [GLOSSY_ROUGHNESS_MIN, glossy_roughness_step()],
+        glossy_tables: GLOSSY_TABLES,
+        pad: [0; 3],
     };
     let mut pass = rg.compute("proxy_shade", shader);
     pass.read("recv_position", &receivers.position)
@@ -554,7 +584,8 @@ pub fn proxy_shade(
         .read("recv_albedo", &receivers.albedo)
         .read("recv_material", &receivers.material)
         .read("sums", sums)
-        .read("environment", &inputs.environment);
+        .read("environment", &inputs.environment)
+        .read("brdf", &inputs.brdf);
     pass.read("tables", &inputs.tables)
         .write("occlusion", &mut occlusion)
         .write("proxy_gi", &mut radiance)

@@ -2,17 +2,21 @@
 //! [`shade_cpu`] compose the shine-sh functions exactly as `proxy_accumulate.comp` and
 //! `proxy_shade.comp` compose their GLSL twins; `tests/proxy.rs` ties the two.
 
-use glam::Vec3;
+use glam::{Mat3, Vec3};
 use shine_sh::exp_log::ShExp;
 use shine_sh::kernels::clamped_cosine_zh;
 use shine_sh::proxy_indirect::{averaged_operator_fit, overlap_normalisation};
+use shine_sh::rotation::ShRotation;
 use shine_sh::sphere_blocker::{BlockerSubstitute, self_shadow_substitute};
 use shine_sh::zonal::rotate_zh;
 
 use crate::gpu_scene::environment_sh::EnvironmentSh;
+use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::proxy::{
     Accumulation, ExpMethod, GpuProxy, INDIRECT_BANDS, ProxyError, ProxyParams, ProxyTables,
 };
+use crate::passes::specular::trace_weight;
+use crate::reference::hvl::receiver_frame;
 
 /// √(4π): the DC coefficient of the constant function 1 (the unoccluded visibility).
 const SQRT_4PI: f32 = 3.544_907_7;
@@ -42,6 +46,18 @@ pub struct ReceiverSample {
     pub albedo: Vec3,
     /// Metallic factor.
     pub metallic: f32,
+    /// Perceptual roughness (selects the glossy row of the BRDF tables).
+    pub roughness: f32,
+}
+
+/// What the shade pass's glossy receivers need beyond the sums: the camera and the BRDF SH
+/// tables at the parameters' band count.
+#[derive(Debug, Clone, Copy)]
+pub struct GlossyView<'a> {
+    /// Camera position.
+    pub camera: Vec3,
+    /// The tables the GPU reads (`GatherBrdf::gpu_data`).
+    pub brdf: &'a GatherBrdf,
 }
 
 /// CPU twin of `proxy_accumulate` at one receiver: the
@@ -122,13 +138,14 @@ pub fn accumulate_cpu(
 }
 
 /// CPU twin of `proxy_shade` at one receiver, from its [`accumulate_cpu`] sums: the occlusion
-/// vector `O_p` and the outgoing radiance.
+/// vector `O_p` and the outgoing radiance towards `view.camera` (diffuse and glossy).
 pub fn shade_cpu(
     receiver: &ReceiverSample,
     sums: &[f32],
     environment: &EnvironmentSh,
     params: &ProxyParams,
     exp: &ShExp,
+    view: &GlossyView<'_>,
 ) -> Result<(Vec<f32>, Vec3), ProxyError> {
     let bands = check_exp(params, exp)?;
     let n2 = bands * bands;
@@ -158,8 +175,26 @@ pub fn shade_cpu(
     }
     let summed = Vec3::new(sums[n2], sums[n2 + 1], sums[n2 + 2]);
     let xi = overlap_normalisation(o[0], sums[n2 + 3]);
-    let kd = receiver.albedo * (1.0 - receiver.metallic);
-    let radiance =
+    let n = receiver.normal.normalize();
+    let wo = (view.camera - receiver.position).normalize();
+    let cos_o = n.dot(wo);
+    let (kd, ks) = indirect_weights(receiver.albedo, receiver.metallic, cos_o);
+    let ks = table_fresnel_weight(ks, cos_o)
+        * (1.0 - trace_weight(receiver.roughness, params.specular_limit));
+    let mut radiance =
         kd / std::f32::consts::PI * (Vec3::from_array(psi) + xi * summed).max(Vec3::ZERO);
+    if cos_o > 0.0 && ks.max_element() > 0.0 {
+        if let Some((t, b, theta_o)) = receiver_frame(n, wo) {
+            // L · (O ∗ F_w): the glossy row rotated from the receiver frame to the world
+            let f_local = view.brdf.glossy_f(receiver.roughness, theta_o);
+            let rotation = ShRotation::from_mat3(Mat3::from_cols(t, b, n), bands)?;
+            let of = exp.tensor().product(&o, &rotation.apply(&f_local)?)?;
+            let mut glossy = [0.0f32; 3];
+            for (c, out) in glossy.iter_mut().enumerate() {
+                *out = shine_sh::dot(&of, &environment.radiance[c])?;
+            }
+            radiance += ks * Vec3::from_array(glossy).max(Vec3::ZERO);
+        }
+    }
     Ok((o, radiance))
 }

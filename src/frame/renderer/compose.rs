@@ -228,7 +228,7 @@ impl Renderer {
             _ => None,
         };
         let proxy_low = match (proxy, &recv) {
-            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers)?),
+            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers, camera.eye)?),
             _ => None,
         };
         let low = sum(rg, "gi_add", hvl_low, proxy_low)?;
