@@ -183,18 +183,18 @@ pub fn shade_cpu(
         * (1.0 - trace_weight(receiver.roughness, params.specular_limit));
     let mut radiance =
         kd / std::f32::consts::PI * (Vec3::from_array(psi) + xi * summed).max(Vec3::ZERO);
-    if cos_o > 0.0 && ks.max_element() > 0.0 {
-        if let Some((t, b, theta_o)) = receiver_frame(n, wo) {
-            // L · (O ∗ F_w): the glossy row rotated from the receiver frame to the world
-            let f_local = view.brdf.glossy_f(receiver.roughness, theta_o);
-            let rotation = ShRotation::from_mat3(Mat3::from_cols(t, b, n), bands)?;
-            let of = exp.tensor().product(&o, &rotation.apply(&f_local)?)?;
-            let mut glossy = [0.0f32; 3];
-            for (c, out) in glossy.iter_mut().enumerate() {
-                *out = shine_sh::dot(&of, &environment.radiance[c])?;
-            }
-            radiance += ks * Vec3::from_array(glossy).max(Vec3::ZERO);
+    if ks.max_element() > 0.0
+        && let Some((t, b, theta_o)) = receiver_frame(n, wo)
+    {
+        // L · (O ∗ F_w): the glossy row rotated from the receiver frame to the world
+        let f_local = view.brdf.glossy_f(receiver.roughness, theta_o);
+        let rotation = ShRotation::from_mat3(Mat3::from_cols(t, b, n), bands)?;
+        let of = exp.tensor().product(&o, &rotation.apply(&f_local)?)?;
+        let mut glossy = [0.0f32; 3];
+        for (c, out) in glossy.iter_mut().enumerate() {
+            *out = shine_sh::dot(&of, &environment.radiance[c])?;
         }
+        radiance += ks * Vec3::from_array(glossy).max(Vec3::ZERO);
     }
     Ok((o, radiance))
 }
