@@ -52,7 +52,7 @@ impl HvlTechnique {
     /// The technique on `device`; nothing is uploaded until the first frame.
     pub fn new(device: &Device) -> Self {
         Self {
-            brdf: BrdfTables::new(device),
+            brdf: BrdfTables::new(device, "hvl brdf tables"),
             last_resolve: None,
         }
     }

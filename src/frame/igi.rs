@@ -42,7 +42,7 @@ impl IgiTechnique {
     /// The technique on `device`; nothing is uploaded until the first frame.
     pub fn new(device: &Device) -> Self {
         Self {
-            brdf: BrdfTables::new(device),
+            brdf: BrdfTables::new(device, "igi brdf tables"),
         }
     }
 

@@ -104,7 +104,7 @@ impl ProxyTechnique {
             environments: Vec::new(),
             tables: Vec::new(),
             ring: UploadRing::new(device),
-            brdf: BrdfTables::new(device),
+            brdf: BrdfTables::new(device, "proxy brdf tables"),
         }
     }
 

@@ -151,15 +151,19 @@ impl GatherBrdf {
 /// uploads it with a transfer pass of its own (nothing waits).
 pub struct BrdfTables {
     device: Device,
+    /// The owner's tables' name (their buffers and upload pass), unique in a frame.
+    name: &'static str,
     tables: Vec<(u32, Buffer)>,
     ring: UploadRing,
 }
 
 impl BrdfTables {
-    /// No tables yet.
-    pub fn new(device: &Device) -> Self {
+    /// No tables yet; `name` names their buffers and upload passes, and must differ between
+    /// the owners whose tables one frame may upload (`hvl brdf tables`, …).
+    pub fn new(device: &Device, name: &'static str) -> Self {
         Self {
             device: device.clone(),
+            name,
             tables: Vec::new(),
             ring: UploadRing::new(device),
         }
@@ -191,12 +195,12 @@ impl BrdfTables {
         let data = tables.gpu_data();
         let buffer = Buffer::storage_for_uploads(
             &self.device,
-            "brdf tables",
+            self.name,
             std::mem::size_of_val(data.as_slice()) as u64,
         )?;
-        let handle =
-            self.ring
-                .upload_once(rg, "brdf tables", &buffer, bytemuck::cast_slice(&data))?;
+        let handle = self
+            .ring
+            .upload_once(rg, self.name, &buffer, bytemuck::cast_slice(&data))?;
         self.tables.push((bands, buffer));
         Ok(handle)
     }
