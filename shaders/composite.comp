@@ -1,9 +1,13 @@
 // Composite (docs/frame.md, "Direct light and composition"): direct + indirect_full radiance,
 // times exposure, into the linear HDR frame, and tonemapped + sRGB-encoded into the LDR frame.
 // With supersampling (ssaa = N > 1) the inputs are N times the output's size and each output
-// pixel is the box average of its N×N input pixels, before exposure and tonemapping.
-//! variant with_indirect INDIRECT=1
-//! variant direct_only INDIRECT=0
+// pixel is the box average of its N×N input pixels, before exposure and tonemapping. With
+// AUTO_EXPOSURE the LDR frame is also multiplied by the frame's automatic exposure (the first
+// float of `exposure`, src/passes/exposure.rs); the HDR frame keeps push.exposure only.
+//! variant with_indirect INDIRECT=1 AUTO_EXPOSURE=0
+//! variant direct_only INDIRECT=0 AUTO_EXPOSURE=0
+//! variant with_indirect_auto INDIRECT=1 AUTO_EXPOSURE=1
+//! variant direct_only_auto INDIRECT=0 AUTO_EXPOSURE=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "tonemap.glsl"
@@ -16,6 +20,11 @@ layout(set = 0, binding = 1, rgba16f) uniform readonly image2D indirect_full;
 #endif
 layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D hdr;
 layout(set = 0, binding = 3, rgba8) uniform writeonly image2D ldr;
+#if AUTO_EXPOSURE
+layout(set = 0, binding = 4, std430) readonly buffer Exposure {
+    float e[];
+} exposure;
+#endif
 
 // CompositePush in src/passes/composite.rs.
 layout(push_constant) uniform Push {
@@ -50,5 +59,8 @@ void main() {
     }
     vec3 exposed = radiance * push.inv_samples * push.exposure;
     imageStore(hdr, p, vec4(exposed, 1.0));
+#if AUTO_EXPOSURE
+    exposed *= exposure.e[0];
+#endif
     imageStore(ldr, p, encode_ldr(push.op, exposed));
 }

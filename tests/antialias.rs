@@ -19,6 +19,8 @@ fn frame(device: &shine::gpu::Device, scene: &Scene, size: u32, gi: &str, ssaa: 
     s.set("shadow.size", "256").expect("shadow");
     s.set("texture.mipmaps", "false").expect("mipmaps");
     s.set("output.ssaa", &ssaa.to_string()).expect("ssaa");
+    // the LDR frames are compared: one fixed exposure for all of them
+    s.set("output.auto_exposure", "false").expect("exposure");
     let mut renderer = Renderer::new(device).expect("renderer");
     renderer.set_scene(scene, 0.0).expect("scene");
     renderer.render(&s).expect("render")
@@ -110,6 +112,7 @@ fn taa_on_a_static_scene_converges_to_the_supersampled_frame() {
     s.set("shadow.size", "256").expect("shadow");
     s.set("texture.mipmaps", "false").expect("mipmaps");
     s.set("output.taa", "true").expect("taa");
+    s.set("output.auto_exposure", "false").expect("exposure");
     let mut renderer = Renderer::new(&device).expect("renderer");
     renderer.set_scene(&scene, 0.0).expect("scene");
     let mut errors = Vec::new();

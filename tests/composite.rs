@@ -143,6 +143,7 @@ fn run_composite(
         &mut rg,
         &direct_image,
         indirect_image.as_ref(),
+        None,
         [W, H],
         params,
     );
@@ -211,6 +212,7 @@ fn every_operator_matches_the_cpu_with_indirect_light() {
                 exposure: 1.0,
                 tonemap,
                 ssaa: 1,
+                auto_exposure: None,
             },
         );
     }
@@ -228,6 +230,7 @@ fn direct_only_with_exposure_matches_the_cpu() {
                 exposure: 0.37,
                 tonemap,
                 ssaa: 1,
+                auto_exposure: None,
             },
         );
     }
@@ -244,6 +247,7 @@ fn supersampled_composite_matches_the_cpu() {
         exposure: 0.5,
         tonemap: Tonemap::PbrNeutral,
         ssaa: 2,
+        auto_exposure: None,
     };
     let (direct, indirect) = (direct_bits(), indirect_bits());
     let shuffle = |bits: &[[u16; 4]], k: usize| bits[(k * 13) % TEXELS];

@@ -28,7 +28,9 @@ pub struct SettingsArgs {
     /// Tonemapping: none, aces, pbr-neutral (default), agx.
     #[arg(long)]
     tonemap: Option<String>,
-    /// Linear exposure factor.
+    /// Linear exposure factor of the EXR, and a compensation on top of the automatic
+    /// exposure of the PNG (`output.auto_exposure`, on by default; `--set
+    /// output.auto_exposure=false` exposes the PNG by this factor alone).
     #[arg(long)]
     exposure: Option<f32>,
     /// Supersampling N (1-4): render at N times the size and box-filter down before

@@ -10,6 +10,7 @@
 pub mod aaf;
 pub mod accumulate;
 pub mod error;
+pub mod exposure;
 pub mod hvl;
 pub mod igi;
 pub mod memory;

@@ -6,6 +6,7 @@ use crate::passes::aaf::AafParams;
 use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{Component, CompositeParams};
 use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParams};
+use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::HvlParams;
 use crate::passes::igi::IgiParams;
 use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
@@ -187,6 +188,10 @@ impl FrameParams {
                 exposure: settings.output.exposure,
                 tonemap: settings.output.tonemap,
                 ssaa: settings.output.ssaa,
+                auto_exposure: settings.output.auto_exposure.then_some(ExposureParams {
+                    adaptation: settings.output.adaptation,
+                    ..ExposureParams::default()
+                }),
             },
             component: settings.output.component,
         }

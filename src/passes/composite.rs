@@ -8,7 +8,8 @@
 use glam::Vec3;
 
 use crate::capture::tonemap::{self, Tonemap};
-use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::exposure::ExposureParams;
 use crate::shaders;
 
 /// Format of the `hdr` output: linear radiance, exposure applied.
@@ -28,6 +29,11 @@ pub struct CompositeParams {
     /// Supersampling N: the inputs are N times the output's size, and each output pixel is the
     /// box average of N×N of them ([`SSAA`] range).
     pub ssaa: u32,
+    /// Automatic exposure ([`crate::passes::exposure`]): the LDR frame's radiance is also
+    /// multiplied by the frame's exposure (`exposure` then a compensation on top); the HDR
+    /// frame stays scene-referred (`exposure` only), so EXR captures compare with each other
+    /// and with the path tracer whatever the scene's brightness.
+    pub auto_exposure: Option<ExposureParams>,
 }
 
 /// Supersampling factors: input pixels per output pixel along each axis.
@@ -41,6 +47,7 @@ impl Default for CompositeParams {
             exposure: 1.0,
             tonemap: tonemap::DEFAULT_TONEMAP,
             ssaa: 1,
+            auto_exposure: None,
         }
     }
 }
@@ -87,13 +94,15 @@ pub struct CompositeOutputs {
 
 /// Adds the composite pass: reads `direct` and, when given, `indirect` (both [`INPUT_FORMAT`],
 /// `extent` × [`CompositeParams::ssaa`]), writes new transient `hdr` and `ldr` images of
-/// `extent`.
+/// `extent`. With `exposure` (the buffer of [`crate::passes::exposure::exposure`]) the LDR
+/// frame's radiance is also multiplied by its first float.
 ///
 /// Without `indirect` the frame is direct light only (`--gi none`).
 pub fn composite(
     rg: &mut RenderGraph,
     direct: &Handle<Image>,
     indirect: Option<&Handle<Image>>,
+    exposure: Option<&Handle<Buffer>>,
     extent: [u32; 2],
     params: &CompositeParams,
 ) -> CompositeOutputs {
@@ -109,14 +118,19 @@ pub fn composite(
         inv_samples: 1.0 / (ssaa * ssaa) as f32,
         pad: [0; 2],
     };
-    let shader = match indirect {
-        Some(_) => &shaders::COMPOSITE_COMP_WITH_INDIRECT,
-        None => &shaders::COMPOSITE_COMP_DIRECT_ONLY,
+    let shader = match (indirect, exposure) {
+        (Some(_), None) => &shaders::COMPOSITE_COMP_WITH_INDIRECT,
+        (None, None) => &shaders::COMPOSITE_COMP_DIRECT_ONLY,
+        (Some(_), Some(_)) => &shaders::COMPOSITE_COMP_WITH_INDIRECT_AUTO,
+        (None, Some(_)) => &shaders::COMPOSITE_COMP_DIRECT_ONLY_AUTO,
     };
     let mut pass = rg.compute("composite", shader);
     pass.read("direct", direct);
     if let Some(indirect) = indirect {
         pass.read("indirect_full", indirect);
+    }
+    if let Some(exposure) = exposure {
+        pass.read("exposure", exposure);
     }
     pass.write("hdr", &mut hdr)
         .write("ldr", &mut ldr)
@@ -198,6 +212,7 @@ mod tests {
             exposure: 0.5,
             tonemap: Tonemap::None,
             ssaa: 1,
+            auto_exposure: None,
         };
         let (hdr, ldr) =
             composite_texel([1.0, 0.25, 0.0, 0.0], Some([1.0, 0.0, 0.5, 0.0]), &params);

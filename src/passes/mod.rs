@@ -8,6 +8,7 @@ pub mod brdf_tables;
 pub mod composite;
 pub mod direct;
 pub mod environment_sh;
+pub mod exposure;
 pub mod gbuffer;
 pub mod gi_add;
 pub mod history;

@@ -42,6 +42,7 @@ use crate::capture::tonemap::Tonemap;
 use crate::passes::aaf::AafParams;
 use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{Component, CompositeParams};
+use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::{Distribution, Falloff, GatherPath, HvlParams, RadiusHeuristic, Window};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
 use crate::passes::proxy::{DEFAULT_ORDER, ExpMethod, INDIRECT_BANDS, paper_expansion};
@@ -192,9 +193,17 @@ pub struct OutputSettings {
     /// Tonemap operator of the LDR (PNG) output: `none`, `aces`, `pbr-neutral`, `agx`.
     /// Default `pbr-neutral`. EXR output stays linear HDR.
     pub tonemap: Tonemap,
-    /// Linear factor applied to radiance before tonemapping (and in the EXR).
+    /// Linear factor applied to radiance before tonemapping (and in the EXR); with
+    /// `auto_exposure` a compensation on top of the automatic exposure.
     /// Range 1e-6..=1e6, default 1.0.
     pub exposure: f32,
+    /// Automatic exposure of the tonemapped (PNG) frame: each frame's log-average luminance
+    /// is mapped to middle grey (Reinhard et al. 2002, key 0.18; `src/passes/exposure.rs`).
+    /// The EXR frame stays scene-referred (`exposure` only). Default true.
+    pub auto_exposure: bool,
+    /// Fraction of the way (in log exposure) each frame of a sequence moves towards its
+    /// automatic exposure (1: at once). Range 0.001..=1.0, default 0.1.
+    pub adaptation: f32,
     /// Radiance shown: `full`, `direct` or `indirect` (GI only). Default `full`.
     pub component: Component,
     /// Supersampling N: the frame is rendered at N × width by N × height and each output pixel
@@ -407,6 +416,8 @@ impl Default for OutputSettings {
             component: Component::Full,
             ssaa: c.ssaa,
             taa: false,
+            auto_exposure: true,
+            adaptation: ExposureParams::default().adaptation,
         }
     }
 }
@@ -558,6 +569,8 @@ mod tests {
                 component: Component::Indirect,
                 ssaa: 2,
                 taa: true,
+                auto_exposure: true,
+                adaptation: 0.5,
             },
             hvl: HvlSettings {
                 radius: RadiusHeuristic::R1,

@@ -8,7 +8,8 @@ use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
 use crate::passes::{
-    aaf, accumulate, composite, hvl, igi, proxy, receivers, rsm, shadows, specular, upsample,
+    aaf, accumulate, composite, exposure, hvl, igi, proxy, receivers, rsm, shadows, specular,
+    upsample,
 };
 
 /// Output sides in pixels.
@@ -55,6 +56,11 @@ impl Settings {
         }
         check("output.exposure", self.output.exposure, &tonemap::EXPOSURE)?;
         check("output.ssaa", self.output.ssaa, &composite::SSAA)?;
+        check(
+            "output.adaptation",
+            self.output.adaptation,
+            &exposure::ADAPTATION_RANGE,
+        )?;
         let rendered = |side: u32| side.saturating_mul(self.output.ssaa);
         if !EXTENT.contains(&rendered(self.width)) || !EXTENT.contains(&rendered(self.height)) {
             return Err(SettingsError::OutOfRange {

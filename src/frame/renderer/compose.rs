@@ -43,6 +43,7 @@ impl Renderer {
         self.motion.reset();
         self.accumulate.reset();
         self.taa.reset();
+        self.exposure.reset();
         self.hvl.forget_uploads();
         self.igi.forget_uploads();
         if let Some(scene) = self.scene.as_mut() {
@@ -122,10 +123,14 @@ impl Renderer {
                 ));
             }
         };
+        let exposure = self
+            .exposure
+            .apply(rg, p.composite.auto_exposure, first, second);
         Ok(composite::composite(
             rg,
             first,
             second,
+            exposure.as_ref(),
             output.extent,
             &p.composite,
         ))

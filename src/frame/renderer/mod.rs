@@ -12,6 +12,7 @@ pub(crate) use host::HostSide;
 use super::aaf::AafTechnique;
 use super::accumulate::AccumulateTechnique;
 use super::error::RenderError;
+use super::exposure::ExposureTechnique;
 use super::hvl::HvlTechnique;
 use super::igi::IgiTechnique;
 use super::memory::MemoryReport;
@@ -168,6 +169,8 @@ pub struct Renderer {
     accumulate: AccumulateTechnique,
     /// The direct light's history under TAA (issue 21).
     taa: AccumulateTechnique,
+    /// The automatic exposure's history (issue 21).
+    exposure: ExposureTechnique,
     /// Readback buffers of [`Renderer::render`].
     readback: Option<Readback>,
 }
@@ -250,6 +253,7 @@ impl Renderer {
             motion: MotionState::new(device)?,
             accumulate: AccumulateTechnique::new("accumulate", "accumulated indirect"),
             taa: AccumulateTechnique::new("taa", "taa direct"),
+            exposure: ExposureTechnique::default(),
             readback: None,
         })
     }
@@ -275,6 +279,7 @@ impl Renderer {
         self.hvl.reset();
         self.accumulate.reset();
         self.taa.reset();
+        self.exposure.reset();
         Ok(())
     }
 
