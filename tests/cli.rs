@@ -126,12 +126,16 @@ fn render_writes_png_and_exr_and_refuses_bad_requests_before_work() {
             "{file} is not a {} file",
             &file[3..]
         );
+        // a capture this small is supersampled 2×2 unless told otherwise
+        let stdout = String::from_utf8_lossy(&run.stdout);
+        assert!(stdout.contains("supersampled 2×"), "{stdout}");
     }
     for (args, message) in [
         (vec!["-o", "cb.jpg"], ".png"),
         (vec!["-o", "cb.png", "--set", "hvl.count=5"], "hvl.count"),
         (vec!["-o", "cb.png", "--set", "nonsense=1"], "nonsense"),
         (vec!["-o", "cb.png", "--gi", "magic"], "magic"),
+        (vec!["-o", "cb.png", "--ssaa", "5"], "output.ssaa"),
     ] {
         let run = shine()
             .current_dir(&dir)

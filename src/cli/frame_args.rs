@@ -34,7 +34,8 @@ pub struct SettingsArgs {
     #[arg(long)]
     exposure: Option<f32>,
     /// Supersampling N (1-4): render at N times the size and box-filter down before
-    /// tonemapping (`output.ssaa`; antialiased captures).
+    /// tonemapping (`output.ssaa`; antialiased captures). 0: automatic, 2 up to 512×512
+    /// pixels and 1 above (`shine render`'s default without --settings).
     #[arg(long)]
     ssaa: Option<u32>,
     /// Any setting by its TOML key, e.g. `--set hvl.count=2000` (repeatable).
@@ -87,9 +88,23 @@ impl EnvironmentArgs {
 impl SettingsArgs {
     /// The file's settings (or the defaults) with every flag applied, validated.
     pub fn resolve(&self) -> Result<Settings, CliError> {
+        self.resolve_from(Settings::default())
+    }
+
+    /// As [`SettingsArgs::resolve`] for a capture: without a settings file the defaults
+    /// supersample automatically (`output.ssaa = 0`, the best antialiasing that fits the
+    /// time; docs/quality.md).
+    pub fn resolve_capture(&self) -> Result<Settings, CliError> {
+        let mut defaults = Settings::default();
+        defaults.output.ssaa = 0;
+        self.resolve_from(defaults)
+    }
+
+    /// The file's settings (or `defaults`) with every flag applied, validated.
+    fn resolve_from(&self, defaults: Settings) -> Result<Settings, CliError> {
         let mut settings = match &self.settings {
             Some(path) => Settings::load(path)?,
-            None => Settings::default(),
+            None => defaults,
         };
         let flags = [
             ("width", self.width.map(|v| v.to_string())),

@@ -44,7 +44,7 @@ pub struct RenderArgs {
 pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     // Refuse a bad output path, frame rate or orbit before any work.
     OutputFormat::from_path(&args.output)?;
-    let mut settings = args.settings.resolve()?;
+    let mut settings = args.settings.resolve_capture()?;
     if let Some(frames) = args.frames {
         settings.set("frames", &frames.to_string())?;
         settings.validate()?;
@@ -110,9 +110,11 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
         pattern.path(0).display().to_string()
     };
     println!(
-        "wrote {written} ({}×{}, last frame {:.2} ms from submission to readback)",
+        "wrote {written} ({}×{}, supersampled {}×, last frame {:.2} ms from submission to \
+         readback)",
         settings.width,
         settings.height,
+        settings.output.ssaa_for(settings.width, settings.height),
         last_wall.as_secs_f64() * 1e3
     );
     Ok(())

@@ -187,7 +187,7 @@ impl FrameParams {
             composite: CompositeParams {
                 exposure: settings.output.exposure,
                 tonemap: settings.output.tonemap,
-                ssaa: settings.output.ssaa,
+                ssaa: settings.output.ssaa_for(settings.width, settings.height),
                 auto_exposure: settings.output.auto_exposure.then_some(ExposureParams {
                     adaptation: settings.output.adaptation,
                     ..ExposureParams::default()

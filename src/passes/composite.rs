@@ -38,6 +38,21 @@ pub struct CompositeParams {
 
 /// Supersampling factors: input pixels per output pixel along each axis.
 pub const SSAA: std::ops::RangeInclusive<u32> = 1..=4;
+/// The largest supersampling [`auto_ssaa`] chooses.
+pub const AUTO_SSAA_MAX: u32 = 2;
+/// The most pixels [`auto_ssaa`] lets a frame render: 1024² (a 512² capture at 2×2, the
+/// Cornell box of `make render` in about 3 s on the CI machine's lavapipe).
+pub const AUTO_SSAA_PIXELS: u64 = 1 << 20;
+
+/// Supersampling for a capture of `extent` that fits the time: the largest factor up to
+/// [`AUTO_SSAA_MAX`] whose rendered frame has at most [`AUTO_SSAA_PIXELS`] pixels, else 1.
+pub fn auto_ssaa(extent: [u32; 2]) -> u32 {
+    let pixels = u64::from(extent[0]) * u64::from(extent[1]);
+    (1..=AUTO_SSAA_MAX)
+        .rev()
+        .find(|&n| u64::from(n * n) * pixels <= AUTO_SSAA_PIXELS)
+        .unwrap_or(1)
+}
 
 impl Default for CompositeParams {
     /// Exposure 1, the default tonemap ([`tonemap::DEFAULT_TONEMAP`], PBR Neutral), no
@@ -204,6 +219,15 @@ mod tests {
                 .binding("indirect_full")
                 .is_none()
         );
+    }
+
+    #[test]
+    fn auto_ssaa_fits_the_pixel_budget() {
+        assert_eq!(auto_ssaa([512, 512]), 2);
+        assert_eq!(auto_ssaa([128, 128]), 2);
+        assert_eq!(auto_ssaa([513, 512]), 1);
+        assert_eq!(auto_ssaa([1280, 720]), 1);
+        assert_eq!(auto_ssaa([0, 0]), AUTO_SSAA_MAX);
     }
 
     #[test]

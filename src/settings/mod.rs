@@ -41,7 +41,7 @@ use serde::{Deserialize, Serialize};
 use crate::capture::tonemap::Tonemap;
 use crate::passes::aaf::AafParams;
 use crate::passes::accumulate::AccumulateParams;
-use crate::passes::composite::{Component, CompositeParams};
+use crate::passes::composite::{self, Component, CompositeParams};
 use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::{Distribution, Falloff, GatherPath, HvlParams, RadiusHeuristic, Window};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
@@ -208,8 +208,9 @@ pub struct OutputSettings {
     pub component: Component,
     /// Supersampling N: the frame is rendered at N × width by N × height and each output pixel
     /// is the box average of N×N of them, before tonemapping (antialiasing for captures; GI
-    /// contexts render at the host's G-buffer size and ignore it). Range 1..=4 with N × width
-    /// and N × height at most 16384, default 1.
+    /// contexts render at the host's G-buffer size and ignore it). 0: automatic, the largest N
+    /// ≤ 2 whose rendered frame has at most 1024² pixels (`shine render`'s default without a
+    /// settings file). Range 0..=4 with N × width and N × height at most 16384, default 1.
     pub ssaa: u32,
     /// Temporal antialiasing for sequences and real time: the camera jitters through 8 Halton
     /// points and the direct light is accumulated over up to 16 frames, reprojected with the
@@ -402,6 +403,17 @@ impl Default for ProxySettings {
             indirect: true,
             brute_force: false,
             fit_count: 0,
+        }
+    }
+}
+
+impl OutputSettings {
+    /// The supersampling factor of a `width` × `height` frame: `ssaa`, or
+    /// [`composite::auto_ssaa`] when it is 0.
+    pub fn ssaa_for(&self, width: u32, height: u32) -> u32 {
+        match self.ssaa {
+            0 => composite::auto_ssaa([width, height]),
+            n => n,
         }
     }
 }

@@ -55,13 +55,16 @@ impl Settings {
             });
         }
         check("output.exposure", self.output.exposure, &tonemap::EXPOSURE)?;
-        check("output.ssaa", self.output.ssaa, &composite::SSAA)?;
+        if self.output.ssaa != 0 {
+            check("output.ssaa", self.output.ssaa, &composite::SSAA)?;
+        }
         check(
             "output.adaptation",
             self.output.adaptation,
             &exposure::ADAPTATION_RANGE,
         )?;
-        let rendered = |side: u32| side.saturating_mul(self.output.ssaa);
+        let ssaa = self.output.ssaa_for(self.width, self.height);
+        let rendered = |side: u32| side.saturating_mul(ssaa);
         if !EXTENT.contains(&rendered(self.width)) || !EXTENT.contains(&rendered(self.height)) {
             return Err(SettingsError::OutOfRange {
                 field: "output.ssaa",
