@@ -185,24 +185,10 @@ fn diffuse_plane_under_a_point_light_matches_analytic_irradiance() {
     let size = 24;
     let images = render_reference(&device, &scene, 0.0, &params(size, 0), 1).expect("reference");
     // The camera ray of every pixel centre, as the tracer builds it.
-    let view_proj = {
-        let gpu = shine::gpu_scene::GpuScene::upload(&device, &scene, 0.0).expect("upload");
-        shine::passes::gbuffer::camera_view(&gpu.state, size, size).view_proj()
-    };
-    let inverse = view_proj.inverse();
+    let rays = common::scenes::pixel_rays(&device, &scene, size);
     for y in 0..size {
         for x in 0..size {
-            let ndc = |z: f32| {
-                let p = inverse
-                    * glam::Vec4::new(
-                        (x as f32 + 0.5) / size as f32 * 2.0 - 1.0,
-                        (y as f32 + 0.5) / size as f32 * 2.0 - 1.0,
-                        z,
-                        1.0,
-                    );
-                p.truncate() / p.w
-            };
-            let (o, d) = (ndc(0.0), (ndc(0.5) - ndc(0.0)).normalize());
+            let (o, d) = rays[(y * size + x) as usize];
             let p = o + d * (-o.y / d.y);
             let to_light = light_position - p;
             let d2 = to_light.length_squared();

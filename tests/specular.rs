@@ -5,7 +5,7 @@
 
 mod common;
 
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 use shine::capture::image_io::HdrImage;
 use shine::reference::{ReferenceImages, ReferenceParams, render_reference};
 use shine::{Renderer, Settings};
@@ -82,36 +82,17 @@ fn truth(device: &shine::gpu::Device, scene: &Scene, spp: u32) -> ReferenceImage
 
 /// The pixels whose centre ray meets the sphere shrunk by 10% (away from its silhouette).
 fn sphere_pixels(device: &shine::gpu::Device, scene: &Scene) -> Vec<usize> {
-    let gpu = shine::gpu_scene::GpuScene::upload(device, scene, 0.0).expect("upload");
-    let inverse = shine::passes::gbuffer::camera_view(&gpu.state, SIZE, SIZE)
-        .view_proj()
-        .inverse();
-    let mut pixels = Vec::new();
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let unproject = |z: f32| {
-                let p = inverse
-                    * Vec4::new(
-                        (x as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0,
-                        (y as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0,
-                        z,
-                        1.0,
-                    );
-                p.truncate() / p.w
-            };
-            let (o, d) = (
-                unproject(0.0),
-                (unproject(0.5) - unproject(0.0)).normalize(),
-            );
-            let to_centre = CENTRE - o;
-            let b = to_centre.dot(d);
-            let r = 0.9 * RADIUS;
-            if b > 0.0 && to_centre.length_squared() - b * b < r * r {
-                pixels.push((y * SIZE + x) as usize);
-            }
-        }
-    }
-    pixels
+    let r = 0.9 * RADIUS;
+    common::scenes::pixel_rays(device, scene, SIZE)
+        .iter()
+        .enumerate()
+        .filter(|(_, (o, d))| {
+            let to_centre = CENTRE - *o;
+            let b = to_centre.dot(*d);
+            b > 0.0 && to_centre.length_squared() - b * b < r * r
+        })
+        .map(|(p, _)| p)
+        .collect()
 }
 
 /// Over `pixels`: the frame's energy over the truth's, and the RMSE over the truth's mean.

@@ -121,3 +121,30 @@ pub fn floor(s: f32, height: f32) -> Vec<[Vec3; 3]> {
     ];
     vec![[c[0], c[1], c[2]], [c[0], c[2], c[3]]]
 }
+
+/// The camera ray through the centre of every pixel of a `size`×`size` frame of `scene` (as
+/// the raster and the path tracer place them), row by row: origin and unit direction.
+pub fn pixel_rays(device: &shine::gpu::Device, scene: &Scene, size: u32) -> Vec<(Vec3, Vec3)> {
+    let gpu = shine::gpu_scene::GpuScene::upload(device, scene, 0.0).expect("upload");
+    let inverse = shine::passes::gbuffer::camera_view(&gpu.state, size, size)
+        .view_proj()
+        .inverse();
+    let mut rays = Vec::with_capacity((size * size) as usize);
+    for y in 0..size {
+        for x in 0..size {
+            let unproject = |z: f32| {
+                let p = inverse
+                    * glam::Vec4::new(
+                        (x as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+                        (y as f32 + 0.5) / size as f32 * 2.0 - 1.0,
+                        z,
+                        1.0,
+                    );
+                p.truncate() / p.w
+            };
+            let origin = unproject(0.0);
+            rays.push((origin, (unproject(0.5) - origin).normalize()));
+        }
+    }
+    rays
+}
