@@ -1,7 +1,7 @@
 // Paths through the scene, shared by the reference path tracer (path_trace.comp) and AAF's
 // sampling pass (aaf_sample.comp): the scene's vertex, index and light buffers (bindings 4-6),
 // the surface at a ray hit, the BRDF, next-event estimation to the punctual lights with shadow
-// rays, and a PCG random-number generator.
+// rays, and the random numbers of random.glsl.
 //
 // The includer includes surface.glsl, brdf.glsl and trace.glsl first, and defines
 // PATH_LIGHT_COUNT (the number of lights) and PATH_FLAGS (PT_* bits) as expressions.
@@ -27,19 +27,7 @@ const uint PT_EMISSIVE_LIGHTING = 2u;
 const uint PT_LAMBERT_ONLY = 4u;
 const float PT_FAR = 1e30;
 
-uint rng_state;
-
-// PCG hash (Jarzynski & Olano 2020).
-uint pcg(uint v) {
-    uint state = v * 747796405u + 2891336453u;
-    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
-
-float rand() {
-    rng_state = pcg(rng_state);
-    return float(rng_state >> 8) * (1.0 / 16777216.0);
-}
+#include "random.glsl"
 
 struct Vertex {
     vec3 position;

@@ -44,6 +44,9 @@ pub enum RenderError {
     /// The AAF passes refused their parameters.
     #[error(transparent)]
     Aaf(#[from] AafError),
+    /// The sky pass refused its parameters.
+    #[error(transparent)]
+    Sky(#[from] crate::passes::sky::SkyError),
     /// The specular pass refused its parameters.
     #[error(transparent)]
     Specular(#[from] crate::passes::specular::SpecularError),

@@ -10,6 +10,7 @@ use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::HvlParams;
 use crate::passes::igi::IgiParams;
 use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
+use crate::passes::sky::SkyParams;
 use crate::passes::specular::SpecularParams;
 use crate::passes::upsample::UpsampleParams;
 use crate::settings::{GiTechnique, Settings};
@@ -42,6 +43,9 @@ pub struct FrameParams {
     /// Traced specular reflections, when on and the frame has a GI technique (the techniques'
     /// `specular_limit` is its limit then, else 0).
     pub specular: Option<SpecularParams>,
+    /// The sky light, when on and the frame has a GI technique but not the proxies (it is
+    /// declared only for a scene with an environment).
+    pub sky: Option<SkyParams>,
     /// The joint bilateral upsample of the receiver-resolution light.
     pub upsample: UpsampleParams,
     /// The indirect light's accumulation over frames, when it has a history longer than one
@@ -173,6 +177,13 @@ impl FrameParams {
                 }
             }),
             specular,
+            sky: (settings.sky.enabled && !gi.is_none() && !gi.contains(GiTechnique::Proxy)).then(
+                || SkyParams {
+                    rays: settings.sky.rays,
+                    range: settings.sky.range,
+                    ..SkyParams::default()
+                },
+            ),
             upsample: UpsampleParams {
                 depth_sigma: settings.upsample.depth_epsilon,
                 normal_power: settings.upsample.normal_power,

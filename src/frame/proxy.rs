@@ -131,7 +131,7 @@ impl ProxyTechnique {
 
     /// The scene environment's SH at `bands` bands in `rg`: imported, or projected on the CPU
     /// and uploaded by this frame (once per band count).
-    fn environment_sh(
+    pub(crate) fn environment_sh(
         &mut self,
         rg: &mut RenderGraph,
         bands: u32,

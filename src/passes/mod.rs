@@ -20,6 +20,7 @@ pub mod proxy;
 pub mod receivers;
 pub mod rsm;
 pub mod shadows;
+pub mod sky;
 pub mod specular;
 pub mod update_vertices;
 pub mod upsample;

@@ -28,11 +28,13 @@
 mod error;
 mod gi;
 mod io;
+mod sky;
 mod specular;
 mod validate;
 
 pub use error::SettingsError;
 pub use gi::{GiTechnique, GiTechniques};
+pub use sky::SkySettings;
 pub use specular::SpecularSettings;
 pub use validate::{EXTENT, FRAMES, TIME};
 
@@ -90,6 +92,8 @@ pub struct Settings {
     pub history: HistorySettings,
     /// Traced specular reflections (issue 21).
     pub specular: SpecularSettings,
+    /// The sky light of frames without proxies (issue 16).
+    pub sky: SkySettings,
 }
 
 /// `[history]`: the indirect light accumulated over frames (`src/passes/accumulate.rs`):
@@ -389,6 +393,7 @@ impl Default for Settings {
             aaf: AafSettings::default(),
             history: HistorySettings::default(),
             specular: SpecularSettings::default(),
+            sky: SkySettings::default(),
         }
     }
 }

@@ -8,7 +8,7 @@ use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
 use crate::passes::{
-    aaf, accumulate, composite, exposure, hvl, igi, proxy, receivers, rsm, shadows, specular,
+    aaf, accumulate, composite, exposure, hvl, igi, proxy, receivers, rsm, shadows, sky, specular,
     upsample,
 };
 
@@ -179,6 +179,8 @@ impl Settings {
             self.specular.limit,
             &specular::LIMIT_RANGE,
         )?;
+        check("sky.rays", self.sky.rays, &sky::RAYS_RANGE)?;
+        check("sky.range", self.sky.range, &sky::RANGE_RANGE)?;
         Ok(())
     }
 

@@ -14,6 +14,7 @@ use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::Distribution;
+use crate::passes::sky;
 use crate::passes::specular::{self, SpecularScene};
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
 use shine_graph::{Handle, Image, RenderGraph};
@@ -210,7 +211,9 @@ impl Renderer {
         let rsm = (!rsm_faces.is_empty()).then_some(rsm_faces.as_slice());
         // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
         // upsample; `hvl,proxy` sums both at receiver resolution first.
-        let recv = if hvl.is_some() || proxy.is_some() {
+        // The sky light (frames without proxies, scenes with an environment).
+        let sky = p.sky.filter(|_| scene.has_environment);
+        let recv = if hvl.is_some() || proxy.is_some() || sky.is_some() {
             Some(receivers::receivers(rg, g, p.receiver_scale)?)
         } else {
             None
@@ -237,6 +240,28 @@ impl Renderer {
             _ => None,
         };
         let low = sum(rg, "gi_add", hvl_low, proxy_low)?;
+        let sky_low = match (sky, &recv) {
+            (Some(params), Some(receivers)) => {
+                let environment = scene.proxy.environment_sh(rg, sky::BANDS)?;
+                // a new seed per frame only when a history averages the frames
+                let seed = if p.history.is_some() {
+                    rg.frame() as u32
+                } else {
+                    0
+                };
+                Some(sky::sky(
+                    rg,
+                    receivers,
+                    &environment,
+                    &handles.trace,
+                    camera.eye,
+                    &params,
+                    seed,
+                )?)
+            }
+            _ => None,
+        };
+        let low = sum(rg, "sky_add", low, sky_low)?;
         let upsampled = match (low, &recv) {
             (Some(low), Some(recv)) => Some(upsample::upsample(rg, &low, recv, g, &p.upsample)?),
             _ => None,

@@ -1,0 +1,93 @@
+// Sky light for the frames without proxies (issue 16, item 7, and issue 18, item 2;
+// src/passes/sky.rs). At every receiver, `rays` cosine-weighted directions about the shading
+// normal (k x k strata, k = floor(sqrt(rays)), the rest uniform; a new rotation per receiver
+// and frame) traced through the BVH up to `range` (0: unbounded). Their unoccluded share A is
+// the cosine-weighted sky visibility (ambient occlusion), their mean direction b the bent
+// normal; the receiver sends kd / pi * A * max(L~ . Y(b), 0) towards the camera, L~ the
+// environment's SH irradiance (paper 002 §3, src/gpu_scene/environment_sh.rs) and kd from
+// brdf_indirect_weights. In a uniform environment this is exactly the path tracer's sky light;
+// elsewhere the bent normal stands for where the open sky lies. Writes RGBA16F, a = 0, 0 on
+// background. No CPU twin: tests/sky.rs checks it against the path tracer.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#define SH_BANDS 3
+#include "sh.glsl"
+#include "brdf.glsl"
+#include "random.glsl"
+#define TRACE_NODES_BINDING 6
+#define TRACE_TRIANGLES_BINDING 7
+#define TRACE_TOP_BINDING 8
+#define TRACE_INSTANCES_BINDING 9
+#include "trace.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
+layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
+layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_albedo;
+layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
+// EnvironmentSh::gpu_data at 3 bands: L r, g, b, then L~ r, g, b (9 floats each).
+layout(set = 0, binding = 4, std430) readonly buffer Environment {
+    float e[];
+} environment;
+layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D sky;
+
+// shine::passes::sky::SkyPush (32 bytes).
+layout(push_constant) uniform Push {
+    // xyz: camera position; w: the rays' range (0: unbounded)
+    vec4 camera;
+    // receiver buffer size
+    uvec2 extent;
+    // rays per receiver
+    uint rays;
+    // seed (varies per frame with a history)
+    uint seed;
+} push;
+
+void main() {
+    uvec2 xy = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(xy, push.extent))) {
+        return;
+    }
+    ivec2 ixy = ivec2(xy);
+    vec4 position = imageLoad(recv_position, ixy);
+    vec3 n = imageLoad(recv_normal, ixy).xyz;
+    if (!(position.w > 0.0) || dot(n, n) <= 0.0) {
+        imageStore(sky, ixy, vec4(0.0));
+        return;
+    }
+    n = normalize(n);
+    vec3 origin = trace_offset(position.xyz, n);
+    float range = push.camera.w > 0.0 ? push.camera.w : 1e30;
+    uint strata = uint(floor(sqrt(float(push.rays))));
+    rng_state = pcg(pcg(xy.x ^ pcg(push.seed)) + xy.y);
+    vec2 rotation = vec2(rand(), rand());
+    vec3 bent = vec3(0.0);
+    float open = 0.0;
+    for (uint s = 0u; s < push.rays; ++s) {
+        vec2 xi = vec2(rand(), rand());
+        if (s < strata * strata) {
+            xi = (vec2(float(s % strata), float(s / strata)) + xi) / float(strata);
+        }
+        vec3 d = sample_cosine(n, fract(xi + rotation));
+        if (!trace_occluded(origin, d, 0.0, range)) {
+            open += 1.0;
+            bent += d;
+        }
+    }
+    float visibility = open / float(push.rays);
+    vec3 b = dot(bent, bent) > 0.0 ? normalize(bent) : n;
+    float y[SH_COEFFS];
+    sh_basis(b, y);
+    vec3 irradiance = vec3(0.0);
+    for (int k = 0; k < SH_COEFFS; ++k) {
+        irradiance += y[k] * vec3(environment.e[3 * SH_COEFFS + k], environment.e[4 * SH_COEFFS + k],
+            environment.e[5 * SH_COEFFS + k]);
+    }
+    vec3 albedo = imageLoad(recv_albedo, ixy).rgb;
+    float metallic = imageLoad(recv_material, ixy).g;
+    vec3 kd;
+    vec3 ks;
+    brdf_indirect_weights(albedo, metallic, dot(n, normalize(push.camera.xyz - position.xyz)), kd, ks);
+    imageStore(sky, ixy, vec4(kd / SH_PI * visibility * max(irradiance, vec3(0.0)), 0.0));
+}

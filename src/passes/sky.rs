@@ -1,0 +1,123 @@
+//! Sky light for the frames without proxies (issue 16, item 7; issue 18, item 2): the `sky`
+//! pass (`shaders/sky.comp`).
+//!
+//! Only the proxies (paper 002) lit a scene by its environment, so under HVL, IGI or AAF the
+//! ground of `spheres` was black wherever the sun did not reach. This pass adds the diffuse sky
+//! light at every receiver: [`SkyParams::rays`] cosine-weighted rays through the BVH measure
+//! the cosine-weighted sky visibility `A` (ambient occlusion, up to [`SkyParams::range`]; 0:
+//! the whole scene) and the bent normal `b` (the mean open direction), and the receiver sends
+//! `kd/π · A · L̃(b)` (`L̃` the environment's SH irradiance at 3 bands, paper 002 §3).
+//!
+//! # Decisions
+//!
+//! * Receiver resolution, summed with HVL's light before the upsample: sky light is smooth.
+//! * Visibility times the unshadowed irradiance at the bent normal rather than a traced sum of
+//!   the sky's radiance: with few rays the noise is in `A` alone, the colour and direction of
+//!   the sky come from the SH (exact for a uniform sky, `tests/sky.rs`).
+//! * Not in frames with proxies: they shadow the environment themselves (paper 002).
+
+use std::ops::RangeInclusive;
+
+use crate::gpu_scene::bvh::TraceBuffers;
+use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::receivers::Receivers;
+use crate::shaders;
+
+/// Default rays per receiver.
+pub const RAYS: u32 = 16;
+/// Rays per receiver the settings take.
+pub const RAYS_RANGE: RangeInclusive<u32> = 1..=1024;
+/// Ranges of the rays the settings take, in world units (0: unbounded).
+pub const RANGE_RANGE: RangeInclusive<f32> = 0.0..=1e6;
+/// SH bands of the environment's irradiance the pass reads.
+pub const BANDS: u32 = 3;
+
+/// Parameters of the sky pass.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SkyParams {
+    /// Rays per receiver.
+    pub rays: u32,
+    /// How far a ray looks for an occluder (0: unbounded, the sky's visibility; a short range
+    /// gives cavity occlusion).
+    pub range: f32,
+    /// Seed of the rays.
+    pub seed: u32,
+}
+
+impl Default for SkyParams {
+    fn default() -> Self {
+        Self {
+            rays: RAYS,
+            range: 0.0,
+            seed: 0,
+        }
+    }
+}
+
+/// What the sky pass refuses.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum SkyError {
+    /// A parameter out of its range.
+    #[error("sky {0}")]
+    OutOfRange(#[from] super::OutOfRange),
+}
+
+impl SkyParams {
+    /// Checks every parameter against its range.
+    pub fn validate(&self) -> Result<(), SkyError> {
+        super::check_range("rays", self.rays, &RAYS_RANGE)?;
+        super::check_range("range", self.range, &RANGE_RANGE)?;
+        Ok(())
+    }
+}
+
+/// Push constants of `shaders/sky.comp` (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SkyPush {
+    /// xyz camera position, w the rays' range (0: unbounded).
+    pub camera: [f32; 4],
+    /// Receiver buffer size.
+    pub extent: [u32; 2],
+    /// Rays per receiver.
+    pub rays: u32,
+    /// Seed.
+    pub seed: u32,
+}
+
+/// Adds the `sky` pass over `receivers` seen from `camera`: the environment's SH (`environment`,
+/// `EnvironmentSh::gpu_data` at [`BANDS`] bands) times each receiver's sky visibility through
+/// `bvh`. Returns the outgoing radiance (RGBA16F at receiver resolution). `seed` is added to
+/// the parameters' (the frame index when a history averages the frames).
+pub fn sky(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    environment: &Handle<Buffer>,
+    bvh: &TraceBuffers,
+    camera: glam::Vec3,
+    params: &SkyParams,
+    seed: u32,
+) -> Result<Handle<Image>, SkyError> {
+    params.validate()?;
+    let [w, h] = receivers.extent;
+    let mut out = rg.create_image(
+        "sky_light",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    let mut pass = rg.compute("sky", &shaders::SKY_COMP);
+    pass.read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("recv_albedo", &receivers.albedo)
+        .read("recv_material", &receivers.material)
+        .read("environment", environment);
+    bvh.bind(&mut pass);
+    pass.write("sky", &mut out)
+        .push(&SkyPush {
+            camera: camera.extend(params.range).to_array(),
+            extent: receivers.extent,
+            rays: params.rays,
+            seed: params.seed.wrapping_add(seed),
+        })
+        .dispatch([w, h, 1]);
+    Ok(out)
+}

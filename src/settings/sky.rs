@@ -1,0 +1,32 @@
+//! `[sky]`: the sky light of frames without proxies (`src/passes/sky.rs`).
+
+use serde::{Deserialize, Serialize};
+
+use crate::passes::sky::SkyParams;
+
+/// `[sky]`: the environment's diffuse light times each receiver's sky visibility and bent
+/// normal (issue 16, item 7), in every frame with a GI technique but the proxies (which
+/// shadow the environment themselves), when the scene has an environment.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SkySettings {
+    /// Light the receivers by the sky. Default true.
+    pub enabled: bool,
+    /// Rays per receiver. Range 1..=1024, default 16.
+    pub rays: u32,
+    /// How far a ray looks for an occluder, in world units (0: unbounded, the sky's
+    /// visibility; a short range gives cavity occlusion). Range 0.0..=1e6, default 0.
+    pub range: f32,
+}
+
+impl Default for SkySettings {
+    /// The defaults of the sky pass ([`SkyParams::default`]).
+    fn default() -> Self {
+        let p = SkyParams::default();
+        Self {
+            enabled: true,
+            rays: p.rays,
+            range: p.range,
+        }
+    }
+}
