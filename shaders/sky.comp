@@ -1,4 +1,4 @@
-// Sky light for the frames without proxies (issue 16, item 7, and issue 18, item 2;
+// Sky light for the frames without proxies, gi = none included (issue 16, item 7; issue 18, item 2;
 // src/passes/sky.rs). At every receiver, `rays` cosine-weighted directions about the shading
 // normal (k x k strata, k = floor(sqrt(rays)), the rest uniform; a new rotation per receiver
 // and frame) traced through the BVH up to `range` (0: unbounded). Their unoccluded share A is
@@ -42,6 +42,11 @@ layout(push_constant) uniform Push {
     uint rays;
     // seed (varies per frame with a history)
     uint seed;
+    // 1: the irradiance at the bent normal; 0: at the shading normal
+    uint bent_normal;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } push;
 
 void main() {
@@ -76,7 +81,7 @@ void main() {
         }
     }
     float visibility = open / float(push.rays);
-    vec3 b = dot(bent, bent) > 0.0 ? normalize(bent) : n;
+    vec3 b = push.bent_normal != 0u && dot(bent, bent) > 0.0 ? normalize(bent) : n;
     float y[SH_COEFFS];
     sh_basis(b, y);
     vec3 irradiance = vec3(0.0);

@@ -43,8 +43,9 @@ pub struct FrameParams {
     /// Traced specular reflections, when on and the frame has a GI technique (the techniques'
     /// `specular_limit` is its limit then, else 0).
     pub specular: Option<SpecularParams>,
-    /// The sky light, when on and the frame has a GI technique but not the proxies (it is
-    /// declared only for a scene with an environment).
+    /// The sky light, when on and the frame has no proxies (which shadow the environment
+    /// themselves), `gi = none` included: the sky's light is direct light. Declared only for a
+    /// scene with an environment.
     pub sky: Option<SkyParams>,
     /// The joint bilateral upsample of the receiver-resolution light.
     pub upsample: UpsampleParams,
@@ -177,13 +178,12 @@ impl FrameParams {
                 }
             }),
             specular,
-            sky: (settings.sky.enabled && !gi.is_none() && !gi.contains(GiTechnique::Proxy)).then(
-                || SkyParams {
-                    rays: settings.sky.rays,
-                    range: settings.sky.range,
-                    ..SkyParams::default()
-                },
-            ),
+            sky: (settings.sky.enabled && !gi.contains(GiTechnique::Proxy)).then(|| SkyParams {
+                rays: settings.sky.rays,
+                range: settings.sky.range,
+                bent_normal: settings.sky.bent_normal,
+                ..SkyParams::default()
+            }),
             upsample: UpsampleParams {
                 depth_sigma: settings.upsample.depth_epsilon,
                 normal_power: settings.upsample.normal_power,

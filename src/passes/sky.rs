@@ -14,7 +14,9 @@
 //! * Visibility times the unshadowed irradiance at the bent normal rather than a traced sum of
 //!   the sky's radiance: with few rays the noise is in `A` alone, the colour and direction of
 //!   the sky come from the SH (exact for a uniform sky, `tests/sky.rs`).
-//! * Not in frames with proxies: they shadow the environment themselves (paper 002).
+//! * Not in frames with proxies: they shadow the environment themselves (paper 002). In every
+//!   other frame, `gi = none` included: light from the sky that scatters once is direct light
+//!   (as the path tracer counts it).
 
 use std::ops::RangeInclusive;
 
@@ -40,6 +42,8 @@ pub struct SkyParams {
     /// How far a ray looks for an occluder (0: unbounded, the sky's visibility; a short range
     /// gives cavity occlusion).
     pub range: f32,
+    /// Look the irradiance up at the bent normal; false: at the shading normal.
+    pub bent_normal: bool,
     /// Seed of the rays.
     pub seed: u32,
 }
@@ -49,6 +53,7 @@ impl Default for SkyParams {
         Self {
             rays: RAYS,
             range: 0.0,
+            bent_normal: true,
             seed: 0,
         }
     }
@@ -71,7 +76,7 @@ impl SkyParams {
     }
 }
 
-/// Push constants of `shaders/sky.comp` (32 bytes).
+/// Push constants of `shaders/sky.comp` (48 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SkyPush {
@@ -83,6 +88,10 @@ pub struct SkyPush {
     pub rays: u32,
     /// Seed.
     pub seed: u32,
+    /// 1: the irradiance at the bent normal; 0: at the shading normal.
+    pub bent_normal: u32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 /// Adds the `sky` pass over `receivers` seen from `camera`: the environment's SH (`environment`,
@@ -117,6 +126,8 @@ pub fn sky(
             extent: receivers.extent,
             rays: params.rays,
             seed: params.seed.wrapping_add(seed),
+            bent_normal: u32::from(params.bent_normal),
+            pad: [0; 3],
         })
         .dispatch([w, h, 1]);
     Ok(out)

@@ -5,8 +5,8 @@ use serde::{Deserialize, Serialize};
 use crate::passes::sky::SkyParams;
 
 /// `[sky]`: the environment's diffuse light times each receiver's sky visibility and bent
-/// normal (issue 16, item 7), in every frame with a GI technique but the proxies (which
-/// shadow the environment themselves), when the scene has an environment.
+/// normal (issue 16, item 7), in every frame without the proxies (which shadow the
+/// environment themselves; `gi = none` included), when the scene has an environment.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SkySettings {
@@ -17,6 +17,9 @@ pub struct SkySettings {
     /// How far a ray looks for an occluder, in world units (0: unbounded, the sky's
     /// visibility; a short range gives cavity occlusion). Range 0.0..=1e6, default 0.
     pub range: f32,
+    /// Look the irradiance up at the bent normal (the mean open direction); false: at the
+    /// shading normal. Default true.
+    pub bent_normal: bool,
 }
 
 impl Default for SkySettings {
@@ -27,6 +30,7 @@ impl Default for SkySettings {
             enabled: true,
             rays: p.rays,
             range: p.range,
+            bent_normal: p.bent_normal,
         }
     }
 }
