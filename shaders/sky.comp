@@ -8,6 +8,11 @@
 // brdf_indirect_weights. In a uniform environment this is exactly the path tracer's sky light;
 // elsewhere the bent normal stands for where the open sky lies. Writes RGBA16F, a = 0, 0 on
 // background. No CPU twin: tests/sky.rs checks it against the path tracer.
+//
+// Variant `cavity` (paper 001's cavity shading, issue 18): the same rays, up to a short range,
+// multiply the receiver's `light` (HVL's unshadowed indirect light) by A instead.
+//! variant sky
+//! variant cavity CAVITY=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #define SH_BANDS 3
@@ -24,15 +29,20 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
+#ifndef CAVITY
 layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_albedo;
 layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
 // EnvironmentSh::gpu_data at 3 bands: L r, g, b, then L~ r, g, b (9 floats each).
 layout(set = 0, binding = 4, std430) readonly buffer Environment {
     float e[];
 } environment;
+#endif
 layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D sky;
+#ifdef CAVITY
+layout(set = 0, binding = 10, rgba16f) readonly uniform image2D light;
+#endif
 
-// shine::passes::sky::SkyPush (32 bytes).
+// shine::passes::sky::SkyPush (48 bytes).
 layout(push_constant) uniform Push {
     // xyz: camera position; w: the rays' range (0: unbounded)
     vec4 camera;
@@ -81,6 +91,9 @@ void main() {
         }
     }
     float visibility = open / float(push.rays);
+#ifdef CAVITY
+    imageStore(sky, ixy, vec4(imageLoad(light, ixy).rgb * visibility, 0.0));
+#else
     vec3 b = push.bent_normal != 0u && dot(bent, bent) > 0.0 ? normalize(bent) : n;
     float y[SH_COEFFS];
     sh_basis(b, y);
@@ -95,4 +108,5 @@ void main() {
     vec3 ks;
     brdf_indirect_weights(albedo, metallic, dot(n, normalize(push.camera.xyz - position.xyz)), kd, ks);
     imageStore(sky, ixy, vec4(kd / SH_PI * visibility * max(irradiance, vec3(0.0)), 0.0));
+#endif
 }

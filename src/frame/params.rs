@@ -47,6 +47,9 @@ pub struct FrameParams {
     /// themselves), `gi = none` included: the sky's light is direct light. Declared only for a
     /// scene with an environment.
     pub sky: Option<SkyParams>,
+    /// Cavity shading of HVL's light, when on: its rays and their reach as a fraction of the
+    /// scene's largest side.
+    pub cavity: Option<SkyParams>,
     /// The joint bilateral upsample of the receiver-resolution light.
     pub upsample: UpsampleParams,
     /// The indirect light's accumulation over frames, when it has a history longer than one
@@ -182,6 +185,12 @@ impl FrameParams {
                 rays: settings.sky.rays,
                 range: settings.sky.range,
                 bent_normal: settings.sky.bent_normal,
+                ..SkyParams::default()
+            }),
+            cavity: settings.cavity.enabled.then(|| SkyParams {
+                rays: settings.cavity.rays,
+                range: settings.cavity.range,
+                bent_normal: false,
                 ..SkyParams::default()
             }),
             upsample: UpsampleParams {

@@ -113,7 +113,7 @@ pub fn sky(
         "sky_light",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
-    let mut pass = rg.compute("sky", &shaders::SKY_COMP);
+    let mut pass = rg.compute("sky", &shaders::SKY_COMP_SKY);
     pass.read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
         .read("recv_albedo", &receivers.albedo)
@@ -127,6 +127,49 @@ pub fn sky(
             rays: params.rays,
             seed: params.seed.wrapping_add(seed),
             bent_normal: u32::from(params.bent_normal),
+            pad: [0; 3],
+        })
+        .dispatch([w, h, 1]);
+    Ok(out)
+}
+
+/// Default reach of the cavity rays, as a fraction of the scene's largest side.
+pub const CAVITY_RANGE: f32 = 0.02;
+/// Cavity ranges the settings take (fractions of the scene's largest side).
+pub const CAVITY_RANGE_RANGE: RangeInclusive<f32> = 1e-4..=1.0;
+/// Default cavity rays per receiver.
+pub const CAVITY_RAYS: u32 = 8;
+
+/// Adds the `cavity` pass (paper 001's cavity shading, issue 18): `light` (RGBA16F at receiver
+/// resolution: HVL's unshadowed indirect light) times each receiver's visibility over
+/// `params.rays` cosine-weighted rays through `bvh` up to `params.range` (world units, > 0).
+/// Returns the darkened light.
+pub fn cavity(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    light: &Handle<Image>,
+    bvh: &TraceBuffers,
+    params: &SkyParams,
+    seed: u32,
+) -> Result<Handle<Image>, SkyError> {
+    params.validate()?;
+    let [w, h] = receivers.extent;
+    let mut out = rg.create_image(
+        "cavity_light",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    let mut pass = rg.compute("cavity", &shaders::SKY_COMP_CAVITY);
+    pass.read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("light", light);
+    bvh.bind(&mut pass);
+    pass.write("sky", &mut out)
+        .push(&SkyPush {
+            camera: [0.0, 0.0, 0.0, params.range],
+            extent: receivers.extent,
+            rays: params.rays,
+            seed: params.seed.wrapping_add(seed),
+            bent_normal: 0,
             pad: [0; 3],
         })
         .dispatch([w, h, 1]);

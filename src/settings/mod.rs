@@ -34,7 +34,7 @@ mod validate;
 
 pub use error::SettingsError;
 pub use gi::{GiTechnique, GiTechniques};
-pub use sky::SkySettings;
+pub use sky::{CavitySettings, SkySettings};
 pub use specular::SpecularSettings;
 pub use validate::{EXTENT, FRAMES, TIME};
 
@@ -94,6 +94,8 @@ pub struct Settings {
     pub specular: SpecularSettings,
     /// The sky light of frames without proxies (issue 16).
     pub sky: SkySettings,
+    /// Cavity shading of HVL's indirect light (issue 18).
+    pub cavity: CavitySettings,
 }
 
 /// `[history]`: the indirect light accumulated over frames (`src/passes/accumulate.rs`):
@@ -394,6 +396,7 @@ impl Default for Settings {
             history: HistorySettings::default(),
             specular: SpecularSettings::default(),
             sky: SkySettings::default(),
+            cavity: CavitySettings::default(),
         }
     }
 }

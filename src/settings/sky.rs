@@ -2,7 +2,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::passes::sky::SkyParams;
+use crate::passes::sky::{CAVITY_RANGE, CAVITY_RAYS, SkyParams};
 
 /// `[sky]`: the environment's diffuse light times each receiver's sky visibility and bent
 /// normal (issue 16, item 7), in every frame without the proxies (which shadow the
@@ -31,6 +31,30 @@ impl Default for SkySettings {
             rays: p.rays,
             range: p.range,
             bent_normal: p.bent_normal,
+        }
+    }
+}
+
+/// `[cavity]`: paper 001's cavity shading of HVL's unshadowed indirect light (issue 18): the
+/// light times the share of short cosine-weighted rays that meet nothing.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct CavitySettings {
+    /// Darken HVL's light by its receivers' cavity occlusion. Default false.
+    pub enabled: bool,
+    /// Rays per receiver. Range 1..=1024, default 8.
+    pub rays: u32,
+    /// Reach of the rays as a fraction of the scene's largest side. Range 1e-4..=1.0,
+    /// default 0.02.
+    pub range: f32,
+}
+
+impl Default for CavitySettings {
+    fn default() -> Self {
+        Self {
+            enabled: false,
+            rays: CAVITY_RAYS,
+            range: CAVITY_RANGE,
         }
     }
 }

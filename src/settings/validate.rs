@@ -181,6 +181,8 @@ impl Settings {
         )?;
         check("sky.rays", self.sky.rays, &sky::RAYS_RANGE)?;
         check("sky.range", self.sky.range, &sky::RANGE_RANGE)?;
+        check("cavity.rays", self.cavity.rays, &sky::RAYS_RANGE)?;
+        check("cavity.range", self.cavity.range, &sky::CAVITY_RANGE_RANGE)?;
         Ok(())
     }
 

@@ -239,6 +239,30 @@ impl Renderer {
             (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers, camera.eye)?),
             _ => None,
         };
+        // Cavity shading of HVL's unshadowed light (paper 001), reach relative to the scene.
+        let hvl_low = match (hvl_low, p.cavity, &recv) {
+            (Some(light), Some(params), Some(receivers)) => {
+                let size = crate::passes::aaf::scene_size(frame.bounds);
+                let params = sky::SkyParams {
+                    range: params.range * size,
+                    ..params
+                };
+                let seed = if p.history.is_some() {
+                    rg.frame() as u32
+                } else {
+                    0
+                };
+                Some(sky::cavity(
+                    rg,
+                    receivers,
+                    &light,
+                    &handles.trace,
+                    &params,
+                    seed,
+                )?)
+            }
+            (light, _, _) => light,
+        };
         let low = sum(rg, "gi_add", hvl_low, proxy_low)?;
         let sky_low = match (sky, &recv) {
             (Some(params), Some(receivers)) => {
