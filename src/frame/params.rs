@@ -102,7 +102,6 @@ impl FrameParams {
         let specular = (settings.specular.enabled && !gi.is_none()).then(|| SpecularParams {
             samples: settings.specular.samples,
             limit: settings.specular.limit,
-            per_frame_seed: settings.history.frames > 1,
             ..SpecularParams::default()
         });
         let specular_limit = specular.map_or(0.0, |s| s.limit);

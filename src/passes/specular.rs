@@ -15,8 +15,8 @@
 //!
 //! * Full resolution (reflections move with the view and change within a pixel); the frame's
 //!   history ([`crate::passes::accumulate`]) averages the noise of successive frames, whose
-//!   seeds differ when there is a history ([`SpecularParams::per_frame_seed`]; without one,
-//!   changing noise would only add flicker).
+//!   seeds differ when there is a history (without one, changing noise would only add
+//!   flicker).
 //! * One bounce: the hit is lit by the punctual lights (shadow rays) and, in a scene with an
 //!   environment, by one cosine-sampled ray towards it; not by its own indirect light or
 //!   emission, as the GI techniques' convention. Rays that escape see the environment.
@@ -54,9 +54,6 @@ pub struct SpecularParams {
     pub limit: f32,
     /// Seed of the random numbers.
     pub seed: u32,
-    /// Add the frame index to the seed, so that a history averages independent rays; off, a
-    /// still scene gives the same image every frame (what a frame without history wants).
-    pub per_frame_seed: bool,
 }
 
 impl Default for SpecularParams {
@@ -65,7 +62,6 @@ impl Default for SpecularParams {
             samples: SAMPLES,
             limit: LIMIT,
             seed: 0,
-            per_frame_seed: false,
         }
     }
 }
@@ -130,21 +126,19 @@ pub struct SpecularScene<'a> {
 }
 
 /// Adds the `specular` pass over the G-buffer `g` seen from `camera`; returns the reflected
-/// radiance towards the camera (RGBA16F, full resolution, a = 0).
+/// radiance towards the camera (RGBA16F, full resolution, a = 0). `seed` is added to the
+/// parameters' (the frame index when a history averages the frames).
 pub fn specular(
     rg: &mut RenderGraph,
     g: &GBuffer,
     scene: &SpecularScene<'_>,
     camera: glam::Vec3,
     params: &SpecularParams,
+    seed: u32,
 ) -> Result<Handle<Image>, SpecularError> {
     params.validate()?;
     let [w, h] = g.extent;
-    let frame_seed = if params.per_frame_seed {
-        params.seed.wrapping_add(rg.frame() as u32)
-    } else {
-        params.seed
-    };
+    let frame_seed = params.seed.wrapping_add(seed);
     let mut out = rg.create_image(
         "specular",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),

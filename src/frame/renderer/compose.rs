@@ -3,6 +3,7 @@
 //! G-buffer, `crate::embed`) share.
 
 use super::Renderer;
+use super::sky_light;
 use crate::frame::aaf::AafInputs;
 use crate::frame::error::RenderError;
 use crate::frame::hvl::HvlInputs;
@@ -14,7 +15,6 @@ use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::Distribution;
-use crate::passes::sky;
 use crate::passes::specular::{self, SpecularScene};
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
 use shine_graph::{Handle, Image, RenderGraph};
@@ -209,9 +209,9 @@ impl Renderer {
             .map(|face| face.render(rg, handles, textures))
             .collect();
         let rsm = (!rsm_faces.is_empty()).then_some(rsm_faces.as_slice());
-        // Receiver-resolution techniques (HVL, proxies) share one receiver buffer and one
-        // upsample; `hvl,proxy` sums both at receiver resolution first.
-        // The sky light (frames without proxies, scenes with an environment).
+        // Receiver-resolution terms (HVL, proxies, the sky) share one receiver buffer and one
+        // upsample; they are summed at receiver resolution first. The sky light is for frames
+        // without proxies, in scenes with an environment.
         let sky = p.sky.filter(|_| scene.has_environment);
         let recv = if hvl.is_some() || proxy.is_some() || sky.is_some() {
             Some(receivers::receivers(rg, g, p.receiver_scale)?)
@@ -239,50 +239,19 @@ impl Renderer {
             (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers, camera.eye)?),
             _ => None,
         };
-        // Cavity shading of HVL's unshadowed light (paper 001), reach relative to the scene.
-        let hvl_low = match (hvl_low, p.cavity, &recv) {
-            (Some(light), Some(params), Some(receivers)) => {
-                let size = crate::passes::aaf::scene_size(frame.bounds);
-                let params = sky::SkyParams {
-                    range: params.range * size,
-                    ..params
-                };
-                let seed = if p.history.is_some() {
-                    rg.frame() as u32
-                } else {
-                    0
-                };
-                Some(sky::cavity(
-                    rg,
-                    receivers,
-                    &light,
-                    &handles.trace,
-                    &params,
-                    seed,
-                )?)
-            }
-            (light, _, _) => light,
-        };
+        let hvl_low =
+            sky_light::cavity_shaded(rg, p, frame.bounds, &handles.trace, recv.as_ref(), hvl_low)?;
         let low = sum(rg, "gi_add", hvl_low, proxy_low)?;
         let sky_low = match (sky, &recv) {
-            (Some(params), Some(receivers)) => {
-                let environment = scene.proxy.environment_sh(rg, sky::BANDS)?;
-                // a new seed per frame only when a history averages the frames
-                let seed = if p.history.is_some() {
-                    rg.frame() as u32
-                } else {
-                    0
-                };
-                Some(sky::sky(
-                    rg,
-                    receivers,
-                    &environment,
-                    &handles.trace,
-                    camera.eye,
-                    &params,
-                    seed,
-                )?)
-            }
+            (Some(params), Some(receivers)) => Some(sky_light::sky_light(
+                rg,
+                p,
+                &params,
+                &mut scene.proxy,
+                &handles.trace,
+                receivers,
+                camera.eye,
+            )?),
             _ => None,
         };
         let low = sum(rg, "sky_add", low, sky_low)?;
@@ -343,6 +312,7 @@ impl Renderer {
                     },
                     camera.eye,
                     &params,
+                    sky_light::history_seed(rg, p),
                 )?)
             }
             None => None,

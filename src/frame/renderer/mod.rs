@@ -6,6 +6,7 @@
 
 mod compose;
 mod host;
+mod sky_light;
 
 pub(crate) use host::HostSide;
 

@@ -1,0 +1,71 @@
+//! The frame's sky light and cavity shading (issues 16 and 18), declared by
+//! [`super::Renderer::declare_indirect`] at receiver resolution, and the per-frame seed of its
+//! Monte-Carlo passes (these and the specular reflections).
+
+use glam::Vec3;
+use shine_graph::{Handle, Image, RenderGraph};
+
+use crate::frame::error::RenderError;
+use crate::frame::params::FrameParams;
+use crate::frame::proxy::ProxyTechnique;
+use crate::gpu_scene::bvh::TraceBuffers;
+use crate::passes::aaf::scene_size;
+use crate::passes::receivers::Receivers;
+use crate::passes::sky::{self, SkyParams};
+
+/// The seed the Monte-Carlo passes add to theirs: the frame index when a history averages the
+/// frames, else 0 (a still frame then looks the same every time).
+pub(super) fn history_seed(rg: &RenderGraph, p: &FrameParams) -> u32 {
+    if p.history.is_some() {
+        rg.frame() as u32
+    } else {
+        0
+    }
+}
+
+/// HVL's unshadowed receiver `light` darkened by paper 001's cavity shading when `p` asks for
+/// it (its reach a fraction of the largest side of the scene's `bounds`); else `light`.
+pub(super) fn cavity_shaded(
+    rg: &mut RenderGraph,
+    p: &FrameParams,
+    bounds: (Vec3, Vec3),
+    bvh: &TraceBuffers,
+    receivers: Option<&Receivers>,
+    light: Option<Handle<Image>>,
+) -> Result<Option<Handle<Image>>, RenderError> {
+    let (Some(light), Some(params), Some(receivers)) = (light, p.cavity, receivers) else {
+        return Ok(light);
+    };
+    let params = SkyParams {
+        range: params.range * scene_size(bounds),
+        ..params
+    };
+    let seed = history_seed(rg, p);
+    Ok(Some(sky::cavity(
+        rg, receivers, &light, bvh, &params, seed,
+    )?))
+}
+
+/// The sky's diffuse light at `receivers` seen from `camera`, from the scene environment's SH
+/// (the proxies' projection, at [`sky::BANDS`] bands).
+pub(super) fn sky_light(
+    rg: &mut RenderGraph,
+    p: &FrameParams,
+    params: &SkyParams,
+    proxy: &mut ProxyTechnique,
+    bvh: &TraceBuffers,
+    receivers: &Receivers,
+    camera: Vec3,
+) -> Result<Handle<Image>, RenderError> {
+    let environment = proxy.environment_sh(rg, sky::BANDS)?;
+    let seed = history_seed(rg, p);
+    Ok(sky::sky(
+        rg,
+        receivers,
+        &environment,
+        bvh,
+        camera,
+        params,
+        seed,
+    )?)
+}
