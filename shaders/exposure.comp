@@ -77,7 +77,7 @@ void main() {
 #if INDIRECT
         radiance += imageLoad(indirect_full, ivec2(pixel)).rgb;
 #endif
-        // Rec. 709 luminance
+        // Rec. 709 luminance (shine::passes::accumulate::TAA_LUMA)
         float l = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
         if (!isnan(l) && !isinf(l)) {
             v = vec2(log(EXPOSURE_LUMINANCE_FLOOR + max(l, 0.0)), 1.0);

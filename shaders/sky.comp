@@ -75,7 +75,12 @@ void main() {
     vec3 origin = trace_offset(position.xyz, n);
     float range = push.camera.w > 0.0 ? push.camera.w : 1e30;
     uint strata = uint(floor(sqrt(float(push.rays))));
+#ifdef CAVITY
+    // rays independent of the sky pass's at the same receiver
+    rng_state = pcg(pcg(xy.x ^ pcg(push.seed ^ 0x9e3779b9u)) + xy.y);
+#else
     rng_state = pcg(pcg(xy.x ^ pcg(push.seed)) + xy.y);
+#endif
     vec2 rotation = vec2(rand(), rand());
     vec3 bent = vec3(0.0);
     float open = 0.0;

@@ -202,3 +202,11 @@ fn specular_fade_matches_the_shader() {
         shine::passes::specular::FADE
     );
 }
+
+#[test]
+fn exposure_floor_matches_the_shader() {
+    assert_eq!(
+        glsl_float("exposure.comp", "EXPOSURE_LUMINANCE_FLOOR"),
+        shine::passes::exposure::LUMINANCE_FLOOR
+    );
+}

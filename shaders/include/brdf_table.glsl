@@ -1,7 +1,7 @@
 // Rows of the BRDF SH tables on the GPU (shine::passes::brdf_tables::GatherBrdf::gpu_data): F of Lambert
 // (albedo 1, table 0) then F of GGX at each roughness node (tables 1..), each 90 rows of
 // SH_COEFFS floats in the receiver frame (z = normal, omega_o in the xz half-plane), the
-// shine_sh::brdf_table layout. Used by hvl_gather.comp and sh_filter.comp.
+// shine_sh::brdf_table layout. Used by hvl_gather.comp, sh_filter.comp and proxy_shade.comp.
 //
 // Before the #include: SH_BANDS (sh.glsl) and a buffer instance `brdf` with `float f[]`.
 #ifndef BRDF_TABLE_GLSL

@@ -34,8 +34,9 @@ pub struct SettingsArgs {
     #[arg(long)]
     exposure: Option<f32>,
     /// Supersampling N (1-4): render at N times the size and box-filter down before
-    /// tonemapping (`output.ssaa`; antialiased captures). 0: automatic, 2 up to 512×512
-    /// pixels and 1 above (`shine render`'s default without --settings).
+    /// tonemapping (`output.ssaa`; antialiased captures). 0: automatic, 2 while the rendered
+    /// frame stays within 1024² pixels (512×512 captures), else 1 (`shine render`'s default
+    /// without --settings).
     #[arg(long)]
     ssaa: Option<u32>,
     /// Any setting by its TOML key, e.g. `--set hvl.count=2000` (repeatable).

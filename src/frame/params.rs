@@ -44,8 +44,8 @@ pub struct FrameParams {
     /// `specular_limit` is its limit then, else 0).
     pub specular: Option<SpecularParams>,
     /// The sky light, when on and the frame has no proxies (which shadow the environment
-    /// themselves), `gi = none` included: the sky's light is direct light. Declared only for a
-    /// scene with an environment.
+    /// themselves), `gi = none` included: the sky's light is direct light, though it travels
+    /// in the indirect image. Declared only for a scene with an environment.
     pub sky: Option<SkyParams>,
     /// Cavity shading of HVL's light, when on: its rays and their reach as a fraction of the
     /// scene's largest side.
@@ -99,7 +99,10 @@ impl FrameParams {
         let h = &settings.hvl;
         let i = &settings.igi;
         let p = &settings.proxy;
-        let specular = (settings.specular.enabled && !gi.is_none()).then(|| SpecularParams {
+        let specular = (settings.specular.enabled
+            && settings.specular.limit > 0.0
+            && !gi.is_none())
+        .then(|| SpecularParams {
             samples: settings.specular.samples,
             limit: settings.specular.limit,
             ..SpecularParams::default()

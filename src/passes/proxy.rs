@@ -7,7 +7,7 @@
 //!   (docs/frame.md, "Proxy GI", says why).
 //! * [`proxy_shade`] exponentiates the sum (OL, PS or HYB), shades the environment through the
 //!   occlusion (eq. 10), normalises the indirect sum (eq. 12) and writes the outgoing diffuse
-//!   radiance at receiver resolution (`proxy_gi`).
+//!   and glossy radiance at receiver resolution (`proxy_gi`).
 //!
 //! Every formula comes from shine-sh ([`shine_sh::sphere_blocker`], [`shine_sh::exp_log`],
 //! [`shine_sh::proxy_indirect`]) on the CPU and from `shaders/include/sh.glsl` on the GPU;

@@ -50,6 +50,7 @@ pub struct CavitySettings {
 }
 
 impl Default for CavitySettings {
+    /// Off, with the cavity pass's default rays and reach.
     fn default() -> Self {
         Self {
             enabled: false,
