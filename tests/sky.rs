@@ -7,24 +7,14 @@ mod common;
 
 use glam::{Mat4, Vec3};
 use shine::capture::image_io::HdrImage;
-use shine::reference::{ReferenceParams, render_reference};
+use shine::reference::render_reference;
 use shine::{Renderer, Settings};
+use shine_scene::Scene;
 use shine_scene::environment::Environment;
-use shine_scene::{Material, Scene};
 
 const SIZE: u32 = 32;
 const BALL: Vec3 = Vec3::new(0.0, 0.7, 0.0);
 const RADIUS: f32 = 0.6;
-
-fn grey(albedo: f32) -> Material {
-    Material {
-        base_color: [albedo, albedo, albedo, 1.0],
-        metallic: 0.0,
-        roughness: 1.0,
-        double_sided: 1,
-        ..Material::default()
-    }
-}
 
 fn scene() -> Scene {
     let sky = Environment {
@@ -37,8 +27,11 @@ fn scene() -> Scene {
     let camera = Mat4::look_at_rh(Vec3::new(0.0, 3.0, 3.0), Vec3::ZERO, Vec3::Y).inverse();
     common::scenes::mesh_scene(
         &[
-            (common::scenes::floor(6.0, 0.0), grey(0.6)),
-            (common::scenes::sphere(BALL, RADIUS, true), grey(0.5)),
+            (common::scenes::floor(6.0, 0.0), common::scenes::matte(0.6)),
+            (
+                common::scenes::sphere(BALL, RADIUS, true),
+                common::scenes::matte(0.5),
+            ),
         ],
         camera,
         vec![],
@@ -103,15 +96,7 @@ fn the_sky_lights_the_floor_around_the_balls_shadow() {
     let scene = scene();
     let pixels = floor_pixels(&device, &scene);
     assert!(pixels.len() > 300, "{} floor pixels", pixels.len());
-    let params = ReferenceParams {
-        width: SIZE,
-        height: SIZE,
-        bounces: 1,
-        jitter: false,
-        emissive_lighting: false,
-        lambert_only: false,
-        seed: 3,
-    };
+    let params = common::scenes::pixel_centre_reference(SIZE, 3);
     let truth = render_reference(&device, &scene, 0.0, &params, 1024).expect("reference");
     let truth = luminance(&truth.full, &pixels);
     let lit = luminance(&frame(&device, &scene, true), &pixels);

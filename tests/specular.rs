@@ -7,7 +7,7 @@ mod common;
 
 use glam::{Mat4, Vec3};
 use shine::capture::image_io::HdrImage;
-use shine::reference::{ReferenceImages, ReferenceParams, render_reference};
+use shine::reference::{ReferenceImages, render_reference};
 use shine::{Renderer, Settings};
 use shine_scene::environment::Environment;
 use shine_scene::{Light, Material, Scene};
@@ -21,16 +21,6 @@ fn metal(roughness: f32) -> Material {
         base_color: [0.95, 0.8, 0.6, 1.0],
         metallic: 1.0,
         roughness,
-        double_sided: 1,
-        ..Material::default()
-    }
-}
-
-fn lambert(albedo: f32) -> Material {
-    Material {
-        base_color: [albedo, albedo, albedo, 1.0],
-        metallic: 0.0,
-        roughness: 1.0,
         double_sided: 1,
         ..Material::default()
     }
@@ -68,15 +58,7 @@ fn frame(
 
 /// The path-traced truth through pixel centres (one bounce, as the pass).
 fn truth(device: &shine::gpu::Device, scene: &Scene, spp: u32) -> ReferenceImages {
-    let params = ReferenceParams {
-        width: SIZE,
-        height: SIZE,
-        bounces: 1,
-        jitter: false,
-        emissive_lighting: false,
-        lambert_only: false,
-        seed: 7,
-    };
+    let params = common::scenes::pixel_centre_reference(SIZE, 7);
     render_reference(device, scene, 0.0, &params, spp).expect("reference")
 }
 
@@ -171,7 +153,7 @@ fn a_metal_sphere_reflects_a_lit_floor() {
     let scene = common::scenes::mesh_scene(
         &[
             (common::scenes::sphere(CENTRE, RADIUS, true), metal(0.1)),
-            (common::scenes::floor(8.0, 0.0), lambert(0.6)),
+            (common::scenes::floor(8.0, 0.0), common::scenes::matte(0.6)),
         ],
         camera(),
         vec![light],

@@ -108,29 +108,56 @@ pub fn sky(
     seed: u32,
 ) -> Result<Handle<Image>, SkyError> {
     params.validate()?;
+    let push = SkyPush {
+        camera: camera.extend(params.range).to_array(),
+        extent: receivers.extent,
+        rays: params.rays,
+        seed: params.seed.wrapping_add(seed),
+        bent_normal: u32::from(params.bent_normal),
+        pad: [0; 3],
+    };
+    Ok(trace_pass(
+        rg,
+        "sky",
+        "sky_light",
+        &shaders::SKY_COMP_SKY,
+        receivers,
+        bvh,
+        &push,
+        |pass| {
+            pass.read("recv_albedo", &receivers.albedo)
+                .read("recv_material", &receivers.material)
+                .read("environment", environment);
+        },
+    ))
+}
+
+/// One pass `name` of `shader` (a variant of `sky.comp`) over `receivers` with `bvh`, the
+/// inputs `extra` binds, and `push`; writes and returns a new RGBA16F image `output` at
+/// receiver resolution.
+#[allow(clippy::too_many_arguments)]
+fn trace_pass(
+    rg: &mut RenderGraph,
+    name: &str,
+    output: &str,
+    shader: &'static crate::gpu::ShaderDesc,
+    receivers: &Receivers,
+    bvh: &TraceBuffers,
+    push: &SkyPush,
+    extra: impl FnOnce(&mut crate::graph::ComputePass<'_>),
+) -> Handle<Image> {
     let [w, h] = receivers.extent;
     let mut out = rg.create_image(
-        "sky_light",
+        output,
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
-    let mut pass = rg.compute("sky", &shaders::SKY_COMP_SKY);
+    let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
-        .read("recv_normal", &receivers.normal)
-        .read("recv_albedo", &receivers.albedo)
-        .read("recv_material", &receivers.material)
-        .read("environment", environment);
+        .read("recv_normal", &receivers.normal);
+    extra(&mut pass);
     bvh.bind(&mut pass);
-    pass.write("sky", &mut out)
-        .push(&SkyPush {
-            camera: camera.extend(params.range).to_array(),
-            extent: receivers.extent,
-            rays: params.rays,
-            seed: params.seed.wrapping_add(seed),
-            bent_normal: u32::from(params.bent_normal),
-            pad: [0; 3],
-        })
-        .dispatch([w, h, 1]);
-    Ok(out)
+    pass.write("sky", &mut out).push(push).dispatch([w, h, 1]);
+    out
 }
 
 /// Default reach of the cavity rays, as a fraction of the scene's largest side.
@@ -153,25 +180,25 @@ pub fn cavity(
     seed: u32,
 ) -> Result<Handle<Image>, SkyError> {
     params.validate()?;
-    let [w, h] = receivers.extent;
-    let mut out = rg.create_image(
+    let push = SkyPush {
+        camera: [0.0, 0.0, 0.0, params.range],
+        extent: receivers.extent,
+        rays: params.rays,
+        seed: params.seed.wrapping_add(seed),
+        bent_normal: 0,
+        pad: [0; 3],
+    };
+    let shader = &shaders::SKY_COMP_CAVITY;
+    Ok(trace_pass(
+        rg,
+        "cavity",
         "cavity_light",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
-    let mut pass = rg.compute("cavity", &shaders::SKY_COMP_CAVITY);
-    pass.read("recv_position", &receivers.position)
-        .read("recv_normal", &receivers.normal)
-        .read("light", light);
-    bvh.bind(&mut pass);
-    pass.write("sky", &mut out)
-        .push(&SkyPush {
-            camera: [0.0, 0.0, 0.0, params.range],
-            extent: receivers.extent,
-            rays: params.rays,
-            seed: params.seed.wrapping_add(seed),
-            bent_normal: 0,
-            pad: [0; 3],
-        })
-        .dispatch([w, h, 1]);
-    Ok(out)
+        shader,
+        receivers,
+        bvh,
+        &push,
+        |pass| {
+            pass.read("light", light);
+        },
+    ))
 }

@@ -148,3 +148,28 @@ pub fn pixel_rays(device: &shine::gpu::Device, scene: &Scene, size: u32) -> Vec<
     }
     rays
 }
+
+/// A rough, double-sided dielectric of grey `albedo` (roughness 1).
+pub fn matte(albedo: f32) -> shine_scene::Material {
+    shine_scene::Material {
+        base_color: [albedo, albedo, albedo, 1.0],
+        metallic: 0.0,
+        roughness: 1.0,
+        double_sided: 1,
+        ..shine_scene::Material::default()
+    }
+}
+
+/// The path tracer's parameters for a one-bounce `size`×`size` reference through pixel
+/// centres (as the raster samples), punctual lights and the environment only, seeded `seed`.
+pub fn pixel_centre_reference(size: u32, seed: u32) -> shine::reference::ReferenceParams {
+    shine::reference::ReferenceParams {
+        width: size,
+        height: size,
+        bounces: 1,
+        jitter: false,
+        emissive_lighting: false,
+        lambert_only: false,
+        seed,
+    }
+}
