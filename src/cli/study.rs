@@ -74,7 +74,7 @@ pub struct TemporalStudyArgs {
 /// Arguments of `shine study aaf`.
 #[derive(clap::Args, Debug)]
 pub struct AafStudyArgs {
-    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room).
+    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room, animated, marbles).
     scene: String,
     /// Image width in pixels.
     #[arg(long, default_value_t = 128)]

@@ -138,6 +138,27 @@ fn spheres_has_environment_animation_and_explicit_proxies() {
 }
 
 #[test]
+fn marbles_has_many_proxies_a_sun_and_a_sky() {
+    let s = Scene::builtin("marbles").unwrap();
+    assert!(s.environment.is_some());
+    assert_eq!(s.lights.len(), 1);
+    assert_eq!(s.lights[0].light_kind(), Some(LightKind::Directional));
+    let spheres: usize = s.proxies.iter().map(|p| p.spheres.len()).sum();
+    assert!(spheres >= 64, "{spheres} proxies");
+    assert!(s.proxies.iter().all(|p| p.source == ProxySource::Explicit));
+    // every proxy bounds its ball at rest: centre on the ball's centre, radius its height
+    for p in s.proxies_at(&s.world_transforms_at(0.0)) {
+        assert!((p.center[1] - p.radius).abs() < 1e-5, "{p:?}");
+    }
+    assert!(
+        s.materials
+            .iter()
+            .any(|m| m.metallic == 1.0 && m.roughness < 0.1)
+    );
+    assert_eq!(s.animations.len(), 1);
+}
+
+#[test]
 fn room_has_textures_lights_and_glossy_materials() {
     let s = Scene::builtin("room").unwrap();
     assert_eq!(s.lights.len(), 2);

@@ -10,12 +10,16 @@
 //! - `animated`: a room with a large window and a sky, a skinned figure walking across it
 //!   (proxy spheres on its bones), a morphing curtain, a sweeping spot light and a dim lamp,
 //!   all moving for 16 s (issue 15).
+//! - `marbles`: 96 balls of six materials (gold, chrome, clay, plastics) on a wide ground
+//!   under a low sun and an evening sky, each with its proxy sphere; a scene nothing was tuned
+//!   on, and the one the proxies' neighbour lists are measured on (issue 18).
 //!
 //! `assets/<name>.glb` holds the exported files; a test checks they equal what [`build`]
 //! produces now.
 
 mod animated;
 mod cornell_box;
+mod marbles;
 mod room;
 pub mod shapes;
 mod spheres;
@@ -31,7 +35,7 @@ use crate::scene::Scene;
 
 /// Names of the built-in scenes.
 pub fn names() -> &'static [&'static str] {
-    &["cornell-box", "spheres", "room", "animated"]
+    &["cornell-box", "spheres", "room", "animated", "marbles"]
 }
 
 /// The built-in scene `name` as GLB bytes.
@@ -41,6 +45,7 @@ pub fn build(name: &str) -> Result<Vec<u8>> {
         "spheres" => Ok(spheres::build()),
         "room" => Ok(room::build()),
         "animated" => animated::build(),
+        "marbles" => Ok(marbles::build()),
         _ => Err(Error::UnknownBuiltin {
             name: name.to_string(),
             known: names().join(", "),
