@@ -5,9 +5,10 @@
 // SPLAT: image-space splatting as a tiled compute pass. shaders/proxy_tiles.comp culled, per
 //   8x8 tile of the receiver buffer, every proxy whose sphere of influence (radius r / support,
 //   see below) misses the world-space box of the tile's receivers; each receiver tests the
-//   tile's remaining proxies for being inside their sphere of influence (the paper's depth test
-//   against the splatted sphere) and accumulates them. No barrier: lavapipe compiles compute
-//   shaders with barriers as coroutines, which took minutes for this shader.
+//   remaining proxies, the tile's neighbour list (paper 001), for being inside their sphere
+//   of influence (the paper's depth test against the splatted sphere) and accumulates them.
+//   No barrier: lavapipe compiles compute shaders with barriers as coroutines, which took
+//   minutes for this shader.
 // BRUTE: every proxy at every receiver, no culling, no influence test (tests compare SPLAT to
 //   it: the result must be equal).
 // PRODUCT: every proxy at every receiver with the unclamped tables, and the occlusion as the
@@ -139,87 +140,93 @@ void main() {
             }
         }
 #ifdef SPLAT
+        // The tile's neighbour list, walked in index order (so the sums equal brute force's
+        // bit for bit) as one flat loop over its entries: nesting the proxy loop inside a loop
+        // over the mask's words made lavapipe 4x slower (docs/performance.md).
+        uint count = 0u;
         for (uint w = 0u; w < TILE_WORDS; ++w) {
-            uint bits = tile_masks.m[tile * TILE_WORDS + w];
-            // (no findLSB: naga types its result as uint, glslang as int)
-            for (uint b = 0u; bits != 0u; ++b, bits >>= 1u) {
-                if ((bits & 1u) == 0u) {
-                    continue;
-                }
-                uint i = w * 32u + b;
+            count += uint(bitCount(tile_masks.m[tile * TILE_WORDS + w]));
+        }
+        uint word = 0u;
+        uint bits = 0u;
+        for (uint j = 0u; j < count; ++j) {
+            while (bits == 0u) {
+                bits = tile_masks.m[tile * TILE_WORDS + word];
+                ++word;
+            }
+            uint i = (word - 1u) * 32u + uint(findLSB(bits));
+            bits &= bits - 1u;
 #else
         for (uint i = 0u; i < push.proxy_count; ++i) {
-            {
 #endif
-                vec4 sphere = proxies.p[2u * i];
-                vec3 albedo = proxies.p[2u * i + 1u].xyz;
+            vec4 sphere = proxies.p[2u * i];
+            vec3 albedo = proxies.p[2u * i + 1u].xyz;
 #ifdef SPLAT
-                // the depth test of the splat: is p inside the sphere of influence?
-                vec3 off = sphere.xyz - p;
-                if (!(sphere.w * sphere.w > support * support * dot(off, off))) {
-                    continue;
-                }
+            // the depth test of the splat: is p inside the sphere of influence?
+            vec3 off = sphere.xyz - p;
+            if (!(sphere.w * sphere.w > support * support * dot(off, off))) {
+                continue;
+            }
 #endif
-                vec4 s = sh_proxy_self_shadow(p, n, sphere.xyz, sphere.w);
-                if (!(s.w > 0.0)) {
-                    continue;
-                }
-                vec3 dv = s.xyz - p;
-                float dist = length(dv);
-                if (!(dist > 0.0)) {
-                    continue;
-                }
-                float alpha = min(s.w / dist, 1.0);
-                vec3 dir = dv / dist;
-                float y[SH_COEFFS];
-                sh_basis(dir, y);
-                float zh[SH_BANDS];
-                float rotated[SH_COEFFS];
+            vec4 s = sh_proxy_self_shadow(p, n, sphere.xyz, sphere.w);
+            if (!(s.w > 0.0)) {
+                continue;
+            }
+            vec3 dv = s.xyz - p;
+            float dist = length(dv);
+            if (!(dist > 0.0)) {
+                continue;
+            }
+            float alpha = min(s.w / dist, 1.0);
+            vec3 dir = dv / dist;
+            float y[SH_COEFFS];
+            sh_basis(dir, y);
+            float zh[SH_BANDS];
+            float rotated[SH_COEFFS];
+#ifdef PRODUCT
+            table_lookup(2u, alpha, zh);
+            sh_rotate_zh_basis(zh, y, rotated);
+            for (int k = 0; k < SH_COEFFS; ++k) {
+                rotated[k] = (k == 0 ? SH_SQRT_4PI : 0.0) - rotated[k];
+            }
+            float product[SH_COEFFS];
+            sh_product(acc, rotated, product);
+            acc = product;
+#else
+            table_lookup(0u, alpha, zh);
+            sh_rotate_zh_basis(zh, y, rotated);
+            for (int k = 0; k < SH_COEFFS; ++k) {
+                acc[k] += rotated[k];
+            }
+#endif
+            if (push.indirect != 0u) {
 #ifdef PRODUCT
                 table_lookup(2u, alpha, zh);
-                sh_rotate_zh_basis(zh, y, rotated);
-                for (int k = 0; k < SH_COEFFS; ++k) {
-                    rotated[k] = (k == 0 ? SH_SQRT_4PI : 0.0) - rotated[k];
-                }
-                float product[SH_COEFFS];
-                sh_product(acc, rotated, product);
-                acc = product;
 #else
-                table_lookup(0u, alpha, zh);
+                table_lookup(1u, alpha, zh);
+#endif
+                // order-3 indirect (paper 002 §5): bands >= 3 of V are dropped
+                for (int l = 3; l < SH_BANDS; ++l) {
+                    zh[l] = 0.0;
+                }
                 sh_rotate_zh_basis(zh, y, rotated);
-                for (int k = 0; k < SH_COEFFS; ++k) {
-                    acc[k] += rotated[k];
+                float vh = sh_dot(rotated, hn);
+                // eq. 12, paper 002: the proxy's true solid angle 2π(1 - cos θ), sin θ = α,
+                // wherever its (clamped) visibility is not 0 — not the clamped table's DC,
+                // which would cancel the indirect fade of §4.1
+                if (zh[0] > 0.0) {
+                    omega += 2.0 * SH_PI * (1.0 - sqrt(max(0.0, 1.0 - alpha * alpha)));
                 }
-#endif
-                if (push.indirect != 0u) {
-#ifdef PRODUCT
-                    table_lookup(2u, alpha, zh);
-#else
-                    table_lookup(1u, alpha, zh);
-#endif
-                    // order-3 indirect (paper 002 §5): bands >= 3 of V are dropped
-                    for (int l = 3; l < SH_BANDS; ++l) {
-                        zh[l] = 0.0;
-                    }
-                    sh_rotate_zh_basis(zh, y, rotated);
-                    float vh = sh_dot(rotated, hn);
-                    // eq. 12, paper 002: the proxy's true solid angle 2π(1 - cos θ), sin θ = α,
-                    // wherever its (clamped) visibility is not 0 — not the clamped table's DC,
-                    // which would cancel the indirect fade of §4.1
-                    if (zh[0] > 0.0) {
-                        omega += 2.0 * SH_PI * (1.0 - sqrt(max(0.0, 1.0 - alpha * alpha)));
-                    }
-                    vec3 d3 = sh_proxy_d_fit(alpha);
-                    for (int l = 0; l < SH_BANDS; ++l) {
-                        zh[l] = l < 3 ? d3[l] : 0.0;
-                    }
-                    sh_rotate_zh_basis(zh, y, rotated);
-                    vec3 kappa = vec3(0.0);
-                    for (int k = 0; k < 9; ++k) {
-                        kappa += rotated[k] * vec3(lt[k], lt[9 + k], lt[18 + k]);
-                    }
-                    indirect += albedo / SH_PI * kappa * vh;
+                vec3 d3 = sh_proxy_d_fit(alpha);
+                for (int l = 0; l < SH_BANDS; ++l) {
+                    zh[l] = l < 3 ? d3[l] : 0.0;
                 }
+                sh_rotate_zh_basis(zh, y, rotated);
+                vec3 kappa = vec3(0.0);
+                for (int k = 0; k < 9; ++k) {
+                    kappa += rotated[k] * vec3(lt[k], lt[9 + k], lt[18 + k]);
+                }
+                indirect += albedo / SH_PI * kappa * vh;
             }
         }
     }

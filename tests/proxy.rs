@@ -3,8 +3,9 @@
 //! (y = 0, normal +y) with a background column, a few proxies above it (one poking through the
 //! ground, one far away), the spheres scene's sky. Validation must report nothing.
 //!
-//! * the splatted accumulation (tile culling + influence test) equals the brute-force one at
-//!   every receiver, and receivers outside every sphere of influence get exactly 0;
+//! * the splatted accumulation (per-tile neighbour lists + influence test) equals the
+//!   brute-force one at every receiver, with a few proxies and with 100 scattered ones, and
+//!   receivers outside every sphere of influence get exactly 0;
 //! * the accumulation and the shading (SH exponential HYB / PS / OL, eq. 10, eq. 12) match the
 //!   CPU twin at every receiver, i.e. the GLSL twins (`sh_proxy_self_shadow`, table lookups,
 //!   `sh_exp_*`, `sh_product`) match shine-sh;
@@ -329,6 +330,67 @@ fn splat_equals_brute_force_and_cpu() {
     assert!(
         inside > 50 && outside > 50,
         "{inside} inside, {outside} outside"
+    );
+}
+
+/// Neighbour lists over many proxies (issue 18, item 4): 100 small proxies scattered over
+/// the receivers, so each 8×8 tile's list holds a different subset, spread over four mask
+/// words. The splatted sums equal brute force's bit for bit, and the lists do cull: no
+/// receiver lies in every sphere of influence, many lie in several.
+#[test]
+fn neighbour_lists_of_many_proxies_equal_brute_force() {
+    let device = device();
+    let bands = 4;
+    let samples = receivers();
+    // a fixed linear congruential sequence in [0, 1)
+    let mut state = 12345u32;
+    let mut next = move || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let list: Vec<GpuProxy> = (0..100)
+        .map(|_| {
+            let r = 0.01 + 0.02 * next();
+            let (x, z) = (6.0 * next() - 3.0, 6.0 * next() - 3.0);
+            GpuProxy::new(Vec3::new(x, r, z), r, Vec3::new(next(), next(), next()))
+        })
+        .collect();
+    let tables = ProxyTables::build(bands, 15.0, 10.0).unwrap();
+    let env = environment(bands);
+    let run = |accumulation| {
+        let p = params(bands, accumulation, ExpMethod::Hyb);
+        run_gpu(&device, &samples, &list, &tables, &env, &p)
+    };
+    let (splat, brute) = (run(Accumulation::Splat), run(Accumulation::Brute));
+    assert_clean(&device);
+    assert_eq!(
+        splat.sums, brute.sums,
+        "neighbour lists and brute force differ"
+    );
+    let support = tables.support_shadow.min(tables.support_indirect);
+    let neighbours: Vec<usize> = samples
+        .iter()
+        .filter(|s| s.valid)
+        .map(|s| {
+            list.iter()
+                .filter(|p| {
+                    p.sphere[3] > support * Vec3::from_slice(&p.sphere[..3]).distance(s.position)
+                })
+                .count()
+        })
+        .collect();
+    let most = neighbours.iter().copied().max().unwrap();
+    let several = neighbours.iter().filter(|&&n| n >= 2).count();
+    println!(
+        "proxies in reach of a receiver: at most {most} of 100; {several} receivers reach 2 or more"
+    );
+    assert!(
+        most < 100 / 4,
+        "the proxies are not scattered: {most} reach one receiver"
+    );
+    assert!(
+        several > samples.len() / 4,
+        "only {several} receivers reach 2 or more proxies"
     );
 }
 
