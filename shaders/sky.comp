@@ -3,11 +3,12 @@
 // normal (k x k strata, k = floor(sqrt(rays)), the rest uniform; a new rotation per receiver
 // and frame) traced through the BVH up to `range` (0: unbounded). Their unoccluded share A is
 // the cosine-weighted sky visibility (ambient occlusion), their mean direction b the bent
-// normal; the receiver sends kd / pi * A * max(L~ . Y(b), 0) towards the camera, L~ the
-// environment's SH irradiance (paper 002 §3, src/gpu_scene/environment_sh.rs) and kd from
-// brdf_indirect_weights. In a uniform environment this is exactly the path tracer's sky light;
-// elsewhere the bent normal stands for where the open sky lies. Writes RGBA16F, a = 0, 0 on
-// background. No CPU twin: tests/sky.rs checks it against the path tracer.
+// normal; the pass writes the demodulated light A * max(L~ . Y(b), 0) / pi, L~ the
+// environment's SH irradiance (paper 002 §3, src/gpu_scene/environment_sh.rs), which
+// shaders/sky_filter.comp filters and multiplies by the receiver's kd. In a uniform environment
+// this is exactly the path tracer's sky light; elsewhere the bent normal stands for where the
+// open sky lies. Writes RGBA16F, a = 0, 0 on background. No CPU twin: tests/sky.rs checks it
+// against the path tracer.
 //
 // Variant `cavity` (paper 001's cavity shading, issue 18): the same rays, up to a short range,
 // multiply the receiver's `light` (HVL's unshadowed indirect light) by A instead.
@@ -30,8 +31,6 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
 #ifndef CAVITY
-layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_albedo;
-layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
 // EnvironmentSh::gpu_data at 3 bands: L r, g, b, then L~ r, g, b (9 floats each).
 layout(set = 0, binding = 4, std430) readonly buffer Environment {
     float e[];
@@ -42,10 +41,8 @@ layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D sky;
 layout(set = 0, binding = 10, rgba16f) readonly uniform image2D light;
 #endif
 
-// shine::passes::sky::SkyPush (48 bytes).
+// shine::passes::sky::SkyPush (32 bytes).
 layout(push_constant) uniform Push {
-    // xyz: camera position; w: the rays' range (0: unbounded)
-    vec4 camera;
     // receiver buffer size
     uvec2 extent;
     // rays per receiver
@@ -54,9 +51,10 @@ layout(push_constant) uniform Push {
     uint seed;
     // 1: the irradiance at the bent normal; 0: at the shading normal
     uint bent_normal;
+    // the rays' range (0: unbounded)
+    float range;
     uint pad0;
     uint pad1;
-    uint pad2;
 } push;
 
 void main() {
@@ -73,7 +71,7 @@ void main() {
     }
     n = normalize(n);
     vec3 origin = trace_offset(position.xyz, n);
-    float range = push.camera.w > 0.0 ? push.camera.w : 1e30;
+    float range = push.range > 0.0 ? push.range : 1e30;
     uint strata = uint(floor(sqrt(float(push.rays))));
 #ifdef CAVITY
     // rays independent of the sky pass's at the same receiver
@@ -107,11 +105,6 @@ void main() {
         irradiance += y[k] * vec3(environment.e[3 * SH_COEFFS + k], environment.e[4 * SH_COEFFS + k],
             environment.e[5 * SH_COEFFS + k]);
     }
-    vec3 albedo = imageLoad(recv_albedo, ixy).rgb;
-    float metallic = imageLoad(recv_material, ixy).g;
-    vec3 kd;
-    vec3 ks;
-    brdf_indirect_weights(albedo, metallic, dot(n, normalize(push.camera.xyz - position.xyz)), kd, ks);
-    imageStore(sky, ixy, vec4(kd / SH_PI * visibility * max(irradiance, vec3(0.0)), 0.0));
+    imageStore(sky, ixy, vec4(visibility * max(irradiance, vec3(0.0)) / SH_PI, 0.0));
 #endif
 }

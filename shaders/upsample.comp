@@ -12,6 +12,8 @@
 // copy. docs/frame.md "Upsample";
 // CPU reference: `shine::passes::upsample::upsample_cpu`.
 #version 460
+#extension GL_GOOGLE_include_directive : require
+#include "bilateral.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -44,9 +46,8 @@ float match_weight(ivec2 c, float z, vec3 n) {
     if (position.w <= 0.0) {
         return -1.0;
     }
-    float wz = 1.0 / (1.0 + abs(z - position.w) / (push.depth_sigma * z));
-    float wn = pow(max(dot(n, imageLoad(recv_normal, c).xyz), 0.0), push.normal_power);
-    return wz * wn;
+    return bilateral_match(z, n, position.w, imageLoad(recv_normal, c).xyz, push.depth_sigma,
+        push.normal_power);
 }
 
 void main() {

@@ -7,6 +7,9 @@
 //! the cosine-weighted sky visibility `A` (ambient occlusion, up to [`SkyParams::range`]; 0:
 //! the whole scene) and the bent normal `b` (the mean open direction), and the receiver sends
 //! `kd/π · A · L̃(b)` (`L̃` the environment's SH irradiance at 3 bands, paper 002 §3).
+//! The `sky_filter` pass (`shaders/sky_filter.comp`) takes the joint bilateral mean of
+//! `A · L̃(b) / π` over [`SkyParams::filter_radius`] receivers around each one before it
+//! multiplies by `kd`.
 //!
 //! # Decisions
 //!
@@ -14,6 +17,11 @@
 //! * Visibility times the unshadowed irradiance at the bent normal rather than a traced sum of
 //!   the sky's radiance: with few rays the noise is in `A` alone, the colour and direction of
 //!   the sky come from the SH (exact for a uniform sky, `tests/sky.rs`).
+//! * A spatial filter of the demodulated light: 16 rays leave the visibility noisy where
+//!   little sky is open (`animated`'s room, lit through its window), and a new seed every
+//!   frame made that noise flicker (docs/quality.md, "The sky's noise, filtered"). The filter
+//!   uses the upsample's bilateral match (paper 002 eq. 11), so it does not blur across
+//!   edges, and it leaves the albedo's texture alone.
 //! * Not in frames with proxies: they shadow the environment themselves (paper 002). In every
 //!   other frame, `gi = none` included: light from the sky that scatters once is direct light
 //!   (as the path tracer counts it).
@@ -23,6 +31,7 @@ use std::ops::RangeInclusive;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::receivers::Receivers;
+use crate::passes::upsample::UpsampleParams;
 use crate::shaders;
 
 /// Default rays per receiver.
@@ -33,6 +42,10 @@ pub const RAYS_RANGE: RangeInclusive<u32> = 1..=1024;
 pub const RANGE_RANGE: RangeInclusive<f32> = 0.0..=1e6;
 /// SH bands of the environment's irradiance the pass reads.
 pub const BANDS: u32 = 3;
+/// Default radius of the sky filter, in receivers.
+pub const FILTER_RADIUS: u32 = 3;
+/// Filter radii the settings take (0: no filter).
+pub const FILTER_RADIUS_RANGE: RangeInclusive<u32> = 0..=8;
 
 /// Parameters of the sky pass.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -46,6 +59,9 @@ pub struct SkyParams {
     pub bent_normal: bool,
     /// Seed of the rays.
     pub seed: u32,
+    /// Radius in receivers of the sky filter's joint bilateral mean (0: none; unused by the
+    /// cavity pass).
+    pub filter_radius: u32,
 }
 
 impl Default for SkyParams {
@@ -55,6 +71,7 @@ impl Default for SkyParams {
             range: 0.0,
             bent_normal: true,
             seed: 0,
+            filter_radius: FILTER_RADIUS,
         }
     }
 }
@@ -72,16 +89,15 @@ impl SkyParams {
     pub fn validate(&self) -> Result<(), SkyError> {
         super::check_range("rays", self.rays, &RAYS_RANGE)?;
         super::check_range("range", self.range, &RANGE_RANGE)?;
+        super::check_range("filter_radius", self.filter_radius, &FILTER_RADIUS_RANGE)?;
         Ok(())
     }
 }
 
-/// Push constants of `shaders/sky.comp` (48 bytes).
+/// Push constants of `shaders/sky.comp` (32 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SkyPush {
-    /// xyz camera position, w the rays' range (0: unbounded).
-    pub camera: [f32; 4],
     /// Receiver buffer size.
     pub extent: [u32; 2],
     /// Rays per receiver.
@@ -90,14 +106,36 @@ pub struct SkyPush {
     pub seed: u32,
     /// 1: the irradiance at the bent normal; 0: at the shading normal.
     pub bent_normal: u32,
+    /// The rays' range (0: unbounded).
+    pub range: f32,
+    /// Padding.
+    pub pad: [u32; 2],
+}
+
+/// Push constants of `shaders/sky_filter.comp` (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SkyFilterPush {
+    /// xyz camera position (the receivers' view direction for `kd`), w unused.
+    pub camera: [f32; 4],
+    /// Receiver buffer size.
+    pub extent: [u32; 2],
+    /// Radius of the filter in receivers (0: none).
+    pub radius: u32,
+    /// σ_z of the bilateral match.
+    pub depth_sigma: f32,
+    /// Normal exponent of the bilateral match.
+    pub normal_power: f32,
     /// Padding.
     pub pad: [u32; 3],
 }
 
-/// Adds the `sky` pass over `receivers` seen from `camera`: the environment's SH (`environment`,
-/// `EnvironmentSh::gpu_data` at [`BANDS`] bands) times each receiver's sky visibility through
-/// `bvh`. Returns the outgoing radiance (RGBA16F at receiver resolution). `seed` is added to
-/// the parameters' (the frame index when a history averages the frames).
+/// Adds the `sky` and `sky_filter` passes over `receivers` seen from `camera`: the
+/// environment's SH (`environment`, `EnvironmentSh::gpu_data` at [`BANDS`] bands) times each
+/// receiver's sky visibility through `bvh`, filtered with the bilateral match of `upsample`
+/// and multiplied by `kd`. Returns the outgoing radiance (RGBA16F at receiver resolution).
+/// `seed` is added to the parameters' (the frame index when a history averages the frames).
+#[allow(clippy::too_many_arguments)]
 pub fn sky(
     rg: &mut RenderGraph,
     receivers: &Receivers,
@@ -105,31 +143,53 @@ pub fn sky(
     bvh: &TraceBuffers,
     camera: glam::Vec3,
     params: &SkyParams,
+    upsample: &UpsampleParams,
     seed: u32,
 ) -> Result<Handle<Image>, SkyError> {
     params.validate()?;
     let push = SkyPush {
-        camera: camera.extend(params.range).to_array(),
         extent: receivers.extent,
         rays: params.rays,
         seed: params.seed.wrapping_add(seed),
         bent_normal: u32::from(params.bent_normal),
-        pad: [0; 3],
+        range: params.range,
+        pad: [0; 2],
     };
-    Ok(trace_pass(
+    let irradiance = trace_pass(
         rg,
         "sky",
-        "sky_light",
+        "sky_irradiance",
         &shaders::SKY_COMP_SKY,
         receivers,
         bvh,
         &push,
         |pass| {
-            pass.read("recv_albedo", &receivers.albedo)
-                .read("recv_material", &receivers.material)
-                .read("environment", environment);
+            pass.read("environment", environment);
         },
-    ))
+    );
+    let [w, h] = receivers.extent;
+    let mut out = rg.create_image(
+        "sky_light",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    let push = SkyFilterPush {
+        camera: camera.extend(0.0).to_array(),
+        extent: receivers.extent,
+        radius: params.filter_radius,
+        depth_sigma: upsample.depth_sigma,
+        normal_power: upsample.normal_power,
+        pad: [0; 3],
+    };
+    rg.compute("sky_filter", &shaders::SKY_FILTER_COMP)
+        .read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("recv_albedo", &receivers.albedo)
+        .read("recv_material", &receivers.material)
+        .read("sky_irradiance", &irradiance)
+        .write("sky", &mut out)
+        .push(&push)
+        .dispatch([w, h, 1]);
+    Ok(out)
 }
 
 /// One pass `name` of `shader` (a variant of `sky.comp`) over `receivers` with `bvh`, the
@@ -181,12 +241,12 @@ pub fn cavity(
 ) -> Result<Handle<Image>, SkyError> {
     params.validate()?;
     let push = SkyPush {
-        camera: [0.0, 0.0, 0.0, params.range],
         extent: receivers.extent,
         rays: params.rays,
         seed: params.seed.wrapping_add(seed),
         bent_normal: 0,
-        pad: [0; 3],
+        range: params.range,
+        pad: [0; 2],
     };
     let shader = &shaders::SKY_COMP_CAVITY;
     Ok(trace_pass(

@@ -180,6 +180,22 @@ pub struct UpsampleInputs<'a> {
     pub scale: u32,
 }
 
+/// The joint bilateral match of a receiver at depth `z_i` with normal `n_i` for a target at
+/// depth `z` with normal `n` (paper 002 §4.2, eq. 11, with ε = σ_z z):
+/// `1 / (1 + |z − z_i| / (σ_z z)) · max(0, n · n_i)^n`. GLSL twin: `bilateral_match` in
+/// `shaders/include/bilateral.glsl` (the upsample and the sky filter).
+pub fn bilateral_match(
+    z: f32,
+    n: [f32; 4],
+    z_i: f32,
+    n_i: [f32; 4],
+    params: &UpsampleParams,
+) -> f32 {
+    let wz = 1.0 / (1.0 + (z - z_i).abs() / (params.depth_sigma * z));
+    let cos = n[0] * n_i[0] + n[1] * n_i[1] + n[2] * n_i[2];
+    wz * cos.max(0.0).powf(params.normal_power)
+}
+
 /// CPU reference of `upsample` (same weights, order and fallback as the shader): the
 /// full-resolution RGBA result, 4 floats per pixel, row-major.
 pub fn upsample_cpu(
@@ -213,7 +229,6 @@ pub fn upsample_cpu(
             data[i * 4 + 3],
         ]
     };
-    let dot3 = |a: [f32; 4], b: [f32; 4]| a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
     let scale = inputs.scale as f32;
     let s = inputs.scale as usize;
     // Receiver index of texel coordinates, clamped to the edge.
@@ -239,10 +254,8 @@ pub fn upsample_cpu(
                 if position[3] <= 0.0 {
                     return -1.0;
                 }
-                let wz = 1.0
-                    / (1.0 + (target[3] - position[3]).abs() / (params.depth_sigma * target[3]));
                 let n = texel(inputs.recv_normal, c);
-                wz * dot3(normal, n).max(0.0).powf(params.normal_power)
+                bilateral_match(target[3], normal, position[3], n, params)
             };
             let u = [
                 (x as f32 + 0.5) / scale - 0.5,

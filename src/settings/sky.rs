@@ -20,6 +20,9 @@ pub struct SkySettings {
     /// Look the irradiance up at the bent normal (the mean open direction); false: at the
     /// shading normal. Default true.
     pub bent_normal: bool,
+    /// Radius in receivers of the joint bilateral filter of the sky's light (0: none).
+    /// Range 0..=8, default 3.
+    pub filter_radius: u32,
 }
 
 impl Default for SkySettings {
@@ -31,6 +34,7 @@ impl Default for SkySettings {
             rays: p.rays,
             range: p.range,
             bent_normal: p.bent_normal,
+            filter_radius: p.filter_radius,
         }
     }
 }

@@ -66,6 +66,7 @@ pub(super) fn sky_light(
         bvh,
         camera,
         params,
+        &p.upsample,
         seed,
     )?)
 }
