@@ -6,7 +6,7 @@
 use super::CliError;
 use shine::capture::image_compare::{compare, flip_map};
 use shine::capture::image_io::{HdrImage, read_exr, read_png_linear, write_png};
-use shine::capture::regions::{Region, error_heatmap, region_grid};
+use shine::capture::regions::{Region, error_heatmap, masked_metrics, region_grid};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `shine compare`.
@@ -30,6 +30,10 @@ pub struct CompareArgs {
     /// blue: darker, saturating at ±1).
     #[arg(long)]
     signed_map: Option<PathBuf>,
+    /// Also report energy ratio and relative RMSE over the pixels where this image is lit
+    /// (any channel above 0.5; e.g. a `cubes.mask` render of the dynamic objects).
+    #[arg(long)]
+    mask: Option<PathBuf>,
 }
 
 /// Reads an image to compare: EXR as radiance, PNG decoded from sRGB to the light it displays.
@@ -69,6 +73,10 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         0 => Vec::new(),
         n => region_grid(&image, &reference, n)?,
     };
+    let masked = match &args.mask {
+        Some(path) => Some(masked_metrics(&image, &reference, &read_image(path)?.0)?),
+        None => None,
+    };
     if let Some(path) = &args.heatmap {
         write_png(path, &flip_map(&image, &reference)?)
             .map_err(|e| format!("{}: {e}", path.display()))?;
@@ -90,6 +98,12 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             "width": image.width,
             "height": image.height,
             "regions": regions,
+            "mask": masked.map(|(pixels, mean, energy, relative)| serde_json::json!({
+                "pixels": pixels,
+                "reference_mean": mean,
+                "energy_ratio": energy.is_finite().then_some(energy),
+                "relative_rmse": relative.is_finite().then_some(relative),
+            })),
         });
         println!("{value}");
     } else {
@@ -100,6 +114,9 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         println!("PSNR    {:.3} dB", c.psnr);
         println!("SSIM    {:.6}", c.ssim);
         println!("FLIP    {:.6}", c.flip);
+        if let Some((pixels, _, energy, relative)) = masked {
+            println!("masked ({pixels} pixels): energy {energy:.4}, RMSE/mean {relative:.4}");
+        }
         print_regions(&regions, args.regions);
     }
     Ok(())

@@ -9,6 +9,7 @@
 
 pub mod aaf;
 pub mod accumulate;
+pub mod cubes;
 pub mod error;
 pub mod exposure;
 pub mod hvl;

@@ -5,6 +5,7 @@
 use crate::passes::aaf::AafParams;
 use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{Component, CompositeParams};
+use crate::passes::cubes::CubeParams;
 use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParams};
 use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::HvlParams;
@@ -50,6 +51,8 @@ pub struct FrameParams {
     /// Cavity shading of HVL's light, when on: its rays and their reach as a fraction of the
     /// scene's largest side.
     pub cavity: Option<SkyParams>,
+    /// Tiny environment cubes for the dynamic objects, when on (paper 001).
+    pub cubes: Option<CubeParams>,
     /// The joint bilateral upsample of the receiver-resolution light.
     pub upsample: UpsampleParams,
     /// The indirect light's accumulation over frames, when it has a history longer than one
@@ -187,6 +190,7 @@ impl FrameParams {
                 rays: settings.sky.rays,
                 range: settings.sky.range,
                 bent_normal: settings.sky.bent_normal,
+                filter_radius: settings.sky.filter_radius,
                 ..SkyParams::default()
             }),
             cavity: settings.cavity.enabled.then(|| SkyParams {
@@ -194,6 +198,11 @@ impl FrameParams {
                 range: settings.cavity.range,
                 bent_normal: false,
                 ..SkyParams::default()
+            }),
+            cubes: settings.cubes.enabled.then_some(CubeParams {
+                lookup: settings.cubes.lookup,
+                solid_angle: settings.cubes.solid_angle,
+                mask: settings.cubes.mask,
             }),
             upsample: UpsampleParams {
                 depth_sigma: settings.upsample.depth_epsilon,

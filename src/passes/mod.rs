@@ -6,6 +6,7 @@ pub mod aaf;
 pub mod accumulate;
 pub mod brdf_tables;
 pub mod composite;
+pub mod cubes;
 pub mod direct;
 pub mod environment_sh;
 pub mod exposure;

@@ -25,6 +25,7 @@
 //! radius = "r2"
 //! ```
 
+mod cubes;
 mod error;
 mod gi;
 mod io;
@@ -32,6 +33,7 @@ mod sky;
 mod specular;
 mod validate;
 
+pub use cubes::CubeSettings;
 pub use error::SettingsError;
 pub use gi::{GiTechnique, GiTechniques};
 pub use sky::{CavitySettings, SkySettings};
@@ -96,6 +98,8 @@ pub struct Settings {
     pub sky: SkySettings,
     /// Cavity shading of HVL's indirect light (issue 18).
     pub cavity: CavitySettings,
+    /// Tiny environment cubes for the dynamic objects (issue 18).
+    pub cubes: CubeSettings,
 }
 
 /// `[history]`: the indirect light accumulated over frames (`src/passes/accumulate.rs`):
@@ -397,6 +401,7 @@ impl Default for Settings {
             specular: SpecularSettings::default(),
             sky: SkySettings::default(),
             cavity: CavitySettings::default(),
+            cubes: CubeSettings::default(),
         }
     }
 }

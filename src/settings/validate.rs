@@ -181,6 +181,11 @@ impl Settings {
         )?;
         check("sky.rays", self.sky.rays, &sky::RAYS_RANGE)?;
         check("sky.range", self.sky.range, &sky::RANGE_RANGE)?;
+        check(
+            "sky.filter_radius",
+            self.sky.filter_radius,
+            &sky::FILTER_RADIUS_RANGE,
+        )?;
         check("cavity.rays", self.cavity.rays, &sky::RAYS_RANGE)?;
         check("cavity.range", self.cavity.range, &sky::CAVITY_RANGE_RANGE)?;
         Ok(())
@@ -225,6 +230,16 @@ impl Settings {
                 list: self.gi.to_string(),
                 reason: "`hvl`, `igi` and `aaf` each compute the indirect light of the punctual \
                          lights: choose one",
+            });
+        }
+        if self.cubes.enabled
+            && (self.gi.contains(GiTechnique::Igi) || self.gi.contains(GiTechnique::Aaf))
+        {
+            return Err(SettingsError::GiList {
+                list: self.gi.to_string(),
+                reason: "`cubes.enabled` replaces the receiver-resolution light of the dynamic \
+                         objects; `igi` and `aaf` light every pixel at full resolution: use \
+                         `hvl`, `proxy` or `none` with the cubes",
             });
         }
         Ok(())

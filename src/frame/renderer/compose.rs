@@ -12,6 +12,7 @@ use crate::frame::params::FrameParams;
 use crate::frame::shadows::ShadowState;
 use crate::gpu_scene::{SAMPLED_READ, SceneHandles};
 use crate::passes::composite::{self, Component, CompositeOutputs};
+use crate::passes::cubes::{self, CubeScene};
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::Distribution;
@@ -182,6 +183,13 @@ impl Renderer {
                     .prepare(rg, setup, &frame.pose.world, environment)
             })
             .transpose()?;
+        let cubes = match p.cubes {
+            Some(params) => scene
+                .cubes
+                .prepare(rg, &frame.pose.world)?
+                .map(|inputs| (params, inputs)),
+            None => None,
+        };
         let light_count = light_count(frame)?;
 
         // HVL and IGI bounce light off RSM faces: placed by flux, every light's (the primary
@@ -213,7 +221,7 @@ impl Renderer {
         // upsample; they are summed at receiver resolution first. The sky light is for frames
         // without proxies, in scenes with an environment.
         let sky = p.sky.filter(|_| scene.has_environment);
-        let recv = if hvl.is_some() || proxy.is_some() || sky.is_some() {
+        let recv = if hvl.is_some() || proxy.is_some() || sky.is_some() || cubes.is_some() {
             Some(receivers::receivers(rg, g, p.receiver_scale)?)
         } else {
             None
@@ -255,6 +263,32 @@ impl Renderer {
             _ => None,
         };
         let low = sum(rg, "sky_add", low, sky_low)?;
+        // Paper 001's environment cubes light the dynamic objects' receivers instead.
+        let low = match (cubes, &recv) {
+            (Some((params, inputs)), Some(receivers)) => {
+                let environment =
+                    rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ);
+                let cube_scene = CubeScene {
+                    handles,
+                    bvh: &handles.trace,
+                    light_count,
+                    texture_sampler: self.textures_level0.raw(),
+                    environment: &environment,
+                    environment_sampler: self.environment_sampler.raw(),
+                    environment_lighting: scene.has_environment,
+                };
+                Some(cubes::cubes(
+                    rg,
+                    &cube_scene,
+                    &inputs,
+                    receivers,
+                    low.as_ref(),
+                    camera.eye,
+                    &params,
+                ))
+            }
+            _ => low,
+        };
         let upsampled = match (low, &recv) {
             (Some(low), Some(recv)) => Some(upsample::upsample(rg, &low, recv, g, &p.upsample)?),
             _ => None,

@@ -12,6 +12,7 @@ pub(crate) use host::HostSide;
 
 use super::aaf::AafTechnique;
 use super::accumulate::AccumulateTechnique;
+use super::cubes::CubeTechnique;
 use super::error::RenderError;
 use super::exposure::ExposureTechnique;
 use super::hvl::HvlTechnique;
@@ -186,6 +187,8 @@ struct SceneState {
     has_environment: bool,
     /// Sphere proxies under the environment (paper 002): scene-bound state.
     proxy: ProxyTechnique,
+    /// Tiny environment cubes of the dynamic objects (paper 001): scene-bound state.
+    cubes: CubeTechnique,
 }
 
 /// The buffers a rendered frame is copied into, kept while the frame size is unchanged.
@@ -273,6 +276,7 @@ impl Renderer {
             )?,
             has_environment: scene.environment.is_some(),
             proxy: ProxyTechnique::new(&self.device, scene),
+            cubes: CubeTechnique::new(&self.device, scene),
         };
         self.scene = Some(state);
         self.shadows = None;
@@ -461,6 +465,7 @@ impl Renderer {
         }
         if let Some(scene) = &self.scene {
             add(scene.proxy.allocated_bytes(), true);
+            add(scene.cubes.allocated_bytes(), true);
             let (data, staging) = scene.gpu.allocated_bytes();
             report.scene += data + scene.environment.allocated_bytes();
             report.staging += staging;

@@ -1,0 +1,283 @@
+//! Tiny environment cubes (issue 18, item 3; paper 001, "Environment maps"): the `cubes_fill`,
+//! `cubes_smooth` and `cubes_shade` passes (`shaders/cubes.comp`).
+//!
+//! Paper 001 gives each object a small cube map of the light around it, [`SIDE`]² texels a
+//! face ("the ideal size … 6×6×6"), painted with the sky and the objects around, smoothed by a
+//! cosine-weighted sum over the hemisphere of each texel, and read as a directional table of
+//! incoming light. shine builds one per dynamic object (a node with proxies) and lights the
+//! object's receivers from it, in place of the frame's technique: a cheap indirect mode for
+//! objects that move, compared with the per-pixel proxy gather (docs/quality.md).
+//!
+//! # Decisions
+//!
+//! * **Filled by rays.** The paper paints each object as z-buffered pixels; a ray through the
+//!   BVH per texel sample ([`SAMPLES`], 2×2 strata) is the same nearest-surface test over the
+//!   whole scene, static geometry included. Rays start on the object's bounding sphere (the
+//!   object does not see itself). A hit sends what its surface reflects of the one-bounce light
+//!   (next-event estimation to the punctual lights, one cosine ray to the environment), the
+//!   light the path tracer counts; an escaped ray sees the environment. Seeds are fixed per
+//!   texel, so a still scene gives the same cube every frame.
+//! * **Smoothing** as published (`Σ L max(0, n·d) / Σ max(0, n·d)` over every texel), or
+//!   weighted by each texel's solid angle ([`CubeLookup`] and `solid_angle`; the texels of a
+//!   6×6 face span solid angles 3.3× apart, corners smallest).
+//! * **Lookup**: the smoothed texel holding the normal (the paper's), or the smoothing sum at
+//!   the normal itself (216 multiply-adds, no facets or seams at 6×6).
+//! * **Which receivers**: those inside one of the object's proxy spheres (1% margin). The
+//!   G-buffer has no object id, and a host's G-buffer (a GI context) would not either.
+//! * **Diffuse only**: the receivers get `kd · L̄`; the traced specular pass still adds the
+//!   sharp part of their glossy lobes, the rough part is left out.
+
+use crate::gpu_scene::SceneHandles;
+use crate::gpu_scene::bvh::TraceBuffers;
+use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::receivers::Receivers;
+use crate::shaders;
+
+/// Texels along a cube face's side: paper 001's "ideal size" of 6×6×6.
+pub const SIDE: u32 = 6;
+/// Texels of a cube.
+pub const TEXELS: u32 = 6 * SIDE * SIDE;
+/// Rays per texel of the fill (2×2 strata).
+pub const SAMPLES: u32 = 4;
+
+crate::choice::named_choice! {
+    /// How a receiver reads its object's cube.
+    pub enum CubeLookup ("environment cube lookup") {
+        /// The smoothed texel that holds the normal (paper 001).
+        Texel = "texel",
+        /// The smoothing sum evaluated at the normal itself.
+        Normal = "normal",
+    }
+}
+
+/// Parameters of the cube passes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CubeParams {
+    /// How receivers read the cube.
+    pub lookup: CubeLookup,
+    /// Weight the smoothing sum by each texel's solid angle (false: the paper's plain sum).
+    pub solid_angle: bool,
+    /// Write 1 at the receivers the cubes light and 0 elsewhere, instead of light (a debugging
+    /// view, and the mask of the cube study's per-object error).
+    pub mask: bool,
+}
+
+impl Default for CubeParams {
+    fn default() -> Self {
+        Self {
+            lookup: CubeLookup::Normal,
+            solid_angle: true,
+            mask: false,
+        }
+    }
+}
+
+/// One cube's bounding sphere as the passes read it (16 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuCube {
+    /// Centre xyz and radius w of the object's bounding sphere.
+    pub sphere: [f32; 4],
+}
+
+/// One proxy sphere with the cube of its object (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GpuCubeSphere {
+    /// Centre xyz and radius w.
+    pub sphere: [f32; 4],
+    /// x: the index of the object's cube (as a float); y, z, w: 0.
+    pub cube: [f32; 4],
+}
+
+/// Push constants of `shaders/cubes.comp` (48 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct CubesPush {
+    /// Fill: cube count, light count, 1 when the environment lights the hits. Smooth: cube
+    /// count. Shade: receiver extent, sphere count, 1 with a light input.
+    pub frame: [u32; 4],
+    /// Shade: the camera position.
+    pub camera: [f32; 4],
+    /// y: look up at the normal (shade); z: solid-angle weights (fill); w: write the mask
+    /// (shade).
+    pub config: [u32; 4],
+}
+
+/// The scene inputs of the fill: the surfaces, lights and BVH the rays meet, and the
+/// environment they escape to.
+#[derive(Debug, Clone, Copy)]
+pub struct CubeScene<'a> {
+    /// The scene's materials, textures, vertices, indices and lights.
+    pub handles: &'a SceneHandles,
+    /// The BVH.
+    pub bvh: &'a TraceBuffers,
+    /// Lights in `handles.lights`.
+    pub light_count: u32,
+    /// Sampler of the scene textures at ray hits (level 0).
+    pub texture_sampler: vk::Sampler,
+    /// The environment map (radiance of escaped rays).
+    pub environment: &'a Handle<Image>,
+    /// Its sampler.
+    pub environment_sampler: vk::Sampler,
+    /// The scene has an environment: hits are lit by it too.
+    pub environment_lighting: bool,
+}
+
+/// The cubes of one frame: their bounding spheres and the proxy spheres naming their receivers.
+pub struct CubeInputs {
+    /// [`GpuCube`] per dynamic object.
+    pub cubes: Handle<Buffer>,
+    /// Cubes in `cubes`.
+    pub cube_count: u32,
+    /// [`GpuCubeSphere`] per proxy sphere.
+    pub spheres: Handle<Buffer>,
+    /// Spheres in `spheres`.
+    pub sphere_count: u32,
+}
+
+/// Adds `cubes_fill`, `cubes_smooth` and `cubes_shade`: fills and smooths every cube of
+/// `inputs`, then lights the receivers inside the cubes' objects from them and keeps `light`
+/// (the technique's RGBA16F light at receiver resolution, if any) elsewhere. Returns the result
+/// (RGBA16F at receiver resolution).
+pub fn cubes(
+    rg: &mut RenderGraph,
+    scene: &CubeScene<'_>,
+    inputs: &CubeInputs,
+    receivers: &Receivers,
+    light: Option<&Handle<Image>>,
+    camera: glam::Vec3,
+    params: &CubeParams,
+) -> Handle<Image> {
+    let texels = u64::from(inputs.cube_count.max(1)) * u64::from(TEXELS) * 16;
+    let config = [
+        0,
+        u32::from(params.lookup == CubeLookup::Normal),
+        u32::from(params.solid_angle),
+        u32::from(params.mask),
+    ];
+    let mut radiance = rg.create_buffer("cube_radiance", BufferDesc::new(texels));
+    let mut pass = rg.compute("cubes_fill", &shaders::CUBES_COMP_FILL);
+    pass.read("materials", &scene.handles.materials)
+        .read("srgb_textures", &scene.handles.srgb_textures)
+        .read("linear_textures", &scene.handles.linear_textures)
+        .sampler("texture_sampler", scene.texture_sampler)
+        .read("vertices", &scene.handles.vertices)
+        .read("indices", &scene.handles.indices)
+        .read("lights", &scene.handles.lights)
+        .read("environment", scene.environment)
+        .sampler("environment_sampler", scene.environment_sampler)
+        .read("cubes", &inputs.cubes);
+    scene.bvh.bind(&mut pass);
+    pass.write("radiance", &mut radiance)
+        .push(&CubesPush {
+            frame: [
+                inputs.cube_count,
+                scene.light_count,
+                u32::from(scene.environment_lighting),
+                0,
+            ],
+            camera: [0.0; 4],
+            config,
+        })
+        .dispatch([TEXELS, inputs.cube_count, 1]);
+    let mut smoothed = rg.create_buffer("cube_smoothed", BufferDesc::new(texels));
+    rg.compute("cubes_smooth", &shaders::CUBES_COMP_SMOOTH)
+        .read("cubes", &inputs.cubes)
+        .read("radiance", &radiance)
+        .write("smoothed", &mut smoothed)
+        .push(&CubesPush {
+            frame: [inputs.cube_count, 0, 0, 0],
+            camera: [0.0; 4],
+            config,
+        })
+        .dispatch([TEXELS, inputs.cube_count, 1]);
+    let [w, h] = receivers.extent;
+    let mut out = rg.create_image(
+        "cube_light",
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    let mut pass = rg.compute("cubes_shade", &shaders::CUBES_COMP_SHADE);
+    pass.read("cubes", &inputs.cubes)
+        .read("radiance", &radiance)
+        .read("smoothed", &smoothed)
+        .read("recv_position", &receivers.position)
+        .read("recv_normal", &receivers.normal)
+        .read("recv_albedo", &receivers.albedo)
+        .read("recv_material", &receivers.material)
+        .read("spheres", &inputs.spheres);
+    // Without a technique's light the input binding reads the receivers' normals, unused.
+    pass.read("light", light.unwrap_or(&receivers.normal));
+    pass.write("shaded", &mut out)
+        .push(&CubesPush {
+            frame: [w, h, inputs.sphere_count, u32::from(light.is_some())],
+            camera: camera.extend(0.0).to_array(),
+            config,
+        })
+        .dispatch([w, h, 1]);
+    out
+}
+
+/// The direction through face coordinates `(u, v)` ∈ [-1, 1]² of `face` (not normalised):
+/// `cube_face_direction` of `shaders/include/cube.glsl`.
+pub fn face_direction(face: u32, u: f32, v: f32) -> glam::Vec3 {
+    use glam::Vec3;
+    match face {
+        0 => Vec3::new(1.0, -v, -u),
+        1 => Vec3::new(-1.0, -v, u),
+        2 => Vec3::new(u, 1.0, v),
+        3 => Vec3::new(u, -1.0, -v),
+        4 => Vec3::new(u, -v, 1.0),
+        _ => Vec3::new(-u, -v, -1.0),
+    }
+}
+
+/// The unit direction through texel `t` at sub-texel position `s` ∈ [0, 1]² (0.5: the centre):
+/// `cube_texel_direction`.
+pub fn texel_direction(t: u32, s: [f32; 2]) -> glam::Vec3 {
+    let face = t / (SIDE * SIDE);
+    let (row, column) = ((t / SIDE) % SIDE, t % SIDE);
+    let step = 2.0 / SIDE as f32;
+    let u = (column as f32 + s[0]) * step - 1.0;
+    let v = (row as f32 + s[1]) * step - 1.0;
+    face_direction(face, u, v).normalize()
+}
+
+/// The solid angle of texel `t`: `cube_texel_solid_angle`.
+pub fn texel_solid_angle(t: u32) -> f32 {
+    let (row, column) = ((t / SIDE) % SIDE, t % SIDE);
+    let step = 2.0 / SIDE as f32;
+    let (lo_x, lo_y) = (column as f32 * step - 1.0, row as f32 * step - 1.0);
+    let (hi_x, hi_y) = (lo_x + step, lo_y + step);
+    let a = |x: f32, y: f32| (x * y).atan2((x * x + y * y + 1.0).sqrt());
+    a(hi_x, hi_y) - a(lo_x, hi_y) - a(hi_x, lo_y) + a(lo_x, lo_y)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn texels_tile_the_sphere() {
+        let total: f32 = (0..TEXELS).map(texel_solid_angle).sum();
+        assert!((total - 4.0 * std::f32::consts::PI).abs() < 1e-4, "{total}");
+        let (min, max) = (0..TEXELS)
+            .map(texel_solid_angle)
+            .fold((f32::MAX, 0.0f32), |(a, b), w| (a.min(w), b.max(w)));
+        // a 6×6 face: the centre texels 3.3 times the corners
+        assert!(max / min > 3.2 && max / min < 3.4, "{min} {max}");
+    }
+
+    #[test]
+    fn every_texel_direction_lies_on_its_face() {
+        for t in 0..TEXELS {
+            let d = texel_direction(t, [0.5, 0.5]);
+            let face = t / (SIDE * SIDE);
+            let axis = (face / 2) as usize;
+            let sign = if face.is_multiple_of(2) { 1.0 } else { -1.0 };
+            let a = d.abs().to_array();
+            assert!(a[axis] >= a[(axis + 1) % 3] && a[axis] >= a[(axis + 2) % 3]);
+            assert!(d.to_array()[axis] * sign > 0.0);
+        }
+    }
+}

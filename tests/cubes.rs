@@ -1,0 +1,149 @@
+//! Paper 001's tiny environment cubes (issue 18, item 3; src/passes/cubes.rs) against the path
+//! tracer: a grey ball floating above a grey floor under a uniform sky, no punctual light, the
+//! ball's proxy its own sphere. The ball's receivers take their light from its 6×6×6 cube
+//! (`gi = none`, `cubes.enabled`): its top sees the sky, its bottom the sky-lit floor. On the
+//! ball's pixels the frame must match the path tracer's energy and shading, for both lookups.
+
+mod common;
+
+use glam::{Mat4, Vec3};
+use shine::capture::image_io::HdrImage;
+use shine::reference::render_reference;
+use shine::{Renderer, Settings};
+use shine_scene::Scene;
+use shine_scene::environment::Environment;
+use shine_scene::proxies::{NodeProxies, ProxySource, ProxySphere};
+
+const SIZE: u32 = 32;
+const BALL: Vec3 = Vec3::new(0.0, 1.0, 0.0);
+const RADIUS: f32 = 0.6;
+
+fn scene() -> Scene {
+    let sky = Environment {
+        zenith: Vec3::splat(1.0),
+        horizon: Vec3::splat(1.0),
+        ground: Vec3::splat(1.0),
+        intensity: 1.0,
+        map: None,
+    };
+    let camera = Mat4::look_at_rh(Vec3::new(0.0, 1.2, 2.2), BALL, Vec3::Y).inverse();
+    let mut scene = common::scenes::mesh_scene(
+        &[
+            (common::scenes::floor(8.0, 0.0), common::scenes::matte(0.6)),
+            (
+                common::scenes::sphere(BALL, RADIUS, true),
+                common::scenes::matte(0.5),
+            ),
+        ],
+        camera,
+        vec![],
+        Some(sky),
+    );
+    scene.proxies.push(NodeProxies {
+        node: 0,
+        spheres: vec![ProxySphere {
+            center: BALL.to_array(),
+            radius: RADIUS,
+        }],
+        source: ProxySource::Explicit,
+    });
+    scene
+}
+
+fn frame(device: &shine::gpu::Device, scene: &Scene, settings: &[(&str, &str)]) -> HdrImage {
+    let mut s = Settings {
+        width: SIZE,
+        height: SIZE,
+        receiver_scale: 1,
+        ..Settings::default()
+    };
+    s.set("gi", "none").expect("gi");
+    for (key, value) in settings {
+        s.set(key, value).expect("setting");
+    }
+    let mut renderer = Renderer::new(device).expect("renderer");
+    renderer.set_scene(scene, 0.0).expect("scene");
+    renderer.render(&s).expect("render").hdr
+}
+
+/// The pixels whose centre ray meets a sphere 10% smaller than the ball (away from its rim).
+fn ball_pixels(device: &shine::gpu::Device, scene: &Scene) -> Vec<usize> {
+    let r = 0.9 * RADIUS;
+    common::scenes::pixel_rays(device, scene, SIZE)
+        .iter()
+        .enumerate()
+        .filter(|(_, (o, d))| {
+            let to_ball = BALL - *o;
+            let b = to_ball.dot(*d);
+            b > 0.0 && to_ball.length_squared() - b * b < r * r
+        })
+        .map(|(p, _)| p)
+        .collect()
+}
+
+fn luminance(image: &HdrImage, pixels: &[usize]) -> Vec<f64> {
+    pixels
+        .iter()
+        .map(|&p| {
+            let t = image.texels[p];
+            f64::from(0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2])
+        })
+        .collect()
+}
+
+/// On the ball: energy within 6% of the path tracer's (the cube leaves out the ball's glossy
+/// reflection, a few percent) and relative RMSE below 0.1, for the paper's texel lookup with
+/// its plain smoothing and for the default (the sum at the normal, solid-angle weights). The
+/// mask view lights exactly the ball's pixels.
+#[test]
+fn the_cube_lights_the_ball_as_the_path_tracer_does() {
+    let device = common::device();
+    let scene = scene();
+    let pixels = ball_pixels(&device, &scene);
+    assert!(pixels.len() > 100, "{} ball pixels", pixels.len());
+    let params = common::scenes::pixel_centre_reference(SIZE, 3);
+    let truth = render_reference(&device, &scene, 0.0, &params, 1024).expect("reference");
+    let truth = luminance(&truth.full, &pixels);
+    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+    for (label, settings) in [
+        (
+            "paper (texel lookup, plain sum)",
+            &[
+                ("cubes.enabled", "true"),
+                ("cubes.lookup", "texel"),
+                ("cubes.solid_angle", "false"),
+            ][..],
+        ),
+        (
+            "default (sum at the normal)",
+            &[("cubes.enabled", "true")][..],
+        ),
+    ] {
+        let lit = luminance(&frame(&device, &scene, settings), &pixels);
+        let energy = mean(&lit) / mean(&truth);
+        let error = (truth
+            .iter()
+            .zip(&lit)
+            .map(|(t, l)| (l - t).powi(2))
+            .sum::<f64>()
+            / truth.len() as f64)
+            .sqrt()
+            / mean(&truth);
+        println!("{label}: energy {energy:.4}, relative RMSE {error:.4}");
+        assert!((energy - 1.0).abs() < 0.06, "{label}: energy {energy}");
+        assert!(error < 0.1, "{label}: relative RMSE {error}");
+    }
+    let mask = frame(
+        &device,
+        &scene,
+        &[
+            ("cubes.enabled", "true"),
+            ("cubes.mask", "true"),
+            ("output.component", "indirect"),
+        ],
+    );
+    assert!(pixels.iter().all(|&p| mask.texels[p][1] == 1.0));
+    let lit = mask.texels.iter().filter(|t| t[1] > 0.0).count();
+    assert!(lit < pixels.len() * 3 / 2, "{lit} mask pixels");
+    common::assert_clean(&device);
+}
