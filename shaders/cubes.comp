@@ -2,13 +2,17 @@
 // one 6x6x6 cube of incoming light per dynamic object (a node with proxies), used as a cheap
 // indirect mode for the object's receivers.
 //
-// FILL: per cube texel, CUBE_SAMPLES rays from the object's bounding sphere (centre c, radius
-//   R: a ray starts at R, so the object does not see itself) through fixed points of the texel
-//   (2x2 strata). The paper paints objects as z-buffered pixels over a sky dome; a ray through
-//   the BVH is the same nearest-surface test over the whole scene. A ray that escapes sees the
-//   environment; a hit sends what it reflects of the one-bounce light the path tracer counts:
-//   next-event estimation to the punctual lights and, in a scene with an environment, one
-//   cosine-sampled ray towards it (fixed seed per texel and sample: no noise over time).
+// FILL and SMOOTH run over the cubes of this frame's refresh list (all of them, or a slice and
+//   the ones whose object or light moved; src/frame/cubes.rs); the others keep last frame's.
+// FILL: per cube texel, CUBE_SAMPLES rays from the centre of the object's bounding sphere
+//   through fixed points of the texel (2x2 strata), starting where they leave the own proxy
+//   spheres that hold the centre; a later hit inside one of the object's own proxy spheres is
+//   stepped over (up to CUBE_SELF_HITS times), so the object does not see itself.
+//   The paper paints objects as z-buffered pixels over a sky dome; a ray through the BVH is the
+//   same nearest-surface test over the whole scene. A ray that escapes sees the environment; a
+//   hit sends what it reflects of the one-bounce light the path tracer counts: next-event
+//   estimation to the punctual lights and, in a scene with an environment, one cosine-sampled
+//   ray towards it (fixed seed per texel and sample: no noise over time).
 // SMOOTH: the paper's smoothing, per texel t of direction n:
 //   Lbar(n) = sum_s L_s max(0, n . d_s) w_s / sum_s max(0, n . d_s) w_s,
 //   w_s = 1 as published, or the texel's solid angle (push.config.z = 1).
@@ -27,6 +31,8 @@
 
 // Rays per texel of the fill (2x2 strata): shine::passes::cubes::SAMPLES.
 const uint CUBE_SAMPLES = 4u;
+// Hits on the object's own proxies a fill ray steps over before it gives up (black).
+const uint CUBE_SELF_HITS = 8u;
 
 #ifdef FILL
 #define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
@@ -48,8 +54,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 // shine::passes::cubes::CubesPush (48 bytes).
 layout(push_constant) uniform Push {
-    // FILL: x cube count, y light count, z 1 when the environment lights the hits.
-    // SMOOTH: x cube count. SHADE: xy receiver extent, z sphere count, w 1 with a light input.
+    // FILL: x refreshed cubes, y light count, z 1 when the environment lights the hits.
+    // SMOOTH: x refreshed cubes. SHADE: xy receiver extent, z sphere count, w 1 with a light
+    // input.
     uvec4 frame;
     // SHADE: xyz camera position.
     vec4 camera;
@@ -64,10 +71,32 @@ layout(push_constant) uniform Push {
 #include "path.glsl"
 #endif
 
-// per cube: centre xyz, bounding radius w
+#ifdef FILL
+// shine::passes::cubes::GpuCube: the bounding sphere (centre, radius), then the first of its
+// object's spheres and their count
+struct Cube {
+    vec4 sphere;
+    uvec4 spheres;
+};
 layout(set = 0, binding = 9, std430) readonly buffer Cubes {
-    vec4 c[];
+    Cube c[];
 } cubes;
+#endif
+
+#if defined(FILL) || defined(SMOOTH)
+// the indices of this frame's refreshed cubes
+layout(set = 0, binding = 15, std430) readonly buffer Refresh {
+    uint r[];
+} refresh;
+#endif
+
+#if defined(FILL) || defined(SHADE)
+// shine::passes::cubes::GpuCubeSphere: (centre, radius), then (the index of its object's
+// cube, as a float, 0, 0, 0)
+layout(set = 0, binding = 12, std430) readonly buffer Spheres {
+    vec4 s[];
+} spheres;
+#endif
 
 // CUBE_TEXELS texels per cube, written by FILL: rgb the radiance times the texel's weight in
 // the smoothing sum, a that weight (its solid angle, or 1 for the paper's plain sum)
@@ -108,10 +137,6 @@ layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
 layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_albedo;
 layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
-// per proxy sphere: (centre, radius), then (the index of its cube, as a float, 0, 0, 0)
-layout(set = 0, binding = 12, std430) readonly buffer Spheres {
-    vec4 s[];
-} spheres;
 layout(set = 0, binding = 13, rgba16f) readonly uniform image2D light;
 layout(set = 0, binding = 14, rgba16f) writeonly uniform image2D shaded;
 #endif
@@ -119,18 +144,53 @@ layout(set = 0, binding = 14, rgba16f) writeonly uniform image2D shaded;
 void main() {
 #ifdef FILL
     uint t = gl_GlobalInvocationID.x;
-    uint cube = gl_GlobalInvocationID.y;
-    if (t >= CUBE_TEXELS || cube >= push.frame.x) {
+    if (t >= CUBE_TEXELS || gl_GlobalInvocationID.y >= push.frame.x) {
         return;
     }
-    vec4 bound = cubes.c[cube];
+    uint cube = refresh.r[gl_GlobalInvocationID.y];
+    vec3 centre = cubes.c[cube].sphere.xyz;
+    uvec2 own = cubes.c[cube].spheres.xy;
     vec3 sum = vec3(0.0);
     for (uint k = 0u; k < CUBE_SAMPLES; ++k) {
         vec2 s = (vec2(k & 1u, k >> 1u) + 0.5) * 0.5;
         vec3 d = cube_texel_direction(t, s);
         rng_state = pcg(pcg(t ^ pcg(cube)) + k);
         TraceHit hit;
-        if (trace_closest(bound.xyz, d, bound.w, PT_FAR, hit)) {
+        // Start where the ray leaves the own spheres that hold the centre (a ball's one proxy:
+        // at its surface), so most rays never meet their own object.
+        float t_min = 0.0;
+        for (uint i = own.x; i < own.x + own.y; ++i) {
+            vec4 sphere = spheres.s[2u * i];
+            vec3 oc = centre - sphere.xyz;
+            float r = sphere.w * 1.01 + 1e-4;
+            float c = dot(oc, oc) - r * r;
+            if (c < 0.0) {
+                float b = dot(oc, d);
+                t_min = max(t_min, -b + sqrt(b * b - c));
+            }
+        }
+        bool found = false;
+        bool escaped = false;
+        for (uint step = 0u; step < CUBE_SELF_HITS; ++step) {
+            found = trace_closest(centre, d, t_min, PT_FAR, hit);
+            if (!found) {
+                escaped = true;
+                break;
+            }
+            bool self_hit = false;
+            for (uint i = own.x; i < own.x + own.y; ++i) {
+                vec4 sphere = spheres.s[2u * i];
+                vec3 off = centre + hit.t * d - sphere.xyz;
+                float r = sphere.w * 1.01 + 1e-4;
+                self_hit = self_hit || dot(off, off) <= r * r;
+            }
+            if (!self_hit) {
+                break;
+            }
+            t_min = hit.t * (1.0 + 1e-5) + 1e-5;
+            found = false;
+        }
+        if (found) {
             Vertex x = shade(hit, d);
             vec3 incoming = punctual_lights(x, -d);
             if (push.frame.z != 0u) {
@@ -143,7 +203,7 @@ void main() {
             if (!any(isnan(incoming)) && !any(isinf(incoming))) {
                 sum += incoming;
             }
-        } else {
+        } else if (escaped) {
             sum += environment_radiance(d);
         }
     }
@@ -152,10 +212,10 @@ void main() {
 #endif
 #ifdef SMOOTH
     uint t = gl_GlobalInvocationID.x;
-    uint cube = gl_GlobalInvocationID.y;
-    if (t >= CUBE_TEXELS || cube >= push.frame.x) {
+    if (t >= CUBE_TEXELS || gl_GlobalInvocationID.y >= push.frame.x) {
         return;
     }
+    uint cube = refresh.r[gl_GlobalInvocationID.y];
     smoothed.s[cube * CUBE_TEXELS + t] = vec4(cube_smoothed(cube, cube_texel_direction(t, vec2(0.5))), 0.0);
 #endif
 #ifdef SHADE

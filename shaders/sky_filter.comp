@@ -21,7 +21,7 @@ layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D sky_irradiance;
 layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D sky;
 
-// shine::passes::sky::SkyFilterPush (32 bytes).
+// shine::passes::sky::SkyFilterPush (48 bytes).
 layout(push_constant) uniform Push {
     // xyz: camera position
     vec4 camera;
@@ -32,6 +32,9 @@ layout(push_constant) uniform Push {
     // sigma_z and n of the bilateral match
     float depth_sigma;
     float normal_power;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } push;
 
 void main() {

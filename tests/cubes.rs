@@ -3,6 +3,8 @@
 //! ball's proxy its own sphere. The ball's receivers take their light from its 6×6×6 cube
 //! (`gi = none`, `cubes.enabled`): its top sees the sky, its bottom the sky-lit floor. On the
 //! ball's pixels the frame must match the path tracer's energy and shading, for both lookups.
+//! Amortised (`cubes.slices`), a still scene gives the per-frame image, and a light that
+//! changes refreshes the cubes at once.
 
 mod common;
 
@@ -145,5 +147,101 @@ fn the_cube_lights_the_ball_as_the_path_tracer_does() {
     assert!(pixels.iter().all(|&p| mask.texels[p][1] == 1.0));
     let lit = mask.texels.iter().filter(|t| t[1] > 0.0).count();
     assert!(lit < pixels.len() * 3 / 2, "{lit} mask pixels");
+    common::assert_clean(&device);
+}
+
+/// Renders `frames` frames of `scene` on one renderer with `settings` (gi = none, sky pass
+/// off: its rays would differ from frame to frame), the update of frame k from `update(k)`;
+/// returns the last frame.
+fn sequence(
+    device: &shine::gpu::Device,
+    scene: &Scene,
+    settings: &[(&str, &str)],
+    frames: u32,
+    update: impl Fn(u32) -> shine::gpu_scene::FrameUpdate,
+) -> HdrImage {
+    let mut s = Settings {
+        width: SIZE,
+        height: SIZE,
+        receiver_scale: 1,
+        ..Settings::default()
+    };
+    s.set("gi", "none").expect("gi");
+    s.set("sky.enabled", "false").expect("sky");
+    s.set("cubes.enabled", "true").expect("cubes");
+    for (key, value) in settings {
+        s.set(key, value).expect("setting");
+    }
+    let mut renderer = Renderer::new(device).expect("renderer");
+    renderer.set_scene(scene, 0.0).expect("scene");
+    let mut last = None;
+    for k in 0..frames {
+        renderer.update(&update(k)).expect("update");
+        last = Some(renderer.render(&s).expect("render").hdr);
+    }
+    last.expect("a frame")
+}
+
+/// The largest difference on the ball's pixels relative to the mean there.
+fn difference(a: &HdrImage, b: &HdrImage, pixels: &[usize]) -> f64 {
+    let (la, lb) = (luminance(a, pixels), luminance(b, pixels));
+    let mean = lb.iter().sum::<f64>() / lb.len() as f64;
+    la.iter()
+        .zip(&lb)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+        / mean
+}
+
+/// A still scene amortised over 4 slices gives, after 6 frames, the image every cube refreshed
+/// every frame gives (to float rounding); with a sun that turns at frame 3, slices = 16 (the one
+/// cube's slice comes round every 16 frames) still shows the turned sun's floor at once, as a
+/// fresh render at that sun does, because a light that changes refreshes every cube.
+#[test]
+fn amortised_cubes_converge_and_refresh_when_a_light_moves() {
+    let device = common::device();
+    let mut scene = scene();
+    let pixels = ball_pixels(&device, &scene);
+    let still = |_| shine::gpu_scene::FrameUpdate::at(0.0);
+    let every = sequence(&device, &scene, &[], 1, still);
+    let sliced = sequence(&device, &scene, &[("cubes.slices", "4")], 6, still);
+    let converged = difference(&sliced, &every, &pixels);
+    assert!(converged < 1e-3, "amortised differs by {converged}");
+
+    let sun = |direction: Vec3| shine_scene::Light {
+        position: [0.0; 3],
+        kind: 0,
+        direction: direction.normalize().to_array(),
+        range: 0.0,
+        color: [1.0; 3],
+        intensity: 3.0,
+        inner_cone_angle: 0.0,
+        outer_cone_angle: 0.0,
+        node: u32::MAX,
+        _pad: 0,
+    };
+    let (before, after) = (
+        sun(Vec3::new(0.3, -1.0, -0.4)),
+        sun(Vec3::new(-0.8, -0.5, 0.6)),
+    );
+    scene.lights.push(before);
+    let turning = |k: u32| shine::gpu_scene::FrameUpdate {
+        lights: vec![(0, if k < 3 { before } else { after })],
+        ..shine::gpu_scene::FrameUpdate::at(0.0)
+    };
+    let history_off = [("cubes.slices", "16"), ("history.frames", "1")];
+    let turned = sequence(&device, &scene, &history_off, 4, turning);
+    let fresh = sequence(&device, &scene, &history_off, 1, |_| turning(3));
+    let stale = sequence(&device, &scene, &history_off, 1, |_| turning(0));
+    let refreshed = difference(&turned, &fresh, &pixels);
+    let changed = difference(&stale, &fresh, &pixels);
+    println!(
+        "after the sun turned: {refreshed:.2e} from a fresh render (the old sun: {changed:.3})"
+    );
+    assert!(refreshed < 1e-3, "{refreshed}");
+    assert!(
+        changed > 0.05,
+        "the sun's turn changes the ball by {changed} only"
+    );
     common::assert_clean(&device);
 }

@@ -1,9 +1,9 @@
 // Tiny environment cubes (paper 001, "Environment maps"): CUBE_SIDE x CUBE_SIDE texels on each
 // of six faces around an object, a directional table of the light reaching it. Texel t =
-// face * CUBE_SIDE^2 + row * CUBE_SIDE + column; faces +x, -x, +y, -y, +z, -z. Rust
-// twins of the direction and the solid angle: shine::passes::cubes::{texel_direction,
-// texel_solid_angle}, unit-tested there (not tied to these by a GPU test yet); tests/cubes.rs
-// checks the cubes end to end against the path tracer.
+// face * CUBE_SIDE^2 + row * CUBE_SIDE + column; faces +x, -x, +y, -y, +z, -z. Rust twins:
+// shine::passes::cubes::{texel_direction, texel_of, texel_solid_angle}, unit-tested there
+// (not tied to these by a GPU test yet); tests/cubes.rs checks the cubes end to end against
+// the path tracer.
 #ifndef CUBE_GLSL
 #define CUBE_GLSL
 

@@ -46,6 +46,9 @@ pub enum CompareError {
     /// An image holds fewer texels than its size says.
     #[error("an image holds {0} texels, its size needs {1}")]
     Truncated(usize, usize),
+    /// A mask that selects no pixel (none has a channel above 0.5).
+    #[error("the mask selects no pixel (none has a channel above 0.5)")]
+    EmptyMask,
 }
 
 /// The metrics of one comparison.

@@ -59,7 +59,7 @@ pub fn region_grid(
 
 /// The metrics over the pixels where `mask` is lit (any channel above 0.5), e.g. the
 /// receivers of one technique (`cubes.mask`): `(pixels, reference mean, energy ratio, relative
-/// RMSE)`.
+/// RMSE)`. A mask that lights no pixel is an error.
 pub fn masked_metrics(
     image: &HdrImage,
     reference: &HdrImage,
@@ -70,6 +70,9 @@ pub fn masked_metrics(
     let pixels: Vec<usize> = (0..mask.texels.len())
         .filter(|&i| mask.texels[i][..3].iter().any(|&v| v > 0.5))
         .collect();
+    if pixels.is_empty() {
+        return Err(CompareError::EmptyMask);
+    }
     let (mean, energy, relative) = pixel_metrics(image, reference, pixels.iter().copied());
     Ok((pixels.len(), mean, energy, relative))
 }
@@ -153,6 +156,7 @@ mod tests {
         assert!((mean - 0.25).abs() < 1e-12 && (energy - 2.0).abs() < 1e-12);
         assert!((error - 1.0).abs() < 1e-12);
         assert!(masked_metrics(&test, &reference, &image(4, 6, |_, _| 1.0)).is_err());
+        assert!(masked_metrics(&test, &reference, &image(8, 6, |_, _| 0.0)).is_err());
     }
 
     /// An image twice as bright on its left half: the left tiles report energy 2 and relative

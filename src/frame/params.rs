@@ -203,6 +203,7 @@ impl FrameParams {
                 lookup: settings.cubes.lookup,
                 solid_angle: settings.cubes.solid_angle,
                 mask: settings.cubes.mask,
+                slices: settings.cubes.slices,
             }),
             upsample: UpsampleParams {
                 depth_sigma: settings.upsample.depth_epsilon,

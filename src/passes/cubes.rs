@@ -12,8 +12,10 @@
 //!
 //! * **Filled by rays.** The paper paints each object as z-buffered pixels; a ray through the
 //!   BVH per texel sample ([`SAMPLES`], 2×2 strata) is the same nearest-surface test over the
-//!   whole scene, static geometry included. Rays start on the object's bounding sphere (the
-//!   object does not see itself). A hit sends what its surface reflects of the one-bounce light
+//!   whole scene, static geometry included. Rays leave from the centre of the object's
+//!   bounding sphere, start where they exit the object's proxy spheres that hold that centre,
+//!   and step over later hits inside its proxy spheres: the object does not see itself (a
+//!   floor inside a proxy that pokes through it is skipped too). A hit sends what its surface reflects of the one-bounce light
 //!   (next-event estimation to the punctual lights, one cosine ray to the environment), the
 //!   light the path tracer counts; an escaped ray sees the environment. Seeds are fixed per
 //!   texel, so a still scene gives the same cube every frame.
@@ -24,12 +26,17 @@
 //!   the normal itself (216 multiply-adds, no facets or seams at 6×6).
 //! * **Which receivers**: those inside one of the object's proxy spheres (1% margin). The
 //!   G-buffer has no object id, and a host's G-buffer (a GI context) would not either.
+//! * **Amortised** (paper 001: "update one object at the time"; issue 18, item 1): with
+//!   `cubes.slices = k` a frame refreshes every k-th cube in turn, and at once every cube whose
+//!   object moved since its last refresh, every cube a moving object is near enough to be seen
+//!   in ([`NEIGHBOUR_ALPHA`]), and all of them when a light changes
+//!   (`crate::frame::cubes`). The others keep their texels from earlier frames.
 //! * **Diffuse only**: the receivers get `kd · L̄`; the traced specular pass still adds the
 //!   sharp part of their glossy lobes, the rough part is left out.
 
 use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::receivers::Receivers;
 use crate::shaders;
 
@@ -39,6 +46,16 @@ pub const SIDE: u32 = 6;
 pub const TEXELS: u32 = 6 * SIDE * SIDE;
 /// Rays per texel of the fill (2×2 strata).
 pub const SAMPLES: u32 = 4;
+/// A cube is refreshed when an object that moved this frame subtends at least this sin of a
+/// half-angle from its centre (`r / d`; 11.5°, about two 6×6 texels' worth of solid angle):
+/// smaller, it moves the cube's smoothed light by a few percent of its own at most. On
+/// `marbles` 0.1 refreshed 58% of the cubes per frame at `slices = 4`, 0.2 refreshes 40%, at
+/// the same error and flicker (docs/quality.md).
+pub const NEIGHBOUR_ALPHA: f32 = 0.2;
+/// Default `cubes.slices`: every cube refreshed every frame.
+pub const SLICES: u32 = 1;
+/// `cubes.slices` the settings take.
+pub const SLICES_RANGE: std::ops::RangeInclusive<u32> = 1..=16;
 
 crate::choice::named_choice! {
     /// How a receiver reads its object's cube.
@@ -60,6 +77,9 @@ pub struct CubeParams {
     /// Write 1 at the receivers the cubes light and 0 elsewhere, instead of light (a debugging
     /// view, and the mask of the cube study's per-object error).
     pub mask: bool,
+    /// Refresh every `slices`-th cube per frame in turn (1: all), plus the cubes of objects and
+    /// lights that move (`crate::frame::cubes`).
+    pub slices: u32,
 }
 
 impl Default for CubeParams {
@@ -68,16 +88,19 @@ impl Default for CubeParams {
             lookup: CubeLookup::Normal,
             solid_angle: true,
             mask: false,
+            slices: SLICES,
         }
     }
 }
 
-/// One cube's bounding sphere as the passes read it (16 bytes).
+/// One cube as the fill reads it (32 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuCube {
     /// Centre xyz and radius w of the object's bounding sphere.
     pub sphere: [f32; 4],
+    /// x: the first of the object's [`GpuCubeSphere`]s, y: their count; z, w: 0.
+    pub spheres: [u32; 4],
 }
 
 /// One proxy sphere with the cube of its object (32 bytes).
@@ -124,83 +147,55 @@ pub struct CubeScene<'a> {
     pub environment_lighting: bool,
 }
 
-/// The cubes of one frame: their bounding spheres and the proxy spheres naming their receivers.
+/// The cubes of one frame: their records, the proxy spheres naming their receivers, the
+/// cubes to refresh, and the texels they keep between frames.
 pub struct CubeInputs {
     /// [`GpuCube`] per dynamic object.
     pub cubes: Handle<Buffer>,
-    /// Cubes in `cubes`.
-    pub cube_count: u32,
     /// [`GpuCubeSphere`] per proxy sphere.
     pub spheres: Handle<Buffer>,
     /// Spheres in `spheres`.
     pub sphere_count: u32,
+    /// The indices (u32) of the cubes this frame fills and smooths.
+    pub refresh: Handle<Buffer>,
+    /// Cubes in `refresh` (0: the fill and smooth passes are left out).
+    pub refresh_count: u32,
+    /// [`TEXELS`] × vec4 per cube: radiance times its smoothing weight, and the weight.
+    pub radiance: Handle<Buffer>,
+    /// [`TEXELS`] × vec4 per cube: the smoothed `L̄` of each texel.
+    pub smoothed: Handle<Buffer>,
 }
 
-/// Adds `cubes_fill`, `cubes_smooth` and `cubes_shade`: fills and smooths every cube of
-/// `inputs`, then lights the receivers inside the cubes' objects from them and keeps `light`
-/// (the technique's RGBA16F light at receiver resolution, if any) elsewhere. Returns the result
-/// (RGBA16F at receiver resolution).
+/// Adds `cubes_fill` and `cubes_smooth` over the cubes `inputs` refreshes (none: neither
+/// pass), then `cubes_shade`: the receivers inside the cubes' objects lit from them, `light`
+/// (the technique's RGBA16F light at receiver resolution, if any) kept elsewhere. Returns the
+/// result (RGBA16F at receiver resolution).
 pub fn cubes(
     rg: &mut RenderGraph,
     scene: &CubeScene<'_>,
-    inputs: &CubeInputs,
+    inputs: &mut CubeInputs,
     receivers: &Receivers,
     light: Option<&Handle<Image>>,
     camera: glam::Vec3,
     params: &CubeParams,
 ) -> Handle<Image> {
-    let texels = u64::from(inputs.cube_count.max(1)) * u64::from(TEXELS) * 16;
     let config = [
         0,
         u32::from(params.lookup == CubeLookup::Normal),
         u32::from(params.solid_angle),
         u32::from(params.mask),
     ];
-    let mut radiance = rg.create_buffer("cube_radiance", BufferDesc::new(texels));
-    let mut pass = rg.compute("cubes_fill", &shaders::CUBES_COMP_FILL);
-    pass.read("materials", &scene.handles.materials)
-        .read("srgb_textures", &scene.handles.srgb_textures)
-        .read("linear_textures", &scene.handles.linear_textures)
-        .sampler("texture_sampler", scene.texture_sampler)
-        .read("vertices", &scene.handles.vertices)
-        .read("indices", &scene.handles.indices)
-        .read("lights", &scene.handles.lights)
-        .read("environment", scene.environment)
-        .sampler("environment_sampler", scene.environment_sampler)
-        .read("cubes", &inputs.cubes);
-    scene.bvh.bind(&mut pass);
-    pass.write("radiance", &mut radiance)
-        .push(&CubesPush {
-            frame: [
-                inputs.cube_count,
-                scene.light_count,
-                u32::from(scene.environment_lighting),
-                0,
-            ],
-            camera: [0.0; 4],
-            config,
-        })
-        .dispatch([TEXELS, inputs.cube_count, 1]);
-    let mut smoothed = rg.create_buffer("cube_smoothed", BufferDesc::new(texels));
-    rg.compute("cubes_smooth", &shaders::CUBES_COMP_SMOOTH)
-        .read("cubes", &inputs.cubes)
-        .read("radiance", &radiance)
-        .write("smoothed", &mut smoothed)
-        .push(&CubesPush {
-            frame: [inputs.cube_count, 0, 0, 0],
-            camera: [0.0; 4],
-            config,
-        })
-        .dispatch([TEXELS, inputs.cube_count, 1]);
+    if inputs.refresh_count > 0 {
+        fill_and_smooth(rg, scene, inputs, config);
+    }
     let [w, h] = receivers.extent;
     let mut out = rg.create_image(
         "cube_light",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
     let mut pass = rg.compute("cubes_shade", &shaders::CUBES_COMP_SHADE);
-    pass.read("cubes", &inputs.cubes)
-        .read("radiance", &radiance)
-        .read("smoothed", &smoothed)
+    pass.read("radiance", &inputs.radiance)
+        .read("smoothed", &inputs.smoothed)
         .read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
         .read("recv_albedo", &receivers.albedo)
@@ -216,6 +211,51 @@ pub fn cubes(
         })
         .dispatch([w, h, 1]);
     out
+}
+
+/// `cubes_fill` and `cubes_smooth` over the refreshed cubes of `inputs`.
+fn fill_and_smooth(
+    rg: &mut RenderGraph,
+    scene: &CubeScene<'_>,
+    inputs: &mut CubeInputs,
+    config: [u32; 4],
+) {
+    let mut pass = rg.compute("cubes_fill", &shaders::CUBES_COMP_FILL);
+    pass.read("materials", &scene.handles.materials)
+        .read("srgb_textures", &scene.handles.srgb_textures)
+        .read("linear_textures", &scene.handles.linear_textures)
+        .sampler("texture_sampler", scene.texture_sampler)
+        .read("vertices", &scene.handles.vertices)
+        .read("indices", &scene.handles.indices)
+        .read("lights", &scene.handles.lights)
+        .read("environment", scene.environment)
+        .sampler("environment_sampler", scene.environment_sampler)
+        .read("cubes", &inputs.cubes)
+        .read("spheres", &inputs.spheres)
+        .read("refresh", &inputs.refresh);
+    scene.bvh.bind(&mut pass);
+    pass.write("radiance", &mut inputs.radiance)
+        .push(&CubesPush {
+            frame: [
+                inputs.refresh_count,
+                scene.light_count,
+                u32::from(scene.environment_lighting),
+                0,
+            ],
+            camera: [0.0; 4],
+            config,
+        })
+        .dispatch([TEXELS, inputs.refresh_count, 1]);
+    rg.compute("cubes_smooth", &shaders::CUBES_COMP_SMOOTH)
+        .read("radiance", &inputs.radiance)
+        .read("refresh", &inputs.refresh)
+        .write("smoothed", &mut inputs.smoothed)
+        .push(&CubesPush {
+            frame: [inputs.refresh_count, 0, 0, 0],
+            camera: [0.0; 4],
+            config,
+        })
+        .dispatch([TEXELS, inputs.refresh_count, 1]);
 }
 
 /// The direction through face coordinates `(u, v)` ∈ [-1, 1]² of `face` (not normalised):
@@ -243,6 +283,30 @@ pub fn texel_direction(t: u32, s: [f32; 2]) -> glam::Vec3 {
     face_direction(face, u, v).normalize()
 }
 
+/// The texel whose square holds direction `d` (any length > 0): `cube_texel_of`.
+pub fn texel_of(d: glam::Vec3) -> u32 {
+    let a = d.abs();
+    let (face, u, v) = if a.x >= a.y && a.x >= a.z {
+        if d.x > 0.0 {
+            (0, -d.z / a.x, -d.y / a.x)
+        } else {
+            (1, d.z / a.x, -d.y / a.x)
+        }
+    } else if a.y >= a.z {
+        if d.y > 0.0 {
+            (2, d.x / a.y, d.z / a.y)
+        } else {
+            (3, d.x / a.y, -d.z / a.y)
+        }
+    } else if d.z > 0.0 {
+        (4, d.x / a.z, -d.y / a.z)
+    } else {
+        (5, -d.x / a.z, -d.y / a.z)
+    };
+    let cell = |x: f32| ((x + 1.0) * 0.5 * SIDE as f32).clamp(0.0, SIDE as f32 - 0.5) as u32;
+    face * SIDE * SIDE + cell(v) * SIDE + cell(u)
+}
+
 /// The solid angle of texel `t`: `cube_texel_solid_angle`.
 pub fn texel_solid_angle(t: u32) -> f32 {
     let (row, column) = ((t / SIDE) % SIDE, t % SIDE);
@@ -266,6 +330,21 @@ mod tests {
             .fold((f32::MAX, 0.0f32), |(a, b), w| (a.min(w), b.max(w)));
         // a 6×6 face: the centre texels 3.3 times the corners
         assert!(max / min > 3.2 && max / min < 3.4, "{min} {max}");
+    }
+
+    #[test]
+    fn texel_of_inverts_texel_direction() {
+        for t in 0..TEXELS {
+            for s in [
+                [0.5, 0.5],
+                [0.05, 0.05],
+                [0.95, 0.05],
+                [0.05, 0.95],
+                [0.95, 0.95],
+            ] {
+                assert_eq!(texel_of(texel_direction(t, s) * 3.0), t, "{t} {s:?}");
+            }
+        }
     }
 
     #[test]

@@ -112,7 +112,7 @@ pub struct SkyPush {
     pub pad: [u32; 2],
 }
 
-/// Push constants of `shaders/sky_filter.comp` (32 bytes).
+/// Push constants of `shaders/sky_filter.comp` (48 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SkyFilterPush {

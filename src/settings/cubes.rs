@@ -22,6 +22,10 @@ pub struct CubeSettings {
     /// Write 1 at the receivers the cubes light and 0 elsewhere, instead of light (see with
     /// `output.component = indirect`). Default false.
     pub mask: bool,
+    /// Refresh one cube in `slices` per frame, in turn, plus at once those of objects that move
+    /// (and their neighbours) and all of them when a light changes (paper 001: "update one
+    /// object at the time"). Range 1..=16, default 1 (every cube every frame).
+    pub slices: u32,
 }
 
 impl Default for CubeSettings {
@@ -33,6 +37,28 @@ impl Default for CubeSettings {
             lookup: p.lookup,
             solid_angle: p.solid_angle,
             mask: p.mask,
+            slices: p.slices,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::settings::Settings;
+
+    #[test]
+    fn cubes_are_refused_with_full_resolution_techniques() {
+        for gi in ["igi", "aaf", "igi,proxy"] {
+            let message =
+                Settings::from_toml_str(&format!("gi = \"{gi}\"\n[cubes]\nenabled = true"))
+                    .unwrap_err()
+                    .to_string();
+            assert!(message.contains("cubes.enabled"), "{gi}: {message}");
+        }
+        for gi in ["hvl", "proxy", "hvl,proxy", "none"] {
+            let toml = format!("gi = \"{gi}\"\n[cubes]\nenabled = true\nlookup = \"texel\"");
+            let settings = Settings::from_toml_str(&toml).unwrap();
+            assert!(settings.cubes.enabled, "{gi}");
         }
     }
 }

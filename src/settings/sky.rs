@@ -63,3 +63,16 @@ impl Default for CavitySettings {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::settings::Settings;
+
+    #[test]
+    fn the_sky_filter_radius_is_checked() {
+        let message = Settings::from_toml_str("[sky]\nfilter_radius = 9")
+            .unwrap_err()
+            .to_string();
+        assert!(message.contains("sky.filter_radius"), "{message}");
+    }
+}

@@ -8,8 +8,8 @@ use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
 use crate::passes::{
-    aaf, accumulate, composite, exposure, hvl, igi, proxy, receivers, rsm, shadows, sky, specular,
-    upsample,
+    aaf, accumulate, composite, cubes, exposure, hvl, igi, proxy, receivers, rsm, shadows, sky,
+    specular, upsample,
 };
 
 /// Output sides in pixels.
@@ -186,6 +186,7 @@ impl Settings {
             self.sky.filter_radius,
             &sky::FILTER_RADIUS_RANGE,
         )?;
+        check("cubes.slices", self.cubes.slices, &cubes::SLICES_RANGE)?;
         check("cavity.rays", self.cavity.rays, &sky::RAYS_RANGE)?;
         check("cavity.range", self.cavity.range, &sky::CAVITY_RANGE_RANGE)?;
         Ok(())

@@ -50,6 +50,7 @@ impl Renderer {
         self.igi.forget_uploads();
         if let Some(scene) = self.scene.as_mut() {
             scene.proxy.forget_uploads();
+            scene.cubes.reset();
         }
     }
 
@@ -186,7 +187,12 @@ impl Renderer {
         let cubes = match p.cubes {
             Some(params) => scene
                 .cubes
-                .prepare(rg, &frame.pose.world)?
+                .prepare(
+                    rg,
+                    &frame.pose.world,
+                    bytemuck::cast_slice(&frame.lights),
+                    &params,
+                )?
                 .map(|inputs| (params, inputs)),
             None => None,
         };
@@ -265,7 +271,7 @@ impl Renderer {
         let low = sum(rg, "sky_add", low, sky_low)?;
         // Paper 001's environment cubes light the dynamic objects' receivers instead.
         let low = match (cubes, &recv) {
-            (Some((params, inputs)), Some(receivers)) => {
+            (Some((params, mut inputs)), Some(receivers)) => {
                 let environment =
                     rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ);
                 let cube_scene = CubeScene {
@@ -280,7 +286,7 @@ impl Renderer {
                 Some(cubes::cubes(
                     rg,
                     &cube_scene,
-                    &inputs,
+                    &mut inputs,
                     receivers,
                     low.as_ref(),
                     camera.eye,

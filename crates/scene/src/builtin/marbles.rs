@@ -115,7 +115,7 @@ pub fn build() -> Vec<u8> {
         if i % BOUNCE_EVERY == 3 {
             // A bounce to 4 radii every second, offset per ball, as a cubic spline.
             let (low, high, v) = (radius, radius * 4.0, 8.0 * radius);
-            let phase = hash01(k + 7) * 0.5;
+            let phase = hash01(BALLS as u32 * 3 + i as u32) * 0.5;
             let times: Vec<f32> = (0..5).map(|j| j as f32 * 0.5 + phase).collect();
             let keys: Vec<f32> = (0..5)
                 .flat_map(|j| {
