@@ -293,7 +293,7 @@ mod tests {
             [1, 3, 5, 6]
         );
         for b in [&mut bounds, &mut previous, &mut refreshed] {
-            b[7] = at(603.0);
+            b[7] = at(602.0);
         }
         assert_eq!(
             refresh_list(&bounds, &previous, &refreshed, 5, 4),
