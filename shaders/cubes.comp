@@ -31,8 +31,12 @@
 
 // Rays per texel of the fill (2x2 strata): shine::passes::cubes::SAMPLES.
 const uint CUBE_SAMPLES = 4u;
-// Hits on the object's own proxies a fill ray steps over before it gives up (black).
+// Hits on the object's own proxies a fill ray steps over before it gives up (black); each step
+// leaves every own sphere holding the hit, so a ray needs at most one per own sphere.
 const uint CUBE_SELF_HITS = 8u;
+// An own proxy, grown by this share of its radius (and 1e-5), holds the object's triangles; a
+// larger margin would reach under the floor an object rests on.
+const float CUBE_SELF_MARGIN = 1e-3;
 
 #ifdef FILL
 #define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
@@ -141,6 +145,21 @@ layout(set = 0, binding = 13, rgba16f) readonly uniform image2D light;
 layout(set = 0, binding = 14, rgba16f) writeonly uniform image2D shaded;
 #endif
 
+#ifdef FILL
+// Where the ray centre + t d leaves `sphere` (grown by CUBE_SELF_MARGIN) if the point at
+// t = `at` lies inside it; else 0.
+float cube_own_exit(vec4 sphere, vec3 centre, vec3 d, float at) {
+    vec3 oc = centre - sphere.xyz;
+    float r = sphere.w * (1.0 + CUBE_SELF_MARGIN) + 1e-5;
+    vec3 p = oc + at * d;
+    if (dot(p, p) > r * r) {
+        return 0.0;
+    }
+    float b = dot(oc, d);
+    return -b + sqrt(max(b * b - (dot(oc, oc) - r * r), 0.0));
+}
+#endif
+
 void main() {
 #ifdef FILL
     uint t = gl_GlobalInvocationID.x;
@@ -160,14 +179,7 @@ void main() {
         // at its surface), so most rays never meet their own object.
         float t_min = 0.0;
         for (uint i = own.x; i < own.x + own.y; ++i) {
-            vec4 sphere = spheres.s[2u * i];
-            vec3 oc = centre - sphere.xyz;
-            float r = sphere.w * 1.01 + 1e-4;
-            float c = dot(oc, oc) - r * r;
-            if (c < 0.0) {
-                float b = dot(oc, d);
-                t_min = max(t_min, -b + sqrt(b * b - c));
-            }
+            t_min = max(t_min, cube_own_exit(spheres.s[2u * i], centre, d, 0.0));
         }
         bool found = false;
         bool escaped = false;
@@ -177,17 +189,15 @@ void main() {
                 escaped = true;
                 break;
             }
-            bool self_hit = false;
+            // past every own sphere that holds the hit (none: the hit is another surface)
+            float exit = 0.0;
             for (uint i = own.x; i < own.x + own.y; ++i) {
-                vec4 sphere = spheres.s[2u * i];
-                vec3 off = centre + hit.t * d - sphere.xyz;
-                float r = sphere.w * 1.01 + 1e-4;
-                self_hit = self_hit || dot(off, off) <= r * r;
+                exit = max(exit, cube_own_exit(spheres.s[2u * i], centre, d, hit.t));
             }
-            if (!self_hit) {
+            if (exit <= hit.t) {
                 break;
             }
-            t_min = hit.t * (1.0 + 1e-5) + 1e-5;
+            t_min = exit;
             found = false;
         }
         if (found) {

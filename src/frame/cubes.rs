@@ -5,15 +5,18 @@
 //!
 //! Which cubes a frame refreshes (`cubes.slices = k`; paper 001: "update one object at the
 //! time"): all of them without a history (the first frame, a frame dropped before, another
-//! weighting, another object count) or when a light changed; else the cubes with `i ≡ frame
-//! (mod k)`, every cube whose object moved since its last refresh, and every cube that an
-//! object moving this frame is near enough to show in (`r / d ≥` [`NEIGHBOUR_ALPHA`]).
+//! weighting), when a light changed, or when anything else the cubes see changed (a node with
+//! a mesh that is not a cube's object, morph weights, skin joints); else the cubes with
+//! `i ≡ frame (mod k)`, every cube whose object's node moved since its last refresh, and every
+//! cube that an object moving this frame is, or was last frame, near enough to show in
+//! (`r / d ≥` [`NEIGHBOUR_ALPHA`]). Matrices count as moved past a relative change of
+//! [`MOVE_TOLERANCE`], so rounding in a still node's matrix does not refresh its neighbours.
 
 use glam::{Mat4, Vec3};
 use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
 use shine_graph::{ExternalState, RenderGraph};
-use shine_scene::Scene;
 use shine_scene::proxies::ProxySphere;
+use shine_scene::{Pose, Scene};
 
 use super::error::RenderError;
 use crate::gpu_scene::upload_ring::UploadRing;
@@ -27,6 +30,8 @@ use crate::passes::proxy::MAX_PROXIES;
 pub struct CubeTechnique {
     /// (node, its proxies in the node's space), one entry per cube.
     objects: Vec<(usize, Vec<ProxySphere>)>,
+    /// The other nodes with a mesh: what the cubes see besides each other.
+    scenery: Vec<usize>,
     /// Device buffers, made on first use.
     buffers: Option<CubeBuffers>,
     ring: UploadRing,
@@ -52,10 +57,29 @@ struct History {
     solid_angle: bool,
     /// The lights' records at that frame.
     lights: Vec<u8>,
+    /// The scenery's world matrices, every morph weight and joint matrix at that frame.
+    scenery: Vec<f32>,
     /// Each cube's bounding sphere at that frame.
     previous: Vec<[f32; 4]>,
-    /// Each cube's bounding sphere when it was last refreshed.
-    refreshed: Vec<[f32; 4]>,
+    /// Each cube's object's world matrix at that frame.
+    world: Vec<Mat4>,
+    /// Each cube's object's world matrix when the cube was last refreshed.
+    refreshed: Vec<Mat4>,
+}
+
+/// Largest change of a matrix element, relative to the matrix's largest element, that still
+/// counts as standing still.
+pub const MOVE_TOLERANCE: f32 = 1e-6;
+
+/// Whether `a` and `b` differ past [`MOVE_TOLERANCE`] of their largest element.
+fn moved(a: &[f32], b: &[f32]) -> bool {
+    if a.len() != b.len() {
+        return true;
+    }
+    let scale = a.iter().chain(b).fold(1.0f32, |m, x| m.max(x.abs()));
+    a.iter()
+        .zip(b)
+        .any(|(x, y)| (x - y).abs() > MOVE_TOLERANCE * scale)
 }
 
 /// Device access of the texel buffers between frames: written and read by compute passes.
@@ -70,13 +94,18 @@ const TEXELS_STATE: ExternalState = ExternalState::new(
 impl CubeTechnique {
     /// The dynamic objects of `scene`; nothing is uploaded yet.
     pub fn new(device: &Device, scene: &Scene) -> Self {
+        let objects: Vec<(usize, Vec<ProxySphere>)> = scene
+            .proxies
+            .iter()
+            .filter(|p| !p.spheres.is_empty())
+            .map(|p| (p.node, p.spheres.clone()))
+            .collect();
+        let scenery = (0..scene.nodes.len())
+            .filter(|&i| scene.nodes[i].mesh.is_some() && objects.iter().all(|(n, _)| *n != i))
+            .collect();
         Self {
-            objects: scene
-                .proxies
-                .iter()
-                .filter(|p| !p.spheres.is_empty())
-                .map(|p| (p.node, p.spheres.clone()))
-                .collect(),
+            objects,
+            scenery,
             buffers: None,
             ring: UploadRing::new(device),
             device: device.clone(),
@@ -100,20 +129,21 @@ impl CubeTechnique {
         self.history = None;
     }
 
-    /// The cubes and spheres placed by the node matrices `world`, this frame's refresh list
-    /// (`params.slices`, the moving objects, the `lights` records), uploaded by this frame and
-    /// imported into `rg` with the persistent texels; `None` when the scene has no dynamic
+    /// The cubes and spheres placed by the frame's `pose`, this frame's refresh list
+    /// (`params.slices`, what moved in `pose`, the `lights` records), uploaded by this frame
+    /// and imported into `rg` with the persistent texels; `None` when the scene has no dynamic
     /// object.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
-        world: &[Mat4],
+        pose: &Pose,
         lights: &[u8],
         params: &CubeParams,
     ) -> Result<Option<CubeInputs>, RenderError> {
         if self.objects.is_empty() {
             return Ok(None);
         }
+        let world = &pose.world;
         let (cubes, spheres) = records(&self.objects, world);
         if spheres.len() > MAX_PROXIES as usize {
             return Err(RenderError::Invalid(format!(
@@ -127,28 +157,50 @@ impl CubeTechnique {
         }
         let frame = rg.frame();
         let bounds: Vec<[f32; 4]> = cubes.iter().map(|c| c.sphere).collect();
+        let object_world: Vec<Mat4> = self
+            .objects
+            .iter()
+            .map(|(node, _)| world.get(*node).copied().unwrap_or(Mat4::IDENTITY))
+            .collect();
+        let scenery: Vec<f32> = self
+            .scenery
+            .iter()
+            .filter_map(|&n| world.get(n))
+            .flat_map(|m| m.to_cols_array())
+            .chain(pose.weights.iter().flatten().copied())
+            .chain(pose.joints.iter().flatten().flat_map(|m| m.to_cols_array()))
+            .collect();
         let (refresh, refreshed) = match self.history.take() {
             Some(h)
                 if h.frame.wrapping_add(1) == frame
                     && h.solid_angle == params.solid_angle
                     && h.lights == lights
-                    && h.previous.len() == bounds.len() =>
+                    && !moved(&h.scenery, &scenery) =>
             {
+                let changed = |a: &[Mat4], i: usize| {
+                    moved(&a[i].to_cols_array(), &object_world[i].to_cols_array())
+                };
+                let moving: Vec<bool> = (0..bounds.len()).map(|i| changed(&h.world, i)).collect();
+                let stale: Vec<bool> = (0..bounds.len())
+                    .map(|i| changed(&h.refreshed, i))
+                    .collect();
                 let refresh =
-                    refresh_list(&bounds, &h.previous, &h.refreshed, frame, params.slices);
+                    refresh_list(&bounds, &h.previous, &moving, &stale, frame, params.slices);
                 let mut refreshed = h.refreshed;
                 for &i in &refresh {
-                    refreshed[i as usize] = bounds[i as usize];
+                    refreshed[i as usize] = object_world[i as usize];
                 }
                 (refresh, refreshed)
             }
-            _ => ((0..bounds.len() as u32).collect(), bounds.clone()),
+            _ => ((0..bounds.len() as u32).collect(), object_world.clone()),
         };
         self.history = Some(History {
             frame,
             solid_angle: params.solid_angle,
             lights: lights.to_vec(),
+            scenery,
             previous: bounds,
+            world: object_world,
             refreshed,
         });
         let buffers = self.buffers.as_ref().ok_or(RenderError::NoScene)?;
@@ -209,30 +261,31 @@ impl CubeTechnique {
     }
 }
 
-/// The cubes a frame with a history refreshes: slice `frame mod slices`, every cube whose
-/// bounding sphere differs from `refreshed` (its last refresh), and every cube in which an
-/// object whose sphere differs from `previous` (last frame) subtends `r / d ≥`
-/// [`NEIGHBOUR_ALPHA`].
+/// The cubes a frame with a history refreshes: slice `frame mod slices`, every `stale` cube
+/// (its object moved since its last refresh), and every cube in which a `moving` object (moved
+/// since last frame) subtends `r / d ≥` [`NEIGHBOUR_ALPHA`] now (`bounds`) or last frame
+/// (`previous`).
 fn refresh_list(
     bounds: &[[f32; 4]],
     previous: &[[f32; 4]],
-    refreshed: &[[f32; 4]],
+    moving: &[bool],
+    stale: &[bool],
     frame: u64,
     slices: u32,
 ) -> Vec<u32> {
-    let moving: Vec<usize> = (0..bounds.len())
-        .filter(|&i| bounds[i] != previous[i])
-        .collect();
+    let movers: Vec<usize> = (0..bounds.len()).filter(|&i| moving[i]).collect();
     let slice = frame % u64::from(slices.max(1));
+    let shows_in = |sphere: &[f32; 4], centre: Vec3| {
+        sphere[3] >= NEIGHBOUR_ALPHA * centre.distance(Vec3::from_slice(&sphere[..3]))
+    };
     (0..bounds.len())
         .filter(|&i| {
             let centre = Vec3::from_slice(&bounds[i][..3]);
             i as u64 % u64::from(slices.max(1)) == slice
-                || bounds[i] != refreshed[i]
-                || moving.iter().any(|&m| {
-                    let other = Vec3::from_slice(&bounds[m][..3]);
-                    bounds[m][3] >= NEIGHBOUR_ALPHA * centre.distance(other)
-                })
+                || stale[i]
+                || movers
+                    .iter()
+                    .any(|&m| shows_in(&bounds[m], centre) || shows_in(&previous[m], centre))
         })
         .map(|i| i as u32)
         .collect()
@@ -277,29 +330,50 @@ fn records(
 mod tests {
     use super::*;
 
-    /// Slice 1 of 4 holds cubes 1 and 5; cube 3 moved since its last refresh; cube 6 moves
-    /// this frame, so cube 7 refreshes when it stands close to it, cube 0 (far) does not.
+    /// Slice 1 of 4 holds cubes 1 and 5; cube 3 is stale; cube 6 moves this frame, so cube 7
+    /// refreshes when it stands close to where cube 6 is, or was, and cube 0 (far) does not.
     #[test]
     fn a_frame_refreshes_its_slice_and_what_moved() {
         let at = |x: f32| [x, 0.0, 0.0, 0.5];
         let mut bounds: Vec<[f32; 4]> = (0..8).map(|i| at(100.0 * i as f32)).collect();
         let mut previous = bounds.clone();
-        let mut refreshed = bounds.clone();
-        refreshed[3] = at(1.0);
+        let mut moving = vec![false; 8];
+        let mut stale = vec![false; 8];
+        stale[3] = true;
+        moving[6] = true;
+        stale[6] = true;
         previous[6] = at(601.0);
-        refreshed[6] = at(601.0);
         assert_eq!(
-            refresh_list(&bounds, &previous, &refreshed, 5, 4),
+            refresh_list(&bounds, &previous, &moving, &stale, 5, 4),
             [1, 3, 5, 6]
         );
-        for b in [&mut bounds, &mut previous, &mut refreshed] {
+        for b in [&mut bounds, &mut previous] {
             b[7] = at(602.0);
         }
         assert_eq!(
-            refresh_list(&bounds, &previous, &refreshed, 5, 4),
+            refresh_list(&bounds, &previous, &moving, &stale, 5, 4),
             [1, 3, 5, 6, 7]
         );
-        assert_eq!(refresh_list(&bounds, &bounds, &bounds, 5, 1).len(), 8);
+        // cube 6 jumps far away: cube 7 still sees where it was
+        bounds[6] = at(5000.0);
+        previous[6] = at(602.5);
+        assert_eq!(
+            refresh_list(&bounds, &previous, &moving, &stale, 5, 4),
+            [1, 3, 5, 6, 7]
+        );
+        let none = vec![false; 8];
+        assert_eq!(refresh_list(&bounds, &bounds, &none, &none, 5, 1).len(), 8);
+    }
+
+    #[test]
+    fn rounding_is_not_motion() {
+        let a = Mat4::from_translation(Vec3::new(3.0, 1.0, -2.0)).to_cols_array();
+        let mut b = a;
+        b[12] += 1e-7;
+        assert!(!moved(&a, &b));
+        b[12] += 1e-3;
+        assert!(moved(&a, &b));
+        assert!(moved(&a, &a[..8]));
     }
 
     #[test]

@@ -14,11 +14,12 @@
 //!   BVH per texel sample ([`SAMPLES`], 2×2 strata) is the same nearest-surface test over the
 //!   whole scene, static geometry included. Rays leave from the centre of the object's
 //!   bounding sphere, start where they exit the object's proxy spheres that hold that centre,
-//!   and step over later hits inside its proxy spheres: the object does not see itself (a
-//!   floor inside a proxy that pokes through it is skipped too). A hit sends what its surface reflects of the one-bounce light
-//!   (next-event estimation to the punctual lights, one cosine ray to the environment), the
-//!   light the path tracer counts; an escaped ray sees the environment. Seeds are fixed per
-//!   texel, so a still scene gives the same cube every frame.
+//!   and jump past every own proxy that holds a later hit: the object does not see itself (a
+//!   floor inside a proxy that pokes through it is skipped too; the spheres are grown by only
+//!   0.1%, so an object resting on a floor still sees it). A hit sends what its surface
+//!   reflects of the one-bounce light (next-event estimation to the punctual lights, one
+//!   cosine ray to the environment), the light the path tracer counts; an escaped ray sees the
+//!   environment. Seeds are fixed per texel, so a still scene gives the same cube every frame.
 //! * **Smoothing** as published (`Σ L max(0, n·d) / Σ max(0, n·d)` over every texel), or
 //!   weighted by each texel's solid angle ([`CubeLookup`] and `solid_angle`; the texels of a
 //!   6×6 face span solid angles 3.3× apart, corners smallest).

@@ -189,7 +189,7 @@ impl Renderer {
                 .cubes
                 .prepare(
                     rg,
-                    &frame.pose.world,
+                    &frame.pose,
                     bytemuck::cast_slice(&frame.lights),
                     &params,
                 )?
