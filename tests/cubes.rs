@@ -8,6 +8,7 @@
 
 mod common;
 
+use common::scenes::luminance;
 use glam::{Mat4, Vec3};
 use shine::capture::image_io::HdrImage;
 use shine::reference::render_reference;
@@ -80,16 +81,6 @@ fn ball_pixels(device: &shine::gpu::Device, scene: &Scene) -> Vec<usize> {
             b > 0.0 && to_ball.length_squared() - b * b < r * r
         })
         .map(|(p, _)| p)
-        .collect()
-}
-
-fn luminance(image: &HdrImage, pixels: &[usize]) -> Vec<f64> {
-    pixels
-        .iter()
-        .map(|&p| {
-            let t = image.texels[p];
-            f64::from(0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2])
-        })
         .collect()
 }
 

@@ -5,6 +5,7 @@
 
 mod common;
 
+use common::scenes::luminance;
 use glam::{Mat4, Vec3};
 use shine::capture::image_io::HdrImage;
 use shine::reference::render_reference;
@@ -85,17 +86,6 @@ fn floor_pixels(device: &shine::gpu::Device, scene: &Scene) -> Vec<usize> {
             on_floor && misses_ball
         })
         .map(|(p, _)| p)
-        .collect()
-}
-
-/// Luminance of `image` at `pixels`.
-fn luminance(image: &HdrImage, pixels: &[usize]) -> Vec<f64> {
-    pixels
-        .iter()
-        .map(|&p| {
-            let t = image.texels[p];
-            f64::from(0.2126 * t[0] + 0.7152 * t[1] + 0.0722 * t[2])
-        })
         .collect()
 }
 

@@ -35,8 +35,6 @@
 //! * **Diffuse only**: the receivers get `kd · L̄`; the traced specular pass still adds the
 //!   sharp part of their glossy lobes, the rough part is left out.
 
-use crate::gpu_scene::SceneHandles;
-use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::receivers::Receivers;
 use crate::shaders;
@@ -129,24 +127,8 @@ pub struct CubesPush {
 }
 
 /// The scene inputs of the fill: the surfaces, lights and BVH the rays meet, and the
-/// environment they escape to.
-#[derive(Debug, Clone, Copy)]
-pub struct CubeScene<'a> {
-    /// The scene's materials, textures, vertices, indices and lights.
-    pub handles: &'a SceneHandles,
-    /// The BVH.
-    pub bvh: &'a TraceBuffers,
-    /// Lights in `handles.lights`.
-    pub light_count: u32,
-    /// Sampler of the scene textures at ray hits (level 0).
-    pub texture_sampler: vk::Sampler,
-    /// The environment map (radiance of escaped rays).
-    pub environment: &'a Handle<Image>,
-    /// Its sampler.
-    pub environment_sampler: vk::Sampler,
-    /// The scene has an environment: hits are lit by it too.
-    pub environment_lighting: bool,
-}
+/// environment they escape to; the specular pass's rays read the same.
+pub type CubeScene<'a> = super::specular::SpecularScene<'a>;
 
 /// The cubes of one frame: their records, the proxy spheres naming their receivers, the
 /// cubes to refresh, and the texels they keep between frames.

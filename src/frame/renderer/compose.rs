@@ -12,7 +12,7 @@ use crate::frame::params::FrameParams;
 use crate::frame::shadows::ShadowState;
 use crate::gpu_scene::{SAMPLED_READ, SceneHandles};
 use crate::passes::composite::{self, Component, CompositeOutputs};
-use crate::passes::cubes::{self, CubeScene};
+use crate::passes::cubes;
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::Distribution;
@@ -197,6 +197,20 @@ impl Renderer {
             None => None,
         };
         let light_count = light_count(frame)?;
+        // What rays that meet the scene's surfaces read (the specular pass and the cubes'
+        // fill): level-0 texture lookups, and the environment where they escape, lighting the
+        // hits too when the scene has one.
+        let environment = (p.specular.is_some() || cubes.is_some())
+            .then(|| rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ));
+        let traced = environment.as_ref().map(|environment| SpecularScene {
+            handles,
+            bvh: &handles.trace,
+            light_count,
+            texture_sampler: self.textures_level0.raw(),
+            environment,
+            environment_sampler: self.environment_sampler.raw(),
+            environment_lighting: scene.has_environment,
+        });
 
         // HVL and IGI bounce light off RSM faces: placed by flux, every light's (the primary
         // light's first); on the paper's grid, the primary light's only (the first spot or
@@ -270,29 +284,16 @@ impl Renderer {
         };
         let low = sum(rg, "sky_add", low, sky_low)?;
         // Paper 001's environment cubes light the dynamic objects' receivers instead.
-        let low = match (cubes, &recv) {
-            (Some((params, mut inputs)), Some(receivers)) => {
-                let environment =
-                    rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ);
-                let cube_scene = CubeScene {
-                    handles,
-                    bvh: &handles.trace,
-                    light_count,
-                    texture_sampler: self.textures_level0.raw(),
-                    environment: &environment,
-                    environment_sampler: self.environment_sampler.raw(),
-                    environment_lighting: scene.has_environment,
-                };
-                Some(cubes::cubes(
-                    rg,
-                    &cube_scene,
-                    &mut inputs,
-                    receivers,
-                    low.as_ref(),
-                    camera.eye,
-                    &params,
-                ))
-            }
+        let low = match (cubes, &recv, &traced) {
+            (Some((params, mut inputs)), Some(receivers), Some(traced)) => Some(cubes::cubes(
+                rg,
+                traced,
+                &mut inputs,
+                receivers,
+                low.as_ref(),
+                camera.eye,
+                &params,
+            )),
             _ => low,
         };
         let upsampled = match (low, &recv) {
@@ -334,28 +335,16 @@ impl Renderer {
         let full = igi_full.or(aaf_full);
         let techniques = sum(rg, "gi_add_full", upsampled, full)?;
         // The sharp part of the glossy lobes, which the techniques above leave out.
-        let reflections = match p.specular {
-            Some(params) => {
-                let environment =
-                    rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ);
-                Some(specular::specular(
-                    rg,
-                    g,
-                    &SpecularScene {
-                        handles,
-                        bvh: &handles.trace,
-                        light_count,
-                        texture_sampler: self.textures_level0.raw(),
-                        environment: &environment,
-                        environment_sampler: self.environment_sampler.raw(),
-                        environment_lighting: scene.has_environment,
-                    },
-                    camera.eye,
-                    &params,
-                    sky_light::history_seed(rg, p),
-                )?)
-            }
-            None => None,
+        let reflections = match (p.specular, &traced) {
+            (Some(params), Some(traced)) => Some(specular::specular(
+                rg,
+                g,
+                traced,
+                camera.eye,
+                &params,
+                sky_light::history_seed(rg, p),
+            )?),
+            _ => None,
         };
         sum(rg, "specular_add", techniques, reflections)
     }
