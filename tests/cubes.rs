@@ -4,7 +4,7 @@
 //! (`gi = none`, `cubes.enabled`): its top sees the sky, its bottom the sky-lit floor. On the
 //! ball's pixels the frame must match the path tracer's energy and shading, for both lookups.
 //! Amortised (`cubes.slices`), a still scene gives the per-frame image, and a light that
-//! changes refreshes the cubes at once.
+//! changes, or an object that moves, refreshes at once the cubes it shows in.
 
 mod common;
 
@@ -239,6 +239,106 @@ fn amortised_cubes_converge_and_refresh_when_a_light_moves() {
     assert!(
         changed > 0.05,
         "the sun's turn changes the ball by {changed} only"
+    );
+    common::assert_clean(&device);
+}
+
+/// A second ball (its own node and cube) beside the first, 0.4 m across from it: `r/d` = 0.29
+/// in the first ball's cube.
+const SECOND: Vec3 = Vec3::new(1.4, 1.0, 0.0);
+const SECOND_RADIUS: f32 = 0.4;
+
+/// The ball scene with a second ball on a node of its own, with its proxy.
+fn two_balls() -> Scene {
+    let mut scene = scene();
+    let second = common::scenes::mesh_scene(
+        &[(
+            common::scenes::sphere(Vec3::ZERO, SECOND_RADIUS, true),
+            common::scenes::matte(0.5),
+        )],
+        Mat4::IDENTITY,
+        vec![],
+        None,
+    );
+    scene.meshes.push(second.meshes[0].clone());
+    let mut node = second.nodes[0].clone();
+    node.mesh = Some(1);
+    node.transform.translation = SECOND;
+    scene.nodes.push(node);
+    scene.roots.push(1);
+    scene.proxies.push(NodeProxies {
+        node: 1,
+        spheres: vec![ProxySphere {
+            center: [0.0; 3],
+            radius: SECOND_RADIUS,
+        }],
+        source: ProxySource::Explicit,
+    });
+    scene
+}
+
+/// Two cubes, `cubes.slices = 16`, the second ball lifted by 0.5 m at frame 3 (neither cube's
+/// slice comes round then): the lifted ball's cube refreshes because its object moved, the
+/// first ball's because the mover shows in it, and frame 3 equals a fresh render of the
+/// lifted scene on both balls (indirect light only). A cube left stale would show the floor
+/// from where the ball was.
+#[test]
+fn a_moving_object_refreshes_its_cube_and_its_neighbours() {
+    let device = common::device();
+    let scene = two_balls();
+    let lift = |k: u32| shine::gpu_scene::FrameUpdate {
+        nodes: if k >= 3 {
+            vec![(
+                1,
+                shine_scene::Transform {
+                    translation: SECOND + Vec3::new(0.0, 0.5, 0.0),
+                    ..shine_scene::Transform::default()
+                },
+            )]
+        } else {
+            vec![]
+        },
+        ..shine::gpu_scene::FrameUpdate::at(0.0)
+    };
+    let settings = [
+        ("cubes.slices", "16"),
+        ("history.frames", "1"),
+        ("output.component", "indirect"),
+    ];
+    let moved = sequence(&device, &scene, &settings, 4, lift);
+    let fresh = sequence(&device, &scene, &settings, 1, |_| lift(3));
+    let still = sequence(&device, &scene, &settings, 1, |_| lift(0));
+    // the first ball's pixels, and the pixels the cubes light in the lifted frame
+    let first = ball_pixels(&device, &scene);
+    let lit: Vec<usize> = (0..fresh.texels.len())
+        .filter(|&p| fresh.texels[p][1] > 0.0 && !first.contains(&p))
+        .collect();
+    let mask = sequence(
+        &device,
+        &scene,
+        &[("cubes.mask", "true"), ("output.component", "indirect")],
+        1,
+        |_| lift(3),
+    );
+    let second: Vec<usize> = lit
+        .into_iter()
+        .filter(|&p| mask.texels[p][1] == 1.0)
+        .collect();
+    assert!(
+        second.len() > 20,
+        "{} pixels of the second ball",
+        second.len()
+    );
+    for (name, pixels) in [("first", &first), ("second", &second)] {
+        let refreshed = difference(&moved, &fresh, pixels);
+        println!("{name} ball: {refreshed:.2e} from a fresh render");
+        assert!(refreshed < 1e-3, "{name}: {refreshed}");
+    }
+    let changed = difference(&still, &fresh, &first);
+    println!("the first ball's light, before and after the lift: {changed:.4}");
+    assert!(
+        changed > 1e-3,
+        "the lift changes the first ball by {changed} only"
     );
     common::assert_clean(&device);
 }
