@@ -75,11 +75,7 @@ fn ball_pixels(device: &shine::gpu::Device, scene: &Scene) -> Vec<usize> {
     common::scenes::pixel_rays(device, scene, SIZE)
         .iter()
         .enumerate()
-        .filter(|(_, (o, d))| {
-            let to_ball = BALL - *o;
-            let b = to_ball.dot(*d);
-            b > 0.0 && to_ball.length_squared() - b * b < r * r
-        })
+        .filter(|(_, (o, d))| common::scenes::ray_meets_sphere(*o, *d, BALL, r))
         .map(|(p, _)| p)
         .collect()
 }
@@ -173,6 +169,14 @@ fn sequence(
     last.expect("a frame")
 }
 
+/// A cube's slice comes round every 16 frames, no history blends the frames, and the frame
+/// shows the indirect light alone (on the balls: the cubes').
+const RARE_SLICES: [(&str, &str); 3] = [
+    ("cubes.slices", "16"),
+    ("history.frames", "1"),
+    ("output.component", "indirect"),
+];
+
 /// The largest difference on the ball's pixels relative to the mean there.
 fn difference(a: &HdrImage, b: &HdrImage, pixels: &[usize]) -> f64 {
     let (la, lb) = (luminance(a, pixels), luminance(b, pixels));
@@ -221,15 +225,9 @@ fn amortised_cubes_converge_and_refresh_when_a_light_moves() {
         lights: vec![(0, if k < 3 { before } else { after })],
         ..shine::gpu_scene::FrameUpdate::at(0.0)
     };
-    // the indirect light alone: the cube's, on the ball
-    let history_off = [
-        ("cubes.slices", "16"),
-        ("history.frames", "1"),
-        ("output.component", "indirect"),
-    ];
-    let turned = sequence(&device, &scene, &history_off, 4, turning);
-    let fresh = sequence(&device, &scene, &history_off, 1, |_| turning(3));
-    let stale = sequence(&device, &scene, &history_off, 1, |_| turning(0));
+    let turned = sequence(&device, &scene, &RARE_SLICES, 4, turning);
+    let fresh = sequence(&device, &scene, &RARE_SLICES, 1, |_| turning(3));
+    let stale = sequence(&device, &scene, &RARE_SLICES, 1, |_| turning(0));
     let refreshed = difference(&turned, &fresh, &pixels);
     let changed = difference(&stale, &fresh, &pixels);
     println!(
@@ -300,14 +298,9 @@ fn a_moving_object_refreshes_its_cube_and_its_neighbours() {
         },
         ..shine::gpu_scene::FrameUpdate::at(0.0)
     };
-    let settings = [
-        ("cubes.slices", "16"),
-        ("history.frames", "1"),
-        ("output.component", "indirect"),
-    ];
-    let moved = sequence(&device, &scene, &settings, 4, lift);
-    let fresh = sequence(&device, &scene, &settings, 1, |_| lift(3));
-    let still = sequence(&device, &scene, &settings, 1, |_| lift(0));
+    let moved = sequence(&device, &scene, &RARE_SLICES, 4, lift);
+    let fresh = sequence(&device, &scene, &RARE_SLICES, 1, |_| lift(3));
+    let still = sequence(&device, &scene, &RARE_SLICES, 1, |_| lift(0));
     // the first ball's pixels, and the pixels the cubes light in the lifted frame
     let first = ball_pixels(&device, &scene);
     let lit: Vec<usize> = (0..fresh.texels.len())

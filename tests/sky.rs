@@ -76,9 +76,7 @@ fn floor_pixels(device: &shine::gpu::Device, scene: &Scene) -> Vec<usize> {
         .iter()
         .enumerate()
         .filter(|(_, (o, d))| {
-            let to_ball = BALL - *o;
-            let b = to_ball.dot(*d);
-            let misses_ball = b <= 0.0 || to_ball.length_squared() - b * b > r * r;
+            let misses_ball = !common::scenes::ray_meets_sphere(*o, *d, BALL, r);
             let on_floor = d.y < 0.0 && {
                 let hit = *o + *d * (-o.y / d.y);
                 hit.x.abs() < 5.5 && hit.z.abs() < 5.5

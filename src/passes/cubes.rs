@@ -37,6 +37,7 @@
 
 use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::receivers::Receivers;
+use crate::passes::traced_scene::TracedScene;
 use crate::shaders;
 
 /// Texels along a cube face's side: paper 001's "ideal size" of 6×6×6.
@@ -126,10 +127,6 @@ pub struct CubesPush {
     pub config: [u32; 4],
 }
 
-/// The scene inputs of the fill: the surfaces, lights and BVH the rays meet, and the
-/// environment they escape to; the specular pass's rays read the same.
-pub type CubeScene<'a> = super::specular::SpecularScene<'a>;
-
 /// The cubes of one frame: their records, the proxy spheres naming their receivers, the
 /// cubes to refresh, and the texels they keep between frames.
 pub struct CubeInputs {
@@ -155,7 +152,7 @@ pub struct CubeInputs {
 /// result (RGBA16F at receiver resolution).
 pub fn cubes(
     rg: &mut RenderGraph,
-    scene: &CubeScene<'_>,
+    scene: &TracedScene<'_>,
     inputs: &mut CubeInputs,
     receivers: &Receivers,
     light: Option<&Handle<Image>>,
@@ -199,25 +196,16 @@ pub fn cubes(
 /// `cubes_fill` and `cubes_smooth` over the refreshed cubes of `inputs`.
 fn fill_and_smooth(
     rg: &mut RenderGraph,
-    scene: &CubeScene<'_>,
+    scene: &TracedScene<'_>,
     inputs: &mut CubeInputs,
     config: [u32; 4],
 ) {
     let mut pass = rg.compute("cubes_fill", &shaders::CUBES_COMP_FILL);
-    pass.read("materials", &scene.handles.materials)
-        .read("srgb_textures", &scene.handles.srgb_textures)
-        .read("linear_textures", &scene.handles.linear_textures)
-        .sampler("texture_sampler", scene.texture_sampler)
-        .read("vertices", &scene.handles.vertices)
-        .read("indices", &scene.handles.indices)
-        .read("lights", &scene.handles.lights)
-        .read("environment", scene.environment)
-        .sampler("environment_sampler", scene.environment_sampler)
-        .read("cubes", &inputs.cubes)
+    scene.bind(&mut pass);
+    pass.read("cubes", &inputs.cubes)
         .read("spheres", &inputs.spheres)
-        .read("refresh", &inputs.refresh);
-    scene.bvh.bind(&mut pass);
-    pass.write("radiance", &mut inputs.radiance)
+        .read("refresh", &inputs.refresh)
+        .write("radiance", &mut inputs.radiance)
         .push(&CubesPush {
             frame: [
                 inputs.refresh_count,

@@ -23,6 +23,7 @@ pub mod rsm;
 pub mod shadows;
 pub mod sky;
 pub mod specular;
+pub mod traced_scene;
 pub mod update_vertices;
 pub mod upsample;
 

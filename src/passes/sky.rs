@@ -147,14 +147,6 @@ pub fn sky(
     seed: u32,
 ) -> Result<Handle<Image>, SkyError> {
     params.validate()?;
-    let push = SkyPush {
-        extent: receivers.extent,
-        rays: params.rays,
-        seed: params.seed.wrapping_add(seed),
-        bent_normal: u32::from(params.bent_normal),
-        range: params.range,
-        pad: [0; 2],
-    };
     let irradiance = trace_pass(
         rg,
         "sky",
@@ -162,7 +154,8 @@ pub fn sky(
         &shaders::SKY_COMP_SKY,
         receivers,
         bvh,
-        &push,
+        params,
+        seed,
         |pass| {
             pass.read("environment", environment);
         },
@@ -193,8 +186,8 @@ pub fn sky(
 }
 
 /// One pass `name` of `shader` (a variant of `sky.comp`) over `receivers` with `bvh`, the
-/// inputs `extra` binds, and `push`; writes and returns a new RGBA16F image `output` at
-/// receiver resolution.
+/// inputs `extra` binds, and the rays of `params` (their seed plus `seed`); writes and returns
+/// a new RGBA16F image `output` at receiver resolution.
 #[allow(clippy::too_many_arguments)]
 fn trace_pass(
     rg: &mut RenderGraph,
@@ -203,9 +196,18 @@ fn trace_pass(
     shader: &'static crate::gpu::ShaderDesc,
     receivers: &Receivers,
     bvh: &TraceBuffers,
-    push: &SkyPush,
+    params: &SkyParams,
+    seed: u32,
     extra: impl FnOnce(&mut crate::graph::ComputePass<'_>),
 ) -> Handle<Image> {
+    let push = SkyPush {
+        extent: receivers.extent,
+        rays: params.rays,
+        seed: params.seed.wrapping_add(seed),
+        bent_normal: u32::from(params.bent_normal),
+        range: params.range,
+        pad: [0; 2],
+    };
     let [w, h] = receivers.extent;
     let mut out = rg.create_image(
         output,
@@ -216,7 +218,7 @@ fn trace_pass(
         .read("recv_normal", &receivers.normal);
     extra(&mut pass);
     bvh.bind(&mut pass);
-    pass.write("sky", &mut out).push(push).dispatch([w, h, 1]);
+    pass.write("sky", &mut out).push(&push).dispatch([w, h, 1]);
     out
 }
 
@@ -240,14 +242,6 @@ pub fn cavity(
     seed: u32,
 ) -> Result<Handle<Image>, SkyError> {
     params.validate()?;
-    let push = SkyPush {
-        extent: receivers.extent,
-        rays: params.rays,
-        seed: params.seed.wrapping_add(seed),
-        bent_normal: 0,
-        range: params.range,
-        pad: [0; 2],
-    };
     let shader = &shaders::SKY_COMP_CAVITY;
     Ok(trace_pass(
         rg,
@@ -256,7 +250,8 @@ pub fn cavity(
         shader,
         receivers,
         bvh,
-        &push,
+        params,
+        seed,
         |pass| {
             pass.read("light", light);
         },

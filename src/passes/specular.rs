@@ -27,10 +27,9 @@
 
 use std::ops::RangeInclusive;
 
-use crate::gpu_scene::SceneHandles;
-use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::gbuffer::GBuffer;
+use crate::passes::traced_scene::TracedScene;
 use crate::shaders;
 
 /// Default roughness limit: lobes rougher than this are left to the SH techniques.
@@ -106,32 +105,13 @@ pub struct SpecularPush {
     pub config: [u32; 4],
 }
 
-/// The scene as the reflection rays see it.
-#[derive(Debug, Clone, Copy)]
-pub struct SpecularScene<'a> {
-    /// The scene's buffers and textures.
-    pub handles: &'a SceneHandles,
-    /// Its BVH.
-    pub bvh: &'a TraceBuffers,
-    /// Lights in the light buffer.
-    pub light_count: u32,
-    /// The sampler of the scene's textures (level 0 at ray hits).
-    pub texture_sampler: vk::Sampler,
-    /// The environment (RGBA32F equirectangular) seen by rays that escape.
-    pub environment: &'a Handle<Image>,
-    /// Its sampler (linear, repeating in u, clamped in v).
-    pub environment_sampler: vk::Sampler,
-    /// The environment also lights the ray hits (one cosine-sampled, shadowed ray each).
-    pub environment_lighting: bool,
-}
-
 /// Adds the `specular` pass over the G-buffer `g` seen from `camera`; returns the reflected
 /// radiance towards the camera (RGBA16F, full resolution, a = 0). `seed` is added to the
 /// parameters' (the frame index when a history averages the frames).
 pub fn specular(
     rg: &mut RenderGraph,
     g: &GBuffer,
-    scene: &SpecularScene<'_>,
+    scene: &TracedScene<'_>,
     camera: glam::Vec3,
     params: &SpecularParams,
     seed: u32,
@@ -144,21 +124,12 @@ pub fn specular(
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
     let mut pass = rg.compute("specular", &shaders::SPECULAR_COMP);
-    pass.read("materials", &scene.handles.materials)
-        .read("srgb_textures", &scene.handles.srgb_textures)
-        .read("linear_textures", &scene.handles.linear_textures)
-        .sampler("texture_sampler", scene.texture_sampler)
-        .read("vertices", &scene.handles.vertices)
-        .read("indices", &scene.handles.indices)
-        .read("lights", &scene.handles.lights)
-        .read("environment", scene.environment)
-        .sampler("environment_sampler", scene.environment_sampler)
-        .read("gb_position", &g.position)
+    scene.bind(&mut pass);
+    pass.read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
         .read("gb_geometric_normal", &g.geometric_normal)
         .read("gb_albedo", &g.albedo)
         .read("gb_material", &g.material);
-    scene.bvh.bind(&mut pass);
     pass.write("specular", &mut out)
         .push(&SpecularPush {
             frame: [w, h, scene.light_count, frame_seed],

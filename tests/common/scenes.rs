@@ -185,3 +185,11 @@ pub fn luminance(image: &shine::capture::image_io::HdrImage, pixels: &[usize]) -
         })
         .collect()
 }
+
+/// Whether the ray `origin + t dir` (t > 0 at the sphere's nearest point; `dir` unit) passes
+/// within `r` of `centre`.
+pub fn ray_meets_sphere(origin: Vec3, dir: Vec3, centre: Vec3, r: f32) -> bool {
+    let to_centre = centre - origin;
+    let b = to_centre.dot(dir);
+    b > 0.0 && to_centre.length_squared() - b * b < r * r
+}

@@ -16,7 +16,8 @@ use crate::passes::cubes;
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::Distribution;
-use crate::passes::specular::{self, SpecularScene};
+use crate::passes::specular;
+use crate::passes::traced_scene::TracedScene;
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
 use shine_graph::{Handle, Image, RenderGraph};
 
@@ -202,7 +203,7 @@ impl Renderer {
         // hits too when the scene has one.
         let environment = (p.specular.is_some() || cubes.is_some())
             .then(|| rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ));
-        let traced = environment.as_ref().map(|environment| SpecularScene {
+        let traced = environment.as_ref().map(|environment| TracedScene {
             handles,
             bvh: &handles.trace,
             light_count,

@@ -1,0 +1,45 @@
+//! What rays that meet the scene's surfaces read: its materials, textures, vertices and
+//! lights (`shaders/include/path.glsl`, `surface.glsl`), its BVH, and the environment where
+//! they escape. Shared by the passes that shade ray hits with the one-bounce light: the
+//! traced specular reflections (`passes::specular`) and the environment cubes' fill
+//! (`passes::cubes`).
+
+use crate::gpu_scene::SceneHandles;
+use crate::gpu_scene::bvh::TraceBuffers;
+use crate::graph::{ComputePass, Handle, Image, vk};
+
+/// The scene as rays see it.
+#[derive(Debug, Clone, Copy)]
+pub struct TracedScene<'a> {
+    /// The scene's buffers and textures.
+    pub handles: &'a SceneHandles,
+    /// Its BVH.
+    pub bvh: &'a TraceBuffers,
+    /// Lights in the light buffer.
+    pub light_count: u32,
+    /// The sampler of the scene's textures (level 0 at ray hits).
+    pub texture_sampler: vk::Sampler,
+    /// The environment (RGBA32F equirectangular) seen by rays that escape.
+    pub environment: &'a Handle<Image>,
+    /// Its sampler (linear, repeating in u, clamped in v).
+    pub environment_sampler: vk::Sampler,
+    /// The environment also lights the ray hits (one cosine-sampled, shadowed ray each).
+    pub environment_lighting: bool,
+}
+
+impl TracedScene<'_> {
+    /// Binds the scene's bindings of `path.glsl`, `surface.glsl`, `trace.glsl` and
+    /// `environment.glsl` to `pass`.
+    pub fn bind(&self, pass: &mut ComputePass<'_>) {
+        pass.read("materials", &self.handles.materials)
+            .read("srgb_textures", &self.handles.srgb_textures)
+            .read("linear_textures", &self.handles.linear_textures)
+            .sampler("texture_sampler", self.texture_sampler)
+            .read("vertices", &self.handles.vertices)
+            .read("indices", &self.handles.indices)
+            .read("lights", &self.handles.lights)
+            .read("environment", self.environment)
+            .sampler("environment_sampler", self.environment_sampler);
+        self.bvh.bind(pass);
+    }
+}
