@@ -1,7 +1,14 @@
 // HVL gather (paper 003 §5.1, eq. 1, 3, 19-22): outgoing radiance towards the camera at each
 // receiver from every HVL of the cache (brute force, as the paper's prototype). As published,
-// HVLs are unshadowed (§6); the `_vis` variants (shine's extension) drop an HVL whose centre,
-// lifted off its surface by 1% of its radius, is hidden from the receiver by a BVH shadow ray.
+// HVLs are unshadowed (§6). The `_vis` and `_shadows` variants (shine's extension) shadow them
+// through the BVH, aiming each shadow ray at the HVL's centre lifted off its surface by 1% of
+// its radius; a receiver inside an HVL's sphere is never shadowed from it.
+//   `_vis`: one ray per receiver and HVL, `indirect` the shadowed sum.
+//   `_shadows`: push.shadow_rays = K rays per receiver, to HVLs drawn in proportion to their
+//     contribution c_j (K weighted reservoirs over the loop): `indirect` is the unbiased estimate
+//     S = sum_inside c_j + (W / K) sum_k v_k c_k / w_k   (w_j = c_j.r + c_j.g + c_j.b, W = sum w_j)
+//     and `unshadowed` the exact unshadowed sum U; hvl_shadow_filter.comp turns them into
+//     U * filter(S) / filter(U) (the ratio estimator of Heitz et al. 2018).
 //
 // Per HVL j at receiver x (omega_j: unit direction x -> y_j, a: half-angle of the sphere):
 //   L_j = Phi_j * max(0, F'_j . Y(-omega_j)) * G_j(-omega_j)               eq. 20, 21, 22
@@ -55,6 +62,26 @@
 //! variant zonal_c8_vis HVL_ZONAL=1 SH_BANDS=8 HVL_VISIBILITY=1
 //! variant zonal_c9_vis HVL_ZONAL=1 SH_BANDS=9 HVL_VISIBILITY=1
 //! variant zonal_c10_vis HVL_ZONAL=1 SH_BANDS=10 HVL_VISIBILITY=1
+//! variant full_c1_shadows HVL_FULL=1 SH_BANDS=1 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c2_shadows HVL_FULL=1 SH_BANDS=2 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c3_shadows HVL_FULL=1 SH_BANDS=3 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c4_shadows HVL_FULL=1 SH_BANDS=4 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c5_shadows HVL_FULL=1 SH_BANDS=5 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c6_shadows HVL_FULL=1 SH_BANDS=6 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c7_shadows HVL_FULL=1 SH_BANDS=7 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c8_shadows HVL_FULL=1 SH_BANDS=8 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c9_shadows HVL_FULL=1 SH_BANDS=9 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant full_c10_shadows HVL_FULL=1 SH_BANDS=10 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c1_shadows HVL_ZONAL=1 SH_BANDS=1 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c2_shadows HVL_ZONAL=1 SH_BANDS=2 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c3_shadows HVL_ZONAL=1 SH_BANDS=3 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c4_shadows HVL_ZONAL=1 SH_BANDS=4 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c5_shadows HVL_ZONAL=1 SH_BANDS=5 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c6_shadows HVL_ZONAL=1 SH_BANDS=6 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c7_shadows HVL_ZONAL=1 SH_BANDS=7 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c8_shadows HVL_ZONAL=1 SH_BANDS=8 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c9_shadows HVL_ZONAL=1 SH_BANDS=9 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
+//! variant zonal_c10_shadows HVL_ZONAL=1 SH_BANDS=10 HVL_VISIBILITY=1 HVL_SHADOW_SAMPLES=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require
@@ -88,6 +115,14 @@ layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
 
 #include "hvl_resolve.glsl"
 
+#ifdef HVL_SHADOW_SAMPLES
+layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D unshadowed;
+#include "random.glsl"
+
+// Most shadow rays per receiver of the sampled visibility: shine::passes::hvl::shadows::RAYS_MAX.
+#define HVL_SHADOW_RAYS_MAX 4
+#endif
+
 #ifdef HVL_VISIBILITY
 #define TRACE_NODES_BINDING 7
 #define TRACE_TRIANGLES_BINDING 8
@@ -99,6 +134,18 @@ layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
 // sender's normal by this fraction of the HVL radius (plus 0.1 mm), so the sender itself never
 // hides it.
 const float HVL_VISIBILITY_LIFT = 0.01;
+
+// Where a shadow ray to an HVL aims: its centre lifted along its normal.
+vec3 hvl_shadow_target(vec4 position_radius, vec3 hvl_normal) {
+    return position_radius.xyz + normalize(hvl_normal) * (HVL_VISIBILITY_LIFT * position_radius.w + 1e-4);
+}
+
+// Whether the segment from origin to target is blocked.
+bool trace_occluded_by(vec3 origin, vec3 target) {
+    vec3 to_target = target - origin;
+    float reach = length(to_target);
+    return trace_occluded(origin, to_target / reach, 0.0, reach);
+}
 #endif
 
 // shine::passes::hvl::GatherPush
@@ -123,8 +170,10 @@ layout(push_constant) uniform Push {
     float window_width;
     // 1: the disc's near-field falloff (hvl_disc_falloff); 0: the paper's sphere
     uint disc_falloff;
-    uint pad1;
-    uint pad2;
+    // `_shadows` variants: shadow rays per receiver, 1..HVL_SHADOW_RAYS_MAX
+    uint shadow_rays;
+    // seed of the sampled shadow rays' random numbers
+    uint seed;
 } push;
 
 // Receivers closer than this to an HVL centre get nothing from it (metres).
@@ -140,6 +189,14 @@ void glossy_row(float roughness, float theta_o, out float f[SH_COEFFS]) {
     brdf_table_glossy_row(roughness, push.roughness_nodes, push.glossy_tables, theta_o, f);
 }
 #endif
+
+// No light at px (background, or a receiver seen from behind).
+void store_nothing(ivec2 px) {
+    imageStore(indirect, px, vec4(0.0));
+#ifdef HVL_SHADOW_SAMPLES
+    imageStore(unshadowed, px, vec4(0.0));
+#endif
+}
 
 void main() {
     ivec2 px = ivec2(gl_GlobalInvocationID.xy);
@@ -160,7 +217,7 @@ void main() {
     }
     vec4 position = imageLoad(recv_position, px);
     if (position.w == 0.0) {
-        imageStore(indirect, px, vec4(0.0));
+        store_nothing(px);
         return;
     }
     vec3 x = position.xyz;
@@ -176,7 +233,7 @@ void main() {
 #ifdef HVL_FULL
     ks = brdf_table_fresnel_weight(ks, cos_o) * (1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w));
     if (cos_o <= 0.0) {
-        imageStore(indirect, px, vec4(0.0));
+        store_nothing(px);
         return;
     }
     // Receiver frame of the tables: z = n, omega_o in the xz half-plane (phi_o = 0, eq. 17).
@@ -202,6 +259,23 @@ void main() {
         win[l] = push.window_width > 0.0 ? sh_window_sinc(l, push.window_width) : 1.0;
     }
     vec3 sum = vec3(0.0);
+#ifdef HVL_VISIBILITY
+    vec3 origin = trace_offset(x, n);
+#endif
+#ifdef HVL_SHADOW_SAMPLES
+    // The unshadowed sum, and the reservoirs: each keeps one HVL (its index, contribution and
+    // weight), all drawn over the same running total weight.
+    vec3 unshadowed_sum = vec3(0.0);
+    uint pick[HVL_SHADOW_RAYS_MAX];
+    vec4 pick_light[HVL_SHADOW_RAYS_MAX];
+    SH_UNROLL for (int k = 0; k < HVL_SHADOW_RAYS_MAX; ++k) {
+        pick[k] = 0u;
+        pick_light[k] = vec4(0.0);
+    }
+    float weight_total = 0.0;
+    int rays = int(clamp(push.shadow_rays, 1u, uint(HVL_SHADOW_RAYS_MAX)));
+    rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y)) ^ pcg(push.seed + 0x9e3779b9u);
+#endif
     for (uint j = 0u; j < push.hvl_count; ++j) {
         // Field by field: naga cannot read the OpCopyLogical of a whole-struct load.
         vec4 position_radius = hvls.h[j].position_radius;
@@ -221,15 +295,9 @@ void main() {
         if (!(g > 0.0)) {
             continue;
         }
-#ifdef HVL_VISIBILITY
-        if (dist > r) {
-            vec3 origin = trace_offset(x, n);
-            vec3 target = position_radius.xyz + normalize(hvl_normal) * (HVL_VISIBILITY_LIFT * r + 1e-4);
-            vec3 to_target = target - origin;
-            float reach = length(to_target);
-            if (trace_occluded(origin, to_target / reach, 0.0, reach)) {
-                continue;
-            }
+#if defined(HVL_VISIBILITY) && !defined(HVL_SHADOW_SAMPLES)
+        if (dist > r && trace_occluded_by(origin, hvl_shadow_target(position_radius, hvl_normal))) {
+            continue;
         }
 #endif
         float emission[8];
@@ -248,15 +316,48 @@ void main() {
         SH_UNROLL for (int i = 0; i < SH_COEFFS; ++i) {
             cap[i] *= win[int(sqrt(float(i) + 0.5))];
         }
-        sum += max(vec3(0.0), lj * (kd * sh_dot(cap, f_lambert) + ks * sh_dot(cap, f_glossy)));
+        vec3 c = max(vec3(0.0), lj * (kd * sh_dot(cap, f_lambert) + ks * sh_dot(cap, f_glossy)));
 #else
         float cap[SH_BANDS];
         sh_cap_zh(cos_a, cap);
         SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
             cap[l] *= win[l];
         }
-        sum += max(vec3(0.0), lj * kd * (hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
+        vec3 c = max(vec3(0.0), lj * kd * (hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
+#endif
+#ifdef HVL_SHADOW_SAMPLES
+        unshadowed_sum += c;
+        float w = c.r + c.g + c.b;
+        if (dist <= r || !(w > 0.0)) {
+            sum += c;
+            continue;
+        }
+        weight_total += w;
+        // One random number per HVL, rotated by k / K for reservoir k (each uniform on its own).
+        float u = rand();
+        SH_UNROLL for (int k = 0; k < HVL_SHADOW_RAYS_MAX; ++k) {
+            if (k < rays && fract(u + float(k) / float(rays)) * weight_total < w) {
+                pick[k] = j;
+                pick_light[k] = vec4(c, w);
+            }
+        }
+#else
+        sum += c;
 #endif
     }
+#ifdef HVL_SHADOW_SAMPLES
+    if (weight_total > 0.0) {
+        vec3 visible = vec3(0.0);
+        for (int k = 0; k < rays; ++k) {
+            uint j = pick[k];
+            vec3 target = hvl_shadow_target(hvls.h[j].position_radius, hvls.h[j].normal_distance.xyz);
+            if (!trace_occluded_by(origin, target)) {
+                visible += pick_light[k].rgb / pick_light[k].a;
+            }
+        }
+        sum += visible * (weight_total / float(rays));
+    }
+    imageStore(unshadowed, px, vec4(unshadowed_sum, 0.0));
+#endif
     imageStore(indirect, px, vec4(sum, 0.0));
 }

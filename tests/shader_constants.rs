@@ -66,10 +66,14 @@ fn tonemap_ids_match_the_shader() {
 }
 
 #[test]
-fn hvl_emission_bands_match_the_shader() {
+fn hvl_emission_bands_and_shadow_rays_match_the_shader() {
     assert_eq!(
         glsl_uint("include/hvl.glsl", "HVL_EMISSION_MAX_BANDS") as usize,
         EMISSION_MAX_BANDS
+    );
+    assert_eq!(
+        glsl_uint("hvl_gather.comp", "HVL_SHADOW_RAYS_MAX"),
+        shine::passes::hvl::shadows::RAYS_MAX
     );
 }
 

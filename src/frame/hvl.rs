@@ -46,6 +46,8 @@ pub struct HvlInputs<'a> {
     pub camera: Vec3,
     /// The G-buffer's motion vectors (amortised frames reproject with them).
     pub motion: &'a Handle<Image>,
+    /// Seed of the sampled shadow rays (the frame index when a history averages frames).
+    pub seed: u32,
 }
 
 impl HvlTechnique {
@@ -115,8 +117,10 @@ impl PreparedHvl {
         rg: &mut RenderGraph,
         inputs: &HvlInputs<'_>,
     ) -> Result<Handle<Image>, RenderError> {
-        let hvls = hvl::hvl_cache(rg, inputs.rsm, &self.params)?;
-        let bvh = self.params.visibility.then_some(inputs.bvh);
+        let mut params = self.params;
+        params.shadows.seed = inputs.seed;
+        let hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
+        let bvh = params.visibility.then_some(inputs.bvh);
         let (slice, has_history) = self.amortised.unwrap_or((0, false));
         let mut gathered = hvl::hvl_gather(
             rg,
@@ -125,7 +129,7 @@ impl PreparedHvl {
             &self.brdf,
             bvh,
             inputs.camera,
-            &self.params,
+            &params,
             slice,
         )?;
         if self.amortised.is_none() {
@@ -150,7 +154,7 @@ impl PreparedHvl {
                 &self.brdf,
                 bvh,
                 inputs.camera,
-                &self.params,
+                &params,
                 &mut gathered,
             )?;
         }

@@ -9,6 +9,7 @@ use crate::passes::cubes::CubeParams;
 use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParams};
 use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::HvlParams;
+use crate::passes::hvl::shadows::ShadowSampling;
 use crate::passes::igi::IgiParams;
 use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
 use crate::passes::sky::SkyParams;
@@ -111,6 +112,11 @@ impl FrameParams {
             ..SpecularParams::default()
         });
         let specular_limit = specular.map_or(0.0, |s| s.limit);
+        let upsample = UpsampleParams {
+            depth_sigma: settings.upsample.depth_epsilon,
+            normal_power: settings.upsample.normal_power,
+            ..UpsampleParams::default()
+        };
         Self {
             extent: [settings.width, settings.height],
             receiver_scale: settings.receiver_scale,
@@ -134,6 +140,12 @@ impl FrameParams {
                 window: h.window,
                 falloff: h.falloff,
                 visibility: h.visibility,
+                shadows: ShadowSampling {
+                    rays: h.shadow_rays,
+                    filter_radius: h.shadow_filter_radius,
+                    matching: upsample,
+                    seed: 0,
+                },
                 slices: h.slices,
                 specular_limit,
             }),
@@ -205,11 +217,7 @@ impl FrameParams {
                 mask: settings.cubes.mask,
                 slices: settings.cubes.slices,
             }),
-            upsample: UpsampleParams {
-                depth_sigma: settings.upsample.depth_epsilon,
-                normal_power: settings.upsample.normal_power,
-                ..UpsampleParams::default()
-            },
+            upsample,
             history: (settings.history.frames > 1).then_some(AccumulateParams {
                 max_frames: settings.history.frames,
                 clip: settings.history.clip,

@@ -332,6 +332,7 @@ pub fn vpls(
         window: hvl::Window::None,
         falloff: hvl::Falloff::Sphere,
         visibility: false,
+        shadows: hvl::shadows::ShadowSampling::default(),
         slices: 1,
         specular_limit: 0.0,
     };

@@ -253,9 +253,16 @@ pub struct HvlSettings {
     /// emission is isotropic and needs band 0 only (paper 003 eq. 20): more bands change
     /// nothing until glossy senders exist.
     pub emission_bands: u32,
-    /// Shadow rays through the scene's BVH from every receiver to every HVL (shine's
-    /// extension: paper 003's HVLs are unshadowed). Default false.
+    /// Shadow the HVLs through the scene's BVH (shine's extension: paper 003's HVLs are
+    /// unshadowed). Default false.
     pub visibility: bool,
+    /// With `visibility`: shadow rays per receiver, to HVLs drawn in proportion to their
+    /// light and denoised by a ratio estimator (`src/passes/hvl/shadows.rs`); 0 traces one
+    /// ray per receiver and HVL (exact, about 8× the gather's cost). Range 0..=4, default 4;
+    /// above 0 needs `slices = 1`.
+    pub shadow_rays: u32,
+    /// Radius in receivers of the sampled shadows' ratio filter. Range 0..=8, default 3.
+    pub shadow_filter_radius: u32,
     /// Gather path: `full` (any BRDF, O(n²)) or `zonal` (symmetric lobes, O(n)).
     /// Default `full`.
     pub gather: GatherPath,
@@ -459,6 +466,8 @@ impl Default for HvlSettings {
             convolution_bands: h.conv_bands,
             emission_bands: h.emission_bands,
             visibility: h.visibility,
+            shadow_rays: h.shadows.rays,
+            shadow_filter_radius: h.shadows.filter_radius,
             gather: h.path,
             window: h.window,
             falloff: h.falloff,

@@ -251,6 +251,7 @@ impl Renderer {
             // No primary light: the HVL passes (and their history) are not in this frame.
             self.hvl.reset();
         }
+        let hvl_seed = sky_light::history_seed(rg, p);
         let hvl_low = match (hvl, rsm, &recv) {
             (Some(hvl), Some(rsm), Some(receivers)) => Some(hvl.declare(
                 rg,
@@ -260,6 +261,7 @@ impl Renderer {
                     bvh: &handles.trace,
                     camera: camera.eye,
                     motion: &g.motion,
+                    seed: hvl_seed,
                 },
             )?),
             _ => None,

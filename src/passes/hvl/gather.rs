@@ -5,7 +5,7 @@ use glam::Vec3;
 
 use super::{
     Falloff, GatherPath, GatherPush, HvlError, HvlParams, Window, cache_bytes, check_extent,
-    resolve,
+    resolve, shadows,
 };
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
@@ -13,12 +13,14 @@ use crate::passes::brdf_tables::{
     GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
 };
 use crate::passes::receivers::Receivers;
+use shadows::Shadowing;
 
 /// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
 /// radiance towards `camera` from all `params.count` HVLs of `hvls`, 0 on background), returned.
 /// `brdf` holds [`GatherBrdf::gpu_data`] at `params.conv_bands` bands (unused by the zonal
 /// path); `bvh` is needed when `params.visibility` is set. `slice` 0 shades every receiver,
-/// 1 + k one per 2×2 cell (the others are left undefined: `hvl_resolve` fills them).
+/// 1 + k one per 2×2 cell (the others are left undefined: `hvl_resolve` fills them). Sampled
+/// shadow rays ([`shadows`]) add `hvl_shadow_filter`, whose output is returned.
 #[allow(clippy::too_many_arguments)]
 pub fn hvl_gather(
     rg: &mut RenderGraph,
@@ -36,8 +38,14 @@ pub fn hvl_gather(
         "indirect",
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
-    record_gather(rg, shader, &inputs, params, &mut indirect, slice);
-    Ok(indirect)
+    Ok(
+        match record_gather(rg, shader, &inputs, params, &mut indirect, slice) {
+            Some(unshadowed) => {
+                shadows::shadow_filter(rg, receivers, &indirect, &unshadowed, &params.shadows)
+            }
+            None => indirect,
+        },
+    )
 }
 
 /// Adds `hvl_regather`: the gather at the receivers `hvl_regather_mask` marked in `target`
@@ -122,7 +130,8 @@ impl<'a> GatherInputs<'a> {
     }
 }
 
-/// Records one gather pass of `slice` into `indirect`.
+/// Records one gather pass of `slice` into `indirect`; with sampled shadows, returns the
+/// unshadowed sum the `_shadows` variants also write.
 fn record_gather(
     rg: &mut RenderGraph,
     shader: &'static crate::gpu::ShaderDesc,
@@ -130,7 +139,7 @@ fn record_gather(
     params: &HvlParams,
     indirect: &mut Handle<Image>,
     slice: u32,
-) {
+) -> Option<Handle<Image>> {
     let (receivers, camera) = (inputs.receivers, inputs.camera);
     let [w, h] = receivers.extent;
     let push = GatherPush {
@@ -146,13 +155,21 @@ fn record_gather(
             Window::Sinc => params.conv_bands as f32,
         },
         disc_falloff: u32::from(params.falloff == Falloff::Disc),
-        pad: [0; 2],
+        shadow_rays: params.shadows.rays,
+        seed: params.shadows.seed,
     };
     let (name, threads) = match slice {
         0 => ("hvl_gather", [w, h, 1]),
         resolve::REGATHER_SLICE => ("hvl_regather", [w, h, 1]),
         _ => ("hvl_gather", [w.div_ceil(2), h.div_ceil(2), 1]),
     };
+    let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
+    let mut unshadowed = sampled.then(|| {
+        rg.create_image(
+            "hvl_unshadowed",
+            ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+        )
+    });
     let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
@@ -165,7 +182,11 @@ fn record_gather(
     if let Some(b) = inputs.bvh {
         b.bind(&mut pass);
     }
+    if let Some(u) = unshadowed.as_mut() {
+        pass.write("unshadowed", u);
+    }
     pass.write("indirect", indirect)
         .push(&push)
         .dispatch(threads);
+    unshadowed
 }

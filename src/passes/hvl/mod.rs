@@ -38,8 +38,9 @@
 //!   Each record stores it (5 bands), the gather reconstructs `F'·Y(-ω_j)` to the emission band
 //!   count of its variant and clamps it at 0 (band-limited ringing).
 //! * **Visibility.** As published, HVLs are unshadowed (§6). [`HvlParams::visibility`] adds
-//!   one BVH shadow ray per receiver and HVL, to the HVL's centre lifted off its surface
-//!   (shine's extension; measured against the path tracer in the issue notes).
+//!   BVH shadow rays to the HVLs' centres lifted off their surfaces (shine's extension): one
+//!   per receiver and HVL, or a few per receiver to HVLs drawn by contribution and denoised by
+//!   a ratio estimator ([`shadows`]).
 //! * **Ringing.** Each HVL's contribution is clamped at 0 per channel so band-limited ringing
 //!   never makes `indirect` negative. The paper's sinc window (§4.2) is [`Window::Sinc`], off
 //!   by default: it costs 5–7% of the energy for no visible ringing (docs/quality.md).
@@ -85,6 +86,7 @@ pub mod flux;
 mod gather;
 mod grid;
 pub mod resolve;
+pub mod shadows;
 pub use gather::{hvl_gather, hvl_regather};
 pub use grid::HvlGrid;
 
@@ -163,8 +165,10 @@ pub struct GatherPush {
     pub window_width: f32,
     /// 1: [`Falloff::Disc`]; 0: the paper's sphere.
     pub disc_falloff: u32,
-    /// Padding.
-    pub pad: [u32; 2],
+    /// `_vis` variants: shadow rays per receiver ([`shadows::ShadowSampling::rays`]).
+    pub shadow_rays: u32,
+    /// Seed of the sampled shadow rays.
+    pub seed: u32,
 }
 
 crate::choice::named_choice! {
@@ -245,9 +249,11 @@ pub struct HvlParams {
     pub window: Window,
     /// Near-field falloff of each HVL.
     pub falloff: Falloff,
-    /// Shadow rays from each receiver to each HVL through the scene's BVH (not in paper 003,
+    /// Shadow rays from each receiver to the HVLs through the scene's BVH (not in paper 003,
     /// whose HVLs are unshadowed).
     pub visibility: bool,
+    /// How many shadow rays, and the filter of sampled ones (with `visibility`).
+    pub shadows: shadows::ShadowSampling,
     /// Receivers per refresh: 1 gathers every receiver every frame; [`resolve::SLICES`]
     /// gathers one per 2×2 cell and reprojects the rest (paper 001).
     pub slices: u32,
@@ -273,6 +279,7 @@ impl Default for HvlParams {
             window: Window::None,
             falloff: Falloff::Sphere,
             visibility: false,
+            shadows: shadows::ShadowSampling::default(),
             slices: 1,
             specular_limit: 0.0,
         }
@@ -360,19 +367,20 @@ pub const GATHER_COUNT: RangeInclusive<u32> = 1..=MAX_HVLS;
 /// The user scale k of the radii (paper 003 §5.3: "between 1 and 2").
 pub const RADIUS_SCALE: RangeInclusive<f32> = 1.0..=2.0;
 
-/// The `hvl_gather.comp` variants: `(path, conv_bands, visibility, shader)` for every path,
-/// every band count of [`CONV_BANDS`] and with or without shadow rays (variants `full_cN`,
-/// `zonal_cN`, `full_cN_vis`, `zonal_cN_vis`).
-pub fn gather_variants() -> Vec<(GatherPath, u32, bool, &'static ShaderDesc)> {
+/// The `hvl_gather.comp` variants: `(path, conv_bands, shadowing, shader)` for every path,
+/// every band count of [`CONV_BANDS`] and every [`shadows::Shadowing`] (variants `full_cN`,
+/// `zonal_cN`, then `_vis` and `_shadows` after them).
+pub fn gather_variants() -> Vec<(GatherPath, u32, shadows::Shadowing, &'static ShaderDesc)> {
+    use shadows::Shadowing;
     let mut variants = Vec::new();
     for (path, name) in [(GatherPath::Full, "full"), (GatherPath::Zonal, "zonal")] {
-        for visibility in [false, true] {
+        for shadowing in [Shadowing::None, Shadowing::EveryHvl, Shadowing::Sampled] {
             for bands in CONV_BANDS {
-                let suffix = if visibility { "_vis" } else { "" };
+                let suffix = shadowing.suffix();
                 if let Some(shader) =
                     shaders::get(&format!("hvl_gather.comp:{name}_c{bands}{suffix}"))
                 {
-                    variants.push((path, bands, visibility, shader));
+                    variants.push((path, bands, shadowing, shader));
                 }
             }
         }
@@ -380,20 +388,21 @@ pub fn gather_variants() -> Vec<(GatherPath, u32, bool, &'static ShaderDesc)> {
     variants
 }
 
-/// The gather shader for `params` (its path, convolution bands and visibility), or
+/// The gather shader for `params` (its path, convolution bands and shadowing), or
 /// [`HvlError::Variant`].
 pub fn gather_shader(params: &HvlParams) -> Result<&'static ShaderDesc, HvlError> {
     let variants = gather_variants();
+    let shadowing = shadows::Shadowing::of(params.visibility, &params.shadows);
     variants
         .iter()
-        .find(|v| v.0 == params.path && v.1 == params.conv_bands && v.2 == params.visibility)
+        .find(|v| v.0 == params.path && v.1 == params.conv_bands && v.2 == shadowing)
         .map(|v| v.3)
         .ok_or_else(|| HvlError::Variant {
             conv_bands: params.conv_bands,
             path: params.path,
             available: variants
                 .iter()
-                .map(|v| format!("{:?} c{}{}", v.0, v.1, if v.2 { " vis" } else { "" }))
+                .map(|v| format!("{:?} c{}{}", v.0, v.1, v.2.suffix()))
                 .collect::<Vec<_>>()
                 .join(", "),
         })
@@ -439,6 +448,9 @@ impl HvlParams {
                 expected: format!("{CONV_BANDS:?}"),
             });
         }
+        if self.visibility {
+            self.validate_shadows()?;
+        }
         if !EMISSION_BANDS.contains(&self.emission_bands) || self.emission_bands > self.conv_bands {
             return Err(HvlError::OutOfRange {
                 name: "emission_bands",
@@ -447,6 +459,38 @@ impl HvlParams {
             });
         }
         gather_shader(self)
+    }
+}
+
+impl HvlParams {
+    /// Checks the shadow sampling: rays and filter radius in range, and sampled rays only on
+    /// frames that gather every receiver (the filter reads each receiver's neighbours).
+    fn validate_shadows(&self) -> Result<(), HvlError> {
+        let s = &self.shadows;
+        for (name, value, range) in [
+            ("shadow_rays", s.rays, shadows::RAYS_RANGE),
+            (
+                "shadow_filter_radius",
+                s.filter_radius,
+                shadows::FILTER_RADIUS_RANGE,
+            ),
+        ] {
+            if !range.contains(&value) {
+                return Err(HvlError::OutOfRange {
+                    name,
+                    value: f64::from(value),
+                    expected: format!("{range:?}"),
+                });
+            }
+        }
+        if s.rays > 0 && self.slices > 1 {
+            return Err(HvlError::OutOfRange {
+                name: "shadow_rays",
+                value: f64::from(s.rays),
+                expected: "0 (one ray per HVL) when the gather is amortised over slices".to_owned(),
+            });
+        }
+        Ok(())
     }
 }
 

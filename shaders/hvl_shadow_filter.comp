@@ -1,0 +1,81 @@
+// HVL shadow filter (src/passes/hvl/shadows.rs): the sampled visibility of hvl_gather.comp's
+// `_vis` variants leaves each receiver with an unbiased but noisy shadowed estimate S next to
+// its exact unshadowed sum U. The ratio estimator (Heitz, Hill and McGuire 2018, "Combining
+// analytic direct illumination and stochastic shadows") keeps U's detail and filters only the
+// shadowing: per channel,
+//   out = U * min(1, sum_q w_q S_q / sum_q w_q U_q)
+// over the (2R+1)^2 receivers q around the receiver, with
+//   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R / 2)
+// the sky filter's weights (paper 002 eq. 11's match with the upsample's sigma_z and normal
+// exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility is.
+// Where sum w U is 0 the receiver takes S.
+// Writes RGBA16F, a = 0, 0 on background. CPU twin: shine::passes::hvl::shadows::ratio_filter.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "bilateral.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
+layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D shadowed;
+layout(set = 0, binding = 3, rgba16f) readonly uniform image2D unshadowed;
+layout(set = 0, binding = 4, rgba16f) writeonly uniform image2D filtered;
+
+// shine::passes::hvl::shadows::ShadowFilterPush (32 bytes).
+layout(push_constant) uniform Push {
+    // receiver buffer size
+    uvec2 extent;
+    // R: the filter's radius in receivers (0: the receiver's own ratio)
+    uint radius;
+    // sigma_z and n of the bilateral match
+    float depth_sigma;
+    float normal_power;
+    uint pad0;
+    uint pad1;
+    uint pad2;
+} push;
+
+void main() {
+    uvec2 xy = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(xy, push.extent))) {
+        return;
+    }
+    ivec2 ixy = ivec2(xy);
+    vec4 position = imageLoad(recv_position, ixy);
+    vec3 n = imageLoad(recv_normal, ixy).xyz;
+    if (!(position.w > 0.0) || dot(n, n) <= 0.0) {
+        imageStore(filtered, ixy, vec4(0.0));
+        return;
+    }
+    n = normalize(n);
+    int r = int(push.radius);
+    float inv_two_sigma2 = r > 0 ? 2.0 / float(r * r) : 0.0;
+    ivec2 last = ivec2(push.extent) - 1;
+    vec3 num = vec3(0.0);
+    vec3 den = vec3(0.0);
+    for (int dy = -r; dy <= r; ++dy) {
+        for (int dx = -r; dx <= r; ++dx) {
+            ivec2 c = ixy + ivec2(dx, dy);
+            if (any(lessThan(c, ivec2(0))) || any(greaterThan(c, last))) {
+                continue;
+            }
+            vec4 pc = imageLoad(recv_position, c);
+            if (!(pc.w > 0.0)) {
+                continue;
+            }
+            float w = exp(-float(dx * dx + dy * dy) * inv_two_sigma2)
+                * bilateral_match(position.w, n, pc.w, imageLoad(recv_normal, c).xyz,
+                    push.depth_sigma, push.normal_power);
+            num += w * imageLoad(shadowed, c).rgb;
+            den += w * imageLoad(unshadowed, c).rgb;
+        }
+    }
+    vec3 u = imageLoad(unshadowed, ixy).rgb;
+    vec3 s = imageLoad(shadowed, ixy).rgb;
+    vec3 out_light;
+    for (int i = 0; i < 3; ++i) {
+        out_light[i] = den[i] > 0.0 ? u[i] * min(1.0, num[i] / den[i]) : s[i];
+    }
+    imageStore(filtered, ixy, vec4(out_light, 0.0));
+}
