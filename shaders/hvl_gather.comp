@@ -8,7 +8,8 @@
 //     contribution c_j (K weighted reservoirs over the loop): `indirect` is the unbiased estimate
 //     S = sum_inside c_j + (W / K) sum_k v_k c_k / w_k   (w_j = c_j.r + c_j.g + c_j.b, W = sum w_j)
 //     and `unshadowed` the exact unshadowed sum U; hvl_shadow_filter.comp turns them into
-//     U * filter(S) / filter(U) (the ratio estimator of Heitz et al. 2018).
+//     U * filter(S) / filter(U) (the ratio estimator of Heitz et al. 2018). Regathered
+//     receivers (amortised frames) are scattered and take U * min(1, S / U) here.
 //
 // Per HVL j at receiver x (omega_j: unit direction x -> y_j, a: half-angle of the sphere):
 //   L_j = Phi_j * max(0, F'_j . Y(-omega_j)) * G_j(-omega_j)               eq. 20, 21, 22
@@ -356,6 +357,13 @@ void main() {
             }
         }
         sum += visible * (weight_total / float(rays));
+    }
+    if (push.slice == HVL_REGATHER_SLICE) {
+        // Scattered receivers have no refreshed neighbours to filter with: each takes its own
+        // ratio (the history smooths it over the next frames).
+        SH_UNROLL for (int i = 0; i < 3; ++i) {
+            sum[i] = unshadowed_sum[i] > 0.0 ? unshadowed_sum[i] * min(1.0, sum[i] / unshadowed_sum[i]) : sum[i];
+        }
     }
     imageStore(unshadowed, px, vec4(unshadowed_sum, 0.0));
 #endif

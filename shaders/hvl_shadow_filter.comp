@@ -8,7 +8,9 @@
 //   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R / 2)
 // the sky filter's weights (paper 002 eq. 11's match with the upsample's sigma_z and normal
 // exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility is.
-// Where sum w U is 0 the receiver takes S.
+// Where sum w U is 0 the receiver takes S. Amortised frames (push.slice = 1 + k) filter only
+// the refreshed receivers, one per 2x2 cell at offset (k & 1, k >> 1), over the receivers of
+// the same slice (offsets in steps of 2); the others are left for hvl_resolve.
 // Writes RGBA16F, a = 0, 0 on background. CPU twin: shine::passes::hvl::shadows::ratio_filter.
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -31,17 +33,23 @@ layout(push_constant) uniform Push {
     // sigma_z and n of the bilateral match
     float depth_sigma;
     float normal_power;
-    uint pad0;
+    // 0: every receiver; 1 + k: the slice of the amortised gather (hvl_gather.comp)
+    uint slice;
     uint pad1;
     uint pad2;
 } push;
 
 void main() {
-    uvec2 xy = gl_GlobalInvocationID.xy;
-    if (any(greaterThanEqual(xy, push.extent))) {
+    ivec2 ixy = ivec2(gl_GlobalInvocationID.xy);
+    int step = 1;
+    if (push.slice != 0u) {
+        uint k = push.slice - 1u;
+        ixy = 2 * ixy + ivec2(k & 1u, k >> 1u);
+        step = 2;
+    }
+    if (any(greaterThanEqual(ixy, ivec2(push.extent)))) {
         return;
     }
-    ivec2 ixy = ivec2(xy);
     vec4 position = imageLoad(recv_position, ixy);
     vec3 n = imageLoad(recv_normal, ixy).xyz;
     if (!(position.w > 0.0) || dot(n, n) <= 0.0) {
@@ -56,7 +64,7 @@ void main() {
     vec3 den = vec3(0.0);
     for (int dy = -r; dy <= r; ++dy) {
         for (int dx = -r; dx <= r; ++dx) {
-            ivec2 c = ixy + ivec2(dx, dy);
+            ivec2 c = ixy + step * ivec2(dx, dy);
             if (any(lessThan(c, ivec2(0))) || any(greaterThan(c, last))) {
                 continue;
             }

@@ -467,24 +467,23 @@ fn bad_parameters_are_errors() {
         }
     }
     assert_eq!(gather_variants().len(), 60);
-    // Sampled shadows: at most RAYS_MAX rays, a filter radius in range, whole frames only.
+    // Sampled shadows: at most RAYS_MAX rays, a filter radius in range.
     let vis = HvlParams {
         visibility: true,
         ..ok
     };
-    for (rays, filter_radius, slices) in [(shadows::RAYS_MAX + 1, 3, 1), (4, 9, 1), (4, 3, 4)] {
+    for (rays, filter_radius) in [(shadows::RAYS_MAX + 1, 3), (4, 9)] {
         let p = HvlParams {
             shadows: ShadowSampling {
                 rays,
                 filter_radius,
                 ..ShadowSampling::default()
             },
-            slices,
             ..vis
         };
         assert!(
             matches!(p.validate_gather(), Err(HvlError::OutOfRange { .. })),
-            "{rays} rays, radius {filter_radius}, {slices} slices"
+            "{rays} rays, radius {filter_radius}"
         );
     }
     let zero = HvlParams { count: 0, ..ok };
@@ -1233,7 +1232,7 @@ fn shadow_filter_matches_the_cpu_twin() {
         let recv = images.import(&mut rg, RECV);
         let s = rg.import_gpu_image(&s_image, uploaded_state(), UNUSED_AFTER);
         let u = rg.import_gpu_image(&u_image, uploaded_state(), UNUSED_AFTER);
-        let filtered = shadows::shadow_filter(&mut rg, &recv, &s, &u, &sampling);
+        let filtered = shadows::shadow_filter(&mut rg, &recv, &s, &u, &sampling, 0);
         read_indirect(&mut rg, &filtered, &readback);
         common::run_graph(&device, &mut executor, rg);
         let gpu = common::decode_rgba16f(&device.read_buffer(&readback).unwrap());

@@ -81,16 +81,17 @@ fn raster_direct_light_matches_the_path_traced_direct_light() {
 }
 
 /// HVL and IGI one-bounce indirect light (default settings: 400 HVLs by flux, receivers at
-/// 1/2; 256 VPLs by flux, 4×4 sets) against the path-traced one-bounce indirect light of the
-/// same lamp, by relative RMSE (RMSE / mean of the reference) and energy ratio. The reference
-/// has 64 spp; its own noise adds about 0.1 to the relative RMSE (docs/quality.md has the
-/// 1024-spp numbers).
+/// 1/2, 4 sampled shadow rays; 256 VPLs by flux, 4×4 sets) against the path-traced one-bounce
+/// indirect light of the same lamp, by relative RMSE (RMSE / mean of the reference) and
+/// energy ratio: both within 5% of the truth's energy (issue 16's bar). The reference has 64
+/// spp; its own noise adds about 0.2 to the relative RMSE (docs/quality.md has the 1024-spp
+/// numbers).
 #[test]
 fn indirect_light_against_the_path_traced_reference() {
     let reference = reference(1, 64);
     // (technique, largest relative RMSE, energy range). Measured on lavapipe against this
-    // 64-spp reference: HVL 0.536 / 1.120 (its own surplus, docs/quality.md), IGI 0.547 / 0.966.
-    let cases = [("hvl", 0.62, 1.0..=1.2), ("igi", 0.62, 0.9..=1.05)];
+    // 64-spp reference: HVL 0.497 / 0.971 (unshadowed it was 0.536 / 1.120), IGI 0.547 / 0.966.
+    let cases = [("hvl", 0.56, 0.95..=1.05), ("igi", 0.6, 0.95..=1.05)];
     for (name, worst, energy) in cases {
         let gi = GiTechniques::from_str(name).expect("technique");
         let image = raster_with(Component::Indirect, gi);

@@ -77,6 +77,76 @@ pub fn masked_metrics(
     Ok((pixels.len(), mean, energy, relative))
 }
 
+/// Normals within this angle of a surface's first normal belong to it (degrees).
+pub const SURFACE_ANGLE_DEGREES: f64 = 10.0;
+/// Surfaces with fewer pixels than this share of the lit ones are left out.
+pub const SURFACE_MIN_SHARE: f64 = 0.01;
+
+/// The metrics over one surface orientation of [`surface_metrics`].
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Surface {
+    /// The unit normal of the surface's first pixel (row-major order).
+    pub normal: [f64; 3],
+    /// Pixels of the surface.
+    pub pixels: usize,
+    /// Mean of the reference over the surface's pixels and channels.
+    pub reference_mean: f64,
+    /// Σ image / Σ reference over the surface.
+    pub energy_ratio: f64,
+    /// RMSE over the surface divided by the reference's mean there.
+    pub relative_rmse: f64,
+}
+
+/// The metrics per surface orientation: `normals` is an image of unit world normals (e.g.
+/// `output.component = "normal"`, rendered without supersampling so edges stay sharp; zero on
+/// the background). Pixels join the first surface whose normal is within
+/// [`SURFACE_ANGLE_DEGREES`] of theirs, in row-major order; surfaces with fewer than
+/// [`SURFACE_MIN_SHARE`] of the pixels are left out. Parallel planes facing the same way (a
+/// floor and the top of a box on it) are one surface.
+pub fn surface_metrics(
+    image: &HdrImage,
+    reference: &HdrImage,
+    normals: &HdrImage,
+) -> Result<Vec<Surface>, CompareError> {
+    check(image, reference)?;
+    check(normals, reference)?;
+    let min_cos = SURFACE_ANGLE_DEGREES.to_radians().cos();
+    let mut surfaces: Vec<([f64; 3], Vec<usize>)> = Vec::new();
+    for (i, t) in normals.texels.iter().enumerate() {
+        let n = [f64::from(t[0]), f64::from(t[1]), f64::from(t[2])];
+        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+        // Background (0) and NaN normals belong to no surface.
+        if len.is_nan() || len <= 0.5 {
+            continue;
+        }
+        let n = n.map(|c| c / len);
+        let dot = |m: &[f64; 3]| n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
+        match surfaces.iter_mut().find(|(m, _)| dot(m) >= min_cos) {
+            Some((_, pixels)) => pixels.push(i),
+            None => surfaces.push((n, vec![i])),
+        }
+    }
+    let lit: usize = surfaces.iter().map(|(_, p)| p.len()).sum();
+    if lit == 0 {
+        return Err(CompareError::EmptyMask);
+    }
+    Ok(surfaces
+        .into_iter()
+        .filter(|(_, pixels)| pixels.len() as f64 >= SURFACE_MIN_SHARE * lit as f64)
+        .map(|(normal, pixels)| {
+            let (reference_mean, energy_ratio, relative_rmse) =
+                pixel_metrics(image, reference, pixels.iter().copied());
+            Surface {
+                normal,
+                pixels: pixels.len(),
+                reference_mean,
+                energy_ratio,
+                relative_rmse,
+            }
+        })
+        .collect())
+}
+
 /// Reference mean, energy ratio and relative RMSE over `pixels` (indices, row-major), on
 /// clamped channels as every metric of `shine compare`.
 fn pixel_metrics(
@@ -157,6 +227,42 @@ mod tests {
         assert!((error - 1.0).abs() < 1e-12);
         assert!(masked_metrics(&test, &reference, &image(4, 6, |_, _| 1.0)).is_err());
         assert!(masked_metrics(&test, &reference, &image(8, 6, |_, _| 0.0)).is_err());
+    }
+
+    /// Normals facing +x on the left half (5° apart per column, all within 10° of the first),
+    /// +y on the right but one background pixel and a lone −z pixel (under 1%: left out):
+    /// the left surface scores energy 2, the right 1; a normal image of another size or all
+    /// background is an error.
+    #[test]
+    fn surfaces_gather_pixels_by_normal() {
+        let (w, h) = (20, 10);
+        let reference = image(w, h, |_, _| 0.25);
+        let test = image(w, h, |x, _| if x < 10 { 0.5 } else { 0.25 });
+        let mut normals = image(w, h, |_, _| 0.0);
+        for y in 0..h {
+            for x in 0..w {
+                let t = &mut normals.texels[(y * w + x) as usize];
+                let n = if x < 10 {
+                    let a = (x % 2) as f32 * 5f32.to_radians();
+                    [a.cos(), a.sin(), 0.0]
+                } else if (x, y) == (19, 9) {
+                    [0.0, 0.0, -1.0]
+                } else if (x, y) == (18, 9) {
+                    [0.0; 3]
+                } else {
+                    [0.0, 1.0, 0.0]
+                };
+                t[..3].copy_from_slice(&n);
+            }
+        }
+        let surfaces = surface_metrics(&test, &reference, &normals).unwrap();
+        assert_eq!(surfaces.len(), 2, "{surfaces:?}");
+        assert_eq!((surfaces[0].pixels, surfaces[1].pixels), (100, 98));
+        assert!((surfaces[0].energy_ratio - 2.0).abs() < 1e-12);
+        assert!((surfaces[1].energy_ratio - 1.0).abs() < 1e-12);
+        assert!(surfaces[1].normal[1] > 0.999);
+        assert!(surface_metrics(&test, &reference, &image(4, 6, |_, _| 1.0)).is_err());
+        assert!(surface_metrics(&test, &reference, &image(w, h, |_, _| 0.0)).is_err());
     }
 
     /// An image twice as bright on its left half: the left tiles report energy 2 and relative

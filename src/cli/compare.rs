@@ -6,7 +6,9 @@
 use super::CliError;
 use shine::capture::image_compare::{compare, flip_map};
 use shine::capture::image_io::{HdrImage, read_exr, read_png_linear, write_png};
-use shine::capture::regions::{Region, error_heatmap, masked_metrics, region_grid};
+use shine::capture::regions::{
+    Region, Surface, error_heatmap, masked_metrics, region_grid, surface_metrics,
+};
 use std::path::{Path, PathBuf};
 
 /// Arguments of `shine compare`.
@@ -34,6 +36,11 @@ pub struct CompareArgs {
     /// (any channel above 0.5; e.g. a `cubes.mask` render of the dynamic objects).
     #[arg(long)]
     mask: Option<PathBuf>,
+    /// Also report energy ratio and relative RMSE per surface orientation, from this image of
+    /// world normals (`--set output.component=normal --ssaa 1`): normals within 10° are one
+    /// surface; surfaces under 1% of the pixels are left out.
+    #[arg(long)]
+    surfaces: Option<PathBuf>,
 }
 
 /// Reads an image to compare: EXR as radiance, PNG decoded from sRGB to the light it displays.
@@ -77,6 +84,10 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         Some(path) => Some(masked_metrics(&image, &reference, &read_image(path)?.0)?),
         None => None,
     };
+    let surfaces = match &args.surfaces {
+        Some(path) => surface_metrics(&image, &reference, &read_image(path)?.0)?,
+        None => Vec::new(),
+    };
     if let Some(path) = &args.heatmap {
         write_png(path, &flip_map(&image, &reference)?)
             .map_err(|e| format!("{}: {e}", path.display()))?;
@@ -98,6 +109,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             "width": image.width,
             "height": image.height,
             "regions": regions,
+            "surfaces": surfaces,
             "mask": masked.map(|(pixels, mean, energy, relative)| serde_json::json!({
                 "pixels": pixels,
                 "reference_mean": mean,
@@ -118,8 +130,24 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             println!("masked ({pixels} pixels): energy {energy:.4}, RMSE/mean {relative:.4}");
         }
         print_regions(&regions, args.regions);
+        print_surfaces(&surfaces);
     }
     Ok(())
+}
+
+/// One line per surface: its normal, pixels, energy ratio and relative RMSE.
+fn print_surfaces(surfaces: &[Surface]) {
+    if surfaces.is_empty() {
+        return;
+    }
+    println!("per surface (normal: pixels, energy ratio, relative RMSE)");
+    for s in surfaces {
+        let [x, y, z] = s.normal;
+        println!(
+            "  ({x:+.2} {y:+.2} {z:+.2}): {:6} px, energy {:.3}, RMSE/mean {:.3}",
+            s.pixels, s.energy_ratio, s.relative_rmse
+        );
+    }
 }
 
 /// The tiles as two grids (energy ratio, relative RMSE), rows top to bottom.

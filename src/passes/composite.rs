@@ -77,6 +77,8 @@ crate::choice::named_choice! {
         Direct = "direct",
         /// The GI technique's indirect light only (needs a GI technique).
         Indirect = "indirect",
+        /// The G-buffer's world shading normal, unlit (for `shine compare --surfaces`).
+        Normal = "normal",
     }
 }
 

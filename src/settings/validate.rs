@@ -115,13 +115,6 @@ impl Settings {
             self.hvl.shadow_filter_radius,
             &hvl::shadows::FILTER_RADIUS_RANGE,
         )?;
-        if self.hvl.visibility && self.hvl.shadow_rays > 0 && self.hvl.slices > 1 {
-            return Err(SettingsError::OutOfRange {
-                field: "hvl.shadow_rays",
-                value: self.hvl.shadow_rays.to_string(),
-                allowed: "0 with hvl.slices > 1 (the shadow filter reads every receiver's neighbours, an amortised gather refreshes a quarter of them)".to_owned(),
-            });
-        }
         if ![1, hvl::resolve::SLICES].contains(&self.hvl.slices) {
             return Err(SettingsError::OutOfRange {
                 field: "hvl.slices",

@@ -120,6 +120,7 @@ impl Renderer {
         let (first, second) = match (p.component, indirect.as_ref()) {
             (Component::Full, indirect) => (&direct, indirect),
             (Component::Direct, _) => (&direct, None),
+            (Component::Normal, _) => (&g.normal, None),
             (Component::Indirect, Some(indirect)) => (indirect, None),
             (Component::Indirect, None) => {
                 return Err(RenderError::Invalid(

@@ -40,16 +40,22 @@ pub fn hvl_gather(
     );
     Ok(
         match record_gather(rg, shader, &inputs, params, &mut indirect, slice) {
-            Some(unshadowed) => {
-                shadows::shadow_filter(rg, receivers, &indirect, &unshadowed, &params.shadows)
-            }
+            Some(unshadowed) => shadows::shadow_filter(
+                rg,
+                receivers,
+                &indirect,
+                &unshadowed,
+                &params.shadows,
+                slice,
+            ),
             None => indirect,
         },
     )
 }
 
 /// Adds `hvl_regather`: the gather at the receivers `hvl_regather_mask` marked in `target`
-/// (alpha -1), written there (amortised frames, [`resolve`]).
+/// (alpha -1), written there (amortised frames, [`resolve`]); sampled shadows take each
+/// receiver's own ratio there, unfiltered.
 #[allow(clippy::too_many_arguments)]
 pub fn hvl_regather(
     rg: &mut RenderGraph,

@@ -14,6 +14,10 @@
 //! and denoises only the shadowing. The weights are the sky filter's: a gaussian of the offset
 //! times paper 002's bilateral match, so shadows do not bleed across edges.
 //!
+//! Amortised frames (`hvl.slices = 4`) filter the refreshed slice over its own receivers
+//! (steps of 2), and the receivers regathered after a disocclusion, scattered, take their own
+//! ratio `U · min(1, S/U)` in the gather; the history smooths both.
+//!
 //! [`ratio_filter`] is the filter's CPU twin.
 
 use std::ops::RangeInclusive;
@@ -102,19 +106,24 @@ pub struct ShadowFilterPush {
     pub depth_sigma: f32,
     /// Normal exponent of the bilateral match.
     pub normal_power: f32,
+    /// 0: every receiver; 1 + k: only the amortised gather's slice k, filtered over its own
+    /// receivers ([`super::resolve::slice_of_frame`]).
+    pub slice: u32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: [u32; 2],
 }
 
 /// Adds `hvl_shadow_filter`: the ratio-filtered light of the sampled gather's `shadowed`
 /// estimate and its `unshadowed` sum (both RGBA16F at receiver resolution), returned as a new
-/// image of the same kind.
+/// image of the same kind. `slice` is the gather's: 0 filters every receiver, 1 + k only
+/// those of slice k (the others are left undefined, as the gather leaves them).
 pub fn shadow_filter(
     rg: &mut RenderGraph,
     receivers: &Receivers,
     shadowed: &Handle<Image>,
     unshadowed: &Handle<Image>,
     sampling: &ShadowSampling,
+    slice: u32,
 ) -> Handle<Image> {
     let [w, h] = receivers.extent;
     let mut filtered = rg.create_image(
@@ -126,7 +135,8 @@ pub fn shadow_filter(
         radius: sampling.filter_radius,
         depth_sigma: sampling.matching.depth_sigma,
         normal_power: sampling.matching.normal_power,
-        pad: [0; 3],
+        slice,
+        pad: [0; 2],
     };
     rg.compute("hvl_shadow_filter", &shaders::HVL_SHADOW_FILTER_COMP)
         .read("recv_position", &receivers.position)
@@ -135,7 +145,11 @@ pub fn shadow_filter(
         .read("unshadowed", unshadowed)
         .write("filtered", &mut filtered)
         .push(&push)
-        .dispatch([w, h, 1]);
+        .dispatch(if slice == 0 {
+            [w, h, 1]
+        } else {
+            [w.div_ceil(2), h.div_ceil(2), 1]
+        });
     filtered
 }
 
@@ -153,7 +167,8 @@ pub struct FilterTexel {
     pub unshadowed: [f32; 3],
 }
 
-/// CPU twin of `hvl_shadow_filter.comp` over a `width`-wide row-major image: per channel,
+/// CPU twin of `hvl_shadow_filter.comp` (every receiver, slice 0) over a `width`-wide
+/// row-major image: per channel,
 /// `U · min(1, Σ w S / Σ w U)` with the shader's weights, `S` where `Σ w U` is 0, and 0 on
 /// background.
 pub fn ratio_filter(
