@@ -5,24 +5,14 @@
 // its radius; a receiver inside an HVL's sphere is never shadowed from it.
 //   `_vis`: one ray per receiver and HVL, `indirect` the shadowed sum.
 //   `_shadows`: push.shadow_rays = K rays per receiver, to HVLs drawn in proportion to their
-//     contribution c_j (K weighted reservoirs over the loop): `indirect` is the unbiased estimate
-//     S = sum_inside c_j + (W / K) sum_k v_k c_k / w_k   (w_j = c_j.r + c_j.g + c_j.b, W = sum w_j)
-//     and `unshadowed` the exact unshadowed sum U; hvl_shadow_filter.comp turns them into
-//     U * filter(S) / filter(U) (the ratio estimator of Heitz et al. 2018). Regathered
-//     receivers (amortised frames) are scattered and take U * min(1, S / U) here.
-//
-// Per HVL j at receiver x (omega_j: unit direction x -> y_j, a: half-angle of the sphere):
-//   L_j = Phi_j * max(0, F'_j . Y(-omega_j)) * G_j(-omega_j)               eq. 20, 21, 22
-//   full path (O(n^2)):  L_j * (kd * L . F_lambert(theta_o) + ks * L . F_glossy(theta_o))  eq. 19
-//     with L = cap SH of the sphere (eq. 14-15) in the receiver frame (normal z, omega_o in
-//     the xz half-plane), F rows of the BRDF SH tables interpolated at theta_o (eq. 18), the
-//     glossy row blended between the two GGX tables around the receiver's roughness;
-//   zonal path (O(n)): L_j * kd * sum_l cap_l (cc_l / pi) P_l(n . omega_j) (Lambert only).
-// kd, ks: brdf_indirect_weights (kd with the hemisphere-averaged Fresnel, ks with Schlick's F at
-// n.v over the tables' own dielectric F). Each HVL's contribution is clamped at 0 per channel
-// (band-limited ringing must not go negative in the RGBA16F output); the paper's sinc window
-// (push.window_width) and the disc falloff (push.disc_falloff) are options. CPU twin:
-// shine::reference::hvl.
+//     weight w_j = c_j.r + c_j.g + c_j.b (c_j the HVL's light; K weighted reservoirs over the
+//     loop). With W the weight outside the spheres and W_in inside, the shadowed weight
+//       S = W_in + W * (visible rays / K)
+//     is unbiased; `unshadowed` holds (U, W_in + W) (U the unshadowed sum), `indirect`
+//     (U * min(1, S / (W_in + W)), S). hvl_shadow_filter.comp then returns
+//     U * min(1, sum w S / sum w (W_in + W)) over the receivers around (the ratio estimator of
+//     Heitz et al. 2018): exactly U where nothing is in the way. Regathered receivers
+//     (amortised frames) are scattered and keep their own ratio.
 //! variant full_c1 HVL_FULL=1 SH_BANDS=1
 //! variant full_c2 HVL_FULL=1 SH_BANDS=2
 //! variant full_c3 HVL_FULL=1 SH_BANDS=3
@@ -264,18 +254,17 @@ void main() {
     vec3 origin = trace_offset(x, n);
 #endif
 #ifdef HVL_SHADOW_SAMPLES
-    // The unshadowed sum, and the reservoirs: each keeps one HVL (its index, contribution and
-    // weight), all drawn over the same running total weight.
+    // The unshadowed sum and its weights (w_j = c_j.r + c_j.g + c_j.b), inside HVLs' spheres and
+    // outside, and the reservoirs: each keeps one HVL, all drawn over the same running weight.
     vec3 unshadowed_sum = vec3(0.0);
+    float weight_inside = 0.0;
+    float weight_total = 0.0;
     uint pick[HVL_SHADOW_RAYS_MAX];
-    vec4 pick_light[HVL_SHADOW_RAYS_MAX];
     SH_UNROLL for (int k = 0; k < HVL_SHADOW_RAYS_MAX; ++k) {
         pick[k] = 0u;
-        pick_light[k] = vec4(0.0);
     }
-    float weight_total = 0.0;
     int rays = int(clamp(push.shadow_rays, 1u, uint(HVL_SHADOW_RAYS_MAX)));
-    rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y)) ^ pcg(push.seed + 0x9e3779b9u);
+    rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y) + pcg(push.seed));
 #endif
     for (uint j = 0u; j < push.hvl_count; ++j) {
         // Field by field: naga cannot read the OpCopyLogical of a whole-struct load.
@@ -329,8 +318,11 @@ void main() {
 #ifdef HVL_SHADOW_SAMPLES
         unshadowed_sum += c;
         float w = c.r + c.g + c.b;
-        if (dist <= r || !(w > 0.0)) {
-            sum += c;
+        if (dist <= r) {
+            weight_inside += w;
+            continue;
+        }
+        if (!(w > 0.0)) {
             continue;
         }
         weight_total += w;
@@ -339,7 +331,6 @@ void main() {
         SH_UNROLL for (int k = 0; k < HVL_SHADOW_RAYS_MAX; ++k) {
             if (k < rays && fract(u + float(k) / float(rays)) * weight_total < w) {
                 pick[k] = j;
-                pick_light[k] = vec4(c, w);
             }
         }
 #else
@@ -347,25 +338,25 @@ void main() {
 #endif
     }
 #ifdef HVL_SHADOW_SAMPLES
+    // The shadowed weight: the HVLs the receiver is inside of, plus the drawn ones' visibility.
+    float visible = 0.0;
     if (weight_total > 0.0) {
-        vec3 visible = vec3(0.0);
         for (int k = 0; k < rays; ++k) {
             uint j = pick[k];
             vec3 target = hvl_shadow_target(hvls.h[j].position_radius, hvls.h[j].normal_distance.xyz);
-            if (!trace_occluded_by(origin, target)) {
-                visible += pick_light[k].rgb / pick_light[k].a;
-            }
-        }
-        sum += visible * (weight_total / float(rays));
-    }
-    if (push.slice == HVL_REGATHER_SLICE) {
-        // Scattered receivers have no refreshed neighbours to filter with: each takes its own
-        // ratio (the history smooths it over the next frames).
-        SH_UNROLL for (int i = 0; i < 3; ++i) {
-            sum[i] = unshadowed_sum[i] > 0.0 ? unshadowed_sum[i] * min(1.0, sum[i] / unshadowed_sum[i]) : sum[i];
+            visible += trace_occluded_by(origin, target) ? 0.0 : 1.0;
         }
     }
-    imageStore(unshadowed, px, vec4(unshadowed_sum, 0.0));
+    float shadowed_weight = weight_inside + weight_total * (visible / float(rays));
+    float unshadowed_weight = weight_inside + weight_total;
+    // The receiver's own ratio; scattered regathered receivers (amortised frames) have no
+    // refreshed neighbours to filter with and keep it, the history smooths it.
+    sum = unshadowed_weight > 0.0 ? unshadowed_sum * min(1.0, shadowed_weight / unshadowed_weight) : vec3(0.0);
+    imageStore(unshadowed, px, vec4(unshadowed_sum, unshadowed_weight));
+    if (push.slice != HVL_REGATHER_SLICE) {
+        imageStore(indirect, px, vec4(sum, shadowed_weight));
+        return;
+    }
 #endif
     imageStore(indirect, px, vec4(sum, 0.0));
 }

@@ -1,17 +1,17 @@
 // HVL shadow filter (src/passes/hvl/shadows.rs): the sampled visibility of hvl_gather.comp's
-// `_vis` variants leaves each receiver with an unbiased but noisy shadowed estimate S next to
-// its exact unshadowed sum U. The ratio estimator (Heitz, Hill and McGuire 2018, "Combining
-// analytic direct illumination and stochastic shadows") keeps U's detail and filters only the
-// shadowing: per channel,
-//   out = U * min(1, sum_q w_q S_q / sum_q w_q U_q)
+// `_shadows` variants leaves each receiver with its exact unshadowed light U, its weight W_u
+// (`unshadowed`: rgb U, a W_u) and an unbiased but noisy shadowed weight S (`shadowed`, a).
+// The ratio estimator (Heitz, Hill and McGuire 2018, "Combining analytic direct illumination
+// and stochastic shadows") keeps U's detail and filters only the shadowing:
+//   out = U * min(1, sum_q w_q S_q / sum_q w_q W_u,q)
 // over the (2R+1)^2 receivers q around the receiver, with
 //   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R / 2)
 // the sky filter's weights (paper 002 eq. 11's match with the upsample's sigma_z and normal
-// exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility is.
-// Where sum w U is 0 the receiver takes S. Amortised frames (push.slice = 1 + k) filter only
-// the refreshed receivers, one per 2x2 cell at offset (k & 1, k >> 1), over the receivers of
-// the same slice (offsets in steps of 2); the others are left for hvl_resolve.
-// Writes RGBA16F, a = 0, 0 on background. CPU twin: shine::passes::hvl::shadows::ratio_filter.
+// exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility
+// is, and exactly 1 where nothing is in the way. Amortised frames (push.slice = 1 + k) filter
+// only the refreshed receivers, one per 2x2 cell at offset (k & 1, k >> 1), over the receivers
+// of the same slice (offsets in steps of 2); the others are left for hvl_resolve. Writes
+// RGBA16F, a = 0, 0 on background. CPU twin: shine::passes::hvl::shadows::ratio_filter.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "bilateral.glsl"
@@ -60,8 +60,8 @@ void main() {
     int r = int(push.radius);
     float inv_two_sigma2 = r > 0 ? 2.0 / float(r * r) : 0.0;
     ivec2 last = ivec2(push.extent) - 1;
-    vec3 num = vec3(0.0);
-    vec3 den = vec3(0.0);
+    float num = 0.0;
+    float den = 0.0;
     for (int dy = -r; dy <= r; ++dy) {
         for (int dx = -r; dx <= r; ++dx) {
             ivec2 c = ixy + step * ivec2(dx, dy);
@@ -75,15 +75,10 @@ void main() {
             float w = exp(-float(dx * dx + dy * dy) * inv_two_sigma2)
                 * bilateral_match(position.w, n, pc.w, imageLoad(recv_normal, c).xyz,
                     push.depth_sigma, push.normal_power);
-            num += w * imageLoad(shadowed, c).rgb;
-            den += w * imageLoad(unshadowed, c).rgb;
+            num += w * imageLoad(shadowed, c).a;
+            den += w * imageLoad(unshadowed, c).a;
         }
     }
     vec3 u = imageLoad(unshadowed, ixy).rgb;
-    vec3 s = imageLoad(shadowed, ixy).rgb;
-    vec3 out_light;
-    for (int i = 0; i < 3; ++i) {
-        out_light[i] = den[i] > 0.0 ? u[i] * min(1.0, num[i] / den[i]) : s[i];
-    }
-    imageStore(filtered, ixy, vec4(out_light, 0.0));
+    imageStore(filtered, ixy, vec4(den > 0.0 ? u * min(1.0, num / den) : vec3(0.0), 0.0));
 }

@@ -116,7 +116,7 @@ pub fn surface_metrics(
         let n = [f64::from(t[0]), f64::from(t[1]), f64::from(t[2])];
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         // Background (0) and NaN normals belong to no surface.
-        if len.is_nan() || len <= 0.5 {
+        if len.is_nan() || len <= 1e-3 {
             continue;
         }
         let n = n.map(|c| c / len);

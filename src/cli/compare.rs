@@ -85,7 +85,17 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         None => None,
     };
     let surfaces = match &args.surfaces {
-        Some(path) => surface_metrics(&image, &reference, &read_image(path)?.0)?,
+        Some(path) => match read_image(path)? {
+            // A PNG clamps the normals' negative components away.
+            (_, true) => {
+                return Err(format!(
+                    "{}: --surfaces needs the normals as EXR (a PNG loses their negative components)",
+                    path.display()
+                )
+                .into());
+            }
+            (normals, false) => surface_metrics(&image, &reference, &normals)?,
+        },
         None => Vec::new(),
     };
     if let Some(path) = &args.heatmap {

@@ -258,7 +258,7 @@ pub struct HvlSettings {
     pub visibility: bool,
     /// With `visibility`: shadow rays per receiver, to HVLs drawn in proportion to their
     /// light and denoised by a ratio estimator (`src/passes/hvl/shadows.rs`); 0 traces one
-    /// ray per receiver and HVL (exact, about 8× the gather's cost). Range 0..=4, default 4.
+    /// ray per receiver and HVL (exact, about 10× the gather's cost). Range 0..=4, default 4.
     pub shadow_rays: u32,
     /// Radius in receivers of the sampled shadows' ratio filter. Range 0..=8, default 3.
     pub shadow_filter_radius: u32,

@@ -252,7 +252,12 @@ impl Renderer {
             // No primary light: the HVL passes (and their history) are not in this frame.
             self.hvl.reset();
         }
-        let hvl_seed = sky_light::history_seed(rg, p);
+        // Sampled shadows draw new rays each frame a history averages: the indirect light's,
+        // or the amortised gather's own.
+        let hvl_seed = match p.hvl {
+            Some(h) if h.slices > 1 => rg.frame() as u32,
+            _ => sky_light::history_seed(rg, p),
+        };
         let hvl_low = match (hvl, rsm, &recv) {
             (Some(hvl), Some(rsm), Some(receivers)) => Some(hvl.declare(
                 rg,

@@ -165,7 +165,7 @@ pub struct GatherPush {
     pub window_width: f32,
     /// 1: [`Falloff::Disc`]; 0: the paper's sphere.
     pub disc_falloff: u32,
-    /// `_vis` variants: shadow rays per receiver ([`shadows::ShadowSampling::rays`]).
+    /// `_shadows` variants: shadow rays per receiver ([`shadows::ShadowSampling::rays`]).
     pub shadow_rays: u32,
     /// Seed of the sampled shadow rays.
     pub seed: u32,

@@ -3,20 +3,24 @@
 //!
 //! Paper 003's HVLs are unshadowed (§6). On the cornell box that leaves the indirect light 12%
 //! too bright, because the boxes hide the floor's HVLs from half the room. One shadow ray per
-//! receiver and HVL ([`ShadowSampling::rays`] = 0) fixes the energy but multiplies the gather's
-//! cost by about 8 on lavapipe (400 rays per receiver). With `rays = K`, the gather
-//! (`shaders/hvl_gather.comp`, `_vis` variants) draws K HVLs per receiver in proportion to
-//! their contribution (weighted reservoirs over its loop) and traces only those, giving an
-//! unbiased, noisy shadowed sum `S` beside the exact unshadowed sum `U`. The filter
-//! (`shaders/hvl_shadow_filter.comp`) then returns `U · min(1, Σ w S / Σ w U)` over the
-//! receivers around each one: the ratio estimator of Heitz, Hill and McGuire (2018,
+//! receiver and HVL ([`ShadowSampling::rays`] = 0, the `_vis` variants) fixes the energy but
+//! multiplies the gather's cost by about 10 on lavapipe (400 rays per receiver). With
+//! `rays = K`, the gather (`shaders/hvl_gather.comp`, `_shadows` variants) draws K HVLs per
+//! receiver in proportion to their weight `w_j` (the `r + g + b` of their light; weighted
+//! reservoirs over its loop) and traces only those, giving an unbiased, noisy shadowed weight
+//! `S` beside the exact unshadowed light `U` and its weight `W_u`. The filter
+//! (`shaders/hvl_shadow_filter.comp`) then returns `U · min(1, Σ w S / Σ w W_u)` over the
+//! receivers around each one: exactly `U` where nothing is in the way (a scalar ratio: the
+//! shadows take the light's colour, not the hidden HVLs' own). This is the ratio estimator of
+//! Heitz, Hill and McGuire (2018,
 //! "Combining analytic direct illumination and stochastic shadows"), which keeps `U`'s detail
 //! and denoises only the shadowing. The weights are the sky filter's: a gaussian of the offset
 //! times paper 002's bilateral match, so shadows do not bleed across edges.
 //!
 //! Amortised frames (`hvl.slices = 4`) filter the refreshed slice over its own receivers
 //! (steps of 2), and the receivers regathered after a disocclusion, scattered, take their own
-//! ratio `U · min(1, S/U)` in the gather; the history smooths both.
+//! ratio `U · min(1, S / W_u)` in the gather; the resolve's history smooths both (amortised
+//! frames draw new rays every frame, [`ShadowSampling::seed`]).
 //!
 //! [`ratio_filter`] is the filter's CPU twin.
 
@@ -79,7 +83,8 @@ pub struct ShadowSampling {
     pub filter_radius: u32,
     /// The filter's bilateral match (the frame's upsample's).
     pub matching: UpsampleParams,
-    /// Seed of the rays' random numbers (the frame index when a history averages frames).
+    /// Seed of the rays' random numbers (the frame index when a history averages frames: the
+    /// indirect light's or the amortised gather's).
     pub seed: u32,
 }
 
@@ -154,48 +159,61 @@ pub fn shadow_filter(
 }
 
 /// One receiver as the filter reads it: position (w: view depth, 0 on background), normal,
-/// shadowed estimate `S` and unshadowed sum `U` (RGB).
+/// unshadowed light `U` with its weight, and the shadowed weight `S`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FilterTexel {
     /// xyz world position, w view depth (0: background).
     pub position: [f32; 4],
     /// Shading normal (xyz).
     pub normal: [f32; 4],
-    /// The gather's shadowed estimate.
-    pub shadowed: [f32; 3],
-    /// The gather's unshadowed sum.
+    /// The gather's unshadowed light (RGB).
     pub unshadowed: [f32; 3],
+    /// Its weight: the sum of every HVL's `r + g + b`.
+    pub unshadowed_weight: f32,
+    /// The gather's estimate of the shadowed weight.
+    pub shadowed_weight: f32,
 }
 
-/// CPU twin of `hvl_shadow_filter.comp` (every receiver, slice 0) over a `width`-wide
-/// row-major image: per channel,
-/// `U · min(1, Σ w S / Σ w U)` with the shader's weights, `S` where `Σ w U` is 0, and 0 on
-/// background.
+/// CPU twin of `hvl_shadow_filter.comp` over a `width`-wide row-major image:
+/// `U · min(1, Σ w S / Σ w W_u)`, 0 where `Σ w W_u` is 0 and on background. `slice` as the
+/// pass's: 0 every receiver; 1 + k those of slice k, filtered over their own slice (`None`
+/// for the others, which the pass leaves alone).
 pub fn ratio_filter(
     texels: &[FilterTexel],
     width: usize,
     sampling: &ShadowSampling,
-) -> Vec<[f32; 3]> {
+    slice: u32,
+) -> Vec<Option<[f32; 3]>> {
     let height = texels.len() / width.max(1);
+    let (step, offset) = match slice {
+        0 => (1, (0, 0)),
+        s => (2, (((s - 1) & 1) as i64, ((s - 1) >> 1) as i64)),
+    };
     let r = sampling.filter_radius as i64;
     let inv_two_sigma2 = if r > 0 { 2.0 / (r * r) as f32 } else { 0.0 };
-    let mut out = vec![[0.0; 3]; texels.len()];
+    let at = |x: i64, y: i64| &texels[(y * width as i64 + x) as usize];
+    let mut out = vec![None; texels.len()];
     for y in 0..height as i64 {
         for x in 0..width as i64 {
-            let centre = &texels[(y * width as i64 + x) as usize];
+            if step == 2 && (x % 2, y % 2) != offset {
+                continue;
+            }
+            let centre = at(x, y);
             let n = centre.normal;
+            let o = &mut out[(y * width as i64 + x) as usize];
+            *o = Some([0.0; 3]);
             if !on_surface(centre.position) || n[0] * n[0] + n[1] * n[1] + n[2] * n[2] <= 0.0 {
                 continue;
             }
             let n = normalized(n);
-            let (mut num, mut den) = ([0.0f32; 3], [0.0f32; 3]);
+            let (mut num, mut den) = (0.0f32, 0.0f32);
             for dy in -r..=r {
                 for dx in -r..=r {
-                    let (cx, cy) = (x + dx, y + dy);
+                    let (cx, cy) = (x + step * dx, y + step * dy);
                     if cx < 0 || cy < 0 || cx >= width as i64 || cy >= height as i64 {
                         continue;
                     }
-                    let q = &texels[(cy * width as i64 + cx) as usize];
+                    let q = at(cx, cy);
                     if !on_surface(q.position) {
                         continue;
                     }
@@ -207,19 +225,12 @@ pub fn ratio_filter(
                             q.normal,
                             &sampling.matching,
                         );
-                    for c in 0..3 {
-                        num[c] += w * q.shadowed[c];
-                        den[c] += w * q.unshadowed[c];
-                    }
+                    num += w * q.shadowed_weight;
+                    den += w * q.unshadowed_weight;
                 }
             }
-            let o = &mut out[(y * width as i64 + x) as usize];
-            for c in 0..3 {
-                o[c] = if den[c] > 0.0 {
-                    centre.unshadowed[c] * (num[c] / den[c]).min(1.0)
-                } else {
-                    centre.shadowed[c]
-                };
+            if den > 0.0 {
+                *o = Some(centre.unshadowed.map(|u| u * (num / den).min(1.0)));
             }
         }
     }
