@@ -111,7 +111,7 @@ layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D unshadowed;
 #include "random.glsl"
 
 // Most shadow rays per receiver of the sampled visibility: shine::passes::hvl::shadows::RAYS_MAX.
-#define HVL_SHADOW_RAYS_MAX 4
+#define HVL_SHADOW_RAYS_MAX 16
 #endif
 
 #ifdef HVL_VISIBILITY
@@ -165,6 +165,12 @@ layout(push_constant) uniform Push {
     uint shadow_rays;
     // seed of the sampled shadow rays' random numbers
     uint seed;
+    // R of the near field (hvl_near.comp, world units): each HVL's light is scaled by
+    // smoothstep(R, 2R, d), d its centre's distance; 0: no near field
+    float near_range;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } push;
 
 // Receivers closer than this to an HVL centre get nothing from it (metres).
@@ -279,6 +285,11 @@ void main() {
         if (dist < HVL_MIN_DISTANCE) {
             continue;
         }
+        // The near field's share is hvl_near.comp's.
+        float far = push.near_range > 0.0 ? smoothstep(push.near_range, 2.0 * push.near_range, dist) : 1.0;
+        if (!(far > 0.0)) {
+            continue;
+        }
         vec3 wj = v / dist;
         float a = hvl_cap_half_angle(dist, r);
         float g = hvl_geometric_factor(wj, hvl_normal, n, r, a);
@@ -298,7 +309,7 @@ void main() {
         if (push.disc_falloff != 0u) {
             e *= hvl_disc_falloff(dist, r);
         }
-        vec3 lj = hvls.h[j].flux.rgb * (e * g);
+        vec3 lj = hvls.h[j].flux.rgb * (e * g * far);
         float cos_a = cos(a);
 #ifdef HVL_FULL
         float cap[SH_COEFFS];
@@ -326,12 +337,17 @@ void main() {
             continue;
         }
         weight_total += w;
-        // One random number per HVL, rotated by k / K for reservoir k (each uniform on its own).
-        float u = rand();
-        SH_UNROLL for (int k = 0; k < HVL_SHADOW_RAYS_MAX; ++k) {
-            if (k < rays && fract(u + float(k) / float(rays)) * weight_total < w) {
-                pick[k] = j;
-            }
+        // One random number u per HVL, rotated by k / K for reservoir k (each uniform on its
+        // own): reservoir k takes HVL j when fract(u + k / K) < p = w / W. The rotated values
+        // are s + m / K (s = fract(u K) / K, m = 0..K-1, reservoir k = (m - floor(u K)) mod K),
+        // so the first ceil((p - s) K) of them take it: no loop over reservoirs that do not.
+        float p = w / weight_total;
+        float uk = rand() * float(rays);
+        float s = fract(uk) / float(rays);
+        int takers = p > s ? min(rays, int(ceil((p - s) * float(rays)))) : 0;
+        int base = int(uk);
+        for (int m = 0; m < takers; ++m) {
+            pick[(m - base + rays) % rays] = j;
         }
 #else
         sum += c;

@@ -5,9 +5,9 @@
 // and stochastic shadows") keeps U's detail and filters only the shadowing:
 //   out = U * min(1, sum_q w_q S_q / sum_q w_q W_u,q)
 // over the (2R+1)^2 receivers q around the receiver, with
-//   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R / 2)
-// the sky filter's weights (paper 002 eq. 11's match with the upsample's sigma_z and normal
-// exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility
+//   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R)
+// (the sky filter's weights with twice its sigma: paper 002 eq. 11's match with the upsample's
+// sigma_z and normal exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility
 // is, and exactly 1 where nothing is in the way. Amortised frames (push.slice = 1 + k) filter
 // only the refreshed receivers, one per 2x2 cell at offset (k & 1, k >> 1), over the receivers
 // of the same slice (offsets in steps of 2); the others are left for hvl_resolve. Writes
@@ -58,7 +58,7 @@ void main() {
     }
     n = normalize(n);
     int r = int(push.radius);
-    float inv_two_sigma2 = r > 0 ? 2.0 / float(r * r) : 0.0;
+    float inv_two_sigma2 = r > 0 ? 0.5 / float(r * r) : 0.0;
     ivec2 last = ivec2(push.extent) - 1;
     float num = 0.0;
     float den = 0.0;

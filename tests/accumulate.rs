@@ -248,9 +248,9 @@ fn disocclusion_rejects_history() {
 }
 
 /// A static scene accumulated over frames renders its single frame (every frame's light is
-/// the same, so the blend changes nothing), for HVL and IGI. HVL's sampled shadows draw new
-/// rays every frame of a history, so HVL runs unshadowed here (its shadows' mean over seeds is
-/// `tests/hvl.rs`'s).
+/// the same, so the blend changes nothing), for HVL and IGI. HVL's sampled shadows and near
+/// field draw new rays every frame of a history, so HVL runs without them here (the shadows'
+/// mean over seeds is `tests/hvl.rs`'s).
 #[test]
 fn a_static_scene_accumulated_converges_to_the_single_frame() {
     let device = common::device();
@@ -266,6 +266,7 @@ fn a_static_scene_accumulated_converges_to_the_single_frame() {
             s.set("shadow.size", "128").expect("shadow");
             s.set("history.frames", history).expect("history");
             s.set("hvl.visibility", "false").expect("visibility");
+            s.set("hvl.near_range", "0").expect("near field");
             let mut renderer = Renderer::new(&device).expect("renderer");
             renderer.set_scene(&scene, 0.0).expect("scene");
             let mut last = None;

@@ -170,6 +170,7 @@ fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
             rays: 0,
             ..ShadowSampling::default()
         },
+        near_range: 0.0,
         slices: 1,
         // the glossy share of the traced specular pass: ties the GLSL fade to the Rust one
         specular_limit: shine::passes::specular::LIMIT,
@@ -421,6 +422,14 @@ fn records_and_push_constants_match_the_shaders() {
             std::mem::size_of::<GatherPush>()
         );
     }
+    assert_eq!(
+        shaders::HVL_SHADOW_FILTER_COMP.push_constant_size as usize,
+        std::mem::size_of::<shadows::ShadowFilterPush>()
+    );
+    assert_eq!(
+        shaders::HVL_NEAR_COMP.push_constant_size as usize,
+        std::mem::size_of::<shine::passes::hvl::near::NearPush>()
+    );
 }
 
 #[test]

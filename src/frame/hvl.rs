@@ -48,6 +48,8 @@ pub struct HvlInputs<'a> {
     pub motion: &'a Handle<Image>,
     /// Seed of the sampled shadow rays (the frame index when a history averages frames).
     pub seed: u32,
+    /// R of the near field the frame traces beside the gather (world units; 0: none).
+    pub near_range: f32,
 }
 
 impl HvlTechnique {
@@ -119,6 +121,7 @@ impl PreparedHvl {
     ) -> Result<Handle<Image>, RenderError> {
         let mut params = self.params;
         params.shadows.seed = inputs.seed;
+        params.near_range = inputs.near_range;
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
         let bvh = params.visibility.then_some(inputs.bvh);
         let (slice, has_history) = self.amortised.unwrap_or((0, false));

@@ -9,6 +9,7 @@ use crate::passes::cubes::CubeParams;
 use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParams};
 use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::HvlParams;
+use crate::passes::hvl::near::NearField;
 use crate::passes::hvl::shadows::ShadowSampling;
 use crate::passes::igi::IgiParams;
 use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
@@ -34,8 +35,11 @@ pub struct FrameParams {
     pub shadow: ShadowParams,
     /// Trilinear texture filtering over the mip chains (off: level 0 only).
     pub mipmaps: bool,
-    /// Harmonics Virtual Lights (paper 003), when the frame has them.
+    /// Harmonics Virtual Lights (paper 003), when the frame has them (their `near_range` is set
+    /// by the frame from `hvl_near`).
     pub hvl: Option<HvlParams>,
+    /// HVL's traced near field, when the frame has HVLs and asks for it.
+    pub hvl_near: Option<NearField>,
     /// Instant GI (paper 000), when the frame has it.
     pub igi: Option<IgiParams>,
     /// Sphere proxies (paper 002), when the frame has them.
@@ -146,8 +150,14 @@ impl FrameParams {
                     matching: upsample,
                     seed: 0,
                 },
+                near_range: 0.0,
                 slices: h.slices,
                 specular_limit,
+            }),
+            hvl_near: (gi.contains(GiTechnique::Hvl) && h.near_range > 0.0).then_some(NearField {
+                range_fraction: h.near_range,
+                rays: h.near_rays,
+                ..NearField::default()
             }),
             igi: gi.contains(GiTechnique::Igi).then_some(IgiParams {
                 pattern: [i.n, i.m],

@@ -333,6 +333,7 @@ pub fn vpls(
         falloff: hvl::Falloff::Sphere,
         visibility: false,
         shadows: hvl::shadows::ShadowSampling::default(),
+        near_range: 0.0,
         slices: 1,
         specular_limit: 0.0,
     };

@@ -160,29 +160,55 @@ pub fn sky(
             pass.read("environment", environment);
         },
     );
+    Ok(bilateral_filter(
+        rg,
+        ["sky_filter", "sky_light"],
+        receivers,
+        &irradiance,
+        camera,
+        params.filter_radius,
+        upsample,
+    ))
+}
+
+/// Adds a pass `names[0]` of `sky_filter.comp` writing a new image `names[1]`: the joint
+/// bilateral mean of the demodulated light
+/// `light` (RGBA16F at receiver resolution, light over π) over `radius` receivers around each
+/// one, with the bilateral match of `upsample`, times the receiver's `kd` seen from `camera`.
+/// Returns the outgoing radiance (RGBA16F at receiver resolution). The sky pass's filter, and
+/// HVL's near field's ([`crate::passes::hvl::near`]).
+pub fn bilateral_filter(
+    rg: &mut RenderGraph,
+    [name, output]: [&str; 2],
+    receivers: &Receivers,
+    light: &Handle<Image>,
+    camera: glam::Vec3,
+    radius: u32,
+    upsample: &UpsampleParams,
+) -> Handle<Image> {
     let [w, h] = receivers.extent;
     let mut out = rg.create_image(
-        "sky_light",
+        output,
         ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
     );
     let push = SkyFilterPush {
         camera: camera.extend(0.0).to_array(),
         extent: receivers.extent,
-        radius: params.filter_radius,
+        radius,
         depth_sigma: upsample.depth_sigma,
         normal_power: upsample.normal_power,
         pad: [0; 3],
     };
-    rg.compute("sky_filter", &shaders::SKY_FILTER_COMP)
+    rg.compute(name, &shaders::SKY_FILTER_COMP)
         .read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
         .read("recv_albedo", &receivers.albedo)
         .read("recv_material", &receivers.material)
-        .read("sky_irradiance", &irradiance)
+        .read("sky_irradiance", light)
         .write("sky", &mut out)
         .push(&push)
         .dispatch([w, h, 1]);
-    Ok(out)
+    out
 }
 
 /// One pass `name` of `shader` (a variant of `sky.comp`) over `receivers` with `bvh`, the

@@ -1,8 +1,8 @@
 //! What rays that meet the scene's surfaces read: its materials, textures, vertices and
 //! lights (`shaders/include/path.glsl`, `surface.glsl`), its BVH, and the environment where
 //! they escape. Shared by the passes that shade ray hits with the one-bounce light: the
-//! traced specular reflections (`passes::specular`) and the environment cubes' fill
-//! (`passes::cubes`).
+//! traced specular reflections (`passes::specular`), the environment cubes' fill
+//! (`passes::cubes`) and HVL's near field (`passes::hvl::near`).
 
 use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
@@ -31,15 +31,21 @@ impl TracedScene<'_> {
     /// Binds the scene's bindings of `path.glsl`, `surface.glsl`, `trace.glsl` and
     /// `environment.glsl` to `pass`.
     pub fn bind(&self, pass: &mut ComputePass<'_>) {
+        self.bind_surfaces(pass);
+        pass.read("environment", self.environment)
+            .sampler("environment_sampler", self.environment_sampler);
+    }
+
+    /// Binds the scene's bindings of `path.glsl`, `surface.glsl` and `trace.glsl` to `pass`
+    /// (a pass whose rays never see the environment).
+    pub fn bind_surfaces(&self, pass: &mut ComputePass<'_>) {
         pass.read("materials", &self.handles.materials)
             .read("srgb_textures", &self.handles.srgb_textures)
             .read("linear_textures", &self.handles.linear_textures)
             .sampler("texture_sampler", self.texture_sampler)
             .read("vertices", &self.handles.vertices)
             .read("indices", &self.handles.indices)
-            .read("lights", &self.handles.lights)
-            .read("environment", self.environment)
-            .sampler("environment_sampler", self.environment_sampler);
+            .read("lights", &self.handles.lights);
         self.bvh.bind(pass);
     }
 }

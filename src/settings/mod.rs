@@ -47,6 +47,7 @@ use crate::passes::aaf::AafParams;
 use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{self, Component, CompositeParams};
 use crate::passes::exposure::ExposureParams;
+use crate::passes::hvl::near::NearField;
 use crate::passes::hvl::{Distribution, Falloff, GatherPath, HvlParams, RadiusHeuristic, Window};
 use crate::passes::igi::{FilterMode, Glossy, IgiParams};
 use crate::passes::proxy::{DEFAULT_ORDER, ExpMethod, INDIRECT_BANDS, paper_expansion};
@@ -258,10 +259,17 @@ pub struct HvlSettings {
     pub visibility: bool,
     /// With `visibility`: shadow rays per receiver, to HVLs drawn in proportion to their
     /// light and denoised by a ratio estimator (`src/passes/hvl/shadows.rs`); 0 traces one
-    /// ray per receiver and HVL (exact, about 10× the gather's cost). Range 0..=4, default 4.
+    /// ray per receiver and HVL (exact, about 10× the gather's cost). Range 0..=16, default 8.
     pub shadow_rays: u32,
-    /// Radius in receivers of the sampled shadows' ratio filter. Range 0..=8, default 3.
+    /// Radius in receivers of the sampled shadows' ratio filter. Range 0..=8, default 4.
     pub shadow_filter_radius: u32,
+    /// R of the traced near field, as a fraction of the scene's largest side: light from
+    /// surfaces closer than R comes from `near_rays` traced rays instead of the HVLs, which
+    /// cap it, blended over R..2R (`src/passes/hvl/near.rs`). 0: none (paper 003). Range
+    /// 0.0..=0.5, default 0.05.
+    pub near_range: f32,
+    /// Rays per receiver of the near field. Range 1..=256, default 4.
+    pub near_rays: u32,
     /// Gather path: `full` (any BRDF, O(n²)) or `zonal` (symmetric lobes, O(n)).
     /// Default `full`.
     pub gather: GatherPath,
@@ -467,6 +475,8 @@ impl Default for HvlSettings {
             visibility: h.visibility,
             shadow_rays: h.shadows.rays,
             shadow_filter_radius: h.shadows.filter_radius,
+            near_range: NearField::default().range_fraction,
+            near_rays: NearField::default().rays,
             gather: h.path,
             window: h.window,
             falloff: h.falloff,

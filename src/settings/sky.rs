@@ -44,7 +44,8 @@ impl Default for SkySettings {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CavitySettings {
-    /// Darken HVL's light by its receivers' cavity occlusion. Default false.
+    /// Darken HVL's light by its receivers' cavity occlusion. Default false. Meant for HVLs
+    /// without shadows (`hvl.visibility = false`): shadowed HVLs already lose that light.
     pub enabled: bool,
     /// Rays per receiver. Range 1..=1024, default 8.
     pub rays: u32,

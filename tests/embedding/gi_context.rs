@@ -141,6 +141,7 @@ impl Bench {
         settings.output.component = Component::Indirect;
         settings.output.exposure = 1.0;
         settings.hvl.shadow_rays = 0;
+        settings.hvl.near_range = 0.0;
         let mut last = Vec::new();
         for frame in 0..=k {
             renderer
@@ -611,11 +612,13 @@ fn contexts_are_send_and_devices_send_and_sync() {
 }
 
 /// The context's description for `technique` at `display`, with HVL's shadows traced one ray
-/// per HVL: the sampled shadows' noise follows the frame index and the G-buffer's last bits,
-/// which these comparisons of two G-buffer paths and of resized contexts are not about.
+/// per HVL and no traced near field: their noise follows the frame index and the G-buffer's
+/// last bits, which these comparisons of two G-buffer paths and of resized contexts are not
+/// about.
 fn exact_desc(display: [u32; 2], technique: &str) -> GiContextDesc {
     let mut desc = GiContextDesc::new(display, technique).expect("desc");
     desc.settings.hvl.shadow_rays = 0;
+    desc.settings.hvl.near_range = 0.0;
     desc
 }
 

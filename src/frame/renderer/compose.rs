@@ -11,11 +11,12 @@ use crate::frame::igi::IgiInputs;
 use crate::frame::params::FrameParams;
 use crate::frame::shadows::ShadowState;
 use crate::gpu_scene::{SAMPLED_READ, SceneHandles};
+use crate::passes::aaf::scene_size;
 use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::cubes;
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
-use crate::passes::hvl::Distribution;
+use crate::passes::hvl::{Distribution, near};
 use crate::passes::specular;
 use crate::passes::traced_scene::TracedScene;
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
@@ -202,7 +203,8 @@ impl Renderer {
         // What rays that meet the scene's surfaces read (the specular pass and the cubes'
         // fill): level-0 texture lookups, and the environment where they escape, lighting the
         // hits too when the scene has one.
-        let environment = (p.specular.is_some() || cubes.is_some())
+        let hvl_near = p.hvl_near.filter(|_| hvl.is_some());
+        let environment = (p.specular.is_some() || cubes.is_some() || hvl_near.is_some())
             .then(|| rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ));
         let traced = environment.as_ref().map(|environment| TracedScene {
             handles,
@@ -254,6 +256,7 @@ impl Renderer {
         }
         // Sampled shadows draw new rays each frame a history averages: the indirect light's,
         // or the amortised gather's own.
+        let near_range = hvl_near.map_or(0.0, |n| n.range_fraction * scene_size(frame.bounds));
         let hvl_seed = match p.hvl {
             Some(h) if h.slices > 1 => rg.frame() as u32,
             _ => sky_light::history_seed(rg, p),
@@ -268,10 +271,26 @@ impl Renderer {
                     camera: camera.eye,
                     motion: &g.motion,
                     seed: hvl_seed,
+                    near_range,
                 },
             )?),
             _ => None,
         };
+        // HVL's traced near field, where the gather left it out.
+        let near_light = match (hvl_near, &recv, &traced, &hvl_low) {
+            (Some(near), Some(receivers), Some(traced), Some(_)) => Some(near::hvl_near(
+                rg,
+                receivers,
+                traced,
+                &near,
+                near_range,
+                hvl_seed,
+                camera.eye,
+                &p.upsample,
+            )),
+            _ => None,
+        };
+        let hvl_low = sum(rg, "hvl_near_add", hvl_low, near_light)?;
         let proxy_low = match (proxy, &recv) {
             (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers, camera.eye)?),
             _ => None,

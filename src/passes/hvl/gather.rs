@@ -163,6 +163,8 @@ fn record_gather(
         disc_falloff: u32::from(params.falloff == Falloff::Disc),
         shadow_rays: params.shadows.rays,
         seed: params.shadows.seed,
+        near_range: params.near_range,
+        pad: [0; 3],
     };
     let (name, threads) = match slice {
         0 => ("hvl_gather", [w, h, 1]),

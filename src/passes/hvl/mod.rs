@@ -77,7 +77,6 @@ use std::ops::RangeInclusive;
 
 use glam::Vec3;
 
-use crate::gpu::ShaderDesc;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::passes::rsm::{Rsm, RsmProjection};
 use crate::shaders;
@@ -85,10 +84,13 @@ use crate::shaders;
 pub mod flux;
 mod gather;
 mod grid;
+pub mod near;
 pub mod resolve;
 pub mod shadows;
+mod variants;
 pub use gather::{hvl_gather, hvl_regather};
 pub use grid::HvlGrid;
+pub use variants::{gather_shader, gather_variants};
 
 /// Most emission bands an [`Hvl`] stores (paper 003 §3 uses 0–5 bands for the emission).
 pub const EMISSION_MAX_BANDS: usize = 5;
@@ -169,6 +171,10 @@ pub struct GatherPush {
     pub shadow_rays: u32,
     /// Seed of the sampled shadow rays.
     pub seed: u32,
+    /// R of the near field ([`HvlParams::near_range`]), 0: none.
+    pub near_range: f32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 crate::choice::named_choice! {
@@ -254,6 +260,10 @@ pub struct HvlParams {
     pub visibility: bool,
     /// How many shadow rays, and the filter of sampled ones (with `visibility`).
     pub shadows: shadows::ShadowSampling,
+    /// R of the near field in world units ([`near`]): each HVL's light is scaled by
+    /// `smoothstep(R, 2R, d)` (d its centre's distance) and `hvl_near` traces the rest; 0:
+    /// none (paper 003).
+    pub near_range: f32,
     /// Receivers per refresh: 1 gathers every receiver every frame; [`resolve::SLICES`]
     /// gathers one per 2×2 cell and reprojects the rest (paper 001).
     pub slices: u32,
@@ -281,6 +291,7 @@ impl Default for HvlParams {
             falloff: Falloff::Sphere,
             visibility: true,
             shadows: shadows::ShadowSampling::default(),
+            near_range: 0.0,
             slices: 1,
             specular_limit: 0.0,
         }
@@ -367,125 +378,6 @@ pub const GATHER_COUNT: RangeInclusive<u32> = 1..=MAX_HVLS;
 
 /// The user scale k of the radii (paper 003 §5.3: "between 1 and 2").
 pub const RADIUS_SCALE: RangeInclusive<f32> = 1.0..=2.0;
-
-/// The `hvl_gather.comp` variants: `(path, conv_bands, shadowing, shader)` for every path,
-/// every band count of [`CONV_BANDS`] and every [`shadows::Shadowing`] (variants `full_cN`,
-/// `zonal_cN`, then `_vis` and `_shadows` after them).
-pub fn gather_variants() -> Vec<(GatherPath, u32, shadows::Shadowing, &'static ShaderDesc)> {
-    use shadows::Shadowing;
-    let mut variants = Vec::new();
-    for (path, name) in [(GatherPath::Full, "full"), (GatherPath::Zonal, "zonal")] {
-        for shadowing in [Shadowing::None, Shadowing::EveryHvl, Shadowing::Sampled] {
-            for bands in CONV_BANDS {
-                let suffix = shadowing.suffix();
-                if let Some(shader) =
-                    shaders::get(&format!("hvl_gather.comp:{name}_c{bands}{suffix}"))
-                {
-                    variants.push((path, bands, shadowing, shader));
-                }
-            }
-        }
-    }
-    variants
-}
-
-/// The gather shader for `params` (its path, convolution bands and shadowing), or
-/// [`HvlError::Variant`].
-pub fn gather_shader(params: &HvlParams) -> Result<&'static ShaderDesc, HvlError> {
-    let variants = gather_variants();
-    let shadowing = shadows::Shadowing::of(params.visibility, &params.shadows);
-    variants
-        .iter()
-        .find(|v| v.0 == params.path && v.1 == params.conv_bands && v.2 == shadowing)
-        .map(|v| v.3)
-        .ok_or_else(|| HvlError::Variant {
-            conv_bands: params.conv_bands,
-            path: params.path,
-            available: variants
-                .iter()
-                .map(|v| format!("{:?} c{}{}", v.0, v.1, v.2.suffix()))
-                .collect::<Vec<_>>()
-                .join(", "),
-        })
-}
-
-impl HvlParams {
-    /// Checks the parameters for the cache built from an RSM of side `rsm_size`; returns the
-    /// cells of the RSM, one per HVL.
-    pub fn validate_cache(&self, rsm_size: u32) -> Result<HvlGrid, HvlError> {
-        let grid = HvlGrid::new(self.count, rsm_size)
-            .filter(|_| CACHE_COUNT.contains(&self.count))
-            .ok_or(HvlError::Count {
-                count: self.count,
-                rsm_size,
-            })?;
-        if self.distribution == Distribution::Flux && self.radius == RadiusHeuristic::R1 {
-            return Err(HvlError::R1NeedsGrid);
-        }
-        if !RADIUS_SCALE.contains(&self.radius_scale) {
-            return Err(HvlError::OutOfRange {
-                name: "radius_scale",
-                value: f64::from(self.radius_scale),
-                expected: format!("{RADIUS_SCALE:?} (paper 003 §5.3)"),
-            });
-        }
-        Ok(grid)
-    }
-
-    /// Checks the band counts and the HVL count of the gather (`1..=10 000` records, bands as
-    /// documented on the fields) and returns the matching shader variant.
-    pub fn validate_gather(&self) -> Result<&'static ShaderDesc, HvlError> {
-        if !GATHER_COUNT.contains(&self.count) {
-            return Err(HvlError::OutOfRange {
-                name: "count",
-                value: f64::from(self.count),
-                expected: format!("{GATHER_COUNT:?} HVLs"),
-            });
-        }
-        if !CONV_BANDS.contains(&self.conv_bands) {
-            return Err(HvlError::OutOfRange {
-                name: "conv_bands",
-                value: f64::from(self.conv_bands),
-                expected: format!("{CONV_BANDS:?}"),
-            });
-        }
-        if self.visibility {
-            self.validate_shadows()?;
-        }
-        if !EMISSION_BANDS.contains(&self.emission_bands) || self.emission_bands > self.conv_bands {
-            return Err(HvlError::OutOfRange {
-                name: "emission_bands",
-                value: f64::from(self.emission_bands),
-                expected: format!("{EMISSION_BANDS:?} and at most conv_bands"),
-            });
-        }
-        gather_shader(self)
-    }
-}
-
-impl HvlParams {
-    /// Checks the shadow sampling: rays and filter radius in range.
-    fn validate_shadows(&self) -> Result<(), HvlError> {
-        let s = &self.shadows;
-        for (name, value, range) in [
-            ("shadow_rays", s.rays, shadows::RAYS_RANGE),
-            (
-                "shadow_filter_radius",
-                s.filter_radius,
-                shadows::FILTER_RADIUS_RANGE,
-            ),
-        ] {
-            if !range.contains(&value) {
-                return Err(HvlError::OutOfRange {
-                    name,
-                    value: f64::from(value),
-                    expected: format!("{range:?}"),
-                });
-            }
-        }
-        Ok(())
-    }
-}
 
 fn check_extent(
     name: &'static str,

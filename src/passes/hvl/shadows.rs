@@ -14,8 +14,9 @@
 //! shadows take the light's colour, not the hidden HVLs' own). This is the ratio estimator of
 //! Heitz, Hill and McGuire (2018,
 //! "Combining analytic direct illumination and stochastic shadows"), which keeps `U`'s detail
-//! and denoises only the shadowing. The weights are the sky filter's: a gaussian of the offset
-//! times paper 002's bilateral match, so shadows do not bleed across edges.
+//! and denoises only the shadowing. The weights are a gaussian of the offset (σ = the radius,
+//! twice the sky filter's: the visibility's noise needs the wider mean) times paper 002's
+//! bilateral match, so shadows do not bleed across edges.
 //!
 //! Amortised frames (`hvl.slices = 4`) filter the refreshed slice over its own receivers
 //! (steps of 2), and the receivers regathered after a disocclusion, scattered, take their own
@@ -32,13 +33,13 @@ use crate::passes::upsample::{UpsampleParams, bilateral_match};
 use crate::shaders;
 
 /// Most shadow rays per receiver (`HVL_SHADOW_RAYS_MAX` in `shaders/hvl_gather.comp`).
-pub const RAYS_MAX: u32 = 4;
+pub const RAYS_MAX: u32 = 16;
 /// Shadow rays per receiver the settings take (0: one per HVL).
 pub const RAYS_RANGE: RangeInclusive<u32> = 0..=RAYS_MAX;
 /// Default shadow rays per receiver of the sampled visibility.
-pub const RAYS: u32 = 4;
+pub const RAYS: u32 = 8;
 /// Default radius of the shadow filter, in receivers.
-pub const FILTER_RADIUS: u32 = 3;
+pub const FILTER_RADIUS: u32 = 4;
 /// Filter radii the settings take (0: each receiver's own ratio).
 pub const FILTER_RADIUS_RANGE: RangeInclusive<u32> = 0..=8;
 
@@ -190,7 +191,7 @@ pub fn ratio_filter(
         s => (2, (((s - 1) & 1) as i64, ((s - 1) >> 1) as i64)),
     };
     let r = sampling.filter_radius as i64;
-    let inv_two_sigma2 = if r > 0 { 2.0 / (r * r) as f32 } else { 0.0 };
+    let inv_two_sigma2 = if r > 0 { 0.5 / (r * r) as f32 } else { 0.0 };
     let at = |x: i64, y: i64| &texels[(y * width as i64 + x) as usize];
     let mut out = vec![None; texels.len()];
     for y in 0..height as i64 {
