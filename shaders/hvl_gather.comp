@@ -81,6 +81,7 @@
 #include "sh.glsl"
 #include "brdf.glsl"
 #include "hvl.glsl"
+#include "hvl_near.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -165,7 +166,7 @@ layout(push_constant) uniform Push {
     uint shadow_rays;
     // seed of the sampled shadow rays' random numbers
     uint seed;
-    // R of the near field (hvl_near.comp, world units): each HVL's light is scaled by
+    // R of the near field (hvl_near.comp, world units): each HVL's diffuse light is scaled by
     // smoothstep(R, 2R, d), d its centre's distance; 0: no near field
     float near_range;
     uint pad0;
@@ -285,11 +286,8 @@ void main() {
         if (dist < HVL_MIN_DISTANCE) {
             continue;
         }
-        // The near field's share is hvl_near.comp's.
-        float far = push.near_range > 0.0 ? smoothstep(push.near_range, 2.0 * push.near_range, dist) : 1.0;
-        if (!(far > 0.0)) {
-            continue;
-        }
+        // The near field's share of the diffuse light is hvl_near.comp's.
+        float far = hvl_far_weight(dist, push.near_range);
         vec3 wj = v / dist;
         float a = hvl_cap_half_angle(dist, r);
         float g = hvl_geometric_factor(wj, hvl_normal, n, r, a);
@@ -309,7 +307,7 @@ void main() {
         if (push.disc_falloff != 0u) {
             e *= hvl_disc_falloff(dist, r);
         }
-        vec3 lj = hvls.h[j].flux.rgb * (e * g * far);
+        vec3 lj = hvls.h[j].flux.rgb * (e * g);
         float cos_a = cos(a);
 #ifdef HVL_FULL
         float cap[SH_COEFFS];
@@ -317,14 +315,15 @@ void main() {
         SH_UNROLL for (int i = 0; i < SH_COEFFS; ++i) {
             cap[i] *= win[int(sqrt(float(i) + 0.5))];
         }
-        vec3 c = max(vec3(0.0), lj * (kd * sh_dot(cap, f_lambert) + ks * sh_dot(cap, f_glossy)));
+        // The near field's traced light is diffuse: the glossy lobe keeps all of the HVL.
+        vec3 c = max(vec3(0.0), lj * (kd * (far * sh_dot(cap, f_lambert)) + ks * sh_dot(cap, f_glossy)));
 #else
         float cap[SH_BANDS];
         sh_cap_zh(cos_a, cap);
         SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
             cap[l] *= win[l];
         }
-        vec3 c = max(vec3(0.0), lj * kd * (hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
+        vec3 c = max(vec3(0.0), lj * kd * (far * hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
 #endif
 #ifdef HVL_SHADOW_SAMPLES
         unshadowed_sum += c;

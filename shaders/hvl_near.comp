@@ -2,7 +2,7 @@
 // 2R, traced, where HVLs cannot give it. An HVL's sphere caps its light near its centre, so a
 // receiver a few centimetres from a lit wall (a room's corners, the base of a box) misses most
 // of that wall's light. Split every sender point y by its distance t from the receiver with
-// the weight f(t) = smoothstep(R, 2R, t): the gather takes f(d) of each HVL's light (d its
+// the weight f(t) = smoothstep(R, 2R, t) (hvl_far_weight): the gather takes f(d) of each HVL's light (d its
 // centre's distance), this pass the rest,
 //   E_near = pi / N * sum_k (1 - f(t_k)) L(y_k -> x)
 // over N cosine-weighted rays (t_k < 2R), L the light the hit reflects towards the receiver
@@ -20,6 +20,7 @@
 #define TRACE_TOP_BINDING 17
 #define TRACE_INSTANCES_BINDING 18
 #include "trace.glsl"
+#include "hvl_near.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -76,7 +77,7 @@ void main() {
         if (!trace_closest(origin, d, 0.0, 2.0 * range, hit)) {
             continue;
         }
-        float near = 1.0 - smoothstep(range, 2.0 * range, hit.t);
+        float near = 1.0 - hvl_far_weight(hit.t, range);
         if (near <= 0.0) {
             continue;
         }

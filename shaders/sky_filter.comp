@@ -2,7 +2,8 @@
 // visibility A, most where little sky is open (a room lit through its window), and a new
 // seed every frame turns that noise into flicker. Each receiver takes the joint bilateral mean
 // of the sky pass's demodulated light A L~(b) / pi over the (2R+1)^2 receivers around it:
-//   w = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R / 2; the match is
+//   w = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R / 2 for the sky, R
+//       for HVL's near field, push.sigma_per_radius; the match is
 //       paper 002's eq. 11 with the upsample's sigma_z and normal exponent)
 // and sends kd times the mean towards the camera (kd from brdf_indirect_weights), so the
 // albedo's texture is not blurred. R = 0 modulates only. Writes RGBA16F, a = 0, 0 on
@@ -32,7 +33,8 @@ layout(push_constant) uniform Push {
     // sigma_z and n of the bilateral match
     float depth_sigma;
     float normal_power;
-    uint pad0;
+    // sigma of the gaussian over the radius R (the sky: 1/2)
+    float sigma_per_radius;
     uint pad1;
     uint pad2;
 } push;
@@ -51,7 +53,8 @@ void main() {
     }
     n = normalize(n);
     int r = int(push.radius);
-    float inv_two_sigma2 = r > 0 ? 2.0 / float(r * r) : 0.0;
+    float sigma = push.sigma_per_radius * float(r);
+    float inv_two_sigma2 = r > 0 ? 0.5 / (sigma * sigma) : 0.0;
     ivec2 last = ivec2(push.extent) - 1;
     vec3 sum = vec3(0.0);
     float weight_sum = 0.0;

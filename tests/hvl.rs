@@ -746,10 +746,13 @@ fn gather_matches_the_cpu_reference() {
         (GatherPath::Zonal, 1, 1, none, sphere),
         (GatherPath::Zonal, 5, 3, Window::Sinc, Falloff::Disc),
     ];
-    for (path, conv, emission, window, falloff) in variants {
+    // The near field's cut (R = 1 m, about twice the HVLs' spacing) on two of them.
+    let near = [(3, 1.0), (6, 1.0)];
+    for (k, (path, conv, emission, window, falloff)) in variants.into_iter().enumerate() {
         let p = HvlParams {
             window,
             falloff,
+            near_range: near.iter().find(|n| n.0 == k).map_or(0.0, |n| n.1),
             ..params(path, conv, emission)
         };
         let brdf = tables(conv, [12, 24]);
@@ -770,8 +773,8 @@ fn gather_matches_the_cpu_reference() {
                 );
             }
         }
-        // The window and the disc falloff each change the light: the same gather without
-        // the one in use differs.
+        // The window, the disc falloff and the near field's cut each change the light: the
+        // same gather without the one in use differs.
         let without = [
             (window == Window::Sinc).then_some(HvlParams {
                 window: Window::None,
@@ -779,6 +782,10 @@ fn gather_matches_the_cpu_reference() {
             }),
             (falloff == Falloff::Disc).then_some(HvlParams {
                 falloff: Falloff::Sphere,
+                ..p
+            }),
+            (p.near_range > 0.0).then_some(HvlParams {
+                near_range: 0.0,
                 ..p
             }),
         ];

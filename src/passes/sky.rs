@@ -126,9 +126,14 @@ pub struct SkyFilterPush {
     pub depth_sigma: f32,
     /// Normal exponent of the bilateral match.
     pub normal_power: f32,
+    /// σ of the gaussian over the radius ([`SKY_SIGMA_PER_RADIUS`] for the sky).
+    pub sigma_per_radius: f32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: [u32; 2],
 }
+
+/// σ of the sky filter's gaussian over its radius.
+pub const SKY_SIGMA_PER_RADIUS: f32 = 0.5;
 
 /// Adds the `sky` and `sky_filter` passes over `receivers` seen from `camera`: the
 /// environment's SH (`environment`, `EnvironmentSh::gpu_data` at [`BANDS`] bands) times each
@@ -166,15 +171,16 @@ pub fn sky(
         receivers,
         &irradiance,
         camera,
-        params.filter_radius,
+        (params.filter_radius, SKY_SIGMA_PER_RADIUS),
         upsample,
     ))
 }
 
 /// Adds a pass `names[0]` of `sky_filter.comp` writing a new image `names[1]`: the joint
 /// bilateral mean of the demodulated light
-/// `light` (RGBA16F at receiver resolution, light over π) over `radius` receivers around each
-/// one, with the bilateral match of `upsample`, times the receiver's `kd` seen from `camera`.
+/// `light` (RGBA16F at receiver resolution, light over π) over `(radius, σ / radius)`: a
+/// gaussian over the receivers within the radius, times the bilateral match of `upsample`;
+/// then times the receiver's `kd` seen from `camera`.
 /// Returns the outgoing radiance (RGBA16F at receiver resolution). The sky pass's filter, and
 /// HVL's near field's ([`crate::passes::hvl::near`]).
 pub fn bilateral_filter(
@@ -183,7 +189,7 @@ pub fn bilateral_filter(
     receivers: &Receivers,
     light: &Handle<Image>,
     camera: glam::Vec3,
-    radius: u32,
+    (radius, sigma_per_radius): (u32, f32),
     upsample: &UpsampleParams,
 ) -> Handle<Image> {
     let [w, h] = receivers.extent;
@@ -197,7 +203,8 @@ pub fn bilateral_filter(
         radius,
         depth_sigma: upsample.depth_sigma,
         normal_power: upsample.normal_power,
-        pad: [0; 3],
+        sigma_per_radius,
+        pad: [0; 2],
     };
     rg.compute(name, &shaders::SKY_FILTER_COMP)
         .read("recv_position", &receivers.position)

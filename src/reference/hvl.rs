@@ -362,6 +362,11 @@ pub fn shade(
         })
         .collect::<Result<_, _>>()?;
     let (x, n) = (receiver.position, receiver.normal.normalize());
+    // The diffuse share the traced near field leaves to the HVL.
+    let far = |hvl: &Hvl| {
+        let centre = Vec4::from(hvl.position_radius).truncate();
+        shine_sh::hvl::far_weight(centre.distance(x), params.near_range)
+    };
     let (kd, ks) = receiver.weights(camera);
     // the glossy share the frame's specular pass leaves to the gather
     let ks = ks
@@ -386,7 +391,7 @@ pub fn shade(
                 for (i, c) in cap.iter_mut().enumerate() {
                     *c *= win[i.isqrt()];
                 }
-                let diffuse = shine_sh::dot(&cap, &f_lambert)?;
+                let diffuse = shine_sh::dot(&cap, &f_lambert)? * far(hvl);
                 let glossy = shine_sh::dot(&cap, &f_glossy)?;
                 sum += (lj * (kd * diffuse + ks * glossy)).max(Vec3::ZERO);
             }
@@ -407,7 +412,7 @@ pub fn shade(
                 for (c, w) in cap.iter_mut().zip(&win) {
                     *c *= w;
                 }
-                sum += (lj * kd * zh_dot(&cap, &cc, n.dot(wj))).max(Vec3::ZERO);
+                sum += (lj * kd * (far(hvl) * zh_dot(&cap, &cc, n.dot(wj)))).max(Vec3::ZERO);
             }
         }
     }

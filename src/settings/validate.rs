@@ -115,6 +115,12 @@ impl Settings {
             self.hvl.shadow_filter_radius,
             &hvl::shadows::FILTER_RADIUS_RANGE,
         )?;
+        check(
+            "hvl.near_range",
+            self.hvl.near_range,
+            &hvl::near::RANGE_RANGE,
+        )?;
+        check("hvl.near_rays", self.hvl.near_rays, &hvl::near::RAYS_RANGE)?;
         if ![1, hvl::resolve::SLICES].contains(&self.hvl.slices) {
             return Err(SettingsError::OutOfRange {
                 field: "hvl.slices",

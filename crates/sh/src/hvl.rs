@@ -189,6 +189,20 @@ pub fn disc_falloff(distance: f32, radius: f32) -> f32 {
     }
 }
 
+/// The share of a sender point's light at `distance` from a receiver that the HVL gather keeps
+/// when the near field within `range` (R) is traced (shine's extension, `hvl.near_range`):
+/// `S((d − R) / R)` with the smoothstep `S`, 0 up to R, 1 from 2R on; 1 everywhere when R is
+/// 0. The near-field pass takes `1 −` this at each ray hit, so the two shares sum to one for
+/// every sender point (Kollig and Keller's split with a smooth boundary). GLSL twin
+/// `hvl_far_weight` in `hvl_near.glsl`.
+pub fn far_weight(distance: f32, range: f32) -> f32 {
+    if range > 0.0 {
+        smoothstep(f64::from((distance - range) / range)) as f32
+    } else {
+        1.0
+    }
+}
+
 /// Smallest cosine of incidence [`rsm_texel_area`] divides by: a texel lit at grazing
 /// incidence (beyond about 84°) counts as lit at 84°, so its patch and the radius taken from
 /// it stay finite.

@@ -276,7 +276,15 @@ impl Renderer {
             )?),
             _ => None,
         };
-        // HVL's traced near field, where the gather left it out.
+        let proxy_low = match (proxy, &recv) {
+            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers, camera.eye)?),
+            _ => None,
+        };
+        let hvl_low =
+            sky_light::cavity_shaded(rg, p, frame.bounds, &handles.trace, recv.as_ref(), hvl_low)?;
+        // HVL's traced near field, where the gather left it out (after the cavity shading: its
+        // rays are shadowed already). New rays each frame only when the indirect light's history
+        // averages them (the amortised gather's resolve comes before it).
         let near_light = match (hvl_near, &recv, &traced, &hvl_low) {
             (Some(near), Some(receivers), Some(traced), Some(_)) => Some(near::hvl_near(
                 rg,
@@ -284,19 +292,13 @@ impl Renderer {
                 traced,
                 &near,
                 near_range,
-                hvl_seed,
+                sky_light::history_seed(rg, p),
                 camera.eye,
                 &p.upsample,
             )),
             _ => None,
         };
         let hvl_low = sum(rg, "hvl_near_add", hvl_low, near_light)?;
-        let proxy_low = match (proxy, &recv) {
-            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers, camera.eye)?),
-            _ => None,
-        };
-        let hvl_low =
-            sky_light::cavity_shaded(rg, p, frame.bounds, &handles.trace, recv.as_ref(), hvl_low)?;
         let low = sum(rg, "gi_add", hvl_low, proxy_low)?;
         let sky_low = match (sky, &recv) {
             (Some(params), Some(receivers)) => Some(sky_light::sky_light(

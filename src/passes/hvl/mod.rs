@@ -260,7 +260,7 @@ pub struct HvlParams {
     pub visibility: bool,
     /// How many shadow rays, and the filter of sampled ones (with `visibility`).
     pub shadows: shadows::ShadowSampling,
-    /// R of the near field in world units ([`near`]): each HVL's light is scaled by
+    /// R of the near field in world units ([`near`]): each HVL's diffuse light is scaled by
     /// `smoothstep(R, 2R, d)` (d its centre's distance) and `hvl_near` traces the rest; 0:
     /// none (paper 003).
     pub near_range: f32,

@@ -34,7 +34,10 @@ pub const RAYS: u32 = 4;
 /// Rays per receiver the settings take.
 pub const RAYS_RANGE: RangeInclusive<u32> = 1..=256;
 /// Default radius of the near field's filter, in receivers.
-pub const FILTER_RADIUS: u32 = 3;
+pub const FILTER_RADIUS: u32 = 4;
+/// σ of the near field filter's gaussian over its radius (the sky's is 1/2: the near field's
+/// few rays need the wider mean).
+pub const SIGMA_PER_RADIUS: f32 = 1.0;
 
 /// The near field a frame asks for.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -116,7 +119,7 @@ pub fn hvl_near(
         receivers,
         &light,
         camera,
-        near.filter_radius,
+        (near.filter_radius, SIGMA_PER_RADIUS),
         upsample,
     )
 }
