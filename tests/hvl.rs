@@ -838,12 +838,7 @@ fn gather_visibility_matches_the_cpu_shadow_rays() {
         ..unshadowed
     };
     let plain = gpu_gather(&device, &receivers, &hvls, &brdf, CAMERA, &unshadowed, None);
-    let far = occluder_scene(&[[
-        Vec3::new(50.0, 50.0, 50.0),
-        Vec3::new(51.0, 50.0, 50.0),
-        Vec3::new(51.0, 51.0, 50.0),
-        Vec3::new(50.0, 51.0, 50.0),
-    ]]);
+    let far = far_occluder();
     let far_bvh = GpuBvh::from_world(&device, &world_bvh(&far)).unwrap();
     let clear = gpu_gather(
         &device,
@@ -1107,6 +1102,16 @@ fn gather_reaches_the_last_of_max_hvls() {
     assert_clean(&device);
 }
 
+/// One quad far from the synthetic receivers and HVLs: a BVH that hides nothing.
+fn far_occluder() -> shine_scene::Scene {
+    occluder_scene(&[[
+        Vec3::new(50.0, 50.0, 50.0),
+        Vec3::new(51.0, 50.0, 50.0),
+        Vec3::new(51.0, 51.0, 50.0),
+        Vec3::new(50.0, 51.0, 50.0),
+    ]])
+}
+
 /// A slab over the left half of the synthetic floor HVLs: part of the receivers' light hidden.
 fn half_slab() -> shine_scene::Scene {
     occluder_scene(&[[
@@ -1192,12 +1197,7 @@ fn sampled_shadows_approach_one_ray_per_hvl() {
         "unfiltered mean / exact energy {ratio}"
     );
 
-    let far = occluder_scene(&[[
-        Vec3::new(50.0, 50.0, 50.0),
-        Vec3::new(51.0, 50.0, 50.0),
-        Vec3::new(51.0, 51.0, 50.0),
-        Vec3::new(50.0, 51.0, 50.0),
-    ]]);
+    let far = far_occluder();
     let far_bvh = GpuBvh::from_world(&device, &world_bvh(&far)).unwrap();
     let clear = energy(&with(4, 3, 0, &far_bvh)) / energy(&plain);
     assert!(

@@ -195,6 +195,9 @@ fn cavity_darkens_hvl_light_by_the_visibility_past_the_ball() {
             ("specular.enabled", "false"),
             ("cavity.rays", "1024"),
             ("cavity.range", "1.0"),
+            // Cavity shading is for paper 003's unshadowed HVLs, without the traced near field.
+            ("hvl.visibility", "false"),
+            ("hvl.near_range", "0"),
         ] {
             s.set(key, value).expect("setting");
         }

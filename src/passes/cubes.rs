@@ -35,7 +35,7 @@
 //! * **Diffuse only**: the receivers get `kd · L̄`; the traced specular pass still adds the
 //!   sharp part of their glossy lobes, the rough part is left out.
 
-use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Buffer, Handle, Image, RenderGraph};
 use crate::passes::receivers::Receivers;
 use crate::passes::traced_scene::TracedScene;
 use crate::shaders;
@@ -169,10 +169,7 @@ pub fn cubes(
         fill_and_smooth(rg, scene, inputs, config);
     }
     let [w, h] = receivers.extent;
-    let mut out = rg.create_image(
-        "cube_light",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
+    let mut out = receivers.light_image(rg, "cube_light");
     let mut pass = rg.compute("cubes_shade", &shaders::CUBES_COMP_SHADE);
     pass.read("radiance", &inputs.radiance)
         .read("smoothed", &inputs.smoothed)

@@ -74,6 +74,18 @@ pub struct Receivers {
     pub scale: u32,
 }
 
+impl Receivers {
+    /// A new transient RGBA16F image `name` at receiver resolution: the format every
+    /// receiver-resolution light (HVL, the sky, the proxies, the cubes) is written in.
+    pub fn light_image(&self, rg: &mut RenderGraph, name: &str) -> Handle<Image> {
+        let [w, h] = self.extent;
+        rg.create_image(
+            name,
+            ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+        )
+    }
+}
+
 /// Push constants of `shaders/receivers.comp`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]

@@ -29,7 +29,7 @@
 use std::ops::RangeInclusive;
 
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Buffer, Handle, Image, RenderGraph};
 use crate::passes::receivers::Receivers;
 use crate::passes::upsample::UpsampleParams;
 use crate::shaders;
@@ -193,10 +193,7 @@ pub fn bilateral_filter(
     upsample: &UpsampleParams,
 ) -> Handle<Image> {
     let [w, h] = receivers.extent;
-    let mut out = rg.create_image(
-        output,
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
+    let mut out = receivers.light_image(rg, output);
     let push = SkyFilterPush {
         camera: camera.extend(0.0).to_array(),
         extent: receivers.extent,
@@ -242,10 +239,7 @@ fn trace_pass(
         pad: [0; 2],
     };
     let [w, h] = receivers.extent;
-    let mut out = rg.create_image(
-        output,
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
+    let mut out = receivers.light_image(rg, output);
     let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal);

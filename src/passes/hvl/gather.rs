@@ -8,7 +8,7 @@ use super::{
     resolve, shadows,
 };
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::graph::{Buffer, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Buffer, Handle, Image, RenderGraph};
 use crate::passes::brdf_tables::{
     GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
 };
@@ -33,11 +33,7 @@ pub fn hvl_gather(
     slice: u32,
 ) -> Result<Handle<Image>, HvlError> {
     let (shader, inputs) = GatherInputs::checked(receivers, hvls, brdf, bvh, camera, params)?;
-    let [w, h] = receivers.extent;
-    let mut indirect = rg.create_image(
-        "indirect",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
+    let mut indirect = receivers.light_image(rg, "indirect");
     Ok(
         match record_gather(rg, shader, &inputs, params, &mut indirect, slice) {
             Some(unshadowed) => shadows::shadow_filter(
@@ -172,12 +168,7 @@ fn record_gather(
         _ => ("hvl_gather", [w.div_ceil(2), h.div_ceil(2), 1]),
     };
     let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
-    let mut unshadowed = sampled.then(|| {
-        rg.create_image(
-            "hvl_unshadowed",
-            ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-        )
-    });
+    let mut unshadowed = sampled.then(|| receivers.light_image(rg, "hvl_unshadowed"));
     let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)

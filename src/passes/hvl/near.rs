@@ -18,7 +18,7 @@
 
 use std::ops::RangeInclusive;
 
-use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Handle, Image, RenderGraph};
 use crate::passes::receivers::Receivers;
 use crate::passes::sky::bilateral_filter;
 use crate::passes::traced_scene::TracedScene;
@@ -94,10 +94,7 @@ pub fn hvl_near(
     upsample: &UpsampleParams,
 ) -> Handle<Image> {
     let [w, h] = receivers.extent;
-    let mut light = rg.create_image(
-        "hvl_near_irradiance",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
+    let mut light = receivers.light_image(rg, "hvl_near_irradiance");
     let push = NearPush {
         extent: receivers.extent,
         rays: near.rays,

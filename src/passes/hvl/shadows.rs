@@ -27,7 +27,7 @@
 
 use std::ops::RangeInclusive;
 
-use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Handle, Image, RenderGraph};
 use crate::passes::receivers::Receivers;
 use crate::passes::upsample::{UpsampleParams, bilateral_match};
 use crate::shaders;
@@ -132,10 +132,7 @@ pub fn shadow_filter(
     slice: u32,
 ) -> Handle<Image> {
     let [w, h] = receivers.extent;
-    let mut filtered = rg.create_image(
-        "hvl_shadowed",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
+    let mut filtered = receivers.light_image(rg, "hvl_shadowed");
     let push = ShadowFilterPush {
         extent: receivers.extent,
         radius: sampling.filter_radius,
