@@ -5,7 +5,7 @@
 // its radius; a receiver inside an HVL's sphere is never shadowed from it.
 //   `_vis`: one ray per receiver and HVL, `indirect` the shadowed sum.
 //   `_shadows`: push.shadow_rays = K rays per receiver, to HVLs drawn in proportion to their
-//     weight w_j = c_j.r + c_j.g + c_j.b (c_j the HVL's light; K weighted reservoirs over the
+//     weight w_j = (c_j.r + c_j.g + c_j.b) / 3 (c_j the HVL's light; K weighted reservoirs over the
 //     loop). With W the weight outside the spheres and W_in inside, the shadowed weight
 //       S = W_in + W * (visible rays / K)
 //     is unbiased; `unshadowed` holds (U, W_in + W) (U the unshadowed sum), `indirect`
@@ -261,7 +261,7 @@ void main() {
     vec3 origin = trace_offset(x, n);
 #endif
 #ifdef HVL_SHADOW_SAMPLES
-    // The unshadowed sum and its weights (w_j = c_j.r + c_j.g + c_j.b), inside HVLs' spheres and
+    // The unshadowed sum and its weights (w_j = mean of c_j's channels), inside HVLs' spheres and
     // outside, and the reservoirs: each keeps one HVL, all drawn over the same running weight.
     vec3 unshadowed_sum = vec3(0.0);
     float weight_inside = 0.0;
@@ -327,7 +327,7 @@ void main() {
 #endif
 #ifdef HVL_SHADOW_SAMPLES
         unshadowed_sum += c;
-        float w = c.r + c.g + c.b;
+        float w = (c.r + c.g + c.b) * (1.0 / 3.0);
         if (dist <= r) {
             weight_inside += w;
             continue;
@@ -345,8 +345,13 @@ void main() {
         float s = fract(uk) / float(rays);
         int takers = p > s ? min(rays, int(ceil((p - s) * float(rays)))) : 0;
         int base = int(uk);
-        for (int m = 0; m < takers; ++m) {
-            pick[(m - base + rays) % rays] = j;
+        // Usually none or one (p falls below 1/K after the first few HVLs): the loop, which
+        // lavapipe's loop limiter counts, runs only for the rare HVL that more reservoirs take.
+        if (takers > 0) {
+            pick[(rays - base) % rays] = j;
+            for (int m = 1; m < takers; ++m) {
+                pick[(m - base + rays) % rays] = j;
+            }
         }
 #else
         sum += c;

@@ -2,8 +2,8 @@
 // 2R, traced, where HVLs cannot give it. An HVL's sphere caps its light near its centre, so a
 // receiver a few centimetres from a lit wall (a room's corners, the base of a box) misses most
 // of that wall's light. Split every sender point y by its distance t from the receiver with
-// the weight f(t) = smoothstep(R, 2R, t) (hvl_far_weight): the gather takes f(d) of each HVL's light (d its
-// centre's distance), this pass the rest,
+// the weight f(t) = smoothstep(R, 2R, t) (hvl_far_weight): the gather takes f(d) of each
+// HVL's diffuse light (d its centre's distance), this pass the rest,
 //   E_near = pi / N * sum_k (1 - f(t_k)) L(y_k -> x)
 // over N cosine-weighted rays (t_k < 2R), L the light the hit reflects towards the receiver
 // from the punctual lights (next-event estimation with shadow rays, path.glsl). Together they

@@ -5,7 +5,7 @@
 // and stochastic shadows") keeps U's detail and filters only the shadowing:
 //   out = U * min(1, sum_q w_q S_q / sum_q w_q W_u,q)
 // over the (2R+1)^2 receivers q around the receiver, with
-//   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R)
+//   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R, push.sigma_per_radius)
 // (the sky filter's weights with twice its sigma: paper 002 eq. 11's match with the upsample's
 // sigma_z and normal exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility
 // is, and exactly 1 where nothing is in the way. Amortised frames (push.slice = 1 + k) filter
@@ -35,7 +35,8 @@ layout(push_constant) uniform Push {
     float normal_power;
     // 0: every receiver; 1 + k: the slice of the amortised gather (hvl_gather.comp)
     uint slice;
-    uint pad1;
+    // sigma of the gaussian over the radius R
+    float sigma_per_radius;
     uint pad2;
 } push;
 
@@ -58,7 +59,8 @@ void main() {
     }
     n = normalize(n);
     int r = int(push.radius);
-    float inv_two_sigma2 = r > 0 ? 0.5 / float(r * r) : 0.0;
+    float sigma = push.sigma_per_radius * float(r);
+    float inv_two_sigma2 = r > 0 ? 0.5 / (sigma * sigma) : 0.0;
     ivec2 last = ivec2(push.extent) - 1;
     float num = 0.0;
     float den = 0.0;

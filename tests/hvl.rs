@@ -1067,7 +1067,8 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
 /// llvmpipe ends every loop of an invocation after 65 535 iterations in all (docs/pitfalls.md):
 /// a gather whose per-HVL work held loops stopped after a few hundred to a couple of thousand
 /// HVLs and silently dropped the rest. One lit HVL behind 9 999 unlit ones must light the
-/// receivers exactly as it does alone, in each path.
+/// receivers exactly as it does alone, in each path; the sampled shadows must see all of
+/// 10 000 lit ones.
 #[test]
 fn gather_reaches_the_last_of_max_hvls() {
     let device = device();
@@ -1099,6 +1100,46 @@ fn gather_reaches_the_last_of_max_hvls() {
             );
         }
     }
+    // The sampled shadows (16 rays, no filter) over 10 000 lit HVLs with nothing in the way:
+    // each receiver's own ratio is exactly 1, so they give the unshadowed gather's light, all
+    // of it only if their reservoir updates left the loop over HVLs whole.
+    let all_lit: Vec<Hvl> = (0..MAX_HVLS)
+        .map(|k| {
+            let mut h = lit;
+            h.flux[0] *= 1.0 + (k % 7) as f32 * 0.1;
+            h
+        })
+        .collect();
+    let brdf = tables(5, [12, 24]);
+    let plain = HvlParams {
+        count: MAX_HVLS,
+        ..params(GatherPath::Full, 5, 3)
+    };
+    let sampled = HvlParams {
+        visibility: true,
+        shadows: ShadowSampling {
+            rays: shadows::RAYS_MAX,
+            filter_radius: 0,
+            ..ShadowSampling::default()
+        },
+        ..plain
+    };
+    let clear = GpuBvh::from_world(&device, &world_bvh(&far_occluder())).unwrap();
+    let unshadowed = gpu_gather(&device, &receivers, &all_lit, &brdf, CAMERA, &plain, None);
+    let shadowed = gpu_gather(
+        &device,
+        &receivers,
+        &all_lit,
+        &brdf,
+        CAMERA,
+        &sampled,
+        Some(&clear),
+    );
+    assert!(unshadowed.iter().any(|v| v.max_element() > 0.0));
+    assert_eq!(
+        unshadowed, shadowed,
+        "sampled shadows over {MAX_HVLS} lit HVLs"
+    );
     assert_clean(&device);
 }
 

@@ -200,9 +200,9 @@ impl Renderer {
             None => None,
         };
         let light_count = light_count(frame)?;
-        // What rays that meet the scene's surfaces read (the specular pass and the cubes'
-        // fill): level-0 texture lookups, and the environment where they escape, lighting the
-        // hits too when the scene has one.
+        // What rays that meet the scene's surfaces read (the specular pass, the cubes' fill
+        // and HVL's near field): level-0 texture lookups, and the environment where they
+        // escape, lighting the hits too when the scene has one.
         let hvl_near = p.hvl_near.filter(|_| hvl.is_some());
         let environment = (p.specular.is_some() || cubes.is_some() || hvl_near.is_some())
             .then(|| rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ));

@@ -276,8 +276,9 @@ impl Default for HvlParams {
     /// Paper 003's choices but two: 400 HVLs (fig. 10), r2 radii scaled by 1.5 (§5.3: 1–2),
     /// 5 convolution and 3 emission bands, the full path, the sphere's falloff; placed by flux
     /// rather than on the paper's grid (relative RMSE of the cornell box's indirect light
-    /// 0.64 → 0.34), and shadowed by 4 sampled rays per receiver rather than unshadowed
-    /// (0.32 → 0.25, energy 1.12 → 0.97; docs/quality.md).
+    /// 0.64 → 0.34), and shadowed by 8 sampled rays per receiver rather than unshadowed
+    /// (0.32 → 0.25, energy 1.12 → 0.98; docs/quality.md). The near field (`near_range`) is
+    /// the frame's to set.
     fn default() -> Self {
         Self {
             count: 400,

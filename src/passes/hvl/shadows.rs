@@ -6,7 +6,7 @@
 //! receiver and HVL ([`ShadowSampling::rays`] = 0, the `_vis` variants) fixes the energy but
 //! multiplies the gather's cost by about 10 on lavapipe (400 rays per receiver). With
 //! `rays = K`, the gather (`shaders/hvl_gather.comp`, `_shadows` variants) draws K HVLs per
-//! receiver in proportion to their weight `w_j` (the `r + g + b` of their light; weighted
+//! receiver in proportion to their weight `w_j` (the mean of their light's channels; weighted
 //! reservoirs over its loop) and traces only those, giving an unbiased, noisy shadowed weight
 //! `S` beside the exact unshadowed light `U` and its weight `W_u`. The filter
 //! (`shaders/hvl_shadow_filter.comp`) then returns `U · min(1, Σ w S / Σ w W_u)` over the
@@ -40,6 +40,9 @@ pub const RAYS_RANGE: RangeInclusive<u32> = 0..=RAYS_MAX;
 pub const RAYS: u32 = 8;
 /// Default radius of the shadow filter, in receivers.
 pub const FILTER_RADIUS: u32 = 4;
+/// σ of the filter's gaussian over its radius (the sky filter's is 1/2: the visibility's noise
+/// needs the wider mean).
+pub const SIGMA_PER_RADIUS: f32 = 1.0;
 /// Filter radii the settings take (0: each receiver's own ratio).
 pub const FILTER_RADIUS_RANGE: RangeInclusive<u32> = 0..=8;
 
@@ -115,8 +118,10 @@ pub struct ShadowFilterPush {
     /// 0: every receiver; 1 + k: only the amortised gather's slice k, filtered over its own
     /// receivers ([`super::resolve::slice_of_frame`]).
     pub slice: u32,
+    /// σ of the gaussian over the radius ([`SIGMA_PER_RADIUS`]).
+    pub sigma_per_radius: f32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// Adds `hvl_shadow_filter`: the ratio-filtered light of the sampled gather's `shadowed`
@@ -139,7 +144,8 @@ pub fn shadow_filter(
         depth_sigma: sampling.matching.depth_sigma,
         normal_power: sampling.matching.normal_power,
         slice,
-        pad: [0; 2],
+        sigma_per_radius: SIGMA_PER_RADIUS,
+        pad: 0,
     };
     rg.compute("hvl_shadow_filter", &shaders::HVL_SHADOW_FILTER_COMP)
         .read("recv_position", &receivers.position)
@@ -166,7 +172,7 @@ pub struct FilterTexel {
     pub normal: [f32; 4],
     /// The gather's unshadowed light (RGB).
     pub unshadowed: [f32; 3],
-    /// Its weight: the sum of every HVL's `r + g + b`.
+    /// Its weight: the sum over the HVLs of the mean of their light's channels.
     pub unshadowed_weight: f32,
     /// The gather's estimate of the shadowed weight.
     pub shadowed_weight: f32,
@@ -188,7 +194,8 @@ pub fn ratio_filter(
         s => (2, (((s - 1) & 1) as i64, ((s - 1) >> 1) as i64)),
     };
     let r = sampling.filter_radius as i64;
-    let inv_two_sigma2 = if r > 0 { 0.5 / (r * r) as f32 } else { 0.0 };
+    let sigma = SIGMA_PER_RADIUS * r as f32;
+    let inv_two_sigma2 = if r > 0 { 0.5 / (sigma * sigma) } else { 0.0 };
     let at = |x: i64, y: i64| &texels[(y * width as i64 + x) as usize];
     let mut out = vec![None; texels.len()];
     for y in 0..height as i64 {
