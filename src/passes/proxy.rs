@@ -44,7 +44,7 @@ use shine_sh::exp_log::ShExp;
 use shine_sh::sphere_blocker::AlphaTable;
 
 use crate::gpu_scene::environment_sh::ORDERS;
-use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::shaders;
 
 use super::brdf_tables::{GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step};
@@ -565,10 +565,7 @@ pub fn proxy_shade(
             expected: format!("{need} bytes"),
         });
     }
-    let mut radiance = rg.create_image(
-        "proxy_gi",
-        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
-    );
+    let mut radiance = receivers.light_image(rg, "proxy_gi");
     let coeffs = u64::from(params.bands * params.bands);
     let mut occlusion = rg.create_buffer("proxy_occlusion", BufferDesc::new(texels * coeffs * 4));
     let push = ShadePush {

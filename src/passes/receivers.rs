@@ -76,7 +76,7 @@ pub struct Receivers {
 
 impl Receivers {
     /// A new transient RGBA16F image `name` at receiver resolution: the format every
-    /// receiver-resolution light (HVL, the sky, the cubes; the proxies' too) is written in.
+    /// receiver-resolution light (HVL, the sky, the proxies, the cubes) is written in.
     pub fn light_image(&self, rg: &mut RenderGraph, name: &str) -> Handle<Image> {
         let [w, h] = self.extent;
         rg.create_image(
