@@ -10,9 +10,9 @@ mod common;
 
 use common::scenes::luminance;
 use glam::{Mat4, Vec3};
+use shine::Renderer;
 use shine::capture::image_io::HdrImage;
 use shine::reference::render_reference;
-use shine::{Renderer, Settings};
 use shine_scene::Scene;
 use shine_scene::environment::Environment;
 use shine_scene::proxies::{NodeProxies, ProxySource, ProxySphere};
@@ -54,19 +54,11 @@ fn scene() -> Scene {
 }
 
 fn frame(device: &shine::gpu::Device, scene: &Scene, settings: &[(&str, &str)]) -> HdrImage {
-    let mut s = Settings {
-        width: SIZE,
-        height: SIZE,
-        receiver_scale: 1,
-        ..Settings::default()
-    };
-    s.set("gi", "none").expect("gi");
+    let mut s = common::scenes::settings(SIZE, &[("gi", "none")]);
     for (key, value) in settings {
         s.set(key, value).expect("setting");
     }
-    let mut renderer = Renderer::new(device).expect("renderer");
-    renderer.set_scene(scene, 0.0).expect("scene");
-    renderer.render(&s).expect("render").hdr
+    common::scenes::render_once(device, scene, &s)
 }
 
 /// The pixels whose centre ray meets a sphere 10% smaller than the ball (away from its rim).
@@ -147,15 +139,14 @@ fn sequence(
     frames: u32,
     update: impl Fn(u32) -> shine::gpu_scene::FrameUpdate,
 ) -> HdrImage {
-    let mut s = Settings {
-        width: SIZE,
-        height: SIZE,
-        receiver_scale: 1,
-        ..Settings::default()
-    };
-    s.set("gi", "none").expect("gi");
-    s.set("sky.enabled", "false").expect("sky");
-    s.set("cubes.enabled", "true").expect("cubes");
+    let mut s = common::scenes::settings(
+        SIZE,
+        &[
+            ("gi", "none"),
+            ("sky.enabled", "false"),
+            ("cubes.enabled", "true"),
+        ],
+    );
     for (key, value) in settings {
         s.set(key, value).expect("setting");
     }

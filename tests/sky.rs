@@ -9,7 +9,6 @@ use common::scenes::luminance;
 use glam::{Mat4, Vec3};
 use shine::capture::image_io::HdrImage;
 use shine::reference::render_reference;
-use shine::{Renderer, Settings};
 use shine_scene::Scene;
 use shine_scene::environment::Environment;
 
@@ -52,20 +51,16 @@ fn frame_with(
     rays: u32,
     filter: u32,
 ) -> HdrImage {
-    let mut s = Settings {
-        width: SIZE,
-        height: SIZE,
-        receiver_scale: 1,
-        ..Settings::default()
-    };
-    s.set("gi", "hvl").expect("gi");
-    s.set("sky.enabled", &sky.to_string()).expect("sky");
-    s.set("sky.rays", &rays.to_string()).expect("rays");
-    s.set("sky.filter_radius", &filter.to_string())
-        .expect("filter");
-    let mut renderer = Renderer::new(device).expect("renderer");
-    renderer.set_scene(scene, 0.0).expect("scene");
-    renderer.render(&s).expect("render").hdr
+    let s = common::scenes::settings(
+        SIZE,
+        &[
+            ("gi", "hvl"),
+            ("sky.enabled", &sky.to_string()),
+            ("sky.rays", &rays.to_string()),
+            ("sky.filter_radius", &filter.to_string()),
+        ],
+    );
+    common::scenes::render_once(device, scene, &s)
 }
 
 /// The floor pixels, away from the ball's silhouette and the floor's edge: their centre ray
@@ -183,29 +178,22 @@ fn cavity_darkens_hvl_light_by_the_visibility_past_the_ball() {
         _pad: 0,
     });
     let indirect = |cavity: bool| {
-        let mut s = Settings {
-            width: SIZE,
-            height: SIZE,
-            receiver_scale: 1,
-            ..Settings::default()
-        };
-        for (key, value) in [
-            ("gi", "hvl"),
-            ("output.component", "indirect"),
-            ("specular.enabled", "false"),
-            ("cavity.rays", "1024"),
-            ("cavity.range", "1.0"),
-            // Cavity shading is for paper 003's unshadowed HVLs, without the traced near field.
-            ("hvl.visibility", "false"),
-            ("hvl.near_range", "0"),
-        ] {
-            s.set(key, value).expect("setting");
-        }
-        s.set("cavity.enabled", &cavity.to_string())
-            .expect("cavity");
-        let mut renderer = Renderer::new(&device).expect("renderer");
-        renderer.set_scene(&scene, 0.0).expect("scene");
-        renderer.render(&s).expect("render").hdr
+        let s = common::scenes::settings(
+            SIZE,
+            &[
+                ("gi", "hvl"),
+                ("output.component", "indirect"),
+                ("specular.enabled", "false"),
+                ("cavity.rays", "1024"),
+                ("cavity.range", "1.0"),
+                // Cavity shading is for paper 003's unshadowed HVLs, without the traced near
+                // field.
+                ("hvl.visibility", "false"),
+                ("hvl.near_range", "0"),
+                ("cavity.enabled", &cavity.to_string()),
+            ],
+        );
+        common::scenes::render_once(&device, &scene, &s)
     };
     let (open, shaded) = (indirect(false), indirect(true));
     let rays = common::scenes::pixel_rays(&device, &scene, SIZE);

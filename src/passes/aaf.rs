@@ -410,18 +410,16 @@ fn sample_pass<'a>(
     scene: &AafScene<'_>,
 ) -> crate::graph::ComputePass<'a> {
     let mut pass = rg.compute(name, shader);
-    pass.read("materials", &scene.handles.materials)
-        .read("srgb_textures", &scene.handles.srgb_textures)
-        .read("linear_textures", &scene.handles.linear_textures)
-        .sampler("texture_sampler", scene.texture_sampler)
-        .read("vertices", &scene.handles.vertices)
-        .read("indices", &scene.handles.indices)
-        .read("lights", &scene.handles.lights)
-        .read("gb_position", &g.position)
+    crate::passes::traced_scene::bind_surfaces(
+        &mut pass,
+        scene.handles,
+        scene.texture_sampler,
+        scene.bvh,
+    );
+    pass.read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
         .read("gb_geometric_normal", &g.geometric_normal)
         .read("gb_albedo", &g.albedo)
         .read("gb_material", &g.material);
-    scene.bvh.bind(&mut pass);
     pass
 }

@@ -39,13 +39,25 @@ impl TracedScene<'_> {
     /// Binds the scene's bindings of `path.glsl`, `surface.glsl` and `trace.glsl` to `pass`
     /// (a pass whose rays never see the environment).
     pub fn bind_surfaces(&self, pass: &mut ComputePass<'_>) {
-        pass.read("materials", &self.handles.materials)
-            .read("srgb_textures", &self.handles.srgb_textures)
-            .read("linear_textures", &self.handles.linear_textures)
-            .sampler("texture_sampler", self.texture_sampler)
-            .read("vertices", &self.handles.vertices)
-            .read("indices", &self.handles.indices)
-            .read("lights", &self.handles.lights);
-        self.bvh.bind(pass);
+        bind_surfaces(pass, self.handles, self.texture_sampler, self.bvh);
     }
+}
+
+/// Binds the bindings of `path.glsl`, `surface.glsl` and `trace.glsl` to `pass`: the scene's
+/// materials, textures (read through `texture_sampler`), vertices and lights in `handles`,
+/// and its BVH `bvh`. For passes that hold these without a [`TracedScene`] (AAF's sampling).
+pub fn bind_surfaces(
+    pass: &mut ComputePass<'_>,
+    handles: &SceneHandles,
+    texture_sampler: vk::Sampler,
+    bvh: &TraceBuffers,
+) {
+    pass.read("materials", &handles.materials)
+        .read("srgb_textures", &handles.srgb_textures)
+        .read("linear_textures", &handles.linear_textures)
+        .sampler("texture_sampler", texture_sampler)
+        .read("vertices", &handles.vertices)
+        .read("indices", &handles.indices)
+        .read("lights", &handles.lights);
+    bvh.bind(pass);
 }

@@ -193,3 +193,29 @@ pub fn ray_meets_sphere(origin: Vec3, dir: Vec3, centre: Vec3, r: f32) -> bool {
     let b = to_centre.dot(dir);
     b > 0.0 && to_centre.length_squared() - b * b < r * r
 }
+
+/// Settings of a `size`×`size` frame with the receivers at full resolution, then `pairs` set by
+/// their TOML keys.
+pub fn settings(size: u32, pairs: &[(&str, &str)]) -> shine::Settings {
+    let mut s = shine::Settings {
+        width: size,
+        height: size,
+        receiver_scale: 1,
+        ..shine::Settings::default()
+    };
+    for (key, value) in pairs {
+        s.set(key, value).expect("setting");
+    }
+    s
+}
+
+/// One frame of `scene` at time 0 on a new renderer with `settings`.
+pub fn render_once(
+    device: &shine::gpu::Device,
+    scene: &Scene,
+    settings: &shine::Settings,
+) -> shine::capture::image_io::HdrImage {
+    let mut renderer = shine::Renderer::new(device).expect("renderer");
+    renderer.set_scene(scene, 0.0).expect("scene");
+    renderer.render(settings).expect("render").hdr
+}
