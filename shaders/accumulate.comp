@@ -18,7 +18,7 @@
 layout(local_size_x = 8, local_size_y = 8) in;
 
 #include "accumulate.glsl"
-#include "hvl_resolve.glsl"
+#include "amortise.glsl"
 
 // This frame's light (indirect; direct under TAA).
 layout(set = 0, binding = 0, rgba16f) readonly uniform image2D current;

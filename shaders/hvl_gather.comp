@@ -105,7 +105,7 @@ layout(set = 0, binding = 5, std430) readonly buffer Brdf {
 
 layout(set = 0, binding = 6, rgba16f) uniform image2D indirect;
 
-#include "hvl_resolve.glsl"
+#include "amortise.glsl"
 
 #ifdef HVL_SHADOW_SAMPLES
 layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D unshadowed;
@@ -155,8 +155,8 @@ layout(push_constant) uniform Push {
     // number of glossy tables
     uint glossy_tables;
     // 0: every receiver; 1 + k: only the receiver at offset (k & 1, k >> 1) of every 2×2
-    // cell; HVL_REGATHER_SLICE: only the receivers marked by alpha -1 in `indirect`
-    // (amortised frames, src/passes/hvl/resolve.rs)
+    // cell; AMORTISE_REGATHER_SLICE: only the receivers marked by alpha -1 in `indirect`
+    // (amortised frames, src/passes/amortise.rs)
     uint slice;
     // width of the sinc window on the light's SH bands (paper 003 §4.2), 0: none
     float window_width;
@@ -197,21 +197,13 @@ void store_nothing(ivec2 px) {
 }
 
 void main() {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 px = amortise_pixel(gl_GlobalInvocationID.xy, push.slice);
     if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
         return;
     }
-    if (push.slice == HVL_REGATHER_SLICE) {
-        // Only the receivers hvl_regather_mask marked.
-        if (imageLoad(indirect, px).a >= 0.0) {
-            return;
-        }
-    } else if (push.slice != 0u) {
-        uint k = push.slice - 1u;
-        px = 2 * px + ivec2(k & 1u, k >> 1u);
-        if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
-            return;
-        }
+    // Only the receivers hvl_regather_mask marked.
+    if (push.slice == AMORTISE_REGATHER_SLICE && imageLoad(indirect, px).a >= 0.0) {
+        return;
     }
     vec4 position = imageLoad(recv_position, px);
     if (position.w == 0.0) {
@@ -373,7 +365,7 @@ void main() {
     // refreshed neighbours to filter with and keep it, the history smooths it.
     sum = unshadowed_weight > 0.0 ? unshadowed_sum * min(1.0, shadowed_weight / unshadowed_weight) : vec3(0.0);
     imageStore(unshadowed, px, vec4(unshadowed_sum, unshadowed_weight));
-    if (push.slice != HVL_REGATHER_SLICE) {
+    if (push.slice != AMORTISE_REGATHER_SLICE) {
         imageStore(indirect, px, vec4(sum, shadowed_weight));
         return;
     }

@@ -10,11 +10,12 @@
 // sigma_z and normal exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility
 // is, and exactly 1 where nothing is in the way. Amortised frames (push.slice = 1 + k) filter
 // only the refreshed receivers, one per 2x2 cell at offset (k & 1, k >> 1), over the receivers
-// of the same slice (offsets in steps of 2); the others are left for hvl_resolve. Writes
+// of the same slice (offsets in steps of 2); the others are left for hvl_resolve (src/passes/amortise.rs). Writes
 // RGBA16F, a = 0, 0 on background. CPU twin: shine::passes::hvl::shadows::ratio_filter.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "bilateral.glsl"
+#include "amortise.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -41,13 +42,8 @@ layout(push_constant) uniform Push {
 } push;
 
 void main() {
-    ivec2 ixy = ivec2(gl_GlobalInvocationID.xy);
-    int step = 1;
-    if (push.slice != 0u) {
-        uint k = push.slice - 1u;
-        ixy = 2 * ixy + ivec2(k & 1u, k >> 1u);
-        step = 2;
-    }
+    ivec2 ixy = amortise_pixel(gl_GlobalInvocationID.xy, push.slice);
+    int step = push.slice == 0u ? 1 : 2;
     if (any(greaterThanEqual(ixy, ivec2(push.extent)))) {
         return;
     }

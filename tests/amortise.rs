@@ -1,4 +1,4 @@
-//! The amortised HVL gather (paper 001; src/passes/hvl/resolve.rs): `hvl_resolve` against its
+//! GI amortised over frames (paper 001; src/passes/amortise.rs): the resolve against its
 //! CPU twin (reprojection, disocclusion, blend), and a static scene amortised over frames
 //! against the per-frame image.
 
@@ -7,13 +7,13 @@ mod common;
 use common::{Rng, bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
 use glam::{Vec2, Vec3, Vec4};
 use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
-use shine::passes::hvl::resolve::{ResolveHistory, hvl_resolve};
+use shine::passes::amortise::{ResolveHistory, Slice, resolve};
 use shine::passes::receivers::Receivers;
 use shine::reference::resolve::{ResolveInputs, resolve_cpu};
 use shine::{Renderer, Settings};
 use shine_scene::Scene;
 
-/// Runs `hvl_resolve` on the GPU over `inp` (as uploaded: f16 values where the images are
+/// Runs the resolve on the GPU over `inp` (as uploaded: f16 values where the images are
 /// f16) and returns the resolved light.
 fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4> {
     let [w, h] = inp.extent;
@@ -67,6 +67,7 @@ fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4
     let motion_handle = import(&mut rg, &motion);
     let desc = shine::graph::ImageDesc::new_2d(rgba16, w, h);
     let mut history = ResolveHistory {
+        name: "test",
         light: History {
             previous: import(&mut rg, &light),
             current: rg.create_image("resolved", desc),
@@ -76,14 +77,17 @@ fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4
             current: rg.create_image("resolved geometry", desc),
         },
     };
-    let resolved = hvl_resolve(
+    let slice = Slice {
+        slice: inp.slice,
+        has_history: inp.has_history,
+    };
+    let resolved = resolve(
         &mut rg,
-        &receivers,
+        (&receivers).into(),
         &fresh_handle,
         &motion_handle,
         &mut history,
-        inp.slice,
-        inp.has_history,
+        slice,
     )
     .expect("resolve");
     let mut out_handle =

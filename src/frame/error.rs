@@ -3,6 +3,7 @@
 use crate::capture::image_io::ImageIoError;
 use crate::gpu_scene::SceneUploadError;
 use crate::passes::aaf::AafError;
+use crate::passes::amortise::AmortiseError;
 use crate::passes::brdf_tables::BrdfTablesError;
 use crate::passes::environment_sh::EnvironmentShError;
 use crate::passes::gi_add::GiAddError;
@@ -44,6 +45,9 @@ pub enum RenderError {
     /// The AAF passes refused their parameters.
     #[error(transparent)]
     Aaf(#[from] AafError),
+    /// An amortised technique's resolve refused its slice.
+    #[error(transparent)]
+    Amortise(#[from] AmortiseError),
     /// The sky pass refused its parameters.
     #[error(transparent)]
     Sky(#[from] crate::passes::sky::SkyError),

@@ -2,7 +2,7 @@
 //! device, and the passes it adds to a frame (`hvl_cache` over the primary light's RSM, then
 //! `hvl_gather` at every receiver; `src/passes/hvl/mod.rs`). With `hvl.slices = 4` the gather
 //! is amortised over frames (paper 001): one receiver per 2×2 cell per frame, the rest
-//! reprojected by `hvl_resolve` (`src/passes/hvl/resolve.rs`) from the history this object
+//! reprojected by `hvl_resolve` (`src/passes/amortise.rs`) from the history this object
 //! keeps track of.
 
 use glam::Vec3;
@@ -11,8 +11,9 @@ use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
 use crate::gpu_scene::bvh::TraceBuffers;
+use crate::passes::amortise::{self, ResolveHistory, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
-use crate::passes::hvl::{self, HvlParams, resolve};
+use crate::passes::hvl::{self, HvlParams};
 use crate::passes::receivers::Receivers;
 use crate::passes::rsm::Rsm;
 
@@ -20,8 +21,8 @@ use crate::passes::rsm::Rsm;
 /// frame last wrote the amortised gather's history.
 pub struct HvlTechnique {
     brdf: BrdfTables,
-    /// Frame number and receiver extent of the last frame that resolved into the history.
-    last_resolve: Option<(u64, [u32; 2])>,
+    /// Which frame last resolved into the amortised gather's history.
+    schedule: Schedule,
 }
 
 /// An HVL frame ready to be declared: its parameters and its tables imported into the graph.
@@ -30,7 +31,7 @@ pub struct PreparedHvl {
     brdf: Handle<Buffer>,
     /// Amortised frames: the refreshed slice (0: every receiver) and whether the history
     /// holds the previous frame.
-    amortised: Option<(u32, bool)>,
+    amortised: Option<Slice>,
 }
 
 /// What the HVL passes read from the rest of the frame.
@@ -57,7 +58,7 @@ impl HvlTechnique {
     pub fn new(device: &Device) -> Self {
         Self {
             brdf: BrdfTables::new(device, "hvl brdf tables"),
-            last_resolve: None,
+            schedule: Schedule::default(),
         }
     }
 
@@ -68,7 +69,7 @@ impl HvlTechnique {
 
     /// Forgets the history (a new scene).
     pub fn reset(&mut self) {
-        self.last_resolve = None;
+        self.schedule.reset();
     }
 
     /// Forgets the history and the tables: a frame that may have uploaded them was dropped
@@ -89,20 +90,9 @@ impl HvlTechnique {
         receiver_extent: [u32; 2],
     ) -> Result<PreparedHvl, RenderError> {
         let brdf = self.brdf.import(rg, params.conv_bands)?;
-        let frame = rg.frame();
-        let amortised = (params.slices > 1).then(|| {
-            let has_history = self.last_resolve == Some((frame.wrapping_sub(1), receiver_extent));
-            self.last_resolve = Some((frame, receiver_extent));
-            let slice = if has_history {
-                resolve::slice_of_frame(frame)
-            } else {
-                0
-            };
-            (slice, has_history)
-        });
-        if amortised.is_none() {
-            self.last_resolve = None;
-        }
+        let amortised = self
+            .schedule
+            .next(rg.frame(), receiver_extent, params.slices);
         Ok(PreparedHvl {
             params,
             brdf,
@@ -124,7 +114,7 @@ impl PreparedHvl {
         params.near_range = inputs.near_range;
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
         let bvh = params.visibility.then_some(inputs.bvh);
-        let (slice, has_history) = self.amortised.unwrap_or((0, false));
+        let slice = self.amortised.map_or(0, |s| s.slice);
         let mut gathered = hvl::hvl_gather(
             rg,
             inputs.receivers,
@@ -135,20 +125,20 @@ impl PreparedHvl {
             &params,
             slice,
         )?;
-        if self.amortised.is_none() {
+        let Some(amortised) = self.amortised else {
             return Ok(gathered);
-        }
-        let mut history = resolve::ResolveHistory::declare(rg, inputs.receivers.extent);
+        };
+        let surfaces = inputs.receivers.into();
+        let mut history = ResolveHistory::declare(rg, "hvl", inputs.receivers.extent);
         if slice != 0 {
             // The receivers whose history was rejected are gathered now (what moved first).
-            resolve::hvl_regather_mask(
+            amortise::regather_mask(
                 rg,
-                inputs.receivers,
+                surfaces,
                 &mut gathered,
                 inputs.motion,
                 &history,
-                slice,
-                has_history,
+                amortised,
             )?;
             hvl::hvl_regather(
                 rg,
@@ -161,14 +151,13 @@ impl PreparedHvl {
                 &mut gathered,
             )?;
         }
-        Ok(resolve::hvl_resolve(
+        Ok(amortise::resolve(
             rg,
-            inputs.receivers,
+            surfaces,
             &gathered,
             inputs.motion,
             &mut history,
-            slice,
-            has_history,
+            amortised,
         )?)
     }
 }

@@ -2,7 +2,7 @@
 //! every GI technique alike; the same pass, in TAA mode ([`AccumulateParams::taa`]), is the direct
 //! light's temporal antialiasing (issue 21). Each pixel's history is reprojected with the
 //! G-buffer's motion vectors, bilinearly over the taps that show the pixel's surface (the amortised
-//! HVL's disocclusion test, [`crate::passes::hvl::resolve::same_surface`]), clipped to the current
+//! HVL's disocclusion test, [`crate::passes::amortise::same_surface`]), clipped to the current
 //! 3×3 neighbourhood's mean ± [`AccumulateParams::clip`] standard deviations per channel (variance
 //! clipping, as TAA clips colour history; the box widened to hold the pixel's own light, so that a
 //! static image keeps its history where a peak lies outside mean ± σ), and blended with weight 1/n,

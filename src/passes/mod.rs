@@ -4,6 +4,7 @@
 
 pub mod aaf;
 pub mod accumulate;
+pub mod amortise;
 pub mod brdf_tables;
 pub mod composite;
 pub mod cubes;

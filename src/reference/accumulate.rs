@@ -7,7 +7,7 @@ use crate::passes::accumulate::{
     ACCUMULATE_MIN_WEIGHT, AccumulateParams, TAA_LUMA, TAA_MIN_INVERSE, TAA_MOVING_FRAMES,
     TAA_STILL_PIXELS,
 };
-use crate::passes::hvl::resolve::same_surface;
+use crate::passes::amortise::same_surface;
 
 /// The images `accumulate` reads, row-major, all of one extent.
 pub struct AccumulateInputs<'a> {

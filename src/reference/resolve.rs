@@ -1,9 +1,9 @@
-//! CPU twin of `hvl_resolve` (src/passes/hvl/resolve.rs, shaders/hvl_resolve.comp): the
-//! amortised HVL gather's reprojection, disocclusion test and blend, texel for texel.
+//! CPU twin of `*_resolve` (src/passes/amortise.rs, shaders/amortise.comp): an amortised
+//! technique's reprojection, disocclusion test and blend, texel for texel.
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::passes::hvl::resolve::{RESOLVE_ALPHA, same_surface};
+use crate::passes::amortise::{RESOLVE_ALPHA, same_surface};
 
 /// The images `hvl_resolve` reads, row-major.
 pub struct ResolveInputs<'a> {

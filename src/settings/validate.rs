@@ -8,8 +8,8 @@ use super::{GiTechnique, Settings, SettingsError};
 use crate::capture::tonemap;
 use crate::gpu_scene::environment_sh;
 use crate::passes::{
-    aaf, accumulate, composite, cubes, exposure, hvl, igi, proxy, receivers, rsm, shadows, sky,
-    specular, upsample,
+    aaf, accumulate, amortise, composite, cubes, exposure, hvl, igi, proxy, receivers, rsm,
+    shadows, sky, specular, upsample,
 };
 
 /// Output sides in pixels.
@@ -121,13 +121,7 @@ impl Settings {
             &hvl::near::RANGE_RANGE,
         )?;
         check("hvl.near_rays", self.hvl.near_rays, &hvl::near::RAYS_RANGE)?;
-        if ![1, hvl::resolve::SLICES].contains(&self.hvl.slices) {
-            return Err(SettingsError::OutOfRange {
-                field: "hvl.slices",
-                value: self.hvl.slices.to_string(),
-                allowed: format!("1 or {}", hvl::resolve::SLICES),
-            });
-        }
+        check_slices("hvl.slices", self.hvl.slices)?;
         if self.hvl.emission_bands > self.hvl.convolution_bands {
             return Err(SettingsError::OutOfRange {
                 field: "hvl.emission_bands",
@@ -272,4 +266,16 @@ impl Settings {
         check("aaf.spp_max", a.spp_max, &aaf::SPP_MAX)?;
         check("aaf.bounces", a.bounces, &aaf::BOUNCES)
     }
+}
+
+/// An amortised technique's `slices`: one of [`amortise::SLICE_CHOICES`].
+fn check_slices(field: &'static str, value: u32) -> Result<(), SettingsError> {
+    if amortise::SLICE_CHOICES.contains(&value) {
+        return Ok(());
+    }
+    Err(SettingsError::OutOfRange {
+        field,
+        value: value.to_string(),
+        allowed: format!("{:?}", amortise::SLICE_CHOICES),
+    })
 }

@@ -5,10 +5,11 @@ use glam::Vec3;
 
 use super::{
     Falloff, GatherPath, GatherPush, HvlError, HvlParams, Window, cache_bytes, check_extent,
-    resolve, shadows,
+    shadows,
 };
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, Handle, Image, RenderGraph};
+use crate::passes::amortise;
 use crate::passes::brdf_tables::{
     GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
 };
@@ -50,7 +51,7 @@ pub fn hvl_gather(
 }
 
 /// Adds `hvl_regather`: the gather at the receivers `hvl_regather_mask` marked in `target`
-/// (alpha -1), written there (amortised frames, [`resolve`]); sampled shadows take each
+/// (alpha -1), written there (amortised frames, [`amortise`]); sampled shadows take each
 /// receiver's own ratio there, unfiltered.
 #[allow(clippy::too_many_arguments)]
 pub fn hvl_regather(
@@ -64,7 +65,14 @@ pub fn hvl_regather(
     target: &mut Handle<Image>,
 ) -> Result<(), HvlError> {
     let (shader, inputs) = GatherInputs::checked(receivers, hvls, brdf, bvh, camera, params)?;
-    record_gather(rg, shader, &inputs, params, target, resolve::REGATHER_SLICE);
+    record_gather(
+        rg,
+        shader,
+        &inputs,
+        params,
+        target,
+        amortise::REGATHER_SLICE,
+    );
     Ok(())
 }
 
@@ -162,11 +170,12 @@ fn record_gather(
         near_range: params.near_range,
         pad: [0; 3],
     };
-    let (name, threads) = match slice {
-        0 => ("hvl_gather", [w, h, 1]),
-        resolve::REGATHER_SLICE => ("hvl_regather", [w, h, 1]),
-        _ => ("hvl_gather", [w.div_ceil(2), h.div_ceil(2), 1]),
+    let name = if slice == amortise::REGATHER_SLICE {
+        "hvl_regather"
+    } else {
+        "hvl_gather"
     };
+    let threads = amortise::slice_threads([w, h], slice);
     let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
     let mut unshadowed = sampled.then(|| receivers.light_image(rg, "hvl_unshadowed"));
     let mut pass = rg.compute(name, shader);

@@ -85,7 +85,6 @@ pub mod flux;
 mod gather;
 mod grid;
 pub mod near;
-pub mod resolve;
 pub mod shadows;
 mod variants;
 pub use gather::{hvl_gather, hvl_regather};
@@ -160,7 +159,7 @@ pub struct GatherPush {
     /// Number of glossy tables ([`GLOSSY_TABLES`](crate::passes::brdf_tables::GLOSSY_TABLES)).
     pub glossy_tables: u32,
     /// 0: every receiver; 1 + k: one receiver per 2×2 cell, at offset (k & 1, k >> 1)
-    /// ([`resolve::slice_of_frame`]).
+    /// ([`crate::passes::amortise::slice_of_frame`]).
     pub slice: u32,
     /// Width of the sinc window on the light's SH bands (the convolution's band count), 0 for
     /// none.
@@ -264,7 +263,7 @@ pub struct HvlParams {
     /// `smoothstep(R, 2R, d)` (d its centre's distance) and `hvl_near` traces the rest; 0:
     /// none (paper 003).
     pub near_range: f32,
-    /// Receivers per refresh: 1 gathers every receiver every frame; [`resolve::SLICES`]
+    /// Receivers per refresh: 1 gathers every receiver every frame; [`crate::passes::amortise::SLICES`]
     /// gathers one per 2×2 cell and reprojects the rest (paper 001).
     pub slices: u32,
     /// Roughness limit of the frame's traced specular pass (0: none): the gather's glossy

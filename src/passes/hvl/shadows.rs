@@ -28,6 +28,7 @@
 use std::ops::RangeInclusive;
 
 use crate::graph::{Handle, Image, RenderGraph};
+use crate::passes::amortise;
 use crate::passes::receivers::Receivers;
 use crate::passes::upsample::{UpsampleParams, bilateral_match};
 use crate::shaders;
@@ -116,7 +117,7 @@ pub struct ShadowFilterPush {
     /// Normal exponent of the bilateral match.
     pub normal_power: f32,
     /// 0: every receiver; 1 + k: only the amortised gather's slice k, filtered over its own
-    /// receivers ([`super::resolve::slice_of_frame`]).
+    /// receivers ([`amortise::slice_of_frame`]).
     pub slice: u32,
     /// σ of the gaussian over the radius ([`SIGMA_PER_RADIUS`]).
     pub sigma_per_radius: f32,
@@ -154,11 +155,7 @@ pub fn shadow_filter(
         .read("unshadowed", unshadowed)
         .write("filtered", &mut filtered)
         .push(&push)
-        .dispatch(if slice == 0 {
-            [w, h, 1]
-        } else {
-            [w.div_ceil(2), h.div_ceil(2), 1]
-        });
+        .dispatch(amortise::slice_threads([w, h], slice));
     filtered
 }
 

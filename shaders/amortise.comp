@@ -1,16 +1,18 @@
-// `hvl_resolve` (paper 001 §"GI need not update every frame"; src/passes/hvl/resolve.rs): the
-// HVL gather refreshed one receiver of every 2×2 cell per frame, the others carried over from
-// the previous frame's resolved light, reprojected with the G-buffer's motion vectors. History
-// is rejected where the receiver was not visible then (disocclusion: linear depth off by more
-// than RESOLVE_DEPTH_TOLERANCE, or normals apart by more than acos RESOLVE_NORMAL_COS).
+// `*_resolve` (paper 001 §"GI need not update every frame"; src/passes/amortise.rs): a
+// technique's light refreshed at one pixel of every 2×2 cell per frame (HVL's gather, the
+// proxies, IGI, AAF; receiver or full resolution, `recv_*` names the surfaces either way), the
+// others carried over from the previous frame's resolved light, reprojected with the
+// G-buffer's motion vectors. History is rejected where the pixel was not visible then
+// (disocclusion: linear depth off by more than RESOLVE_DEPTH_TOLERANCE, or normals apart by
+// more than acos RESOLVE_NORMAL_COS).
 //
-// Variant `mask` (`hvl_regather_mask`) runs between the two gathers: it marks every receiver
-// that is neither refreshed nor covered by its history (alpha -1 in `fresh`; 0 elsewhere), and
-// the second gather (slice HVL_REGATHER_SLICE) shades exactly those: the issue's "priority"
-// refresh of what moved. Variant `resolve` then blends: refreshed receivers mix the fresh value
-// into valid history with weight RESOLVE_ALPHA; the others keep their history, changed by the
-// change their cell's refreshed receiver makes where it shows the same surface, or, where their
-// history was rejected, take their own fresh value. CPU twin:
+// Variant `mask` (`*_regather_mask`) runs between the technique's two dispatches: it marks every
+// pixel that is neither refreshed nor covered by its history (alpha -1 in `fresh`; 0
+// elsewhere), and the second dispatch (slice AMORTISE_REGATHER_SLICE) shades exactly those:
+// paper 001's priority refresh of what moved. Variant `resolve` then blends: refreshed pixels
+// mix the fresh value into valid history with weight RESOLVE_ALPHA; the others keep their
+// history, changed by the change their cell's refreshed pixel makes where it shows the same
+// surface, or, where their history was rejected, take their own fresh value. CPU twin:
 // shine::reference::resolve::resolve_cpu.
 //! variant mask RESOLVE_MASK=1
 //! variant resolve RESOLVE_MASK=0
@@ -19,19 +21,19 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-#include "hvl_resolve.glsl"
+#include "amortise.glsl"
 
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D recv_position;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
 // Full-resolution motion (uv now minus uv then).
 layout(set = 0, binding = 3, rg16f) readonly uniform image2D gb_motion;
-// The previous frame's receivers' (normal, linear depth).
+// The previous frame's (normal, linear depth).
 layout(set = 0, binding = 5, rgba16f) readonly uniform image2D history_geometry;
 #if RESOLVE_MASK
-// This frame's gather, valid at the refreshed receivers: the others are marked here.
+// This frame's light, valid at the refreshed pixels: the others are marked here.
 layout(set = 0, binding = 2, rgba16f) uniform image2D fresh;
 #else
-// This frame's gathers: every receiver the resolve takes fresh light from.
+// This frame's light: at every pixel the resolve takes fresh light from.
 layout(set = 0, binding = 2, rgba16f) readonly uniform image2D fresh;
 // The previous frame's resolved light.
 layout(set = 0, binding = 4, rgba16f) readonly uniform image2D history_light;
@@ -40,13 +42,13 @@ layout(set = 0, binding = 6, rgba16f) uniform image2D resolved;
 layout(set = 0, binding = 7, rgba16f) uniform image2D resolved_geometry;
 #endif
 
-// shine::passes::hvl::resolve::ResolvePush
+// shine::passes::amortise::ResolvePush
 layout(push_constant) uniform Push {
-    // receiver buffer size
+    // image size
     uvec2 extent;
     // full-resolution size (gb_motion)
     uvec2 full_extent;
-    // 1 + k: the refreshed receiver of every cell is at (k & 1, k >> 1); 0: every receiver
+    // 1 + k: the refreshed pixel of every cell is at (k & 1, k >> 1); 0: every pixel
     // was gathered this frame (no history yet): the fresh light passes through
     uint slice;
     // 1 when the history holds the previous frame
@@ -55,17 +57,16 @@ layout(push_constant) uniform Push {
     uint pad1;
 } push;
 
-// The refreshed receiver of p's cell (clamped where an odd edge cuts the cell: callers check
+// The refreshed pixel of p's cell (clamped where an odd edge cuts the cell: callers check
 // that it is refreshed).
 ivec2 cell_pixel(ivec2 p) {
     uint k = push.slice - 1u;
     return min((p / 2) * 2 + ivec2(k & 1u, k >> 1u), ivec2(push.extent) - 1);
 }
 
-// Whether receiver p is refreshed this frame.
+// Whether pixel p is refreshed this frame.
 bool refreshed(ivec2 p) {
-    uint k = push.slice - 1u;
-    return (uint(p.x) & 1u) == (k & 1u) && (uint(p.y) & 1u) == (k >> 1u);
+    return amortise_refreshed(p, push.slice);
 }
 
 // Where p's history is (reprojected with the motion vectors), and whether it shows p's
@@ -117,8 +118,8 @@ void main() {
         if (refreshed(p)) {
             light = mix(history, light, RESOLVE_ALPHA);
         } else {
-            // The change the cell's refreshed receiver makes this frame, shared where it
-            // shows the same surface: held receivers follow the light every frame instead of
+            // The change the cell's refreshed pixel makes this frame, shared where it
+            // shows the same surface: held pixels follow the light every frame instead of
             // stepping every fourth (and a static scene, whose change is 0, stays exact).
             light = history;
             ivec2 c = cell_pixel(p);

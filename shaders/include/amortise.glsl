@@ -1,0 +1,45 @@
+// GI amortised over frames (paper 001): which pixel a thread shades in a slice, and the
+// constants and the disocclusion test of shaders/amortise.comp; Rust twin:
+// shine::passes::amortise (REGATHER_SLICE, RESOLVE_ALPHA, RESOLVE_DEPTH_TOLERANCE,
+// RESOLVE_NORMAL_COS, same_surface, slice_threads), tied by tests/shader_constants.rs.
+#ifndef AMORTISE_GLSL
+#define AMORTISE_GLSL
+
+// The slice that shades only the pixels `*_regather_mask` marked (alpha -1 in the light).
+const uint AMORTISE_REGATHER_SLICE = 5u;
+
+// Weight of the fresh light where a pixel is refreshed and its history is valid.
+const float RESOLVE_ALPHA = 0.5;
+// Largest relative difference of linear depth between a pixel and its history.
+const float RESOLVE_DEPTH_TOLERANCE = 0.1;
+// Smallest cosine between a pixel's normal and its history's.
+const float RESOLVE_NORMAL_COS = 0.9;
+
+// The pixel thread `id` shades in `slice`: itself for 0 (every pixel) and the regather slice,
+// the pixel at offset (k & 1, k >> 1) of cell `id` for slice 1 + k (a quarter of the threads,
+// `slice_threads`).
+ivec2 amortise_pixel(uvec2 id, uint slice) {
+    if (slice == 0u || slice == AMORTISE_REGATHER_SLICE) {
+        return ivec2(id);
+    }
+    uint k = slice - 1u;
+    return 2 * ivec2(id) + ivec2(k & 1u, k >> 1u);
+}
+
+// Whether pixel p is the refreshed one of its cell in slice 1 + k (true for slice 0).
+bool amortise_refreshed(ivec2 p, uint slice) {
+    if (slice == 0u) {
+        return true;
+    }
+    uint k = slice - 1u;
+    return (uint(p.x) & 1u) == (k & 1u) && (uint(p.y) & 1u) == (k >> 1u);
+}
+
+// Whether history at linear depth `depth_then` with normal `n_then` shows the same surface as
+// a pixel at `depth` with unit normal `n`.
+bool resolve_same_surface(float depth, vec3 n, float depth_then, vec3 n_then) {
+    return depth_then > 0.0 && abs(depth_then - depth) <= RESOLVE_DEPTH_TOLERANCE * depth
+        && dot(n, n_then) >= RESOLVE_NORMAL_COS * length(n_then);
+}
+
+#endif

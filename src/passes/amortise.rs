@@ -1,0 +1,263 @@
+//! GI amortised over frames (paper 001, "GI need not update every frame"), for any technique
+//! whose light is shaded per pixel: HVL's gather, the proxies' occlusion, IGI's VPL sets and
+//! AAF's samples (`hvl.slices`, `proxy.slices`, `igi.slices`, `aaf.slices` = [`SLICES`]).
+//!
+//! A technique refreshes one pixel of every 2×2 cell per frame, in turn ([`Schedule`] picks
+//! the cell's pixel, [`slice_of_frame`]); `*_resolve` (shaders/amortise.comp) carries the other
+//! three over from the previous frame's resolved light, reprojected with the G-buffer's motion
+//! vectors, and rejects history where the surface was not visible then (depth or normal too
+//! different): `*_regather_mask` marks those pixels (alpha −1 in the fresh light) and the
+//! technique shades them again the same frame with [`REGATHER_SLICE`] (paper 001's priority
+//! refresh of what moved). Refreshed pixels blend fresh light into valid history
+//! ([`RESOLVE_ALPHA`]), the others keep theirs, changed by the change their cell's refreshed
+//! pixel makes. Tried and dropped for HVL (docs/quality.md): filling disocclusions from the
+//! cell's fresh value, pulling every pixel towards it each frame, and filling from the nearest
+//! of nine refreshed pixels; all flickered more than the per-frame gather. CPU twin:
+//! [`crate::reference::resolve::resolve_cpu`]. The GLSL side of a slice (which pixel a thread
+//! shades) is `amortise_pixel` in shaders/include/amortise.glsl.
+
+use glam::Vec3;
+
+use crate::graph::{History, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::gbuffer::GBuffer;
+use crate::passes::receivers::Receivers;
+use crate::shaders;
+use shine_graph::Handle;
+
+/// Weight of the fresh light at a refreshed pixel whose history is valid (an exponential
+/// history: lag of about 1/α refreshes, less flicker).
+pub const RESOLVE_ALPHA: f32 = 0.5;
+/// Largest relative difference of linear depth between a pixel and its history.
+pub const RESOLVE_DEPTH_TOLERANCE: f32 = 0.1;
+/// Smallest cosine between a pixel's normal and its history's.
+pub const RESOLVE_NORMAL_COS: f32 = 0.9;
+/// Pixels per refresh cell (2×2): an amortised technique shades one of them per frame.
+pub const SLICES: u32 = 4;
+/// The slice that shades only the pixels `*_regather_mask` marked
+/// (`AMORTISE_REGATHER_SLICE` in shaders/include/amortise.glsl).
+pub const REGATHER_SLICE: u32 = SLICES + 1;
+/// The slice counts a technique's `slices` setting takes: every pixel every frame, or one of
+/// every 2×2 cell.
+pub const SLICE_CHOICES: [u32; 2] = [1, SLICES];
+
+/// Whether history at `depth_then` with normal `n_then` shows the same surface as a pixel at
+/// `depth` with unit normal `n` (`resolve_same_surface` in shaders/include/amortise.glsl).
+pub fn same_surface(depth: f32, n: Vec3, depth_then: f32, n_then: Vec3) -> bool {
+    depth_then > 0.0
+        && (depth_then - depth).abs() <= RESOLVE_DEPTH_TOLERANCE * depth
+        && n.dot(n_then) >= RESOLVE_NORMAL_COS * n_then.length()
+}
+
+/// The refreshed pixel of every cell in frame `frame`: its offset index k (x = k & 1,
+/// y = k >> 1), as the slice `1 + k` the passes take.
+pub fn slice_of_frame(frame: u64) -> u32 {
+    1 + (frame % u64::from(SLICES)) as u32
+}
+
+/// Threads a pass dispatches to shade `slice` of an `extent` image: every pixel for slice 0
+/// and [`REGATHER_SLICE`], one per 2×2 cell otherwise (`amortise_pixel` maps them).
+pub fn slice_threads(extent: [u32; 2], slice: u32) -> [u32; 3] {
+    if slice == 0 || slice == REGATHER_SLICE {
+        [extent[0], extent[1], 1]
+    } else {
+        [extent[0].div_ceil(2), extent[1].div_ceil(2), 1]
+    }
+}
+
+/// Which frame an amortised technique last resolved, so the next one knows whether its history
+/// holds the previous frame. Without it (first frame, a resize, a frame skipped, the setting
+/// just turned on) the technique shades every pixel (slice 0).
+#[derive(Debug, Default)]
+pub struct Schedule {
+    /// Frame number and image extent of the last frame that resolved into the history.
+    last: Option<(u64, [u32; 2])>,
+}
+
+/// This frame's slice of an amortised technique.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Slice {
+    /// 0: every pixel; 1 + k: the pixel at (k & 1, k >> 1) of every 2×2 cell.
+    pub slice: u32,
+    /// Whether the history holds the previous frame.
+    pub has_history: bool,
+}
+
+impl Schedule {
+    /// The slice of `frame` for a technique of `slices` (1: not amortised, `None`) shading
+    /// images of `extent`.
+    pub fn next(&mut self, frame: u64, extent: [u32; 2], slices: u32) -> Option<Slice> {
+        if slices <= 1 {
+            self.last = None;
+            return None;
+        }
+        let has_history = self.last == Some((frame.wrapping_sub(1), extent));
+        self.last = Some((frame, extent));
+        Some(Slice {
+            slice: if has_history {
+                slice_of_frame(frame)
+            } else {
+                0
+            },
+            has_history,
+        })
+    }
+
+    /// Forgets the history (a new scene, a frame dropped unrun).
+    pub fn reset(&mut self) {
+        self.last = None;
+    }
+}
+
+/// The surfaces an amortised light is resolved over: receivers (HVL, proxies) or the
+/// full-resolution G-buffer (IGI, AAF).
+#[derive(Clone, Copy)]
+pub struct Surfaces<'a> {
+    /// RGBA32F world position, w: linear depth (0: background).
+    pub position: &'a Handle<Image>,
+    /// RGBA16F normal.
+    pub normal: &'a Handle<Image>,
+    /// Image size.
+    pub extent: [u32; 2],
+}
+
+impl<'a> From<&'a Receivers> for Surfaces<'a> {
+    fn from(r: &'a Receivers) -> Self {
+        Self {
+            position: &r.position,
+            normal: &r.normal,
+            extent: r.extent,
+        }
+    }
+}
+
+impl<'a> From<&'a GBuffer> for Surfaces<'a> {
+    /// The G-buffer's geometric normals: normal maps do not reject history.
+    fn from(g: &'a GBuffer) -> Self {
+        Self {
+            position: &g.position,
+            normal: &g.geometric_normal,
+            extent: g.extent,
+        }
+    }
+}
+
+/// Push constants of `shaders/amortise.comp` (32 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ResolvePush {
+    /// Size of the resolved image.
+    pub extent: [u32; 2],
+    /// Full-resolution size (of the motion image).
+    pub full_extent: [u32; 2],
+    /// 1 + k: the refreshed pixel of every cell; 0: every pixel was shaded.
+    pub slice: u32,
+    /// 1 when the history holds the previous frame.
+    pub has_history: u32,
+    /// Padding.
+    pub pad: [u32; 2],
+}
+
+/// Errors of the amortising passes.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum AmortiseError {
+    /// A slice outside `0..=SLICES`.
+    #[error("amortised slice {0} is not one of 0..={SLICES}")]
+    Slice(u32),
+}
+
+/// An amortised technique's temporal images at the resolution it shades: light and
+/// (normal, linear depth), keyed by the technique's name.
+pub struct ResolveHistory {
+    /// The technique's name: the passes' prefix.
+    pub name: &'static str,
+    /// Resolved light.
+    pub light: History<Image>,
+    /// Normal and linear depth.
+    pub geometry: History<Image>,
+}
+
+impl ResolveHistory {
+    /// The pair of history images of technique `name` (e.g. `hvl`) for images of `extent`.
+    pub fn declare(rg: &mut RenderGraph, name: &'static str, extent: [u32; 2]) -> Self {
+        let desc = ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, extent[0], extent[1]);
+        Self {
+            name,
+            light: rg.history_image(&format!("{name} resolved"), desc),
+            geometry: rg.history_image(&format!("{name} resolved geometry"), desc),
+        }
+    }
+}
+
+/// Adds `NAME_regather_mask`: marks, in `fresh` (this frame's light at the pixels of `slice`),
+/// every other pixel whose history does not show its surface (alpha −1; 0 elsewhere), for the
+/// technique to shade again with [`REGATHER_SLICE`].
+pub fn regather_mask(
+    rg: &mut RenderGraph,
+    surfaces: Surfaces<'_>,
+    fresh: &mut Handle<Image>,
+    motion: &Handle<Image>,
+    history: &ResolveHistory,
+    slice: Slice,
+) -> Result<(), AmortiseError> {
+    let push = resolve_push(surfaces, motion, slice)?;
+    rg.compute(
+        &format!("{}_regather_mask", history.name),
+        &shaders::AMORTISE_COMP_MASK,
+    )
+    .read("recv_position", surfaces.position)
+    .read("recv_normal", surfaces.normal)
+    .read("gb_motion", motion)
+    .read("history_geometry", &history.geometry.previous)
+    .write("fresh", fresh)
+    .push(&push)
+    .dispatch([push.extent[0], push.extent[1], 1]);
+    Ok(())
+}
+
+/// The push constants of both variants, after checking the slice.
+fn resolve_push(
+    surfaces: Surfaces<'_>,
+    motion: &Handle<Image>,
+    slice: Slice,
+) -> Result<ResolvePush, AmortiseError> {
+    if slice.slice > SLICES {
+        return Err(AmortiseError::Slice(slice.slice));
+    }
+    let full = motion.desc().extent;
+    Ok(ResolvePush {
+        extent: surfaces.extent,
+        full_extent: [full.width, full.height],
+        slice: slice.slice,
+        has_history: u32::from(slice.has_history),
+        pad: [0; 2],
+    })
+}
+
+/// Adds `NAME_resolve`: this frame's light `fresh` (at the pixels of the slice and those
+/// [`regather_mask`] marked; at every pixel for slice 0, which then passes through) and the
+/// reprojected history into the history's current images; returns the resolved light.
+pub fn resolve(
+    rg: &mut RenderGraph,
+    surfaces: Surfaces<'_>,
+    fresh: &Handle<Image>,
+    motion: &Handle<Image>,
+    history: &mut ResolveHistory,
+    slice: Slice,
+) -> Result<Handle<Image>, AmortiseError> {
+    let push = resolve_push(surfaces, motion, slice)?;
+    rg.compute(
+        &format!("{}_resolve", history.name),
+        &shaders::AMORTISE_COMP_RESOLVE,
+    )
+    .read("recv_position", surfaces.position)
+    .read("recv_normal", surfaces.normal)
+    .read("fresh", fresh)
+    .read("gb_motion", motion)
+    .read("history_light", &history.light.previous)
+    .read("history_geometry", &history.geometry.previous)
+    .write("resolved", &mut history.light.current)
+    .write("resolved_geometry", &mut history.geometry.current)
+    .push(&push)
+    .dispatch([push.extent[0], push.extent[1], 1]);
+    Ok(history.light.current)
+}
