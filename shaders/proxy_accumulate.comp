@@ -44,6 +44,7 @@
 #define PROXY_TABLES_BINDING 3
 #include "proxy_tables.glsl"
 #include "sh.glsl"
+#include "amortise.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -62,6 +63,10 @@ layout(set = 0, binding = 5, std430) buffer Sums {
     float s[];
 } sums;
 
+// Slice AMORTISE_REGATHER_SLICE: the receivers to accumulate, alpha -1 (proxy_regather_mask);
+// not read by the other slices.
+layout(set = 0, binding = 7, rgba16f) readonly uniform image2D marks;
+
 // shine::passes::proxy::AccumulatePush
 layout(push_constant) uniform Push {
     uvec2 extent;
@@ -72,7 +77,9 @@ layout(push_constant) uniform Push {
     float support_indirect;
     // 1: accumulate the indirect sums; 0: leave them 0
     uint indirect;
-    uint pad;
+    // 0: every receiver; 1 + k: the receiver at (k & 1, k >> 1) of every 2x2 cell;
+    // AMORTISE_REGATHER_SLICE: the receivers `marks` marks (src/passes/amortise.rs)
+    uint slice;
 } push;
 
 // Row l-major lookup of table `table` (0 log-occlusion, 1 clamped visibility, 2 unclamped
@@ -102,7 +109,7 @@ layout(set = 0, binding = 6, std430) readonly buffer TileMasks {
 #endif
 
 void main() {
-    uvec2 xy = gl_GlobalInvocationID.xy;
+    uvec2 xy = uvec2(amortise_pixel(gl_GlobalInvocationID.xy, push.slice));
     bool inside = all(lessThan(xy, push.extent));
     ivec2 ixy = ivec2(min(xy, push.extent - 1u));
     vec4 pos = imageLoad(recv_position, ixy);
@@ -114,6 +121,9 @@ void main() {
     uint tile = (xy.y / 8u) * tiles_x + xy.x / 8u;
 #endif
     if (!inside) {
+        return;
+    }
+    if (push.slice == AMORTISE_REGATHER_SLICE && imageLoad(marks, ixy).a >= 0.0) {
         return;
     }
     uint base = (xy.y * push.extent.x + xy.x) * uint(SH_COEFFS + 4);

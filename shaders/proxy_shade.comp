@@ -34,6 +34,7 @@
 #include "proxy_tables.glsl"
 #include "sh.glsl"
 #include "brdf.glsl"
+#include "amortise.glsl"
 
 // shine::passes::brdf_tables::GatherBrdf::gpu_data at SH_BANDS: the glossy receivers' rows.
 layout(set = 0, binding = 9, std430) readonly buffer Brdf {
@@ -72,18 +73,24 @@ layout(push_constant) uniform Push {
     vec2 roughness_nodes;
     // number of glossy tables
     uint glossy_tables;
+    // 0: every receiver; 1 + k: the receiver at (k & 1, k >> 1) of every 2x2 cell;
+    // AMORTISE_REGATHER_SLICE: the receivers marked by alpha -1 in proxy_gi
+    // (src/passes/amortise.rs)
+    uint slice;
     uint pad0;
     uint pad1;
-    uint pad2;
 } push;
 
 
 void main() {
-    uvec2 xy = gl_GlobalInvocationID.xy;
+    uvec2 xy = uvec2(amortise_pixel(gl_GlobalInvocationID.xy, push.slice));
     if (any(greaterThanEqual(xy, push.extent))) {
         return;
     }
     ivec2 ixy = ivec2(xy);
+    if (push.slice == AMORTISE_REGATHER_SLICE && imageLoad(proxy_gi, ixy).a >= 0.0) {
+        return;
+    }
     uint r = xy.y * push.extent.x + xy.x;
     uint base = r * uint(SH_COEFFS + 4);
     vec4 nw = imageLoad(recv_normal, ixy);

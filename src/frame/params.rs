@@ -82,6 +82,8 @@ pub struct ProxySetup {
     pub indirect_expansion: f32,
     /// 0: the scene's proxies; k > 0: k spheres refitted to each proxied mesh.
     pub fit_count: u32,
+    /// Receivers per refresh (paper 001; 1 or [`crate::passes::amortise::SLICES`]).
+    pub slices: u32,
 }
 
 impl FrameParams {
@@ -191,6 +193,7 @@ impl FrameParams {
                 },
                 indirect_expansion: p.indirect_expansion,
                 fit_count: p.fit_count,
+                slices: p.slices,
             }),
             aaf: gi.contains(GiTechnique::Aaf).then(|| {
                 let a = &settings.aaf;

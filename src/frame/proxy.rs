@@ -19,9 +19,10 @@ use super::params::ProxySetup;
 use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::environment_sh::EnvironmentSh;
 use crate::gpu_scene::upload_ring::UploadRing;
+use crate::passes::amortise::{self, ResolveHistory, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::proxy::{
-    self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyParams, ProxyTables,
+    self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyParams, ProxySlice, ProxyTables,
 };
 use crate::passes::receivers::Receivers;
 
@@ -50,6 +51,8 @@ pub struct ProxyTechnique {
     ring: UploadRing,
     /// The BRDF SH tables of the glossy receivers, per band count.
     brdf: BrdfTables,
+    /// Which frame last resolved into the amortised light's history (`proxy.slices`).
+    schedule: Schedule,
 }
 
 /// The proxies of one `fit_count`: in their nodes' space, and their device buffer, rewritten
@@ -71,6 +74,8 @@ pub struct PreparedProxy<'a> {
     params: ProxyParams,
     inputs: ProxyInputs,
     tables: &'a ProxyTables,
+    /// Amortised frames (`proxy.slices = 4`): this frame's slice.
+    amortised: Option<Slice>,
 }
 
 impl ProxyTechnique {
@@ -105,6 +110,7 @@ impl ProxyTechnique {
             tables: Vec::new(),
             ring: UploadRing::new(device),
             brdf: BrdfTables::new(device, "proxy brdf tables"),
+            schedule: Schedule::default(),
         }
     }
 
@@ -124,6 +130,7 @@ impl ProxyTechnique {
 
     /// Forgets the uploaded tables: a frame that may have uploaded them was dropped unrun.
     pub fn forget_uploads(&mut self) {
+        self.schedule.reset();
         self.environments.clear();
         self.tables.clear();
         self.brdf.clear();
@@ -184,8 +191,12 @@ impl ProxyTechnique {
         setup: &ProxySetup,
         world: &[Mat4],
         environment: Option<Handle<shine_graph::Buffer>>,
+        receiver_extent: [u32; 2],
     ) -> Result<PreparedProxy<'_>, RenderError> {
         let bands = setup.pass.bands;
+        let amortised = self
+            .schedule
+            .next(rg.frame(), receiver_extent, setup.slices);
         let environment = match environment {
             Some(host) => host,
             None => self.environment_sh(rg, bands)?,
@@ -253,6 +264,7 @@ impl ProxyTechnique {
             params: setup.pass,
             inputs,
             tables,
+            amortised,
         })
     }
 
@@ -281,24 +293,55 @@ impl ProxyTechnique {
 
 impl PreparedProxy<'_> {
     /// Adds `proxy_tiles`, `proxy_accumulate` and `proxy_shade` over `receivers` seen from
-    /// `camera`; returns `proxy_gi` (RGBA16F outgoing radiance at receiver resolution).
+    /// `camera`; returns `proxy_gi` (RGBA16F outgoing radiance at receiver resolution). With
+    /// `proxy.slices = 4` they shade one receiver per 2×2 cell, `proxy_regather_mask`,
+    /// `proxy_reaccumulate` and `proxy_reshade` those whose history `motion` rejects, and
+    /// `proxy_resolve` the rest (src/passes/amortise.rs).
     pub fn declare(
         self,
         rg: &mut RenderGraph,
         receivers: &Receivers,
         camera: Vec3,
+        motion: &Handle<Image>,
     ) -> Result<Handle<Image>, RenderError> {
         let params = &self.params;
-        let sums = proxy::proxy_accumulate(rg, receivers, &self.inputs, self.tables, params)?;
-        let out = proxy::proxy_shade(
+        let (inputs, tables) = (&self.inputs, self.tables);
+        let first = ProxySlice {
+            slice: self.amortised.map_or(0, |s| s.slice),
+            ..ProxySlice::default()
+        };
+        let (sums, masks) =
+            proxy::proxy_accumulate_slice(rg, receivers, inputs, tables, params, first)?;
+        let mut light =
+            proxy::proxy_shade_slice(rg, receivers, &sums, inputs, tables, params, camera, first)?
+                .radiance;
+        let Some(amortised) = self.amortised else {
+            return Ok(light);
+        };
+        let surfaces = receivers.into();
+        let mut history = ResolveHistory::declare(rg, "proxy", receivers.extent);
+        if amortised.slice != 0 {
+            // The receivers whose history was rejected are shaded now (what moved first).
+            amortise::regather_mask(rg, surfaces, &mut light, motion, &history, amortised)?;
+            let again = ProxySlice {
+                slice: amortise::REGATHER_SLICE,
+                marks: Some(light),
+                masks,
+            };
+            let (sums, _) =
+                proxy::proxy_accumulate_slice(rg, receivers, inputs, tables, params, again)?;
+            light = proxy::proxy_shade_slice(
+                rg, receivers, &sums, inputs, tables, params, camera, again,
+            )?
+            .radiance;
+        }
+        Ok(amortise::resolve(
             rg,
-            receivers,
-            &sums,
-            &self.inputs,
-            self.tables,
-            params,
-            camera,
-        )?;
-        Ok(out.radiance)
+            surfaces,
+            &light,
+            motion,
+            &mut history,
+            amortised,
+        )?)
     }
 }

@@ -47,6 +47,7 @@ use crate::gpu_scene::environment_sh::ORDERS;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::shaders;
 
+use super::amortise;
 use super::brdf_tables::{GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step};
 use super::receivers::Receivers;
 
@@ -338,8 +339,8 @@ pub struct AccumulatePush {
     pub support_indirect: f32,
     /// 1: accumulate the indirect sums.
     pub indirect: u32,
-    /// Padding.
-    pub pad: u32,
+    /// The receivers of this dispatch ([`ProxySlice::slice`]).
+    pub slice: u32,
 }
 
 /// Push constants of `shaders/proxy_tiles.comp` (16 bytes).
@@ -371,8 +372,10 @@ pub struct ShadePush {
     pub roughness_nodes: [f32; 2],
     /// Number of glossy tables.
     pub glossy_tables: u32,
+    /// The receivers of this dispatch ([`ProxySlice::slice`]).
+    pub slice: u32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: [u32; 2],
 }
 
 /// Floats per receiver in the `proxy_sums` buffer: `bands²` (log-occlusion, or occlusion for
@@ -399,12 +402,28 @@ pub struct ProxyInputs {
     pub brdf: Handle<Buffer>,
 }
 
+/// Which receivers one dispatch of the proxy passes shades: paper 001's amortised frames
+/// (`proxy.slices`, [`crate::passes::amortise`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct ProxySlice {
+    /// 0: every receiver; 1 + k: the receiver at (k & 1, k >> 1) of every 2×2 cell;
+    /// [`amortise::REGATHER_SLICE`]: the receivers `marks` marks with alpha −1.
+    pub slice: u32,
+    /// The proxy light after `proxy_regather_mask` (the regather reads its marks and writes
+    /// into it); required by the regather slice.
+    pub marks: Option<Handle<Image>>,
+    /// The tile lists of the frame's first dispatch, which the regather reuses (`None`: built
+    /// by this dispatch).
+    pub masks: Option<Handle<Buffer>>,
+}
+
 /// The outputs of [`proxy_shade`].
 #[derive(Debug, Clone, Copy)]
 pub struct ProxyOutputs {
     /// `proxy_gi`: RGBA16F at receiver resolution, outgoing radiance (a = 0, 0 on background).
     pub radiance: Handle<Image>,
-    /// `proxy_occlusion`: `bands²` floats per receiver, the occlusion vector `O_p`.
+    /// `proxy_occlusion`: `bands²` floats per receiver, the occlusion vector `O_p` (at the
+    /// receivers of the dispatch's slice only).
     pub occlusion: Handle<Buffer>,
 }
 
@@ -473,8 +492,8 @@ fn check_inputs(
     Ok(())
 }
 
-/// Adds the `proxy_accumulate` pass: a new `proxy_sums` buffer ([`sums_stride`] floats per
-/// receiver, row-major), returned.
+/// Adds the `proxy_accumulate` pass at every receiver: a new `proxy_sums` buffer
+/// ([`sums_stride`] floats per receiver, row-major), returned.
 pub fn proxy_accumulate(
     rg: &mut RenderGraph,
     receivers: &Receivers,
@@ -482,7 +501,24 @@ pub fn proxy_accumulate(
     tables: &ProxyTables,
     params: &ProxyParams,
 ) -> Result<Handle<Buffer>, ProxyError> {
+    let (sums, _) =
+        proxy_accumulate_slice(rg, receivers, inputs, tables, params, ProxySlice::default())?;
+    Ok(sums)
+}
+
+/// Adds `proxy_tiles` (for splatting, unless `slice` brings the frame's tile lists) and
+/// `proxy_accumulate` (`proxy_reaccumulate` for the regather slice) at the receivers of
+/// `slice`: returns a new `proxy_sums` buffer, valid at those receivers, and the tile lists.
+pub fn proxy_accumulate_slice(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    inputs: &ProxyInputs,
+    tables: &ProxyTables,
+    params: &ProxyParams,
+    slice: ProxySlice,
+) -> Result<(Handle<Buffer>, Option<Handle<Buffer>>), ProxyError> {
     check_inputs(receivers, inputs, tables, params)?;
+    let marks = checked_marks(&slice)?;
     let shader = params.accumulate_shader()?;
     let [w, h] = receivers.extent;
     let support_indirect = if params.indirect {
@@ -490,7 +526,11 @@ pub fn proxy_accumulate(
     } else {
         tables.support_shadow
     };
-    let masks = if params.accumulation == Accumulation::Splat {
+    let masks = if params.accumulation != Accumulation::Splat {
+        None
+    } else if let Some(masks) = slice.masks {
+        Some(masks)
+    } else {
         let tiles = [w.div_ceil(TILE), h.div_ceil(TILE)];
         let bytes = u64::from(tiles[0]) * u64::from(tiles[1]) * u64::from(TILE_WORDS) * 4;
         let mut masks = rg.create_buffer("proxy_tile_masks", BufferDesc::new(bytes));
@@ -505,8 +545,6 @@ pub fn proxy_accumulate(
             })
             .dispatch([tiles[0], tiles[1], 1]);
         Some(masks)
-    } else {
-        None
     };
     let bytes = u64::from(w) * u64::from(h) * sums_stride(params.bands) as u64 * 4;
     let mut sums = rg.create_buffer("proxy_sums", BufferDesc::new(bytes));
@@ -517,9 +555,14 @@ pub fn proxy_accumulate(
         support_shadow: tables.support_shadow,
         support_indirect,
         indirect: u32::from(params.indirect),
-        pad: 0,
+        slice: slice.slice,
     };
-    let mut pass = rg.compute("proxy_accumulate", shader);
+    let name = if slice.slice == amortise::REGATHER_SLICE {
+        "proxy_reaccumulate"
+    } else {
+        "proxy_accumulate"
+    };
+    let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
         .read("proxies", &inputs.proxies)
@@ -528,10 +571,31 @@ pub fn proxy_accumulate(
     if let Some(masks) = &masks {
         pass.read("tile_masks", masks);
     }
-    pass.write("sums", &mut sums)
+    // Read only by the regather slice; any receiver-sized RGBA16F image fills the binding
+    // of the others.
+    pass.read("marks", marks.unwrap_or(&receivers.normal))
+        .write("sums", &mut sums)
         .push(&push)
-        .dispatch([w, h, 1]);
-    Ok(sums)
+        .dispatch(amortise::slice_threads([w, h], slice.slice));
+    Ok((sums, masks))
+}
+
+/// The marks of `slice`, after checking that the regather slice has them and no other slice
+/// is out of range.
+fn checked_marks(slice: &ProxySlice) -> Result<Option<&Handle<Image>>, ProxyError> {
+    match slice.slice {
+        amortise::REGATHER_SLICE if slice.marks.is_none() => Err(ProxyError::Size {
+            name: "marks",
+            actual: "missing".into(),
+            expected: "the proxy light marked by proxy_regather_mask".into(),
+        }),
+        s if s > amortise::REGATHER_SLICE => Err(ProxyError::OutOfRange {
+            name: "slice",
+            value: f64::from(s),
+            expected: format!("0..={}", amortise::REGATHER_SLICE),
+        }),
+        _ => Ok(slice.marks.as_ref()),
+    }
 }
 
 /// Adds the `proxy_shade` pass over the sums of [`proxy_accumulate`] (`inputs.proxies` is not
@@ -545,7 +609,25 @@ pub fn proxy_shade(
     params: &ProxyParams,
     camera: Vec3,
 ) -> Result<ProxyOutputs, ProxyError> {
+    let slice = ProxySlice::default();
+    proxy_shade_slice(rg, receivers, sums, inputs, tables, params, camera, slice)
+}
+
+/// [`proxy_shade`] at the receivers of `slice` (`proxy_reshade` for the regather slice, which
+/// writes into its marks; a new `proxy_gi` otherwise, valid at the slice's receivers).
+#[allow(clippy::too_many_arguments)]
+pub fn proxy_shade_slice(
+    rg: &mut RenderGraph,
+    receivers: &Receivers,
+    sums: &Handle<Buffer>,
+    inputs: &ProxyInputs,
+    tables: &ProxyTables,
+    params: &ProxyParams,
+    camera: Vec3,
+    slice: ProxySlice,
+) -> Result<ProxyOutputs, ProxyError> {
     check_inputs(receivers, inputs, tables, params)?;
+    let marks = checked_marks(&slice)?.copied();
     let shader = params.shade_shader()?;
     let table_bytes = (tables.gpu_data().len() * 4) as u64;
     if inputs.tables.desc().size != table_bytes {
@@ -565,7 +647,10 @@ pub fn proxy_shade(
             expected: format!("{need} bytes"),
         });
     }
-    let mut radiance = receivers.light_image(rg, "proxy_gi");
+    let (mut radiance, name) = match marks {
+        Some(marks) if slice.slice == amortise::REGATHER_SLICE => (marks, "proxy_reshade"),
+        _ => (receivers.light_image(rg, "proxy_gi"), "proxy_shade"),
+    };
     let coeffs = u64::from(params.bands * params.bands);
     let mut occlusion = rg.create_buffer("proxy_occlusion", BufferDesc::new(texels * coeffs * 4));
     let push = ShadePush {
@@ -573,9 +658,10 @@ pub fn proxy_shade(
         extent: receivers.extent,
         roughness_nodes: [GLOSSY_ROUGHNESS_MIN, glossy_roughness_step()],
         glossy_tables: GLOSSY_TABLES,
-        pad: [0; 3],
+        slice: slice.slice,
+        pad: [0; 2],
     };
-    let mut pass = rg.compute("proxy_shade", shader);
+    let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
         .read("recv_normal", &receivers.normal)
         .read("recv_albedo", &receivers.albedo)
@@ -587,7 +673,7 @@ pub fn proxy_shade(
         .write("occlusion", &mut occlusion)
         .write("proxy_gi", &mut radiance)
         .push(&push)
-        .dispatch([w, h, 1]);
+        .dispatch(amortise::slice_threads([w, h], slice.slice));
     Ok(ProxyOutputs {
         radiance,
         occlusion,

@@ -195,6 +195,10 @@ pub struct ProxySettings {
     /// 0: the scene's proxies; k in 1..=64: refit k spheres to the mesh of every node that has
     /// proxies (for profiling with many proxies). Default 0.
     pub fit_count: u32,
+    /// Receivers per refresh (paper 001): 1 shades every receiver every frame; 4 shades one
+    /// receiver per 2×2 cell per frame and reprojects the others from the previous frames
+    /// (`proxy_resolve`, src/passes/amortise.rs). Default 1.
+    pub slices: u32,
 }
 
 /// `[output]`: how the HDR frame becomes the written image.
@@ -430,6 +434,7 @@ impl Default for ProxySettings {
             indirect: true,
             brute_force: false,
             fit_count: 0,
+            slices: 1,
         }
     }
 }

@@ -171,6 +171,7 @@ impl Settings {
             &proxy::EXPANSION,
         )?;
         check("proxy.fit_count", self.proxy.fit_count, &proxy::FIT_COUNT)?;
+        check_slices("proxy.slices", self.proxy.slices)?;
         self.validate_igi()?;
         self.validate_aaf()?;
         check(

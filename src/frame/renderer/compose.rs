@@ -184,7 +184,7 @@ impl Renderer {
             .map(|setup| {
                 scene
                     .proxy
-                    .prepare(rg, setup, &frame.pose.world, environment)
+                    .prepare(rg, setup, &frame.pose.world, environment, receiver_extent)
             })
             .transpose()?;
         let cubes = match p.cubes {
@@ -277,7 +277,9 @@ impl Renderer {
             _ => None,
         };
         let proxy_low = match (proxy, &recv) {
-            (Some(proxy), Some(receivers)) => Some(proxy.declare(rg, receivers, camera.eye)?),
+            (Some(proxy), Some(receivers)) => {
+                Some(proxy.declare(rg, receivers, camera.eye, &g.motion)?)
+            }
             _ => None,
         };
         let hvl_low =
