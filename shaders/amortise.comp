@@ -14,8 +14,15 @@
 // history, changed by the change their cell's refreshed pixel makes where it shows the same
 // surface, or, where their history was rejected, take their own fresh value. CPU twin:
 // shine::reference::resolve::resolve_cpu.
-//! variant mask RESOLVE_MASK=1
-//! variant resolve RESOLVE_MASK=0
+//
+// Variant `records` (`*_reproject`) amortises a technique's per-pixel records instead of its
+// light (IGI's incident-radiance SH, `words` uints per pixel): after the refreshed pixels
+// gathered theirs, every other pixel copies its history's records where they show its
+// surface, and is marked (alpha -1 in `fresh`) for the regather otherwise; it writes the
+// geometry history of every pixel. CPU twin: shine::reference::resolve::reproject_cpu.
+//! variant mask RESOLVE_MASK=1 RESOLVE_RECORDS=0
+//! variant resolve RESOLVE_MASK=0 RESOLVE_RECORDS=0
+//! variant records RESOLVE_MASK=0 RESOLVE_RECORDS=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 
@@ -32,6 +39,17 @@ layout(set = 0, binding = 5, rgba16f) readonly uniform image2D history_geometry;
 #if RESOLVE_MASK
 // This frame's light, valid at the refreshed pixels: the others are marked here.
 layout(set = 0, binding = 2, rgba16f) uniform image2D fresh;
+#elif RESOLVE_RECORDS
+// The marks of the regather (alpha -1), written at every pixel.
+layout(set = 0, binding = 2, rgba16f) writeonly uniform image2D fresh;
+layout(set = 0, binding = 7, rgba16f) writeonly uniform image2D resolved_geometry;
+// The previous frame's records, and this frame's (the refreshed pixels' written already).
+layout(set = 0, binding = 8, std430) readonly buffer HistoryRecords {
+    uint w[];
+} history_records;
+layout(set = 0, binding = 9, std430) buffer Records {
+    uint w[];
+} records;
 #else
 // This frame's light: at every pixel the resolve takes fresh light from.
 layout(set = 0, binding = 2, rgba16f) readonly uniform image2D fresh;
@@ -53,8 +71,9 @@ layout(push_constant) uniform Push {
     uint slice;
     // 1 when the history holds the previous frame
     uint has_history;
+    // uints per pixel of the records (variant records)
+    uint words;
     uint pad0;
-    uint pad1;
 } push;
 
 // The refreshed pixel of p's cell (clamped where an odd edge cuts the cell: callers check
@@ -92,7 +111,22 @@ void main() {
     }
     vec4 position = imageLoad(recv_position, p);
     vec3 n = normalize(imageLoad(recv_normal, p).xyz);
-#if RESOLVE_MASK
+#if RESOLVE_RECORDS
+    imageStore(resolved_geometry, p, position.w == 0.0 ? vec4(0.0) : vec4(n, position.w));
+    ivec2 q;
+    bool regather = false;
+    if (push.slice != 0u && !refreshed(p) && position.w != 0.0) {
+        regather = !history_at(p, position.w, n, q);
+        if (!regather) {
+            uint to = (uint(p.y) * push.extent.x + uint(p.x)) * push.words;
+            uint from = (uint(q.y) * push.extent.x + uint(q.x)) * push.words;
+            for (uint i = 0u; i < push.words; ++i) {
+                records.w[to + i] = history_records.w[from + i];
+            }
+        }
+    }
+    imageStore(fresh, p, vec4(0.0, 0.0, 0.0, regather ? -1.0 : 0.0));
+#elif RESOLVE_MASK
     if (push.slice == 0u || refreshed(p)) {
         return;
     }

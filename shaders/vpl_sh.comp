@@ -16,6 +16,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "igi.glsl"
+#include "amortise.glsl"
 #include "hvl.glsl"
 #define TRACE_NODES_BINDING 6
 #define TRACE_TRIANGLES_BINDING 7
@@ -40,6 +41,10 @@ layout(set = 0, binding = 5, std430) buffer VplSh {
     uint c[];
 } vpl_sh;
 
+// Slice AMORTISE_REGATHER_SLICE: the pixels to gather, alpha -1 (igi_reproject); not read by
+// the other slices.
+layout(set = 0, binding = 10, rgba16f) readonly uniform image2D marks;
+
 #ifdef IGI_IRRADIANCE
 #define SH_OUT 2
 #else
@@ -58,8 +63,11 @@ layout(push_constant) uniform Push {
     uint vpl_count;
     // permutation stride (coprime with M)
     uint stride;
+    // 0: every pixel; 1 + k: the pixel at (k & 1, k >> 1) of every 2x2 cell;
+    // AMORTISE_REGATHER_SLICE: the pixels `marks` marks (amortised frames,
+    // src/passes/amortise.rs); each pixel gathers its own set
+    uint slice;
     uint pad0;
-    uint pad1;
 } push;
 
 // A ray to a VPL stops this fraction short of it (the VPL lies on a surface).
@@ -72,8 +80,11 @@ void store(uint base, int k, vec3 v) {
 }
 
 void main() {
-    ivec2 px = ivec2(gl_GlobalInvocationID.xy);
+    ivec2 px = amortise_pixel(gl_GlobalInvocationID.xy, push.slice);
     if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
+        return;
+    }
+    if (push.slice == AMORTISE_REGATHER_SLICE && imageLoad(marks, px).a >= 0.0) {
         return;
     }
     uint base = (uint(px.y) * push.extent.x + uint(px.x)) * uint(SH_OUT) * 2u;

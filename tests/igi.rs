@@ -22,7 +22,7 @@ use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::composite::Component;
 use shine::passes::gbuffer::GBuffer;
 use shine::passes::hvl::Hvl;
-use shine::passes::igi::{self, FilterMode, Glossy, IgiParams};
+use shine::passes::igi::{self, FilterMode, Glossy, IgiParams, IgiSlice};
 use shine::reference::igi::{self as reference, GBufferData};
 use shine::reference::{ReferenceImages, ReferenceParams, render_reference};
 use shine::settings::{GiTechniques, Settings};
@@ -291,7 +291,16 @@ fn run_gpu(
             let lights =
                 rg.import_gpu_buffer(&vpl_buffer, uploaded_state(), ExternalState::UNDEFINED);
             let trace = gpu_bvh.import(&mut rg, uploaded_state());
-            let sh = igi::vpl_sh(&mut rg, &gb, &lights, &trace, CAMERA, params).expect("vpl_sh");
+            let sh = igi::vpl_sh(
+                &mut rg,
+                &gb,
+                &lights,
+                &trace,
+                CAMERA,
+                params,
+                IgiSlice::default(),
+            )
+            .expect("vpl_sh");
             let mut out =
                 rg.import_gpu_buffer(&sh_readback, ExternalState::UNDEFINED, read_by_copy());
             rg.copy_buffer("read sh", &sh, &mut out);

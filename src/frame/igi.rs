@@ -1,6 +1,12 @@
 //! The IGI technique (paper 000) as the frame uses it: the BRDF SH tables of its GGX resolve,
 //! and the passes it adds to a frame at full resolution (VPLs from the primary light's RSM,
-//! `vpl_sh` with shadow rays through the BVH, `sh_filter`; `src/passes/igi.rs`).
+//! `vpl_sh` with shadow rays through the BVH, `sh_filter`; `src/passes/igi.rs`). With
+//! `igi.slices = 4` the VPL sets are amortised over frames (paper 001): `vpl_sh` gathers the
+//! set of one pixel per 2×2 cell per frame into a history of per-pixel SH, `igi_reproject`
+//! carries every other pixel's SH over from the previous frame where it shows the same surface,
+//! `igi_regather` gathers the rest, and `sh_filter` filters them all as every frame
+//! (`src/passes/amortise.rs`). A static view thus gathers every set of the pattern in four
+//! frames and renders the per-frame image exactly.
 
 use glam::Vec3;
 use shine_gpu::Device;
@@ -8,14 +14,17 @@ use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
 use crate::gpu_scene::bvh::TraceBuffers;
+use crate::passes::amortise::{self, RecordHistory, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::gbuffer::GBuffer;
-use crate::passes::igi::{self, IgiParams};
+use crate::passes::igi::{self, IgiParams, IgiSlice};
 use crate::passes::rsm::Rsm;
 
-/// The IGI technique's persistent state: the BRDF tables of the GGX resolve per SH order.
+/// The IGI technique's persistent state: the BRDF tables of the GGX resolve per SH order, and
+/// which frame last wrote the amortised light's history.
 pub struct IgiTechnique {
     brdf: BrdfTables,
+    schedule: Schedule,
 }
 
 /// An IGI frame ready to be declared: its parameters and, for the GGX resolve, its tables
@@ -23,6 +32,8 @@ pub struct IgiTechnique {
 pub struct PreparedIgi {
     params: IgiParams,
     brdf: Option<Handle<Buffer>>,
+    /// Amortised frames (`igi.slices = 4`): this frame's slice.
+    amortised: Option<Slice>,
 }
 
 /// What the IGI passes read from the rest of the frame.
@@ -43,6 +54,7 @@ impl IgiTechnique {
     pub fn new(device: &Device) -> Self {
         Self {
             brdf: BrdfTables::new(device, "igi brdf tables"),
+            schedule: Schedule::default(),
         }
     }
 
@@ -51,24 +63,32 @@ impl IgiTechnique {
         self.brdf.allocated_bytes()
     }
 
-    /// Forgets the tables: a frame that may have uploaded them was dropped unrun.
+    /// Forgets the tables and the history: a frame that may have uploaded or written them was
+    /// dropped unrun.
     pub fn forget_uploads(&mut self) {
         self.brdf.clear();
+        self.schedule.reset();
     }
 
     /// Uploads the BRDF tables of the GGX resolve when `params` uses it (once per SH order)
-    /// and imports them into `rg`.
+    /// and imports them into `rg`; for amortised frames of `extent`, picks this frame's slice.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
         params: IgiParams,
+        extent: [u32; 2],
     ) -> Result<PreparedIgi, RenderError> {
+        let amortised = self.schedule.next(rg.frame(), extent, params.slices);
         let brdf = if params.needs_brdf_tables() {
             Some(self.brdf.import(rg, params.sh_order)?)
         } else {
             None
         };
-        Ok(PreparedIgi { params, brdf })
+        Ok(PreparedIgi {
+            params,
+            brdf,
+            amortised,
+        })
     }
 }
 
@@ -79,14 +99,54 @@ impl PreparedIgi {
         rg: &mut RenderGraph,
         inputs: &IgiInputs<'_>,
     ) -> Result<Handle<Image>, RenderError> {
-        Ok(igi::igi(
+        let (g, params, camera) = (inputs.gbuffer, &self.params, inputs.camera);
+        let lights = igi::vpls(rg, inputs.rsm, params)?;
+        let Some(amortised) = self.amortised else {
+            let sh = igi::vpl_sh(
+                rg,
+                g,
+                &lights,
+                inputs.bvh,
+                camera,
+                params,
+                IgiSlice::default(),
+            )?;
+            return Ok(igi::sh_filter(
+                rg,
+                g,
+                &sh,
+                self.brdf.as_ref(),
+                camera,
+                params,
+            )?);
+        };
+        let words = params.coefficients() * igi::COEFFICIENT_WORDS;
+        let mut history = RecordHistory::declare(rg, "igi", g.extent, words);
+        let first = IgiSlice {
+            slice: amortised.slice,
+            marks: None,
+            into: Some(history.records.current),
+        };
+        history.records.current = igi::vpl_sh(rg, g, &lights, inputs.bvh, camera, params, first)?;
+        let marks = amortise::reproject_records(rg, g.into(), &g.motion, &mut history, amortised)?;
+        if amortised.slice != 0 {
+            // The pixels whose history was rejected gather their sets now (what moved first).
+            let again = IgiSlice {
+                slice: amortise::REGATHER_SLICE,
+                marks: Some(marks),
+                into: Some(history.records.current),
+            };
+            history.records.current =
+                igi::vpl_sh(rg, g, &lights, inputs.bvh, camera, params, again)?;
+        }
+        let sh = history.records.current;
+        Ok(igi::sh_filter(
             rg,
-            inputs.gbuffer,
-            inputs.rsm,
-            inputs.bvh,
+            g,
+            &sh,
             self.brdf.as_ref(),
-            inputs.camera,
-            &self.params,
+            camera,
+            params,
         )?)
     }
 }

@@ -173,6 +173,7 @@ impl FrameParams {
                 depth_tolerance: i.depth_tolerance,
                 normal_threshold: i.normal_threshold,
                 specular_limit,
+                slices: i.slices,
             }),
             proxy: gi.contains(GiTechnique::Proxy).then_some(ProxySetup {
                 pass: ProxyParams {

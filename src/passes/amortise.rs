@@ -18,7 +18,7 @@
 
 use glam::Vec3;
 
-use crate::graph::{History, Image, ImageDesc, RenderGraph, vk};
+use crate::graph::{Buffer, BufferDesc, History, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::receivers::Receivers;
 use crate::shaders;
@@ -153,8 +153,10 @@ pub struct ResolvePush {
     pub slice: u32,
     /// 1 when the history holds the previous frame.
     pub has_history: u32,
+    /// uints per pixel of the records (variant `records`).
+    pub words: u32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// Errors of the amortising passes.
@@ -229,7 +231,8 @@ fn resolve_push(
         full_extent: [full.width, full.height],
         slice: slice.slice,
         has_history: u32::from(slice.has_history),
-        pad: [0; 2],
+        words: 0,
+        pad: 0,
     })
 }
 
@@ -260,4 +263,68 @@ pub fn resolve(
     .push(&push)
     .dispatch([push.extent[0], push.extent[1], 1]);
     Ok(history.light.current)
+}
+
+/// A technique amortised by its per-pixel records instead of its light (IGI's incident-radiance
+/// SH, which its filter reads at every pixel every frame): the records and the geometry they
+/// were gathered for, as temporal resources keyed by the technique's name.
+pub struct RecordHistory {
+    /// The technique's name: the passes' prefix.
+    pub name: &'static str,
+    /// `words` uints per pixel, row-major.
+    pub records: History<Buffer>,
+    /// Normal and linear depth.
+    pub geometry: History<Image>,
+    /// uints per pixel.
+    pub words: u32,
+}
+
+impl RecordHistory {
+    /// The history of technique `name` (e.g. `igi`) for images of `extent` with `words` uints
+    /// per pixel.
+    pub fn declare(rg: &mut RenderGraph, name: &'static str, extent: [u32; 2], words: u32) -> Self {
+        let bytes = u64::from(extent[0]) * u64::from(extent[1]) * u64::from(words) * 4;
+        let desc = ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, extent[0], extent[1]);
+        Self {
+            name,
+            records: rg.history_buffer(&format!("{name} records"), BufferDesc::new(bytes)),
+            geometry: rg.history_image(&format!("{name} records geometry"), desc),
+            words,
+        }
+    }
+}
+
+/// Adds `NAME_reproject` after the refreshed pixels of `slice` gathered their records into
+/// `history.records.current`: every other pixel copies its history's records where they show
+/// its surface; returns the marks (RGBA16F, alpha −1) of those whose history was rejected, for
+/// the technique to gather with [`REGATHER_SLICE`]. Writes the geometry history.
+pub fn reproject_records(
+    rg: &mut RenderGraph,
+    surfaces: Surfaces<'_>,
+    motion: &Handle<Image>,
+    history: &mut RecordHistory,
+    slice: Slice,
+) -> Result<Handle<Image>, AmortiseError> {
+    let mut push = resolve_push(surfaces, motion, slice)?;
+    push.words = history.words;
+    let [w, h] = surfaces.extent;
+    let mut marks = rg.create_image(
+        &format!("{}_marks", history.name),
+        ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
+    );
+    rg.compute(
+        &format!("{}_reproject", history.name),
+        &shaders::AMORTISE_COMP_RECORDS,
+    )
+    .read("recv_position", surfaces.position)
+    .read("recv_normal", surfaces.normal)
+    .read("gb_motion", motion)
+    .read("history_geometry", &history.geometry.previous)
+    .read("history_records", &history.records.previous)
+    .write("records", &mut history.records.current)
+    .write("fresh", &mut marks)
+    .write("resolved_geometry", &mut history.geometry.current)
+    .push(&push)
+    .dispatch([w, h, 1]);
+    Ok(marks)
 }

@@ -69,6 +69,7 @@ use glam::Vec3;
 
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::amortise;
 use crate::passes::brdf_tables;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::hvl::{self, HvlError, HvlParams};
@@ -80,6 +81,8 @@ pub const MAX_STORAGE_BUFFER: u64 = 1 << 27;
 
 /// Bytes per stored rgb coefficient of `vpl_sh` (two u32 of packed halves).
 pub const COEFFICIENT_BYTES: u64 = 8;
+/// uints per stored rgb coefficient ([`COEFFICIENT_BYTES`] / 4).
+pub const COEFFICIENT_WORDS: u32 = (COEFFICIENT_BYTES / 4) as u32;
 
 /// Interleaving pattern sides n and m (paper 000 §2.2 uses 4×4 and 8×8 patterns).
 pub const PATTERN: RangeInclusive<u32> = 1..=8;
@@ -144,6 +147,24 @@ pub struct IgiParams {
     /// Roughness limit of the frame's traced specular pass (0: none): the filter's glossy
     /// term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
     pub specular_limit: f32,
+    /// Pixels per refresh (paper 001): 1, or [`amortise::SLICES`]: `vpl_sh` gathers the VPL
+    /// sets of one pixel per 2×2 cell per frame and the others keep theirs, reprojected
+    /// ([`IgiSlice`], [`igi_reproject`]).
+    pub slices: u32,
+}
+
+/// Which pixels one `vpl_sh` dispatch gathers, and into which buffer: paper 001's amortised
+/// frames (`igi.slices`, [`crate::passes::amortise`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct IgiSlice {
+    /// 0: every pixel; 1 + k: the pixel at (k & 1, k >> 1) of every 2×2 cell;
+    /// [`amortise::REGATHER_SLICE`]: the pixels `marks` marks with alpha −1. Each pixel
+    /// gathers its own set, so four frames gather every set of the pattern.
+    pub slice: u32,
+    /// The marks of [`igi_reproject`]; required by the regather slice.
+    pub marks: Option<Handle<Image>>,
+    /// The buffer to gather into (the amortised frame's SH history; `None`: a new one).
+    pub into: Option<Handle<Buffer>>,
 }
 
 impl Default for IgiParams {
@@ -160,6 +181,7 @@ impl Default for IgiParams {
             depth_tolerance: 0.05,
             normal_threshold: 0.9,
             specular_limit: 0.0,
+            slices: 1,
         }
     }
 }
@@ -178,8 +200,10 @@ pub struct VplShPush {
     pub vpl_count: u32,
     /// Permutation stride ([`permutation_stride`]).
     pub stride: u32,
+    /// The pixels shaded ([`IgiSlice::slice`]).
+    pub slice: u32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// Push constants of `shaders/sh_filter.comp` (64 bytes).
@@ -244,6 +268,13 @@ impl IgiParams {
         check("clamp_distance", self.clamp_distance, &CLAMP_DISTANCE)?;
         check("depth_tolerance", self.depth_tolerance, &DEPTH_TOLERANCE)?;
         check("normal_threshold", self.normal_threshold, &NORMAL_THRESHOLD)?;
+        if !amortise::SLICE_CHOICES.contains(&self.slices) {
+            return Err(IgiError::OutOfRange(super::OutOfRange {
+                name: "slices",
+                value: f64::from(self.slices),
+                expected: format!("one of {:?}", amortise::SLICE_CHOICES),
+            }));
+        }
         Ok(())
     }
 
@@ -340,8 +371,10 @@ pub fn vpls(
     Ok(hvl::hvl_cache(rg, rsm, &cache)?)
 }
 
-/// Adds `vpl_sh`: the per-pixel incident radiance of the pixel's VPL set, shadowed through
-/// `bvh`, as `params.coefficients()` packed rgb coefficients per pixel (a new buffer).
+/// Adds `vpl_sh` (`igi_regather` for the regather slice): the per-pixel incident radiance of
+/// the pixel's VPL set, shadowed through `bvh`, as `params.coefficients()` packed rgb
+/// coefficients per pixel, at the pixels of `slice` ([`IgiSlice::default`]: every pixel, into
+/// a new buffer); returns the buffer.
 pub fn vpl_sh(
     rg: &mut RenderGraph,
     g: &GBuffer,
@@ -349,8 +382,20 @@ pub fn vpl_sh(
     bvh: &TraceBuffers,
     camera: Vec3,
     params: &IgiParams,
+    slice: IgiSlice,
 ) -> Result<Handle<Buffer>, IgiError> {
     params.validate()?;
+    let regather = slice.slice == amortise::REGATHER_SLICE;
+    if slice.slice > amortise::REGATHER_SLICE || (regather && slice.marks.is_none()) {
+        return Err(IgiError::OutOfRange(super::OutOfRange {
+            name: "vpl_sh slice",
+            value: f64::from(slice.slice),
+            expected: format!(
+                "0..={} (the regather slice with the marks of igi_reproject)",
+                amortise::REGATHER_SLICE
+            ),
+        }));
+    }
     let bytes = params.sh_bytes(g.extent)?;
     let need = hvl::cache_bytes(params.vpl_count);
     if vpls.desc().size < need {
@@ -361,16 +406,28 @@ pub fn vpl_sh(
         }));
     }
     let shader = shader("vpl_sh.comp", params, false)?;
-    let mut sh = rg.create_buffer("vpl_sh", BufferDesc::new(bytes));
+    let mut sh = match slice.into {
+        Some(into) if into.desc().size >= bytes => into,
+        Some(into) => {
+            return Err(IgiError::OutOfRange(super::OutOfRange {
+                name: "vpl_sh buffer bytes",
+                value: into.desc().size as f64,
+                expected: "W × H × coefficients × 8 bytes".to_owned(),
+            }));
+        }
+        None => rg.create_buffer("vpl_sh", BufferDesc::new(bytes)),
+    };
     let push = VplShPush {
         camera_clamp: camera.extend(params.clamp_distance).to_array(),
         extent: g.extent,
         pattern: params.pattern,
         vpl_count: params.vpl_count,
         stride: permutation_stride(params.vpl_count),
-        pad: [0; 2],
+        slice: slice.slice,
+        pad: 0,
     };
-    let mut pass = rg.compute("vpl_sh", shader);
+    let name = if regather { "igi_regather" } else { "vpl_sh" };
+    let mut pass = rg.compute(name, shader);
     pass.read("gb_position", &g.position)
         .read("gb_geometric_normal", &g.geometric_normal);
     if params.mode == FilterMode::Irradiance {
@@ -378,10 +435,13 @@ pub fn vpl_sh(
             .read("gb_material", &g.material);
     }
     bvh.bind(&mut pass);
+    // Read only by the regather slice; any full-resolution RGBA16F image fills the binding of
+    // the others.
     pass.read("vpls", vpls)
+        .read("marks", slice.marks.as_ref().unwrap_or(&g.geometric_normal))
         .write("vpl_sh", &mut sh)
         .push(&push)
-        .dispatch([g.extent[0], g.extent[1], 1]);
+        .dispatch(amortise::slice_threads(g.extent, slice.slice));
     Ok(sh)
 }
 
@@ -453,22 +513,6 @@ pub fn sh_filter(
         .push(&push)
         .dispatch([w, h, 1]);
     Ok(indirect)
-}
-
-/// The three IGI passes in a row: VPLs from the RSM faces `rsm` (the primary light's first),
-/// `vpl_sh`, `sh_filter`; returns `indirect`. `brdf`: as for [`sh_filter`].
-pub fn igi(
-    rg: &mut RenderGraph,
-    g: &GBuffer,
-    rsm: &[Rsm],
-    bvh: &TraceBuffers,
-    brdf: Option<&Handle<Buffer>>,
-    camera: Vec3,
-    params: &IgiParams,
-) -> Result<Handle<Image>, IgiError> {
-    let lights = vpls(rg, rsm, params)?;
-    let sh = vpl_sh(rg, g, &lights, bvh, camera, params)?;
-    sh_filter(rg, g, &sh, brdf, camera, params)
 }
 
 /// The compiled variant of `file` for `params` (`filter`: the sh_filter variants).

@@ -375,6 +375,10 @@ pub struct IgiSettings {
     /// Cosine threshold of the filter's geometric-normal test (n_p · n_q ≥ this).
     /// Range -1.0..=1.0, default 0.9.
     pub normal_threshold: f32,
+    /// Pixels per refresh (paper 001): 1 shades every pixel every frame; 4 shades one pixel
+    /// per 2×2 cell per frame, the VPL sets interleaved over the cells, and reprojects the
+    /// others from the previous frames (`igi_resolve`, src/passes/amortise.rs). Default 1.
+    pub slices: u32,
 }
 
 impl Default for IgiSettings {
@@ -393,6 +397,7 @@ impl Default for IgiSettings {
             clamp_distance: p.clamp_distance,
             depth_tolerance: p.depth_tolerance,
             normal_threshold: p.normal_threshold,
+            slices: p.slices,
         }
     }
 }

@@ -213,6 +213,7 @@ impl Settings {
         check("igi.sh_order", i.sh_order, &igi::SH_ORDERS)?;
         check("igi.filter_radius", i.filter_radius, &igi::FILTER_RADIUS)?;
         check("igi.clamp_distance", i.clamp_distance, &igi::CLAMP_DISTANCE)?;
+        check_slices("igi.slices", i.slices)?;
         check(
             "igi.depth_tolerance",
             i.depth_tolerance,

@@ -176,7 +176,10 @@ impl Renderer {
             .hvl
             .map(|h| self.hvl.prepare(rg, h, receiver_extent))
             .transpose()?;
-        let igi = p.igi.map(|i| self.igi.prepare(rg, i)).transpose()?;
+        let igi = p
+            .igi
+            .map(|i| self.igi.prepare(rg, i, p.extent))
+            .transpose()?;
         let aaf = p.aaf.map(|a| self.aaf.prepare(a)).transpose()?;
         let proxy = p
             .proxy
