@@ -11,6 +11,7 @@
 #extension GL_GOOGLE_include_directive : require
 #include "brdf.glsl"
 #include "aaf.glsl"
+#include "amortise.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -24,7 +25,7 @@ layout(set = 0, binding = 2, std430) buffer Filter {
     vec2 f[];
 } filter_widths;
 
-// shine::passes::aaf::BetaPush (48 bytes).
+// shine::passes::aaf::BetaPush (64 bytes).
 layout(push_constant) uniform Push {
     uvec2 extent;
     // d = linear depth * footprint.x + footprint.y.
@@ -33,11 +34,22 @@ layout(push_constant) uniform Push {
     vec4 paper;
     // x: lower clamp of z_min, y: spp_min, z: spp_max, w: the scene's size S.
     vec4 clamps;
+    // the pixels (aaf_sample.comp's config.z)
+    uint slice;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } push;
 
+// Slice AMORTISE_REGATHER_SLICE: the pixels to compute, alpha -1; not read by the others.
+layout(set = 0, binding = 4, rgba16f) readonly uniform image2D marks;
+
 void main() {
-    uvec2 pixel = gl_GlobalInvocationID.xy;
+    uvec2 pixel = uvec2(amortise_pixel(gl_GlobalInvocationID.xy, push.slice));
     if (any(greaterThanEqual(pixel, push.extent))) {
+        return;
+    }
+    if (push.slice == AMORTISE_REGATHER_SLICE && imageLoad(marks, ivec2(pixel)).a >= 0.0) {
         return;
     }
     uint p = pixel.y * push.extent.x + pixel.x;

@@ -25,6 +25,7 @@
 #define TRACE_INSTANCES_BINDING 18
 #include "trace.glsl"
 #include "aaf.glsl"
+#include "amortise.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -32,7 +33,9 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(push_constant) uniform Push {
     // x: width, y: height, z: light count, w: seed.
     uvec4 frame;
-    // x: bounces B, y: samples of the first pass, z, w: unused.
+    // x: bounces B, y: samples of the first pass, z: the pixels sampled (0: every pixel;
+    // 1 + k: the pixel at (k & 1, k >> 1) of every 2x2 cell; AMORTISE_REGATHER_SLICE: those
+    // `marks` marks; src/passes/amortise.rs), w: unused.
     uvec4 config;
     // xyz: camera position, w: the specular pass's roughness limit (0: none).
     vec4 camera;
@@ -51,6 +54,9 @@ layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
 layout(set = 0, binding = 12, std430) buffer Sums {
     vec4 s[];
 } sums;
+// Slice AMORTISE_REGATHER_SLICE: the pixels to sample, alpha -1 (aaf_reproject); not read by
+// the other slices.
+layout(set = 0, binding = 19, rgba16f) readonly uniform image2D marks;
 #ifdef AAF_FIRST
 // x: z_min, y: z_max of the pixel's hits.
 layout(set = 0, binding = 13, std430) buffer Depths {
@@ -97,9 +103,12 @@ vec3 incident(vec3 dir, TraceHit hit, uint bounces) {
 }
 
 void main() {
-    uvec2 pixel = gl_GlobalInvocationID.xy;
+    uvec2 pixel = uvec2(amortise_pixel(gl_GlobalInvocationID.xy, push.config.z));
     uvec2 extent = push.frame.xy;
     if (any(greaterThanEqual(pixel, extent))) {
+        return;
+    }
+    if (push.config.z == AMORTISE_REGATHER_SLICE && imageLoad(marks, ivec2(pixel)).a >= 0.0) {
         return;
     }
     uint p = pixel.y * extent.x + pixel.x;

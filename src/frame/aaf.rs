@@ -1,6 +1,10 @@
 //! The AAF technique (paper 004) as the frame uses it: path-traced indirect light at every
-//! G-buffer pixel through the BVH, sampled adaptively and filtered (`src/passes/aaf.rs`). It
-//! keeps no state between frames yet; it reads the scene's buffers and BVH each frame.
+//! G-buffer pixel through the BVH, sampled adaptively and filtered (`src/passes/aaf.rs`). With
+//! `aaf.slices = 4` its samples are amortised (paper 001): one pixel per 2×2 cell per frame is
+//! sampled into a history of per-pixel sums and filter widths, `aaf_reproject` carries the
+//! others over where they show the same surface, the rest are sampled again
+//! (`aaf_resample_*`), and the filter runs over all of them every frame
+//! (`src/passes/amortise.rs`).
 
 use glam::Vec3;
 use shine_graph::{Handle, Image, RenderGraph};
@@ -9,16 +13,21 @@ use super::error::RenderError;
 use crate::gpu::vk;
 use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::passes::aaf::{self, AafParams, AafScene};
+use crate::passes::aaf::{self, AafParams, AafRecords, AafScene, AafSlice};
+use crate::passes::amortise::{self, RecordHistory, Schedule, Slice};
 use crate::passes::gbuffer::{GBuffer, View};
 
-/// The AAF technique.
+/// The AAF technique: which frame last wrote its amortised samples' history.
 #[derive(Debug, Default)]
-pub struct AafTechnique;
+pub struct AafTechnique {
+    schedule: Schedule,
+}
 
 /// An AAF frame ready to be declared: its checked parameters.
 pub struct PreparedAaf {
     params: AafParams,
+    /// Amortised frames (`aaf.slices = 4`): this frame's slice.
+    amortised: Option<Slice>,
 }
 
 /// What the AAF passes read from the rest of the frame.
@@ -40,10 +49,23 @@ pub struct AafInputs<'a> {
 }
 
 impl AafTechnique {
-    /// Checks `params` (AAF uploads nothing of its own).
-    pub fn prepare(&mut self, params: AafParams) -> Result<PreparedAaf, RenderError> {
+    /// Checks `params` (AAF uploads nothing of its own); for amortised frames of `extent`,
+    /// picks this frame's slice.
+    pub fn prepare(
+        &mut self,
+        rg: &mut RenderGraph,
+        params: AafParams,
+        extent: [u32; 2],
+    ) -> Result<PreparedAaf, RenderError> {
         params.validate()?;
-        Ok(PreparedAaf { params })
+        let amortised = self.schedule.next(rg.frame(), extent, params.slices);
+        Ok(PreparedAaf { params, amortised })
+    }
+
+    /// Forgets the history: a new scene, or a frame that may have written it was dropped
+    /// unrun.
+    pub fn reset(&mut self) {
+        self.schedule.reset();
     }
 }
 
@@ -61,6 +83,47 @@ impl PreparedAaf {
             size: aaf::scene_size(inputs.bounds),
             texture_sampler: inputs.texture_sampler,
         };
-        Ok(aaf::aaf(rg, inputs.gbuffer, &scene, inputs.camera, &self.params)?.indirect)
+        let (g, camera, params) = (inputs.gbuffer, inputs.camera, &self.params);
+        let Some(amortised) = self.amortised else {
+            return Ok(aaf::aaf(rg, g, &scene, camera, params)?.indirect);
+        };
+        let sums_words = (aaf::SUMS_BYTES / 4) as u32;
+        let widths_words = (aaf::WIDTHS_BYTES / 4) as u32;
+        let mut sums = RecordHistory::declare(rg, "aaf", g.extent, sums_words);
+        let mut widths = RecordHistory::declare(rg, "aaf_widths", g.extent, widths_words);
+        let mut slice = AafSlice {
+            slice: amortised.slice,
+            marks: None,
+            into: Some(AafRecords {
+                sums: sums.records.current,
+                widths: widths.records.current,
+            }),
+        };
+        let mut samples = aaf::aaf_sample(rg, g, &scene, camera, params, slice)?;
+        sums.records.current = samples.sums;
+        widths.records.current = samples.widths;
+        let marks = amortise::reproject_records(rg, g.into(), &g.motion, &mut sums, amortised)?;
+        // Same surfaces, same marks: this pass's own are not read.
+        amortise::reproject_records(rg, g.into(), &g.motion, &mut widths, amortised)?;
+        if amortised.slice != 0 {
+            // The pixels whose history was rejected are sampled now (what moved first).
+            slice = AafSlice {
+                slice: amortise::REGATHER_SLICE,
+                marks: Some(marks),
+                into: Some(AafRecords {
+                    sums: sums.records.current,
+                    widths: widths.records.current,
+                }),
+            };
+            samples = aaf::aaf_sample(rg, g, &scene, camera, params, slice)?;
+        }
+        Ok(aaf::aaf_filter(
+            rg,
+            g,
+            &samples.sums,
+            &samples.widths,
+            camera,
+            params,
+        )?)
     }
 }

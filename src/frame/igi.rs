@@ -63,6 +63,11 @@ impl IgiTechnique {
         self.brdf.allocated_bytes()
     }
 
+    /// Forgets the history (a new scene).
+    pub fn reset(&mut self) {
+        self.schedule.reset();
+    }
+
     /// Forgets the tables and the history: a frame that may have uploaded or written them was
     /// dropped unrun.
     pub fn forget_uploads(&mut self) {

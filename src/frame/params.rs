@@ -208,6 +208,7 @@ impl FrameParams {
                     adaptive: a.adaptive,
                     filter: a.filter,
                     specular_limit,
+                    slices: a.slices,
                     ..AafParams::default()
                 }
             }),

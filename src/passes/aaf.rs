@@ -45,6 +45,7 @@ use std::ops::RangeInclusive;
 use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
+use crate::passes::amortise;
 use crate::passes::gbuffer::{GBuffer, View};
 use crate::shaders;
 
@@ -101,6 +102,10 @@ pub struct AafParams {
     /// Roughness limit of the frame's traced specular pass (0: none): the samples' specular
     /// BRDF term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
     pub specular_limit: f32,
+    /// Pixels per refresh (paper 001): 1, or [`amortise::SLICES`]: the sampling passes sample
+    /// one pixel per 2×2 cell per frame and the others keep their sums, reprojected
+    /// ([`AafSlice`]).
+    pub slices: u32,
 }
 
 impl Default for AafParams {
@@ -121,6 +126,7 @@ impl Default for AafParams {
             filter: true,
             seed: 0,
             specular_limit: 0.0,
+            slices: 1,
         }
     }
 }
@@ -151,6 +157,13 @@ impl AafParams {
             self.normal_threshold_degrees,
             &(0.0..=180.0),
         )?;
+        if !amortise::SLICE_CHOICES.contains(&self.slices) {
+            return Err(AafError::OutOfRange(super::OutOfRange {
+                name: "slices",
+                value: f64::from(self.slices),
+                expected: format!("one of {:?}", amortise::SLICE_CHOICES),
+            }));
+        }
         Ok(())
     }
 
@@ -183,13 +196,13 @@ pub fn scene_size(bounds: (glam::Vec3, glam::Vec3)) -> f32 {
 pub struct SamplePush {
     /// Width, height, light count, seed.
     pub frame: [u32; 4],
-    /// Bounces, samples of the first pass, unused, unused.
+    /// Bounces, samples of the first pass, the pixels sampled ([`AafSlice::slice`]), unused.
     pub config: [u32; 4],
     /// xyz camera position, w the specular pass's roughness limit (0: none).
     pub camera: [f32; 4],
 }
 
-/// Push constants of `shaders/aaf_beta.comp` (48 bytes).
+/// Push constants of `shaders/aaf_beta.comp` (64 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct BetaPush {
@@ -201,6 +214,10 @@ pub struct BetaPush {
     pub paper: [f32; 4],
     /// Lower clamp of z_min (world units), spp_min, spp_upper, the scene's size.
     pub clamps: [f32; 4],
+    /// The pixels computed ([`AafSlice::slice`]).
+    pub slice: u32,
+    /// Padding.
+    pub pad: [u32; 3],
 }
 
 /// Push constants of `shaders/aaf_filter.comp` (48 bytes).
@@ -261,49 +278,143 @@ pub fn aaf(
     camera: &View,
     params: &AafParams,
 ) -> Result<AafOutputs, AafError> {
+    let samples = aaf_sample(rg, g, scene, camera, params, AafSlice::default())?;
+    let indirect = aaf_filter(rg, g, &samples.sums, &samples.widths, camera, params)?;
+    Ok(AafOutputs {
+        indirect,
+        sums: samples.sums,
+        depths: samples.depths,
+        widths: samples.widths,
+    })
+}
+
+/// Which pixels one run of AAF's sampling passes samples, and into which buffers: paper 001's
+/// amortised frames (`aaf.slices`, [`crate::passes::amortise`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct AafSlice {
+    /// 0: every pixel; 1 + k: the pixel at (k & 1, k >> 1) of every 2×2 cell;
+    /// [`amortise::REGATHER_SLICE`]: the pixels `marks` marks with alpha −1.
+    pub slice: u32,
+    /// The marks of `aaf_reproject`; required by the regather slice.
+    pub marks: Option<Handle<Image>>,
+    /// The sums and widths buffers to write (the amortised frame's records; `None`: new ones).
+    pub into: Option<AafRecords>,
+}
+
+/// AAF's per-pixel records: what the filter reads.
+#[derive(Debug, Clone, Copy)]
+pub struct AafRecords {
+    /// vec4 per pixel: rgb sum of the samples, their count.
+    pub sums: Handle<Buffer>,
+    /// vec2 per pixel: β, samples per pixel ([`aaf_beta`]).
+    pub widths: Handle<Buffer>,
+}
+
+/// Bytes per pixel of [`AafRecords::sums`].
+pub const SUMS_BYTES: u64 = 16;
+/// Bytes per pixel of [`AafRecords::widths`] (and of the depths).
+pub const WIDTHS_BYTES: u64 = 8;
+
+/// What [`aaf_sample`] returns.
+#[derive(Debug, Clone, Copy)]
+pub struct AafSamples {
+    /// The sums the filter reads.
+    pub sums: Handle<Buffer>,
+    /// The first pass's z_min, z_max.
+    pub depths: Handle<Buffer>,
+    /// β and the sample counts.
+    pub widths: Handle<Buffer>,
+}
+
+/// Adds the sampling half of AAF at the pixels of `slice`: `aaf_sample_first`, `aaf_beta` and
+/// (adaptive) `aaf_sample_second`, named `aaf_resample_*` and `aaf_rebeta` for the regather
+/// slice. The sums and widths are valid at those pixels.
+pub fn aaf_sample(
+    rg: &mut RenderGraph,
+    g: &GBuffer,
+    scene: &AafScene<'_>,
+    camera: &View,
+    params: &AafParams,
+    slice: AafSlice,
+) -> Result<AafSamples, AafError> {
     params.validate()?;
+    let regather = slice.slice == amortise::REGATHER_SLICE;
+    if slice.slice > amortise::REGATHER_SLICE || (regather && slice.marks.is_none()) {
+        return Err(AafError::OutOfRange(super::OutOfRange {
+            name: "slice",
+            value: f64::from(slice.slice),
+            expected: format!(
+                "0..={} (the regather slice with the marks of aaf_reproject)",
+                amortise::REGATHER_SLICE
+            ),
+        }));
+    }
     let [w, h] = g.extent;
     let pixels = u64::from(w) * u64::from(h);
     let sample_push = SamplePush {
         frame: [w, h, scene.light_count, params.seed],
-        config: [params.bounces, params.first_samples, 0, 0],
+        config: [params.bounces, params.first_samples, slice.slice, 0],
         camera: camera.eye.extend(params.specular_limit).to_array(),
     };
-    let mut first = rg.create_buffer("aaf_sums_first", BufferDesc::new(pixels * 16));
-    let mut depths = rg.create_buffer("aaf_depths", BufferDesc::new(pixels * 8));
+    let into = match slice.into {
+        Some(r) => r,
+        None => AafRecords {
+            sums: rg.create_buffer("aaf_sums", BufferDesc::new(pixels * SUMS_BYTES)),
+            widths: rg.create_buffer("aaf_widths", BufferDesc::new(pixels * WIDTHS_BYTES)),
+        },
+    };
+    // Read only by the regather slice; any full-resolution RGBA16F image fills the binding
+    // of the others.
+    let marks = slice.marks.unwrap_or(g.geometric_normal);
+    let threads = amortise::slice_threads(g.extent, slice.slice);
+    let name = |first: &'static str, again: &'static str| if regather { again } else { first };
+    let mut first = if params.adaptive {
+        rg.create_buffer("aaf_sums_first", BufferDesc::new(pixels * SUMS_BYTES))
+    } else {
+        into.sums
+    };
+    let mut depths = rg.create_buffer("aaf_depths", BufferDesc::new(pixels * WIDTHS_BYTES));
     sample_pass(
         rg,
-        "aaf_sample_first",
+        name("aaf_sample_first", "aaf_resample_first"),
         &shaders::AAF_SAMPLE_COMP_FIRST,
         g,
         scene,
     )
+    .read("marks", &marks)
     .write("sums", &mut first)
     .write("depths", &mut depths)
     .push(&sample_push)
-    .dispatch([w, h, 1]);
-    let widths = aaf_beta(rg, g, &depths, camera, scene.size, params)?;
+    .dispatch(threads);
+    let mut widths = into.widths;
+    rg.compute(name("aaf_beta", "aaf_rebeta"), &shaders::AAF_BETA_COMP)
+        .read("gb_position", &g.position)
+        .read("gb_material", &g.material)
+        .read("depths", &depths)
+        .read("marks", &marks)
+        .write("filter_widths", &mut widths)
+        .push(&beta_push(g, camera, scene.size, params, slice.slice))
+        .dispatch(threads);
     let sums = if params.adaptive {
-        let mut second = rg.create_buffer("aaf_sums", BufferDesc::new(pixels * 16));
+        let mut second = into.sums;
         sample_pass(
             rg,
-            "aaf_sample_second",
+            name("aaf_sample_second", "aaf_resample_second"),
             &shaders::AAF_SAMPLE_COMP_SECOND,
             g,
             scene,
         )
         .read("first_sums", &first)
         .read("filter_widths", &widths)
+        .read("marks", &marks)
         .write("sums", &mut second)
         .push(&sample_push)
-        .dispatch([w, h, 1]);
+        .dispatch(threads);
         second
     } else {
         first
     };
-    let indirect = aaf_filter(rg, g, &sums, &widths, camera, params)?;
-    Ok(AafOutputs {
-        indirect,
+    Ok(AafSamples {
         sums,
         depths,
         widths,
@@ -325,26 +436,40 @@ pub fn aaf_beta(
     let [w, h] = g.extent;
     let mut widths = rg.create_buffer(
         "aaf_widths",
-        BufferDesc::new(u64::from(w) * u64::from(h) * 8),
+        BufferDesc::new(u64::from(w) * u64::from(h) * WIDTHS_BYTES),
     );
     rg.compute("aaf_beta", &shaders::AAF_BETA_COMP)
         .read("gb_position", &g.position)
         .read("gb_material", &g.material)
         .read("depths", depths)
+        .read("marks", &g.geometric_normal)
         .write("filter_widths", &mut widths)
-        .push(&BetaPush {
-            extent: g.extent,
-            footprint: footprint(camera, h),
-            paper: [params.omega_h, params.alpha, params.mu, params.gamma],
-            clamps: [
-                params.z_min_fraction * scene_size,
-                params.spp_min as f32,
-                params.spp_upper(),
-                scene_size,
-            ],
-        })
+        .push(&beta_push(g, camera, scene_size, params, 0))
         .dispatch([w, h, 1]);
     Ok(widths)
+}
+
+/// The push constants of `aaf_beta` at the pixels of `slice`.
+fn beta_push(
+    g: &GBuffer,
+    camera: &View,
+    scene_size: f32,
+    params: &AafParams,
+    slice: u32,
+) -> BetaPush {
+    BetaPush {
+        extent: g.extent,
+        footprint: footprint(camera, g.extent[1]),
+        paper: [params.omega_h, params.alpha, params.mu, params.gamma],
+        clamps: [
+            params.z_min_fraction * scene_size,
+            params.spp_min as f32,
+            params.spp_upper(),
+            scene_size,
+        ],
+        slice,
+        pad: [0; 3],
+    }
 }
 
 /// Adds `aaf_filter_x` and `aaf_filter_y`: the separable filter of the mean of `sums` (vec4

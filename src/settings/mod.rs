@@ -152,6 +152,10 @@ pub struct AafSettings {
     pub adaptive: bool,
     /// The screen-space filter; off: the unfiltered Monte-Carlo mean. Default true.
     pub filter: bool,
+    /// Pixels per refresh (paper 001): 1 samples every pixel every frame; 4 samples one pixel
+    /// per 2×2 cell per frame and reprojects the others' sums from the previous frames
+    /// (`aaf_reproject`, src/passes/amortise.rs). Default 1.
+    pub slices: u32,
 }
 
 impl Default for AafSettings {
@@ -167,6 +171,7 @@ impl Default for AafSettings {
             bounces: p.bounces,
             adaptive: p.adaptive,
             filter: p.filter,
+            slices: p.slices,
         }
     }
 }

@@ -266,7 +266,8 @@ impl Settings {
         check("aaf.omega_h", a.omega_h, &aaf::OMEGA_H_RANGE)?;
         check("aaf.spp_min", a.spp_min, &aaf::SPP_MIN)?;
         check("aaf.spp_max", a.spp_max, &aaf::SPP_MAX)?;
-        check("aaf.bounces", a.bounces, &aaf::BOUNCES)
+        check("aaf.bounces", a.bounces, &aaf::BOUNCES)?;
+        check_slices("aaf.slices", a.slices)
     }
 }
 

@@ -50,6 +50,7 @@ impl Renderer {
         self.exposure.reset();
         self.hvl.forget_uploads();
         self.igi.forget_uploads();
+        self.aaf.reset();
         if let Some(scene) = self.scene.as_mut() {
             scene.proxy.forget_uploads();
             scene.cubes.reset();
@@ -180,7 +181,10 @@ impl Renderer {
             .igi
             .map(|i| self.igi.prepare(rg, i, p.extent))
             .transpose()?;
-        let aaf = p.aaf.map(|a| self.aaf.prepare(a)).transpose()?;
+        let aaf = p
+            .aaf
+            .map(|a| self.aaf.prepare(rg, a, p.extent))
+            .transpose()?;
         let proxy = p
             .proxy
             .as_ref()

@@ -253,7 +253,7 @@ impl Renderer {
             shadows: None,
             hvl: HvlTechnique::new(device),
             igi: IgiTechnique::new(device),
-            aaf: AafTechnique,
+            aaf: AafTechnique::default(),
             motion: MotionState::new(device)?,
             accumulate: AccumulateTechnique::new("accumulate", "accumulated indirect"),
             taa: AccumulateTechnique::new("taa", "taa direct"),
@@ -282,6 +282,8 @@ impl Renderer {
         self.shadows = None;
         self.motion.reset();
         self.hvl.reset();
+        self.igi.reset();
+        self.aaf.reset();
         self.accumulate.reset();
         self.taa.reset();
         self.exposure.reset();
