@@ -7,9 +7,11 @@ mod common;
 use common::{Rng, bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
 use glam::{Vec2, Vec3, Vec4};
 use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
-use shine::passes::amortise::{ResolveHistory, Slice, resolve};
+use shine::passes::amortise::{
+    RecordHistory, ResolveHistory, Slice, Surfaces, reproject_records, resolve,
+};
 use shine::passes::receivers::Receivers;
-use shine::reference::resolve::{ResolveInputs, resolve_cpu};
+use shine::reference::resolve::{ResolveInputs, reproject_cpu, resolve_cpu};
 use shine::{Renderer, Settings};
 use shine_scene::Scene;
 
@@ -102,76 +104,27 @@ fn resolve_gpu(device: &shine::gpu::Device, inp: &ResolveInputs<'_>) -> Vec<Vec4
 #[test]
 fn resolve_matches_the_cpu_twin() {
     let device = common::device();
-    // Odd sides: the cells on the last row and column are cut (the gather clamps).
-    let (extent, full_extent) = ([11u32, 9], [22u32, 18]);
-    let n = (extent[0] * extent[1]) as usize;
-    let mut rng = Rng(2024);
-    let mut position = Vec::new();
-    let mut normal = Vec::new();
-    for _ in 0..n {
-        let background = rng.next() < 0.1;
-        let depth = 1.0 + 4.0 * rng.next();
-        position.push(Vec4::new(
-            rng.next(),
-            rng.next(),
-            rng.next(),
-            if background { 0.0 } else { depth },
-        ));
-        normal.push(Vec3::new(rng.next() - 0.5, rng.next() - 0.5, 1.0).normalize());
-    }
+    let r = RandomFrame::new();
+    let (extent, full_extent, n) = (r.extent, r.full_extent, r.position.len());
+    let mut rng = Rng(7);
     let fresh: Vec<Vec4> = (0..n)
         .map(|_| q16(Vec4::new(rng.next(), rng.next(), rng.next(), 0.0)))
         .collect();
     let history_light: Vec<Vec4> = (0..n)
         .map(|_| q16(Vec4::new(rng.next(), rng.next(), rng.next(), 0.0)))
         .collect();
-    // History geometry: mostly the receiver's own (kept), sometimes another depth or normal.
-    let history_geometry: Vec<Vec4> = (0..n)
-        .map(|i| {
-            let r = rng.next();
-            let (nn, d) = (normal[i], position[i].w);
-            q16(if r < 0.6 {
-                nn.extend(d)
-            } else if r < 0.8 {
-                nn.extend(d * 1.5)
-            } else {
-                (-nn).extend(d)
-            })
-        })
-        .collect();
-    // Motion: none for most pixels, a few receivers' worth (some off screen) for the rest.
-    let motion: Vec<Vec2> = (0..full_extent[0] * full_extent[1])
-        .map(|_| {
-            if rng.next() < 0.7 {
-                Vec2::ZERO
-            } else {
-                (Vec2::new(rng.next(), rng.next()) - 0.5) * 0.6
-            }
-        })
-        .map(|m| Vec2::new(f16_to_f32(f32_to_f16(m.x)), f16_to_f32(f32_to_f16(m.y))))
-        .collect();
-    let normal_q: Vec<Vec3> = normal
-        .iter()
-        .map(|v| q16(v.extend(0.0)).truncate())
-        .collect();
+    let position = &r.position;
     let mut branches = [0usize; 2];
-    for (slice, has_history) in [
-        (0, false),
-        (1, true),
-        (2, true),
-        (3, true),
-        (4, true),
-        (3, false),
-    ] {
+    for (slice, has_history) in SLICE_CASES {
         let inputs = ResolveInputs {
             extent,
             full_extent,
-            position: &position,
-            normal: &normal_q,
+            position,
+            normal: &r.normal,
             fresh: &fresh,
-            motion: &motion,
+            motion: &r.motion,
             history_light: &history_light,
-            history_geometry: &history_geometry,
+            history_geometry: &r.history_geometry,
             slice,
             has_history,
         };
@@ -188,6 +141,210 @@ fn resolve_matches_the_cpu_twin() {
         }
     }
     assert!(branches[0] > 0 && branches[1] > 0, "branches {branches:?}");
+    common::assert_clean(&device);
+}
+
+/// The slices and history flags the twin tests run: every slice, and none without history.
+const SLICE_CASES: [(u32, bool); 6] = [
+    (0, false),
+    (1, true),
+    (2, true),
+    (3, true),
+    (4, true),
+    (3, false),
+];
+
+/// Random surfaces and their history: kept, moved, and rejected (other depth or normal, off
+/// screen), as f16 images store them.
+struct RandomFrame {
+    extent: [u32; 2],
+    full_extent: [u32; 2],
+    position: Vec<Vec4>,
+    normal: Vec<Vec3>,
+    history_geometry: Vec<Vec4>,
+    motion: Vec<Vec2>,
+}
+
+impl RandomFrame {
+    fn new() -> Self {
+        // Odd sides: the cells on the last row and column are cut (the gather clamps).
+        let (extent, full_extent) = ([11u32, 9], [22u32, 18]);
+        let n = (extent[0] * extent[1]) as usize;
+        let mut rng = Rng(2024);
+        let mut position = Vec::new();
+        let mut normal = Vec::new();
+        for _ in 0..n {
+            let background = rng.next() < 0.1;
+            let depth = 1.0 + 4.0 * rng.next();
+            position.push(Vec4::new(
+                rng.next(),
+                rng.next(),
+                rng.next(),
+                if background { 0.0 } else { depth },
+            ));
+            normal.push(Vec3::new(rng.next() - 0.5, rng.next() - 0.5, 1.0).normalize());
+        }
+        // History geometry: mostly the receiver's own (kept), sometimes another depth or
+        // normal.
+        let history_geometry: Vec<Vec4> = (0..n)
+            .map(|i| {
+                let r = rng.next();
+                let (nn, d) = (normal[i], position[i].w);
+                q16(if r < 0.6 {
+                    nn.extend(d)
+                } else if r < 0.8 {
+                    nn.extend(d * 1.5)
+                } else {
+                    (-nn).extend(d)
+                })
+            })
+            .collect();
+        // Motion: none for most pixels, a few receivers' worth (some off screen) for the rest.
+        let motion: Vec<Vec2> = (0..full_extent[0] * full_extent[1])
+            .map(|_| {
+                if rng.next() < 0.7 {
+                    Vec2::ZERO
+                } else {
+                    (Vec2::new(rng.next(), rng.next()) - 0.5) * 0.6
+                }
+            })
+            .map(|m| Vec2::new(f16_to_f32(f32_to_f16(m.x)), f16_to_f32(f32_to_f16(m.y))))
+            .collect();
+        let normal = normal
+            .iter()
+            .map(|v| q16(v.extend(0.0)).truncate())
+            .collect();
+        Self {
+            extent,
+            full_extent,
+            position,
+            normal,
+            history_geometry,
+            motion,
+        }
+    }
+}
+
+/// Runs `*_reproject` on the GPU over the geometry of `inp` and the records; returns the
+/// records and the marks it writes.
+fn reproject_gpu(
+    device: &shine::gpu::Device,
+    inp: &ResolveInputs<'_>,
+    history_records: &[u32],
+    records: &[u32],
+    words: u32,
+) -> (Vec<u32>, Vec<bool>) {
+    let [w, h] = inp.extent;
+    let rgba16 = vk::Format::R16G16B16A16_SFLOAT;
+    let position = storage_image_with(
+        device,
+        "recv_position",
+        vk::Format::R32G32B32A32_SFLOAT,
+        inp.extent,
+        bytemuck::cast_slice(inp.position),
+    );
+    let normals: Vec<Vec4> = inp.normal.iter().map(|n| n.extend(0.0)).collect();
+    let normal = storage_image_with(device, "normal", rgba16, inp.extent, &bytes_f16(&normals));
+    let motion = common::motion_image(device, inp.full_extent, inp.motion);
+    let geometry = storage_image_with(
+        device,
+        "history geometry",
+        rgba16,
+        inp.extent,
+        &bytes_f16(inp.history_geometry),
+    );
+    let bytes = |words: &[u32]| bytemuck::cast_slice::<u32, u8>(words).to_vec();
+    let then = common::transfer_storage(device, "then", 0, Some(&bytes(history_records)));
+    let now = common::transfer_storage(device, "now", 0, Some(&bytes(records)));
+    let out = common::transfer_storage(device, "out", (records.len() * 4) as u64, None);
+    let marks_out = common::transfer_storage(device, "marks", u64::from(w * h) * 8, None);
+    let mut executor = Executor::new(device, 1).expect("executor");
+    let mut rg = executor.begin_frame();
+    let image = |rg: &mut RenderGraph, image| {
+        rg.import_gpu_image(image, uploaded_state(), ExternalState::UNDEFINED)
+    };
+    let (position, normal) = (image(&mut rg, &position), image(&mut rg, &normal));
+    let motion = image(&mut rg, &motion);
+    let desc = shine::graph::ImageDesc::new_2d(rgba16, w, h);
+    let mut history = RecordHistory {
+        name: "test",
+        records: History {
+            previous: rg.import_gpu_buffer(&then, uploaded_state(), ExternalState::UNDEFINED),
+            current: rg.import_gpu_buffer(&now, uploaded_state(), ExternalState::UNDEFINED),
+        },
+        geometry: History {
+            previous: image(&mut rg, &geometry),
+            current: rg.create_image("geometry", desc),
+        },
+        words,
+    };
+    let surfaces = Surfaces {
+        position: &position,
+        normal: &normal,
+        extent: inp.extent,
+    };
+    let slice = Slice {
+        slice: inp.slice,
+        has_history: inp.has_history,
+    };
+    let marks =
+        reproject_records(&mut rg, surfaces, &motion, &mut history, slice).expect("reproject");
+    let mut out_handle =
+        rg.import_gpu_buffer(&out, ExternalState::UNDEFINED, common::read_by_copy());
+    rg.copy_buffer("read records", &history.records.current, &mut out_handle);
+    let mut marks_handle =
+        rg.import_gpu_buffer(&marks_out, ExternalState::UNDEFINED, common::read_by_copy());
+    rg.copy_image_to_buffer("read marks", &marks, &mut marks_handle);
+    common::run_graph(device, &mut executor, rg);
+    let records = bytemuck::cast_slice(&device.read_buffer(&out).expect("read")).to_vec();
+    let marks = common::decode_rgba16f(&device.read_buffer(&marks_out).expect("read marks"))
+        .iter()
+        .map(|m| m.w < 0.0)
+        .collect();
+    (records, marks)
+}
+
+/// The GPU reprojection of per-pixel records (IGI's SH, AAF's sums) equals its CPU twin for
+/// every slice: copied where the history shows the surface, left as gathered at the refreshed
+/// pixels and the background, marked for the regather elsewhere.
+#[test]
+fn reproject_matches_the_cpu_twin() {
+    let device = common::device();
+    let r = RandomFrame::new();
+    let n = r.position.len();
+    let words = 3usize;
+    let mut rng = Rng(99);
+    let mut words_of = || -> Vec<u32> { (0..n * words).map(|_| rng.next().to_bits()).collect() };
+    let (history_records, records) = (words_of(), words_of());
+    let mut counts = [0usize; 3];
+    for (slice, has_history) in SLICE_CASES {
+        let inputs = ResolveInputs {
+            extent: r.extent,
+            full_extent: r.full_extent,
+            position: &r.position,
+            normal: &r.normal,
+            fresh: &[],
+            motion: &r.motion,
+            history_light: &[],
+            history_geometry: &r.history_geometry,
+            slice,
+            has_history,
+        };
+        let (cpu, cpu_marks) = reproject_cpu(&inputs, &history_records, &records, words);
+        let (gpu, gpu_marks) =
+            reproject_gpu(&device, &inputs, &history_records, &records, words as u32);
+        assert_eq!(
+            gpu_marks, cpu_marks,
+            "marks, slice {slice}, history {has_history}"
+        );
+        assert_eq!(gpu, cpu, "records, slice {slice}, history {has_history}");
+        for i in 0..n {
+            let copied = cpu[i * words..(i + 1) * words] != records[i * words..(i + 1) * words];
+            counts[if cpu_marks[i] { 2 } else { usize::from(copied) }] += 1;
+        }
+    }
+    // Every outcome happened: kept as gathered, copied from history, marked.
+    assert!(counts.iter().all(|&c| c > 0), "outcomes {counts:?}");
     common::assert_clean(&device);
 }
 
@@ -239,27 +396,29 @@ fn disocclusion_rejects_history() {
     common::assert_clean(&device);
 }
 
-/// A static scene with the gather amortised over 2×2 cells renders the per-frame image (the
-/// first frame gathers every receiver; later frames blend identical values), frame after frame.
-#[test]
-fn a_static_scene_amortised_converges_to_the_per_frame_image() {
-    let device = common::device();
-    let scene = Scene::builtin("cornell-box").expect("scene");
-    let frame = |slices: &str, frames: u32| {
+/// The relative RMSE between the last of `frames` frames of a static `scene` amortised by
+/// `slices_key = 4` and the last of as many refreshing every pixel (the other terms' history
+/// averages the same frames in both), at 32² with the settings `pairs`.
+fn amortised_against_per_frame(
+    device: &shine::gpu::Device,
+    scene: &str,
+    pairs: &[(&str, &str)],
+    slices_key: &str,
+    frames: u32,
+) -> f64 {
+    let scene = Scene::builtin(scene).expect("scene");
+    let frame = |slices: &str| {
         let mut s = Settings {
             width: 32,
             height: 32,
             ..Settings::default()
         };
-        s.set("gi", "hvl").expect("gi");
         s.set("shadow.size", "128").expect("shadow");
-        s.set("hvl.slices", slices).expect("slices");
-        // One shadow ray per HVL and no traced near field: the sampled shadows' filter reads
-        // other neighbours when a slice is refreshed, and both draw new rays every amortised
-        // frame, so the two would differ by their noise.
-        s.set("hvl.shadow_rays", "0").expect("shadow rays");
-        s.set("hvl.near_range", "0").expect("near field");
-        let mut renderer = Renderer::new(&device).expect("renderer");
+        for (key, value) in pairs {
+            s.set(key, value).expect(key);
+        }
+        s.set(slices_key, slices).expect("slices");
+        let mut renderer = Renderer::new(device).expect("renderer");
         renderer.set_scene(&scene, 0.0).expect("scene");
         let mut last = None;
         for _ in 0..frames {
@@ -267,9 +426,32 @@ fn a_static_scene_amortised_converges_to_the_per_frame_image() {
         }
         last.expect("a frame").hdr
     };
-    let per_frame = frame("1", 1);
-    let amortised = frame("4", 6);
-    let e = common::relative_rmse(&amortised, &per_frame);
-    assert!(e <= 2e-3, "relative RMSE {e}");
+    common::relative_rmse(&frame("4"), &frame("1"))
+}
+
+/// A static scene with the HVL gather amortised over 2×2 cells renders the per-frame image (the
+/// first frame gathers every receiver; later frames blend identical values), frame after frame.
+#[test]
+fn a_static_scene_amortised_converges_to_the_per_frame_image() {
+    let device = common::device();
+    // One shadow ray per HVL and no traced near field: the sampled shadows' filter reads other
+    // neighbours when a slice is refreshed, and both draw new rays every amortised frame, so
+    // the two would differ by their noise.
+    let hvl = [
+        ("gi", "hvl"),
+        ("hvl.shadow_rays", "0"),
+        ("hvl.near_range", "0"),
+    ];
+    let e = amortised_against_per_frame(&device, "cornell-box", &hvl, "hvl.slices", 6);
+    assert!(e <= 2e-3, "hvl: relative RMSE {e}");
+    // The proxies' light blends as HVL's does.
+    let e = amortised_against_per_frame(&device, "spheres", &[("gi", "proxy")], "proxy.slices", 6);
+    assert!(e <= 2e-3, "proxy: relative RMSE {e}");
+    // IGI and AAF keep per-pixel records (SH, sample sums): after the four slices every pixel
+    // holds what the per-frame pass gathers, and the filter sees exactly its input.
+    for (gi, key) in [("igi", "igi.slices"), ("aaf", "aaf.slices")] {
+        let e = amortised_against_per_frame(&device, "cornell-box", &[("gi", gi)], key, 5);
+        assert!(e <= 1e-6, "{gi}: relative RMSE {e}");
+    }
     common::assert_clean(&device);
 }
