@@ -16,7 +16,7 @@
 // shine::reference::resolve::resolve_cpu.
 //
 // Variant `records` (`*_reproject`) amortises a technique's per-pixel records instead of its
-// light (IGI's incident-radiance SH, `words` uints per pixel): after the refreshed pixels
+// light (IGI's gathered SH, AAF's sums and widths; `words` uints per pixel): after the refreshed pixels
 // gathered theirs, every other pixel copies its history's records where they show its
 // surface, and is marked (alpha -1 in `fresh`) for the regather otherwise; it writes the
 // geometry history of every pixel. CPU twin: shine::reference::resolve::reproject_cpu.

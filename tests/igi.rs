@@ -18,6 +18,7 @@ use shine::frame::renderer::Renderer;
 use shine::gpu::Device;
 use shine::graph::vk;
 use shine::graph::{Buffer, Executor, ExternalState, Handle, RenderGraph};
+use shine::passes::amortise;
 use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::composite::Component;
 use shine::passes::gbuffer::GBuffer;
@@ -186,7 +187,19 @@ struct GpuResult {
     indirect: Vec<Vec3>,
 }
 
-/// Runs `vpl_sh` (or uploads `field` as its output) and `sh_filter` on the synthetic inputs.
+/// An amortised `vpl_sh` dispatch for [`run_gpu`]: its slice and, for the regather slice, the
+/// marked pixels; it gathers into a buffer of [`UNSET`] words.
+struct SliceRun<'a> {
+    slice: u32,
+    marked: &'a [bool],
+}
+
+/// The words of the buffer an amortised `vpl_sh` gathers into (NaN halves, which the test's
+/// decoder reads as infinities): a pixel the slice leaves out keeps them.
+const UNSET: u32 = u32::MAX;
+
+/// Runs `vpl_sh` (or uploads `field` as its output; or gathers `slice` only) and `sh_filter` on
+/// the synthetic inputs.
 fn run_gpu(
     device: &Device,
     g: &GBufferData,
@@ -194,6 +207,7 @@ fn run_gpu(
     bvh: &Bvh,
     params: &IgiParams,
     field: Option<&[Vec<Vec3>]>,
+    slice: Option<SliceRun<'_>>,
 ) -> GpuResult {
     let e = g.extent;
     let images = [
@@ -260,6 +274,23 @@ fn run_gpu(
         )
     });
     let sh_readback = transfer_storage(device, "sh readback", sh_bytes, None);
+    let unset = vec![UNSET; (sh_bytes / 4) as usize];
+    let slice_buffers = slice.as_ref().map(|s| {
+        let marks: Vec<Vec4> = s
+            .marked
+            .iter()
+            .map(|&m| Vec4::new(0.0, 0.0, 0.0, if m { -1.0 } else { 0.0 }))
+            .collect();
+        let into = transfer_storage(device, "into", sh_bytes, Some(bytemuck::cast_slice(&unset)));
+        let marks = storage_image_with(
+            device,
+            "marks",
+            vk::Format::R16G16B16A16_SFLOAT,
+            e,
+            &bytes_f16(&marks),
+        );
+        (into, marks)
+    });
     let pixels = u64::from(e[0] * e[1]);
     let indirect_readback = transfer_storage(device, "indirect readback", pixels * 8, None);
     let mut executor = Executor::new(device, 1).expect("executor");
@@ -291,16 +322,24 @@ fn run_gpu(
             let lights =
                 rg.import_gpu_buffer(&vpl_buffer, uploaded_state(), ExternalState::UNDEFINED);
             let trace = gpu_bvh.import(&mut rg, uploaded_state());
-            let sh = igi::vpl_sh(
-                &mut rg,
-                &gb,
-                &lights,
-                &trace,
-                CAMERA,
-                params,
-                IgiSlice::default(),
-            )
-            .expect("vpl_sh");
+            let amortised = match (&slice, &slice_buffers) {
+                (Some(s), Some((into, marks))) => IgiSlice {
+                    slice: s.slice,
+                    marks: Some(rg.import_gpu_image(
+                        marks,
+                        uploaded_state(),
+                        ExternalState::UNDEFINED,
+                    )),
+                    into: Some(rg.import_gpu_buffer(
+                        into,
+                        uploaded_state(),
+                        ExternalState::UNDEFINED,
+                    )),
+                },
+                _ => IgiSlice::default(),
+            };
+            let sh = igi::vpl_sh(&mut rg, &gb, &lights, &trace, CAMERA, params, amortised)
+                .expect("vpl_sh");
             let mut out =
                 rg.import_gpu_buffer(&sh_readback, ExternalState::UNDEFINED, read_by_copy());
             rg.copy_buffer("read sh", &sh, &mut out);
@@ -399,7 +438,7 @@ fn vpl_sh_projection_matches_shine_sh() {
         ([2, 3], 3, FilterMode::Irradiance),
     ] {
         let p = params(pattern, order, 1, mode);
-        let gpu = run_gpu(&device, &g, &vpls, &bvh, &p, None);
+        let gpu = run_gpu(&device, &g, &vpls, &bvh, &p, None, None);
         let cpu = reference::vpl_sh(&g, &vpls, CAMERA, &p, occluded(&bvh)).expect("cpu");
         let flat = |c: &[Vec<Vec3>]| c.concat();
         let err = worst(&flat(&gpu.coefficients), &flat(&cpu));
@@ -414,6 +453,44 @@ fn vpl_sh_projection_matches_shine_sh() {
     assert_clean(&device);
 }
 
+/// An amortised `vpl_sh` (`igi.slices = 4`) gathers exactly the pixels of its slice, one per
+/// 2×2 cell, each its own set as the per-frame pass gathers it, and the regather slice exactly
+/// the marked pixels; every other pixel keeps what its buffer held.
+#[test]
+fn vpl_sh_gathers_a_slice_and_the_marked_pixels() {
+    let device = device();
+    let (g, vpls, bvh) = (synthetic_gbuffer(), synthetic_vpls(), occluder());
+    let p = params([4, 4], 3, 1, FilterMode::Sh);
+    let every = run_gpu(&device, &g, &vpls, &bvh, &p, None, None).coefficients;
+    let [w, _] = g.extent;
+    let mut rng = common::Rng(5);
+    let marked: Vec<bool> = (0..every.len()).map(|_| rng.next() < 0.2).collect();
+    for slice in 1..=amortise::REGATHER_SLICE {
+        let run = SliceRun {
+            slice,
+            marked: &marked,
+        };
+        let got = run_gpu(&device, &g, &vpls, &bvh, &p, None, Some(run)).coefficients;
+        let k = slice - 1;
+        for (i, (got, every)) in got.iter().zip(&every).enumerate() {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            let shaded = if slice == amortise::REGATHER_SLICE {
+                marked[i]
+            } else {
+                (x & 1) == (k & 1) && (y & 1) == (k >> 1)
+            };
+            if shaded {
+                assert_eq!(got, every, "slice {slice}, pixel ({x}, {y})");
+            } else {
+                // The test's f16 decoder reads the NaN halves as infinities.
+                let unset = got.iter().all(|c| !c.is_finite());
+                assert!(unset, "slice {slice}, pixel ({x}, {y})");
+            }
+        }
+    }
+    assert_clean(&device);
+}
+
 /// n = m = 1 and no filter: every pixel sees every VPL, and the irradiance mode is exactly the
 /// brute-force VPL shading; the SH mode is its band-limited version through shine-sh's Lambert
 /// and Phong r_l (paper 000 §3.3): GPU = CPU twin, and the truncation against the brute force
@@ -424,7 +501,7 @@ fn one_set_without_filter_is_brute_force_vpl_shading() {
     let device = device();
     let (g, vpls, bvh) = (synthetic_gbuffer(), synthetic_vpls(), occluder());
     let irr = params([1, 1], 3, 0, FilterMode::Irradiance);
-    let gpu = run_gpu(&device, &g, &vpls, &bvh, &irr, None);
+    let gpu = run_gpu(&device, &g, &vpls, &bvh, &irr, None, None);
     let brute = reference::brute_force(&g, &vpls, CAMERA, &irr, occluded(&bvh));
     let err = worst(&gpu.indirect, &brute);
     println!("irradiance mode vs brute force: worst error {err:.2e} of the largest");
@@ -442,7 +519,7 @@ fn one_set_without_filter_is_brute_force_vpl_shading() {
             glossy,
             ..params([1, 1], order, 0, FilterMode::Sh)
         };
-        let gpu = run_gpu(&device, &g, &vpls, &bvh, &sh, None);
+        let gpu = run_gpu(&device, &g, &vpls, &bvh, &sh, None, None);
         let coefficients = reference::vpl_sh(&g, &vpls, CAMERA, &sh, occluded(&bvh)).expect("cpu");
         let cpu = cpu_filter(&g, &coefficients, &sh);
         let err = worst(&gpu.indirect, &cpu);
@@ -484,13 +561,13 @@ fn filtering_a_constant_field_leaves_it_unchanged() {
             .map(|k| Vec3::new(0.5 - 0.1 * k as f32, 0.25 + 0.05 * k as f32, 0.3))
             .collect();
         let field = vec![constant; (EXTENT[0] * EXTENT[1]) as usize];
-        let unfiltered = run_gpu(&device, &g, &vpls, &bvh, &p0, Some(&field)).indirect;
+        let unfiltered = run_gpu(&device, &g, &vpls, &bvh, &p0, Some(&field), None).indirect;
         for radius in [1, 2] {
             let p = IgiParams {
                 filter_radius: radius,
                 ..p0
             };
-            let filtered = run_gpu(&device, &g, &vpls, &bvh, &p, Some(&field)).indirect;
+            let filtered = run_gpu(&device, &g, &vpls, &bvh, &p, Some(&field), None).indirect;
             let err = worst(&filtered, &unfiltered);
             assert!(err < 1e-3, "{mode:?} order {order} radius {radius}: {err}");
         }
@@ -511,7 +588,7 @@ fn filter_matches_the_cpu_reference() {
         (1, FilterMode::Irradiance),
     ] {
         let p = params([4, 4], 3, radius, mode);
-        let gpu = run_gpu(&device, &g, &vpls, &bvh, &p, None);
+        let gpu = run_gpu(&device, &g, &vpls, &bvh, &p, None, None);
         let cpu = cpu_filter(&g, &gpu.coefficients, &p);
         let err = worst(&gpu.indirect, &cpu);
         assert!(err < 3e-3, "radius {radius} {mode:?}: {err}");

@@ -58,7 +58,7 @@ impl AafTechnique {
         extent: [u32; 2],
     ) -> Result<PreparedAaf, RenderError> {
         params.validate()?;
-        let amortised = self.schedule.next(rg.frame(), extent, params.slices);
+        let amortised = self.schedule.next(rg.frame(), extent, params.slices, 0);
         Ok(PreparedAaf { params, amortised })
     }
 

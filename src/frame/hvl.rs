@@ -92,7 +92,7 @@ impl HvlTechnique {
         let brdf = self.brdf.import(rg, params.conv_bands)?;
         let amortised = self
             .schedule
-            .next(rg.frame(), receiver_extent, params.slices);
+            .next(rg.frame(), receiver_extent, params.slices, 0);
         Ok(PreparedHvl {
             params,
             brdf,

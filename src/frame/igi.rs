@@ -83,7 +83,9 @@ impl IgiTechnique {
         params: IgiParams,
         extent: [u32; 2],
     ) -> Result<PreparedIgi, RenderError> {
-        let amortised = self.schedule.next(rg.frame(), extent, params.slices);
+        // The SH history's layout: another order or mode is no history.
+        let words = params.coefficients() * igi::COEFFICIENT_WORDS;
+        let amortised = self.schedule.next(rg.frame(), extent, params.slices, words);
         let brdf = if params.needs_brdf_tables() {
             Some(self.brdf.import(rg, params.sh_order)?)
         } else {

@@ -196,7 +196,7 @@ impl ProxyTechnique {
         let bands = setup.pass.bands;
         let amortised = self
             .schedule
-            .next(rg.frame(), receiver_extent, setup.slices);
+            .next(rg.frame(), receiver_extent, setup.slices, 0);
         let environment = match environment {
             Some(host) => host,
             None => self.environment_sh(rg, bands)?,

@@ -137,6 +137,9 @@ pub enum AafError {
     /// A parameter out of its range.
     #[error("AAF {0}")]
     OutOfRange(#[from] super::OutOfRange),
+    /// An amortised dispatch's slice without its marks, or out of range.
+    #[error(transparent)]
+    Slice(#[from] amortise::AmortiseError),
 }
 
 impl AafParams {
@@ -338,17 +341,8 @@ pub fn aaf_sample(
     slice: AafSlice,
 ) -> Result<AafSamples, AafError> {
     params.validate()?;
+    amortise::check_slice(slice.slice, slice.marks.is_some())?;
     let regather = slice.slice == amortise::REGATHER_SLICE;
-    if slice.slice > amortise::REGATHER_SLICE || (regather && slice.marks.is_none()) {
-        return Err(AafError::OutOfRange(super::OutOfRange {
-            name: "slice",
-            value: f64::from(slice.slice),
-            expected: format!(
-                "0..={} (the regather slice with the marks of aaf_reproject)",
-                amortise::REGATHER_SLICE
-            ),
-        }));
-    }
     let [w, h] = g.extent;
     let pixels = u64::from(w) * u64::from(h);
     let sample_push = SamplePush {
@@ -363,9 +357,9 @@ pub fn aaf_sample(
             widths: rg.create_buffer("aaf_widths", BufferDesc::new(pixels * WIDTHS_BYTES)),
         },
     };
-    // Read only by the regather slice; any full-resolution RGBA16F image fills the binding
-    // of the others.
-    let marks = slice.marks.unwrap_or(g.geometric_normal);
+    // Read only by the regather slice; the G-buffer's normals (any full-resolution RGBA16F
+    // image the frame writes) fill the binding of the others.
+    let marks = slice.marks.unwrap_or(g.normal);
     let threads = amortise::slice_threads(g.extent, slice.slice);
     let name = |first: &'static str, again: &'static str| if regather { again } else { first };
     let mut first = if params.adaptive {
@@ -442,7 +436,7 @@ pub fn aaf_beta(
         .read("gb_position", &g.position)
         .read("gb_material", &g.material)
         .read("depths", depths)
-        .read("marks", &g.geometric_normal)
+        .read("marks", &g.normal)
         .write("filter_widths", &mut widths)
         .push(&beta_push(g, camera, scene_size, params, 0))
         .dispatch([w, h, 1]);

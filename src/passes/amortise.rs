@@ -66,11 +66,12 @@ pub fn slice_threads(extent: [u32; 2], slice: u32) -> [u32; 3] {
 
 /// Which frame an amortised technique last resolved, so the next one knows whether its history
 /// holds the previous frame. Without it (first frame, a resize, a frame skipped, the setting
-/// just turned on) the technique shades every pixel (slice 0).
+/// just turned on, another record layout) the technique shades every pixel (slice 0).
 #[derive(Debug, Default)]
 pub struct Schedule {
-    /// Frame number and image extent of the last frame that resolved into the history.
-    last: Option<(u64, [u32; 2])>,
+    /// Frame number, image extent and record layout of the last frame that resolved into the
+    /// history.
+    last: Option<(u64, [u32; 2], u32)>,
 }
 
 /// This frame's slice of an amortised technique.
@@ -84,14 +85,21 @@ pub struct Slice {
 
 impl Schedule {
     /// The slice of `frame` for a technique of `slices` (1: not amortised, `None`) shading
-    /// images of `extent`.
-    pub fn next(&mut self, frame: u64, extent: [u32; 2], slices: u32) -> Option<Slice> {
+    /// images of `extent`, whose history holds records of `layout` (e.g. uints per pixel; 0
+    /// for a light history): another layout than the last frame's is no history.
+    pub fn next(
+        &mut self,
+        frame: u64,
+        extent: [u32; 2],
+        slices: u32,
+        layout: u32,
+    ) -> Option<Slice> {
         if slices <= 1 {
             self.last = None;
             return None;
         }
-        let has_history = self.last == Some((frame.wrapping_sub(1), extent));
-        self.last = Some((frame, extent));
+        let has_history = self.last == Some((frame.wrapping_sub(1), extent, layout));
+        self.last = Some((frame, extent, layout));
         Some(Slice {
             slice: if has_history {
                 slice_of_frame(frame)
@@ -162,9 +170,21 @@ pub struct ResolvePush {
 /// Errors of the amortising passes.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum AmortiseError {
-    /// A slice outside `0..=SLICES`.
-    #[error("amortised slice {0} is not one of 0..={SLICES}")]
+    /// A slice outside `0..=SLICES` (or `0..=REGATHER_SLICE` for a technique's dispatch).
+    #[error("amortised slice {0} is out of range")]
     Slice(u32),
+    /// The regather slice without the marks of `*_regather_mask` or `*_reproject`.
+    #[error("the regather slice needs the marks of the frame's mask or reproject pass")]
+    NoMarks,
+}
+
+/// Checks a technique's dispatch of `slice`: at most [`REGATHER_SLICE`], which needs marks.
+pub fn check_slice(slice: u32, has_marks: bool) -> Result<(), AmortiseError> {
+    match slice {
+        REGATHER_SLICE if !has_marks => Err(AmortiseError::NoMarks),
+        s if s > REGATHER_SLICE => Err(AmortiseError::Slice(s)),
+        _ => Ok(()),
+    }
 }
 
 /// An amortised technique's temporal images at the resolution it shades: light and
@@ -265,9 +285,13 @@ pub fn resolve(
     Ok(history.light.current)
 }
 
-/// A technique amortised by its per-pixel records instead of its light (IGI's incident-radiance
-/// SH, which its filter reads at every pixel every frame): the records and the geometry they
-/// were gathered for, as temporal resources keyed by the technique's name.
+/// A technique amortised by its per-pixel records instead of its light (IGI's gathered VPL set,
+/// AAF's sample sums and filter widths: what the technique's filter reads at every pixel every
+/// frame): the records and the geometry they were gathered for, as temporal resources keyed by
+/// the technique's name. Records are carried over as they are: a record that depends on the
+/// view (IGI's glossy term in irradiance mode, the specular part of AAF's sums) keeps the view
+/// it was gathered from until its pixel is refreshed, and a carried IGI record keeps the VPL set
+/// of the pixel it was gathered at.
 pub struct RecordHistory {
     /// The technique's name: the passes' prefix.
     pub name: &'static str,

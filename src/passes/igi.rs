@@ -149,7 +149,7 @@ pub struct IgiParams {
     pub specular_limit: f32,
     /// Pixels per refresh (paper 001): 1, or [`amortise::SLICES`]: `vpl_sh` gathers the VPL
     /// sets of one pixel per 2×2 cell per frame and the others keep theirs, reprojected
-    /// ([`IgiSlice`], [`igi_reproject`]).
+    /// ([`IgiSlice`], `igi_reproject`: [`amortise::reproject_records`]).
     pub slices: u32,
 }
 
@@ -161,7 +161,8 @@ pub struct IgiSlice {
     /// [`amortise::REGATHER_SLICE`]: the pixels `marks` marks with alpha −1. Each pixel
     /// gathers its own set, so four frames gather every set of the pattern.
     pub slice: u32,
-    /// The marks of [`igi_reproject`]; required by the regather slice.
+    /// The marks of `igi_reproject` ([`amortise::reproject_records`]); required by the
+    /// regather slice.
     pub marks: Option<Handle<Image>>,
     /// The buffer to gather into (the amortised frame's SH history; `None`: a new one).
     pub into: Option<Handle<Buffer>>,
@@ -253,6 +254,9 @@ pub enum IgiError {
     /// The VPL construction (the HVL cache pass) refused its inputs.
     #[error(transparent)]
     Vpls(#[from] HvlError),
+    /// An amortised dispatch's slice without its marks, or out of range.
+    #[error(transparent)]
+    Slice(#[from] amortise::AmortiseError),
 }
 
 impl IgiParams {
@@ -385,17 +389,8 @@ pub fn vpl_sh(
     slice: IgiSlice,
 ) -> Result<Handle<Buffer>, IgiError> {
     params.validate()?;
+    amortise::check_slice(slice.slice, slice.marks.is_some())?;
     let regather = slice.slice == amortise::REGATHER_SLICE;
-    if slice.slice > amortise::REGATHER_SLICE || (regather && slice.marks.is_none()) {
-        return Err(IgiError::OutOfRange(super::OutOfRange {
-            name: "vpl_sh slice",
-            value: f64::from(slice.slice),
-            expected: format!(
-                "0..={} (the regather slice with the marks of igi_reproject)",
-                amortise::REGATHER_SLICE
-            ),
-        }));
-    }
     let bytes = params.sh_bytes(g.extent)?;
     let need = hvl::cache_bytes(params.vpl_count);
     if vpls.desc().size < need {
@@ -435,10 +430,10 @@ pub fn vpl_sh(
             .read("gb_material", &g.material);
     }
     bvh.bind(&mut pass);
-    // Read only by the regather slice; any full-resolution RGBA16F image fills the binding of
-    // the others.
+    // Read only by the regather slice; the G-buffer's normals (any full-resolution RGBA16F
+    // image the frame writes) fill the binding of the others.
     pass.read("vpls", vpls)
-        .read("marks", slice.marks.as_ref().unwrap_or(&g.geometric_normal))
+        .read("marks", slice.marks.as_ref().unwrap_or(&g.normal))
         .write("vpl_sh", &mut sh)
         .push(&push)
         .dispatch(amortise::slice_threads(g.extent, slice.slice));

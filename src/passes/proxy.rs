@@ -179,6 +179,9 @@ pub enum ProxyError {
     /// No compiled shader for the parameters.
     #[error("no compiled shader `{0}` (see the variants of shaders/proxy_*.comp)")]
     Variant(String),
+    /// An amortised dispatch's slice without its marks, or out of range.
+    #[error(transparent)]
+    Slice(#[from] amortise::AmortiseError),
     /// An SH table or projection failed.
     #[error("proxy SH: {0}")]
     Sh(#[from] ShError),
@@ -583,19 +586,8 @@ pub fn proxy_accumulate_slice(
 /// The marks of `slice`, after checking that the regather slice has them and no other slice
 /// is out of range.
 fn checked_marks(slice: &ProxySlice) -> Result<Option<&Handle<Image>>, ProxyError> {
-    match slice.slice {
-        amortise::REGATHER_SLICE if slice.marks.is_none() => Err(ProxyError::Size {
-            name: "marks",
-            actual: "missing".into(),
-            expected: "the proxy light marked by proxy_regather_mask".into(),
-        }),
-        s if s > amortise::REGATHER_SLICE => Err(ProxyError::OutOfRange {
-            name: "slice",
-            value: f64::from(s),
-            expected: format!("0..={}", amortise::REGATHER_SLICE),
-        }),
-        _ => Ok(slice.marks.as_ref()),
-    }
+    amortise::check_slice(slice.slice, slice.marks.is_some())?;
+    Ok(slice.marks.as_ref())
 }
 
 /// Adds the `proxy_shade` pass over the sums of [`proxy_accumulate`] (`inputs.proxies` is not

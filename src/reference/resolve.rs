@@ -48,12 +48,18 @@ fn history_at(inp: &ResolveInputs<'_>, x: u32, y: u32, depth: f32, n: Vec3) -> O
     same_surface(depth, n, g.w, g.truncate()).then_some(j)
 }
 
+/// Whether pixel (x, y) is the refreshed one of its cell in slice 1 + k (`amortise_refreshed`).
+fn refreshed(slice: u32, x: u32, y: u32) -> bool {
+    let k = slice.saturating_sub(1);
+    (x & 1) == (k & 1) && (y & 1) == (k >> 1)
+}
+
 /// The resolved light and geometry, as the pass writes them.
 pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
     let [w, h] = inp.extent;
     let at = |x: u32, y: u32| (y * w + x) as usize;
     let k = inp.slice.saturating_sub(1);
-    let refreshed = |x: u32, y: u32| (x & 1) == (k & 1) && (y & 1) == (k >> 1);
+    let refreshed = |x, y| refreshed(inp.slice, x, y);
     let history_at = |x, y, depth, n| history_at(inp, x, y, depth, n);
     let mut light = vec![Vec4::ZERO; (w * h) as usize];
     let mut geometry = vec![Vec4::ZERO; (w * h) as usize];
@@ -112,8 +118,7 @@ pub fn reproject_cpu(
     words: usize,
 ) -> (Vec<u32>, Vec<bool>) {
     let [w, h] = inp.extent;
-    let k = inp.slice.saturating_sub(1);
-    let refreshed = |x: u32, y: u32| (x & 1) == (k & 1) && (y & 1) == (k >> 1);
+    let refreshed = |x, y| refreshed(inp.slice, x, y);
     let mut out = records.to_vec();
     let mut marks = vec![false; (w * h) as usize];
     for y in 0..h {

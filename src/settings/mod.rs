@@ -380,9 +380,9 @@ pub struct IgiSettings {
     /// Cosine threshold of the filter's geometric-normal test (n_p · n_q ≥ this).
     /// Range -1.0..=1.0, default 0.9.
     pub normal_threshold: f32,
-    /// Pixels per refresh (paper 001): 1 shades every pixel every frame; 4 shades one pixel
-    /// per 2×2 cell per frame, the VPL sets interleaved over the cells, and reprojects the
-    /// others from the previous frames (`igi_resolve`, src/passes/amortise.rs). Default 1.
+    /// Pixels per refresh (paper 001): 1 gathers every pixel's VPL set every frame; 4 gathers
+    /// the sets of one pixel per 2×2 cell per frame and reprojects the others' SH from the
+    /// previous frames (`igi_reproject`, src/passes/amortise.rs). Default 1.
     pub slices: u32,
 }
 

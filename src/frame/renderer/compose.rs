@@ -257,9 +257,11 @@ impl Renderer {
         } else {
             None
         };
-        if hvl.is_some() && rsm.is_none() {
-            // No primary light: the HVL passes (and their history) are not in this frame.
+        if rsm.is_none() {
+            // No primary light: the HVL and IGI passes (and their history) are not in this
+            // frame.
             self.hvl.reset();
+            self.igi.reset();
         }
         // Sampled shadows draw new rays each frame a history averages: the indirect light's,
         // or the amortised gather's own.
