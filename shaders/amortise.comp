@@ -7,19 +7,23 @@
 // more than acos RESOLVE_NORMAL_COS).
 //
 // Variant `mask` (`*_regather_mask`) runs between the technique's two dispatches: it marks every
-// pixel that is neither refreshed nor covered by its history (alpha -1 in `fresh`; 0
-// elsewhere), and the second dispatch (slice AMORTISE_REGATHER_SLICE) shades exactly those:
-// paper 001's priority refresh of what moved. Variant `resolve` then blends: refreshed pixels
-// mix the fresh value into valid history with weight RESOLVE_ALPHA; the others keep their
-// history, changed by the change their cell's refreshed pixel makes where it shows the same
-// surface, or, where their history was rejected, take their own fresh value. CPU twin:
-// shine::reference::resolve::resolve_cpu.
+// pixel that is not refreshed and either not covered by its history or in a changed cell (its
+// refreshed pixel, or where that says nothing of p's surface those of the cells beside it,
+// changed by more than RESOLVE_CHANGE_LIMIT: a light or object moved) (alpha -1 in `fresh`; 0 elsewhere), and the second dispatch (slice
+// AMORTISE_REGATHER_SLICE) shades exactly those: paper 001's priority refresh of what moved.
+// Variant `resolve` then blends: refreshed pixels mix the fresh value into valid history with
+// weight RESOLVE_ALPHA, or take it where it changed by more than RESOLVE_CHANGE_LIMIT; the
+// others keep their history, changed by the change their cell's refreshed pixel makes where it
+// shows the same surface, or, where their history was rejected or their cell changed, take
+// their own fresh value. CPU twin: shine::reference::resolve::resolve_cpu.
 //
 // Variant `records` (`*_reproject`) amortises a technique's per-pixel records instead of its
 // light (IGI's gathered SH, AAF's sums and widths; `words` uints per pixel): after the refreshed pixels
 // gathered theirs, every other pixel copies its history's records where they show its
-// surface, and is marked (alpha -1 in `fresh`) for the regather otherwise; it writes the
-// geometry history of every pixel. CPU twin: shine::reference::resolve::reproject_cpu.
+// surface and its cell did not change (with `signal`: the first rgb value of the cell's
+// refreshed record, now against its history), and is marked (alpha -1 in `fresh`) for the
+// regather otherwise; it writes the geometry history of every pixel. CPU twin:
+// shine::reference::resolve::reproject_cpu.
 //! variant mask RESOLVE_MASK=1 RESOLVE_RECORDS=0
 //! variant resolve RESOLVE_MASK=0 RESOLVE_RECORDS=0
 //! variant records RESOLVE_MASK=0 RESOLVE_RECORDS=1
@@ -39,6 +43,8 @@ layout(set = 0, binding = 5, rgba16f) readonly uniform image2D history_geometry;
 #if RESOLVE_MASK
 // This frame's light, valid at the refreshed pixels: the others are marked here.
 layout(set = 0, binding = 2, rgba16f) uniform image2D fresh;
+// The previous frame's resolved light (the change test).
+layout(set = 0, binding = 4, rgba16f) readonly uniform image2D history_light;
 #elif RESOLVE_RECORDS
 // The marks of the regather (alpha -1), written at every pixel.
 layout(set = 0, binding = 2, rgba16f) writeonly uniform image2D fresh;
@@ -73,7 +79,9 @@ layout(push_constant) uniform Push {
     uint has_history;
     // uints per pixel of the records (variant records)
     uint words;
-    uint pad0;
+    // What the change test compares of a record (variant records): 0 nothing, 1 an rgb value
+    // as two words of packed halves, 2 an rgb sum and its count as four floats
+    uint signal;
 } push;
 
 // The refreshed pixel of p's cell (clamped where an odd edge cuts the cell: callers check
@@ -104,6 +112,83 @@ bool history_at(ivec2 p, float depth, vec3 n, out ivec2 q) {
     return resolve_same_surface(depth, n, g.w, g.xyz);
 }
 
+#if RESOLVE_RECORDS
+// The rgb signal of the record at pixel index i of `records` or `history_records`: push.signal
+// 1, two words of packed halves; 2, a sum of rgb samples and their count as four floats (its
+// mean).
+vec3 record_signal(uint i, bool history) {
+    uint at = i * push.words;
+    uint n = push.signal == 1u ? 2u : 4u;
+    uvec4 w = uvec4(0u);
+    for (uint k = 0u; k < n; ++k) {
+        w[k] = history ? history_records.w[at + k] : records.w[at + k];
+    }
+    if (push.signal == 1u) {
+        return vec3(unpackHalf2x16(w.x), unpackHalf2x16(w.y).x);
+    }
+    vec4 sum = uintBitsToFloat(w);
+    return sum.w > 0.0 ? sum.rgb / sum.w : vec3(0.0);
+}
+#endif
+
+// Refreshed pixel c's value now and in its history (the light, or the records' signal) and
+// its position and normal; false where it has no history.
+bool refreshed_value(ivec2 c, out vec4 cp, out vec3 cn, out vec4 now, out vec4 then) {
+    now = vec4(0.0);
+    then = vec4(0.0);
+    cp = imageLoad(recv_position, c);
+    cn = normalize(imageLoad(recv_normal, c).xyz);
+    ivec2 cq;
+    if (!refreshed(c) || !history_at(c, cp.w, cn, cq)) {
+        return false;
+    }
+#if RESOLVE_RECORDS
+    now.rgb = record_signal(uint(c.y) * push.extent.x + uint(c.x), false);
+    then.rgb = record_signal(uint(cq.y) * push.extent.x + uint(cq.x), true);
+#else
+    now = imageLoad(fresh, c);
+    then = imageLoad(history_light, cq);
+#endif
+    return true;
+}
+
+// Whether p's cell (p not refreshed, at `depth` with normal `n`) changed this frame: a light or
+// object moved. Its refreshed pixel decides where it has history and shows p's surface, or
+// changed by more than RESOLVE_CHANGE_LIMIT anyway (the light changed nearby: an edge cell is
+// shaded again whole); otherwise the refreshed pixels of the four cells beside it, changed.
+// `on_surface`: the cell's refreshed pixel shows p's surface, whose change `now - then` p may
+// share.
+bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 now, out vec4 then) {
+    on_surface = false;
+#if RESOLVE_RECORDS
+    if (push.signal == 0u) {
+        return false;
+    }
+#endif
+    ivec2 c = cell_pixel(p);
+    vec4 cp;
+    vec3 cn;
+    if (refreshed_value(c, cp, cn, now, then)) {
+        on_surface = resolve_same_surface(depth, n, cp.w, cn);
+        bool changed = amortise_changed(now.rgb, then.rgb);
+        if (on_surface || changed) {
+            return changed;
+        }
+    }
+    const ivec2 beside[4] = ivec2[](ivec2(-2, 0), ivec2(2, 0), ivec2(0, -2), ivec2(0, 2));
+    for (int i = 0; i < 4; ++i) {
+        ivec2 s = c + beside[i];
+        vec4 sp, s_now, s_then;
+        vec3 sn;
+        if (all(greaterThanEqual(s, ivec2(0))) && all(lessThan(s, ivec2(push.extent)))
+            && refreshed_value(s, sp, sn, s_now, s_then)
+            && amortise_changed(s_now.rgb, s_then.rgb)) {
+            return true;
+        }
+    }
+    return false;
+}
+
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (any(greaterThanEqual(uvec2(p), push.extent))) {
@@ -116,7 +201,10 @@ void main() {
     ivec2 q;
     bool regather = false;
     if (push.slice != 0u && !refreshed(p) && position.w != 0.0) {
-        regather = !history_at(p, position.w, n, q);
+        bool on_surface;
+        vec4 now, then;
+        regather = !history_at(p, position.w, n, q)
+            || cell_changed(p, position.w, n, on_surface, now, then);
         if (!regather) {
             uint to = (uint(p.y) * push.extent.x + uint(p.x)) * push.words;
             uint from = (uint(q.y) * push.extent.x + uint(q.x)) * push.words;
@@ -131,7 +219,11 @@ void main() {
         return;
     }
     ivec2 q;
-    bool regather = position.w != 0.0 && !history_at(p, position.w, n, q);
+    bool on_surface;
+    vec4 now, then;
+    bool regather = position.w != 0.0
+        && (!history_at(p, position.w, n, q)
+            || cell_changed(p, position.w, n, on_surface, now, then));
     imageStore(fresh, p, vec4(0.0, 0.0, 0.0, regather ? -1.0 : 0.0));
 #else
     if (position.w == 0.0) {
@@ -150,20 +242,18 @@ void main() {
     if (valid) {
         vec4 history = imageLoad(history_light, q);
         if (refreshed(p)) {
-            light = mix(history, light, RESOLVE_ALPHA);
+            if (!amortise_changed(light.rgb, history.rgb)) {
+                light = mix(history, light, RESOLVE_ALPHA);
+            }
         } else {
             // The change the cell's refreshed pixel makes this frame, shared where it
             // shows the same surface: held pixels follow the light every frame instead of
             // stepping every fourth (and a static scene, whose change is 0, stays exact).
-            light = history;
-            ivec2 c = cell_pixel(p);
-            vec4 cp = imageLoad(recv_position, c);
-            vec3 cn = normalize(imageLoad(recv_normal, c).xyz);
-            ivec2 cq;
-            if (refreshed(c) && resolve_same_surface(position.w, n, cp.w, cn)
-                && history_at(c, cp.w, cn, cq)) {
-                vec4 change = RESOLVE_ALPHA * (imageLoad(fresh, c) - imageLoad(history_light, cq));
-                light = max(history + change, vec4(0.0));
+            // Where it changed by more than the limit, the pixel was shaded again.
+            bool on_surface;
+            vec4 now, then;
+            if (!cell_changed(p, position.w, n, on_surface, now, then)) {
+                light = on_surface ? max(history + RESOLVE_ALPHA * (now - then), vec4(0.0)) : history;
             }
         }
     }

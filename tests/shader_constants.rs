@@ -130,7 +130,8 @@ fn glsl_float(file: &str, name: &str) -> f32 {
 #[test]
 fn amortise_constants_match_the_shader() {
     use shine::passes::amortise::{
-        REGATHER_SLICE, RESOLVE_ALPHA, RESOLVE_DEPTH_TOLERANCE, RESOLVE_NORMAL_COS,
+        REGATHER_SLICE, RESOLVE_ALPHA, RESOLVE_CHANGE_LIMIT, RESOLVE_DEPTH_TOLERANCE,
+        RESOLVE_NORMAL_COS,
     };
     let file = "include/amortise.glsl";
     assert_eq!(glsl_uint(file, "AMORTISE_REGATHER_SLICE"), REGATHER_SLICE);
@@ -140,6 +141,10 @@ fn amortise_constants_match_the_shader() {
         RESOLVE_DEPTH_TOLERANCE
     );
     assert_eq!(glsl_float(file, "RESOLVE_NORMAL_COS"), RESOLVE_NORMAL_COS);
+    assert_eq!(
+        glsl_float(file, "RESOLVE_CHANGE_LIMIT"),
+        RESOLVE_CHANGE_LIMIT
+    );
 }
 
 #[test]

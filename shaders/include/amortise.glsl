@@ -1,7 +1,8 @@
 // GI amortised over frames (paper 001): which pixel a thread shades in a slice, and the
 // constants and the disocclusion test of shaders/amortise.comp; Rust twin:
 // shine::passes::amortise (REGATHER_SLICE, RESOLVE_ALPHA, RESOLVE_DEPTH_TOLERANCE,
-// RESOLVE_NORMAL_COS, same_surface, slice_threads), tied by tests/shader_constants.rs.
+// RESOLVE_NORMAL_COS, RESOLVE_CHANGE_LIMIT, same_surface, changed, slice_threads), tied by
+// tests/shader_constants.rs and the CPU twins of tests/amortise.rs.
 #ifndef AMORTISE_GLSL
 #define AMORTISE_GLSL
 
@@ -14,6 +15,10 @@ const float RESOLVE_ALPHA = 0.5;
 const float RESOLVE_DEPTH_TOLERANCE = 0.1;
 // Smallest cosine between a pixel's normal and its history's.
 const float RESOLVE_NORMAL_COS = 0.9;
+// Largest change of a cell's refreshed pixel, relative to the larger of its light now and in
+// its history, before the cell's other pixels are shaded again the same frame (a light or an
+// object moved: paper 001's priority refresh of what it affects).
+const float RESOLVE_CHANGE_LIMIT = 0.25;
 
 // The pixel thread `id` shades in `slice`: itself for 0 (every pixel) and the regather slice,
 // the pixel at offset (k & 1, k >> 1) of cell `id` for slice 1 + k (a quarter of the threads,
@@ -40,6 +45,14 @@ bool amortise_refreshed(ivec2 p, uint slice) {
 bool resolve_same_surface(float depth, vec3 n, float depth_then, vec3 n_then) {
     return depth_then > 0.0 && abs(depth_then - depth) <= RESOLVE_DEPTH_TOLERANCE * depth
         && dot(n, n_then) >= RESOLVE_NORMAL_COS * length(n_then);
+}
+
+// Whether light `now` differs from `then`, in any channel, by more than RESOLVE_CHANGE_LIMIT
+// of the brightest channel of either (a dim channel's noise does not count).
+bool amortise_changed(vec3 now, vec3 then) {
+    vec3 big = max(abs(now), abs(then));
+    vec3 d = abs(now - then);
+    return max(d.r, max(d.g, d.b)) > RESOLVE_CHANGE_LIMIT * max(big.r, max(big.g, big.b));
 }
 
 #endif

@@ -14,7 +14,7 @@ use crate::gpu::vk;
 use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::aaf::{self, AafParams, AafRecords, AafScene, AafSlice};
-use crate::passes::amortise::{self, RecordHistory, Schedule, Slice};
+use crate::passes::amortise::{self, RecordHistory, RecordSignal, Schedule, Slice};
 use crate::passes::gbuffer::{GBuffer, View};
 
 /// The AAF technique: which frame last wrote its amortised samples' history.
@@ -89,8 +89,10 @@ impl PreparedAaf {
         };
         let sums_words = (aaf::SUMS_BYTES / 4) as u32;
         let widths_words = (aaf::WIDTHS_BYTES / 4) as u32;
-        let mut sums = RecordHistory::declare(rg, "aaf", g.extent, sums_words);
-        let mut widths = RecordHistory::declare(rg, "aaf_widths", g.extent, widths_words);
+        let mut sums =
+            RecordHistory::declare(rg, "aaf", g.extent, sums_words, RecordSignal::MeanRgb);
+        let mut widths =
+            RecordHistory::declare(rg, "aaf_widths", g.extent, widths_words, RecordSignal::None);
         let mut slice = AafSlice {
             slice: amortised.slice,
             marks: None,

@@ -14,7 +14,7 @@ use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::passes::amortise::{self, RecordHistory, Schedule, Slice};
+use crate::passes::amortise::{self, RecordHistory, RecordSignal, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::igi::{self, IgiParams, IgiSlice};
@@ -128,7 +128,8 @@ impl PreparedIgi {
             )?);
         };
         let words = params.coefficients() * igi::COEFFICIENT_WORDS;
-        let mut history = RecordHistory::declare(rg, "igi", g.extent, words);
+        let mut history =
+            RecordHistory::declare(rg, "igi", g.extent, words, RecordSignal::PackedRgb);
         let first = IgiSlice {
             slice: amortised.slice,
             marks: None,

@@ -8,9 +8,11 @@
 //! vectors, and rejects history where the surface was not visible then (depth or normal too
 //! different): `*_regather_mask` marks those pixels (alpha −1 in the fresh light) and the
 //! technique shades them again the same frame with [`REGATHER_SLICE`] (paper 001's priority
-//! refresh of what moved). Refreshed pixels blend fresh light into valid history
-//! ([`RESOLVE_ALPHA`]), the others keep theirs, changed by the change their cell's refreshed
-//! pixel makes. Tried and dropped for HVL (docs/quality.md): filling disocclusions from the
+//! refresh of what moved). A cell whose refreshed pixel changed by more than
+//! [`RESOLVE_CHANGE_LIMIT`] (a light or object moved) is marked and shaded again the same way,
+//! so what a change affects is refreshed at once and what it does not stays amortised.
+//! Refreshed pixels blend fresh light into valid history ([`RESOLVE_ALPHA`]), the others keep
+//! theirs, changed by the change their cell's refreshed pixel makes. Tried and dropped for HVL (docs/quality.md): filling disocclusions from the
 //! cell's fresh value, pulling every pixel towards it each frame, and filling from the nearest
 //! of nine refreshed pixels; all flickered more than the per-frame gather. CPU twin:
 //! [`crate::reference::resolve::resolve_cpu`]. The GLSL side of a slice (which pixel a thread
@@ -31,6 +33,12 @@ pub const RESOLVE_ALPHA: f32 = 0.5;
 pub const RESOLVE_DEPTH_TOLERANCE: f32 = 0.1;
 /// Smallest cosine between a pixel's normal and its history's.
 pub const RESOLVE_NORMAL_COS: f32 = 0.9;
+/// Largest change of a cell's refreshed pixel, relative to the brighter of its light now and in
+/// its history ([`changed`]), before the cell's other pixels are shaded again the same frame
+/// (paper 001's priority refresh of what a moving light or object affects). 0.25 lets the
+/// sweeping spot light of `builtin:animated` stay amortised and catches a light that jumps or
+/// switches (docs/quality.md).
+pub const RESOLVE_CHANGE_LIMIT: f32 = 0.25;
 /// Pixels per refresh cell (2×2): an amortised technique shades one of them per frame.
 pub const SLICES: u32 = 4;
 /// The slice that shades only the pixels `*_regather_mask` marked
@@ -46,6 +54,14 @@ pub fn same_surface(depth: f32, n: Vec3, depth_then: f32, n_then: Vec3) -> bool 
     depth_then > 0.0
         && (depth_then - depth).abs() <= RESOLVE_DEPTH_TOLERANCE * depth
         && n.dot(n_then) >= RESOLVE_NORMAL_COS * n_then.length()
+}
+
+/// Whether light `now` differs from `then`, in any channel, by more than
+/// [`RESOLVE_CHANGE_LIMIT`] of the brightest channel of either (`amortise_changed` in
+/// shaders/include/amortise.glsl).
+pub fn changed(now: Vec3, then: Vec3) -> bool {
+    let big = now.abs().max(then.abs()).max_element();
+    (now - then).abs().max_element() > RESOLVE_CHANGE_LIMIT * big
 }
 
 /// The refreshed pixel of every cell in frame `frame`: its offset index k (x = k & 1,
@@ -163,8 +179,9 @@ pub struct ResolvePush {
     pub has_history: u32,
     /// uints per pixel of the records (variant `records`).
     pub words: u32,
-    /// Padding.
-    pub pad: u32,
+    /// What the change test reads of a record (variant `records`, [`RecordSignal`]): 0 nothing,
+    /// 1 packed rgb halves, 2 an rgb sum and its count.
+    pub signal: u32,
 }
 
 /// Errors of the amortising passes.
@@ -176,6 +193,9 @@ pub enum AmortiseError {
     /// The regather slice without the marks of `*_regather_mask` or `*_reproject`.
     #[error("the regather slice needs the marks of the frame's mask or reproject pass")]
     NoMarks,
+    /// Records too short for the change test's signal.
+    #[error("records of {0} words are too short for their change signal")]
+    SignalWords(u32),
 }
 
 /// Checks a technique's dispatch of `slice`: at most [`REGATHER_SLICE`], which needs marks.
@@ -211,8 +231,9 @@ impl ResolveHistory {
 }
 
 /// Adds `NAME_regather_mask`: marks, in `fresh` (this frame's light at the pixels of `slice`),
-/// every other pixel whose history does not show its surface (alpha −1; 0 elsewhere), for the
-/// technique to shade again with [`REGATHER_SLICE`].
+/// every other pixel whose history does not show its surface or whose cell's refreshed pixel
+/// changed by more than [`RESOLVE_CHANGE_LIMIT`] (alpha −1; 0 elsewhere), for the technique to
+/// shade again with [`REGATHER_SLICE`].
 pub fn regather_mask(
     rg: &mut RenderGraph,
     surfaces: Surfaces<'_>,
@@ -229,6 +250,7 @@ pub fn regather_mask(
     .read("recv_position", surfaces.position)
     .read("recv_normal", surfaces.normal)
     .read("gb_motion", motion)
+    .read("history_light", &history.light.previous)
     .read("history_geometry", &history.geometry.previous)
     .write("fresh", fresh)
     .push(&push)
@@ -252,7 +274,7 @@ fn resolve_push(
         slice: slice.slice,
         has_history: u32::from(slice.has_history),
         words: 0,
-        pad: 0,
+        signal: 0,
     })
 }
 
@@ -301,12 +323,54 @@ pub struct RecordHistory {
     pub geometry: History<Image>,
     /// uints per pixel.
     pub words: u32,
+    /// What the change test reads of a record.
+    pub signal: RecordSignal,
+}
+
+/// What `*_reproject`'s change test compares of the records of a cell's refreshed pixel, now
+/// against its history, to regather the cell's other pixels the same frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RecordSignal {
+    /// No change test.
+    None,
+    /// The first two words are an rgb value as packed halves (IGI's first SH coefficient).
+    PackedRgb,
+    /// The first four words are an rgb sum of samples and their count as floats; the test
+    /// compares their mean (AAF's sums: a pixel's samples are drawn with the same seeds every
+    /// frame, so a still pixel's mean does not change).
+    MeanRgb,
+}
+
+impl RecordSignal {
+    /// The value of `ResolvePush::signal`.
+    fn push(self) -> u32 {
+        match self {
+            Self::None => 0,
+            Self::PackedRgb => 1,
+            Self::MeanRgb => 2,
+        }
+    }
+
+    /// Uints a record needs for the test to read its signal.
+    pub fn words(self) -> u32 {
+        match self {
+            Self::None => 0,
+            Self::PackedRgb => 2,
+            Self::MeanRgb => 4,
+        }
+    }
 }
 
 impl RecordHistory {
     /// The history of technique `name` (e.g. `igi`) for images of `extent` with `words` uints
-    /// per pixel.
-    pub fn declare(rg: &mut RenderGraph, name: &'static str, extent: [u32; 2], words: u32) -> Self {
+    /// per pixel, of which the change test reads `signal`.
+    pub fn declare(
+        rg: &mut RenderGraph,
+        name: &'static str,
+        extent: [u32; 2],
+        words: u32,
+        signal: RecordSignal,
+    ) -> Self {
         let bytes = u64::from(extent[0]) * u64::from(extent[1]) * u64::from(words) * 4;
         let desc = ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, extent[0], extent[1]);
         Self {
@@ -314,14 +378,16 @@ impl RecordHistory {
             records: rg.history_buffer(&format!("{name} records"), BufferDesc::new(bytes)),
             geometry: rg.history_image(&format!("{name} records geometry"), desc),
             words,
+            signal,
         }
     }
 }
 
 /// Adds `NAME_reproject` after the refreshed pixels of `slice` gathered their records into
 /// `history.records.current`: every other pixel copies its history's records where they show
-/// its surface; returns the marks (RGBA16F, alpha −1) of those whose history was rejected, for
-/// the technique to gather with [`REGATHER_SLICE`]. Writes the geometry history.
+/// its surface and its cell's refreshed record did not change (`history.signal`); returns the
+/// marks (RGBA16F, alpha −1) of the others, for the technique to gather with
+/// [`REGATHER_SLICE`]. Writes the geometry history.
 pub fn reproject_records(
     rg: &mut RenderGraph,
     surfaces: Surfaces<'_>,
@@ -331,6 +397,10 @@ pub fn reproject_records(
 ) -> Result<Handle<Image>, AmortiseError> {
     let mut push = resolve_push(surfaces, motion, slice)?;
     push.words = history.words;
+    if history.words < history.signal.words() {
+        return Err(AmortiseError::SignalWords(history.words));
+    }
+    push.signal = history.signal.push();
     let [w, h] = surfaces.extent;
     let mut marks = rg.create_image(
         &format!("{}_marks", history.name),

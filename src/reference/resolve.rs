@@ -3,7 +3,8 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::passes::amortise::{RESOLVE_ALPHA, same_surface};
+use crate::passes::amortise::{RESOLVE_ALPHA, RecordSignal, changed, same_surface};
+use crate::study::runner::f16_to_f32;
 
 /// The images `hvl_resolve` reads, row-major.
 pub struct ResolveInputs<'a> {
@@ -54,13 +55,64 @@ fn refreshed(slice: u32, x: u32, y: u32) -> bool {
     (x & 1) == (k & 1) && (y & 1) == (k >> 1)
 }
 
+/// Refreshed pixel (cx, cy) and its history's index, where it has history
+/// (`refreshed_value` in the shader).
+fn refreshed_history(inp: &ResolveInputs<'_>, cx: u32, cy: u32) -> Option<(usize, usize)> {
+    let c = (cy * inp.extent[0] + cx) as usize;
+    let (cd, cn) = (inp.position[c].w, inp.normal[c].normalize());
+    if !refreshed(inp.slice, cx, cy) {
+        return None;
+    }
+    history_at(inp, cx, cy, cd, cn).map(|cj| (c, cj))
+}
+
+/// What `cell_changed` in the shader says of (x, y)'s cell, which shows the surface at `depth`
+/// with normal `n`, for values (now, then) of a refreshed pixel and its history `value(c, cj)`:
+/// whether it changed beyond the limit, and the cell's refreshed pixel and its history's
+/// index where it shows that surface (whose change the pixel may share).
+fn cell_changed(
+    inp: &ResolveInputs<'_>,
+    (x, y): (u32, u32),
+    (depth, n): (f32, Vec3),
+    value: impl Fn(usize, usize) -> (Vec3, Vec3),
+) -> (bool, Option<(usize, usize)>) {
+    let [w, h] = inp.extent;
+    let k = inp.slice.saturating_sub(1);
+    let (cx, cy) = (
+        ((x / 2) * 2 + (k & 1)).min(w - 1),
+        ((y / 2) * 2 + (k >> 1)).min(h - 1),
+    );
+    let moved = |(c, cj): (usize, usize)| {
+        let (now, then) = value(c, cj);
+        changed(now, then)
+    };
+    if let Some((c, cj)) = refreshed_history(inp, cx, cy) {
+        let on_surface = same_surface(depth, n, inp.position[c].w, inp.normal[c].normalize());
+        if on_surface || moved((c, cj)) {
+            return (moved((c, cj)), on_surface.then_some((c, cj)));
+        }
+    }
+    let beside = [(-2, 0), (2, 0), (0, -2), (0, 2)]
+        .into_iter()
+        .any(|(dx, dy)| {
+            let (sx, sy) = (cx as i64 + dx, cy as i64 + dy);
+            (0..i64::from(w)).contains(&sx)
+                && (0..i64::from(h)).contains(&sy)
+                && refreshed_history(inp, sx as u32, sy as u32).is_some_and(moved)
+        });
+    (beside, None)
+}
+
+/// The change test of the light: the light now and in the history.
+fn light_change<'a>(inp: &'a ResolveInputs<'a>) -> impl Fn(usize, usize) -> (Vec3, Vec3) + 'a {
+    |c, cj| (inp.fresh[c].truncate(), inp.history_light[cj].truncate())
+}
+
 /// The resolved light and geometry, as the pass writes them.
 pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
     let [w, h] = inp.extent;
     let at = |x: u32, y: u32| (y * w + x) as usize;
-    let k = inp.slice.saturating_sub(1);
     let refreshed = |x, y| refreshed(inp.slice, x, y);
-    let history_at = |x, y, depth, n| history_at(inp, x, y, depth, n);
     let mut light = vec![Vec4::ZERO; (w * h) as usize];
     let mut geometry = vec![Vec4::ZERO; (w * h) as usize];
     for y in 0..h {
@@ -76,46 +128,66 @@ pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
                 light[i] = inp.fresh[i];
                 continue;
             }
-            light[i] = match history_at(x, y, position.w, n) {
+            let (fresh, valid) = (inp.fresh[i], history_at(inp, x, y, position.w, n));
+            light[i] = match valid {
                 // Regathered this frame (`hvl_regather`).
-                None => inp.fresh[i],
+                None => fresh,
                 Some(j) if refreshed(x, y) => {
-                    inp.history_light[j].lerp(inp.fresh[i], RESOLVE_ALPHA)
-                }
-                Some(j) => {
-                    // The change of the cell's refreshed receiver, where it shows this
-                    // surface.
-                    let held = inp.history_light[j];
-                    let (cx, cy) = (
-                        ((x / 2) * 2 + (k & 1)).min(w - 1),
-                        ((y / 2) * 2 + (k >> 1)).min(h - 1),
-                    );
-                    let c = at(cx, cy);
-                    let (cd, cn) = (inp.position[c].w, inp.normal[c].normalize());
-                    let shared = (refreshed(cx, cy) && same_surface(position.w, n, cd, cn))
-                        .then(|| history_at(cx, cy, cd, cn))
-                        .flatten();
-                    match shared {
-                        Some(cj) => (held + RESOLVE_ALPHA * (inp.fresh[c] - inp.history_light[cj]))
-                            .max(Vec4::ZERO),
-                        None => held,
+                    let history = inp.history_light[j];
+                    if changed(fresh.truncate(), history.truncate()) {
+                        fresh
+                    } else {
+                        history.lerp(fresh, RESOLVE_ALPHA)
                     }
                 }
+                Some(j) => match cell_changed(inp, (x, y), (position.w, n), light_change(inp)) {
+                    // Its cell changed beyond the limit: regathered this frame.
+                    (true, _) => fresh,
+                    // The change of the cell's refreshed receiver, where it shows this
+                    // surface.
+                    (false, Some((c, cj))) => (inp.history_light[j]
+                        + RESOLVE_ALPHA * (inp.fresh[c] - inp.history_light[cj]))
+                        .max(Vec4::ZERO),
+                    (false, None) => inp.history_light[j],
+                },
             };
         }
     }
     (light, geometry)
 }
 
+/// The rgb value the change test reads of a record (`record_signal`).
+fn record_signal(signal: RecordSignal, record: &[u32]) -> Vec3 {
+    let half = |word: u32, high: bool| f16_to_f32(if high { word >> 16 } else { word } as u16);
+    match signal {
+        RecordSignal::None => Vec3::ZERO,
+        RecordSignal::PackedRgb => Vec3::new(
+            half(record[0], false),
+            half(record[0], true),
+            half(record[1], false),
+        ),
+        RecordSignal::MeanRgb => {
+            let sum = Vec4::from_array([0, 1, 2, 3].map(|k| f32::from_bits(record[k])));
+            if sum.w > 0.0 {
+                sum.truncate() / sum.w
+            } else {
+                Vec3::ZERO
+            }
+        }
+    }
+}
+
 /// CPU twin of `*_reproject` (variant `records` of shaders/amortise.comp): `records` (`words`
 /// u32 per pixel, the refreshed pixels' gathered already) with every other pixel's records
-/// copied from `history_records` where its history shows its surface; and which pixels the
-/// pass marks for the regather. `inp.fresh` and `inp.history_light` are not read.
+/// copied from `history_records` where its history shows its surface and, with `signal`, its
+/// cell's refreshed record's signal did not change beyond the limit; and which pixels the pass marks
+/// for the regather. `inp.fresh` and `inp.history_light` are not read.
 pub fn reproject_cpu(
     inp: &ResolveInputs<'_>,
     history_records: &[u32],
     records: &[u32],
     words: usize,
+    signal: RecordSignal,
 ) -> (Vec<u32>, Vec<bool>) {
     let [w, h] = inp.extent;
     let refreshed = |x, y| refreshed(inp.slice, x, y);
@@ -128,7 +200,14 @@ pub fn reproject_cpu(
             if inp.slice == 0 || refreshed(x, y) || depth == 0.0 {
                 continue;
             }
-            match history_at(inp, x, y, depth, inp.normal[i].normalize()) {
+            let n = inp.normal[i].normalize();
+            let record = |r: &[u32], at: usize| record_signal(signal, &r[at * words..]);
+            let cell_changed = signal != RecordSignal::None
+                && cell_changed(inp, (x, y), (depth, n), |c, cj| {
+                    (record(records, c), record(history_records, cj))
+                })
+                .0;
+            match history_at(inp, x, y, depth, n).filter(|_| !cell_changed) {
                 Some(j) => out[i * words..(i + 1) * words]
                     .copy_from_slice(&history_records[j * words..(j + 1) * words]),
                 None => marks[i] = true,
