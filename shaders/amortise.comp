@@ -7,22 +7,23 @@
 // more than acos RESOLVE_NORMAL_COS).
 //
 // Variant `mask` (`*_regather_mask`) runs between the technique's two dispatches: it marks every
-// pixel that is not refreshed and either not covered by its history or in a changed cell (its
-// refreshed pixel, or where that says nothing of p's surface those of the cells beside it,
-// changed by more than RESOLVE_CHANGE_LIMIT: a light or object moved) (alpha -1 in `fresh`; 0 elsewhere), and the second dispatch (slice
-// AMORTISE_REGATHER_SLICE) shades exactly those: paper 001's priority refresh of what moved.
-// Variant `resolve` then blends: refreshed pixels mix the fresh value into valid history with
-// weight RESOLVE_ALPHA, or take it where it changed by more than RESOLVE_CHANGE_LIMIT; the
-// others keep their history, changed by the change their cell's refreshed pixel makes where it
-// shows the same surface, or, where their history was rejected or their cell changed, take
-// their own fresh value. CPU twin: shine::reference::resolve::resolve_cpu.
+// pixel that is not refreshed and either not covered by its history or in a changed cell whose
+// refreshed pixel shows another surface (it, or the refreshed pixels of the cells beside it,
+// changed by more than RESOLVE_CHANGE_LIMIT: a light or object moved) (alpha -1 in `fresh`; 0
+// elsewhere), and the second dispatch (slice AMORTISE_REGATHER_SLICE) shades exactly those:
+// paper 001's priority refresh of what moved. Variant `resolve` then blends: refreshed pixels
+// mix the fresh value into valid history with weight RESOLVE_ALPHA, or take it where it changed
+// by more than RESOLVE_CHANGE_LIMIT; the others keep their history, changed by the change their
+// cell's refreshed pixel makes where it shows the same surface, or take that pixel's light
+// where it changed beyond the limit, or, where they were shaded again, their own fresh value.
+// CPU twin: shine::reference::resolve::resolve_cpu.
 //
 // Variant `records` (`*_reproject`) amortises a technique's per-pixel records instead of its
-// light (IGI's gathered SH, AAF's sums and widths; `words` uints per pixel): after the refreshed pixels
-// gathered theirs, every other pixel copies its history's records where they show its
-// surface and its cell did not change (with `signal`: the first rgb value of the cell's
-// refreshed record, now against its history), and is marked (alpha -1 in `fresh`) for the
-// regather otherwise; it writes the geometry history of every pixel. CPU twin:
+// light (IGI's gathered SH, AAF's sums and widths; `words` uints per pixel): after the
+// refreshed pixels gathered theirs, every other pixel copies its history's records where they
+// show its surface and its block did not change (with `signal`: the summed signals of the
+// block's refreshed records, now against their history), and is marked (alpha -1 in `fresh`)
+// for the regather otherwise; it writes the geometry history of every pixel. CPU twin:
 // shine::reference::resolve::reproject_cpu.
 //! variant mask RESOLVE_MASK=1 RESOLVE_RECORDS=0
 //! variant resolve RESOLVE_MASK=0 RESOLVE_RECORDS=0
@@ -152,19 +153,43 @@ bool refreshed_value(ivec2 c, out vec4 cp, out vec3 cn, out vec4 now, out vec4 t
     return true;
 }
 
-// Whether p's cell (p not refreshed, at `depth` with normal `n`) changed this frame: a light or
-// object moved. Its refreshed pixel decides where it has history and shows p's surface, or
-// changed by more than RESOLVE_CHANGE_LIMIT anyway (the light changed nearby: an edge cell is
-// shaded again whole); otherwise the refreshed pixels of the four cells beside it, changed.
-// `on_surface`: the cell's refreshed pixel shows p's surface, whose change `now - then` p may
-// share.
-bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 now, out vec4 then) {
-    on_surface = false;
 #if RESOLVE_RECORDS
+// Whether the records around p changed this frame: the signals of the refreshed pixels of p's
+// block of AMORTISE_RECORD_BLOCK² pixels, summed, now against their history. A record's signal
+// is one pixel's noisy estimate (IGI's VPL subset, AAF's samples); their sum over a block
+// changes with the light, not with the noise.
+bool block_changed(ivec2 p) {
     if (push.signal == 0u) {
         return false;
     }
-#endif
+    ivec2 origin = (p / AMORTISE_RECORD_BLOCK) * AMORTISE_RECORD_BLOCK;
+    uint k = push.slice - 1u;
+    ivec2 offset = ivec2(k & 1u, k >> 1u);
+    vec3 now = vec3(0.0);
+    vec3 then = vec3(0.0);
+    for (int j = 0; j < AMORTISE_RECORD_BLOCK; j += 2) {
+        for (int i = 0; i < AMORTISE_RECORD_BLOCK; i += 2) {
+            ivec2 c = origin + ivec2(i, j) + offset;
+            vec4 cp, c_now, c_then;
+            vec3 cn;
+            if (all(lessThan(c, ivec2(push.extent)))
+                && refreshed_value(c, cp, cn, c_now, c_then)) {
+                now += c_now.rgb;
+                then += c_then.rgb;
+            }
+        }
+    }
+    return amortise_changed(now, then);
+}
+#else
+// Whether p's cell (p not refreshed, at `depth` with normal `n`) changed this frame: a light or
+// object moved. Its refreshed pixel decides where it has history and shows p's surface, or
+// changed by more than RESOLVE_CHANGE_LIMIT anyway (the light changed nearby); otherwise the
+// refreshed pixels of the four cells beside it, changed. `on_surface`: the cell's refreshed
+// pixel shows p's surface: p follows its change `now - then`, or takes `now` where it changed
+// beyond the limit; a changed cell whose refreshed pixel shows another surface is shaded again.
+bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 now, out vec4 then) {
+    on_surface = false;
     ivec2 c = cell_pixel(p);
     vec4 cp;
     vec3 cn;
@@ -188,6 +213,7 @@ bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 no
     }
     return false;
 }
+#endif
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -201,10 +227,7 @@ void main() {
     ivec2 q;
     bool regather = false;
     if (push.slice != 0u && !refreshed(p) && position.w != 0.0) {
-        bool on_surface;
-        vec4 now, then;
-        regather = !history_at(p, position.w, n, q)
-            || cell_changed(p, position.w, n, on_surface, now, then);
+        regather = !history_at(p, position.w, n, q) || block_changed(p);
         if (!regather) {
             uint to = (uint(p.y) * push.extent.x + uint(p.x)) * push.words;
             uint from = (uint(q.y) * push.extent.x + uint(q.x)) * push.words;
@@ -223,7 +246,7 @@ void main() {
     vec4 now, then;
     bool regather = position.w != 0.0
         && (!history_at(p, position.w, n, q)
-            || cell_changed(p, position.w, n, on_surface, now, then));
+            || (cell_changed(p, position.w, n, on_surface, now, then) && !on_surface));
     imageStore(fresh, p, vec4(0.0, 0.0, 0.0, regather ? -1.0 : 0.0));
 #else
     if (position.w == 0.0) {
@@ -249,10 +272,13 @@ void main() {
             // The change the cell's refreshed pixel makes this frame, shared where it
             // shows the same surface: held pixels follow the light every frame instead of
             // stepping every fourth (and a static scene, whose change is 0, stays exact).
-            // Where it changed by more than the limit, the pixel was shaded again.
+            // Where it changed by more than the limit the pixel takes the refreshed pixel's
+            // light, or its own where it was shaded again.
             bool on_surface;
             vec4 now, then;
-            if (!cell_changed(p, position.w, n, on_surface, now, then)) {
+            if (cell_changed(p, position.w, n, on_surface, now, then)) {
+                light = on_surface ? now : light;
+            } else {
                 light = on_surface ? max(history + RESOLVE_ALPHA * (now - then), vec4(0.0)) : history;
             }
         }

@@ -130,11 +130,12 @@ fn glsl_float(file: &str, name: &str) -> f32 {
 #[test]
 fn amortise_constants_match_the_shader() {
     use shine::passes::amortise::{
-        REGATHER_SLICE, RESOLVE_ALPHA, RESOLVE_CHANGE_LIMIT, RESOLVE_DEPTH_TOLERANCE,
+        RECORD_BLOCK, REGATHER_SLICE, RESOLVE_ALPHA, RESOLVE_CHANGE_LIMIT, RESOLVE_DEPTH_TOLERANCE,
         RESOLVE_NORMAL_COS,
     };
     let file = "include/amortise.glsl";
     assert_eq!(glsl_uint(file, "AMORTISE_REGATHER_SLICE"), REGATHER_SLICE);
+    assert_eq!(glsl_uint(file, "AMORTISE_RECORD_BLOCK"), RECORD_BLOCK);
     assert_eq!(glsl_float(file, "RESOLVE_ALPHA"), RESOLVE_ALPHA);
     assert_eq!(
         glsl_float(file, "RESOLVE_DEPTH_TOLERANCE"),

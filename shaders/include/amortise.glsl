@@ -1,7 +1,7 @@
 // GI amortised over frames (paper 001): which pixel a thread shades in a slice, and the
 // constants and the disocclusion test of shaders/amortise.comp; Rust twin:
 // shine::passes::amortise (REGATHER_SLICE, RESOLVE_ALPHA, RESOLVE_DEPTH_TOLERANCE,
-// RESOLVE_NORMAL_COS, RESOLVE_CHANGE_LIMIT, same_surface, changed, slice_threads), tied by
+// RESOLVE_NORMAL_COS, RESOLVE_CHANGE_LIMIT, RECORD_BLOCK, same_surface, changed, slice_threads), tied by
 // tests/shader_constants.rs and the CPU twins of tests/amortise.rs.
 #ifndef AMORTISE_GLSL
 #define AMORTISE_GLSL
@@ -18,7 +18,10 @@ const float RESOLVE_NORMAL_COS = 0.9;
 // Largest change of a cell's refreshed pixel, relative to the larger of its light now and in
 // its history, before the cell's other pixels are shaded again the same frame (a light or an
 // object moved: paper 001's priority refresh of what it affects).
-const float RESOLVE_CHANGE_LIMIT = 0.25;
+const float RESOLVE_CHANGE_LIMIT = 0.5;
+// Side of the square block of pixels whose refreshed records' signals the records' change test
+// sums (4×4 cells).
+const int AMORTISE_RECORD_BLOCK = 8;
 
 // The pixel thread `id` shades in `slice`: itself for 0 (every pixel) and the regather slice,
 // the pixel at offset (k & 1, k >> 1) of cell `id` for slice 1 + k (a quarter of the threads,

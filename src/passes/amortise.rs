@@ -8,9 +8,12 @@
 //! vectors, and rejects history where the surface was not visible then (depth or normal too
 //! different): `*_regather_mask` marks those pixels (alpha −1 in the fresh light) and the
 //! technique shades them again the same frame with [`REGATHER_SLICE`] (paper 001's priority
-//! refresh of what moved). A cell whose refreshed pixel changed by more than
-//! [`RESOLVE_CHANGE_LIMIT`] (a light or object moved) is marked and shaded again the same way,
-//! so what a change affects is refreshed at once and what it does not stays amortised.
+//! refresh of what moved). What a moving light or object changed is refreshed at once too: a
+//! cell whose refreshed pixel changed by more than [`RESOLVE_CHANGE_LIMIT`] takes that pixel's
+//! light (or, where it shows another surface, is shaded again); a technique amortised by its
+//! records regathers every pixel of a block of [`RECORD_BLOCK`]² whose refreshed records'
+//! summed signal changed beyond the limit ([`RecordSignal`]). What a change does not reach
+//! stays amortised.
 //! Refreshed pixels blend fresh light into valid history ([`RESOLVE_ALPHA`]), the others keep
 //! theirs, changed by the change their cell's refreshed pixel makes. Tried and dropped for HVL (docs/quality.md): filling disocclusions from the
 //! cell's fresh value, pulling every pixel towards it each frame, and filling from the nearest
@@ -33,12 +36,15 @@ pub const RESOLVE_ALPHA: f32 = 0.5;
 pub const RESOLVE_DEPTH_TOLERANCE: f32 = 0.1;
 /// Smallest cosine between a pixel's normal and its history's.
 pub const RESOLVE_NORMAL_COS: f32 = 0.9;
-/// Largest change of a cell's refreshed pixel, relative to the brighter of its light now and in
-/// its history ([`changed`]), before the cell's other pixels are shaded again the same frame
-/// (paper 001's priority refresh of what a moving light or object affects). 0.25 lets the
-/// sweeping spot light of `builtin:animated` stay amortised and catches a light that jumps or
-/// switches (docs/quality.md).
-pub const RESOLVE_CHANGE_LIMIT: f32 = 0.25;
+/// Largest change of a cell's refreshed pixel (or a block's summed records), relative to the
+/// brighter of its value now and in its history ([`changed`]), before the cell's other pixels
+/// take the new light the same frame (paper 001's priority refresh of what a moving light or
+/// object affects); below it they follow the change (docs/quality.md, 0.25 against 0.5).
+pub const RESOLVE_CHANGE_LIMIT: f32 = 0.5;
+/// Side of the square block of pixels whose refreshed records' signals `*_reproject`'s change
+/// test sums (4×4 cells): one record is one pixel's noisy estimate (IGI's VPL subset, AAF's
+/// samples), their sum over a block follows the light (`AMORTISE_RECORD_BLOCK`).
+pub const RECORD_BLOCK: u32 = 8;
 /// Pixels per refresh cell (2×2): an amortised technique shades one of them per frame.
 pub const SLICES: u32 = 4;
 /// The slice that shades only the pixels `*_regather_mask` marked
@@ -231,9 +237,9 @@ impl ResolveHistory {
 }
 
 /// Adds `NAME_regather_mask`: marks, in `fresh` (this frame's light at the pixels of `slice`),
-/// every other pixel whose history does not show its surface or whose cell's refreshed pixel
-/// changed by more than [`RESOLVE_CHANGE_LIMIT`] (alpha −1; 0 elsewhere), for the technique to
-/// shade again with [`REGATHER_SLICE`].
+/// every other pixel whose history does not show its surface, or whose cell changed by more
+/// than [`RESOLVE_CHANGE_LIMIT`] where its refreshed pixel shows another surface (alpha −1; 0
+/// elsewhere), for the technique to shade again with [`REGATHER_SLICE`].
 pub fn regather_mask(
     rg: &mut RenderGraph,
     surfaces: Surfaces<'_>,
@@ -385,7 +391,7 @@ impl RecordHistory {
 
 /// Adds `NAME_reproject` after the refreshed pixels of `slice` gathered their records into
 /// `history.records.current`: every other pixel copies its history's records where they show
-/// its surface and its cell's refreshed record did not change (`history.signal`); returns the
+/// its surface and its block's refreshed records did not change (`history.signal`); returns the
 /// marks (RGBA16F, alpha −1) of the others, for the technique to gather with
 /// [`REGATHER_SLICE`]. Writes the geometry history.
 pub fn reproject_records(

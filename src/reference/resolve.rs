@@ -3,7 +3,7 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::passes::amortise::{RESOLVE_ALPHA, RecordSignal, changed, same_surface};
+use crate::passes::amortise::{RECORD_BLOCK, RESOLVE_ALPHA, RecordSignal, changed, same_surface};
 use crate::study::runner::f16_to_f32;
 
 /// The images `hvl_resolve` reads, row-major.
@@ -69,7 +69,7 @@ fn refreshed_history(inp: &ResolveInputs<'_>, cx: u32, cy: u32) -> Option<(usize
 /// What `cell_changed` in the shader says of (x, y)'s cell, which shows the surface at `depth`
 /// with normal `n`, for values (now, then) of a refreshed pixel and its history `value(c, cj)`:
 /// whether it changed beyond the limit, and the cell's refreshed pixel and its history's
-/// index where it shows that surface (whose change the pixel may share).
+/// index where it shows that surface (whose change the pixel may share or take).
 fn cell_changed(
     inp: &ResolveInputs<'_>,
     (x, y): (u32, u32),
@@ -101,6 +101,36 @@ fn cell_changed(
                 && refreshed_history(inp, sx as u32, sy as u32).is_some_and(moved)
         });
     (beside, None)
+}
+
+/// What `block_changed` in the shader says of (x, y)'s block: whether the summed values
+/// `value(c, cj)` of its refreshed pixels with history changed beyond the limit.
+fn block_changed(
+    inp: &ResolveInputs<'_>,
+    (x, y): (u32, u32),
+    value: impl Fn(usize, usize) -> (Vec3, Vec3),
+) -> bool {
+    let [w, h] = inp.extent;
+    let k = inp.slice.saturating_sub(1);
+    let (ox, oy) = (
+        (x / RECORD_BLOCK) * RECORD_BLOCK,
+        (y / RECORD_BLOCK) * RECORD_BLOCK,
+    );
+    let (mut now, mut then) = (Vec3::ZERO, Vec3::ZERO);
+    for j in (0..RECORD_BLOCK).step_by(2) {
+        for i in (0..RECORD_BLOCK).step_by(2) {
+            let (cx, cy) = (ox + i + (k & 1), oy + j + (k >> 1));
+            if cx >= w || cy >= h {
+                continue;
+            }
+            if let Some((c, cj)) = refreshed_history(inp, cx, cy) {
+                let (a, b) = value(c, cj);
+                now += a;
+                then += b;
+            }
+        }
+    }
+    changed(now, then)
 }
 
 /// The change test of the light: the light now and in the history.
@@ -141,8 +171,10 @@ pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
                     }
                 }
                 Some(j) => match cell_changed(inp, (x, y), (position.w, n), light_change(inp)) {
-                    // Its cell changed beyond the limit: regathered this frame.
-                    (true, _) => fresh,
+                    // Its cell changed beyond the limit: the refreshed receiver's light where
+                    // it shows this surface, regathered this frame otherwise.
+                    (true, Some((c, _))) => inp.fresh[c],
+                    (true, None) => fresh,
                     // The change of the cell's refreshed receiver, where it shows this
                     // surface.
                     (false, Some((c, cj))) => (inp.history_light[j]
@@ -180,7 +212,7 @@ fn record_signal(signal: RecordSignal, record: &[u32]) -> Vec3 {
 /// CPU twin of `*_reproject` (variant `records` of shaders/amortise.comp): `records` (`words`
 /// u32 per pixel, the refreshed pixels' gathered already) with every other pixel's records
 /// copied from `history_records` where its history shows its surface and, with `signal`, its
-/// cell's refreshed record's signal did not change beyond the limit; and which pixels the pass marks
+/// block's refreshed records' summed signal did not change beyond the limit; and which pixels the pass marks
 /// for the regather. `inp.fresh` and `inp.history_light` are not read.
 pub fn reproject_cpu(
     inp: &ResolveInputs<'_>,
@@ -200,14 +232,14 @@ pub fn reproject_cpu(
             if inp.slice == 0 || refreshed(x, y) || depth == 0.0 {
                 continue;
             }
+            let changed = block_changed(inp, (x, y), |c, cj| {
+                (
+                    record_signal(signal, &records[c * words..]),
+                    record_signal(signal, &history_records[cj * words..]),
+                )
+            });
             let n = inp.normal[i].normalize();
-            let record = |r: &[u32], at: usize| record_signal(signal, &r[at * words..]);
-            let cell_changed = signal != RecordSignal::None
-                && cell_changed(inp, (x, y), (depth, n), |c, cj| {
-                    (record(records, c), record(history_records, cj))
-                })
-                .0;
-            match history_at(inp, x, y, depth, n).filter(|_| !cell_changed) {
+            match history_at(inp, x, y, depth, n).filter(|_| !changed) {
                 Some(j) => out[i * words..(i + 1) * words]
                     .copy_from_slice(&history_records[j * words..(j + 1) * words]),
                 None => marks[i] = true,
