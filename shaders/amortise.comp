@@ -162,7 +162,10 @@ bool block_changed(ivec2 p) {
     if (push.signal == 0u) {
         return false;
     }
+    // Blocks cut by the image's edge are moved inside it (where the image is wide enough),
+    // so each holds its full share of refreshed pixels.
     ivec2 origin = (p / AMORTISE_RECORD_BLOCK) * AMORTISE_RECORD_BLOCK;
+    origin = max(min(origin, ivec2(push.extent) - AMORTISE_RECORD_BLOCK), ivec2(0));
     uint k = push.slice - 1u;
     ivec2 offset = ivec2(k & 1u, k >> 1u);
     vec3 now = vec3(0.0);
@@ -185,7 +188,8 @@ bool block_changed(ivec2 p) {
 // Whether p's cell (p not refreshed, at `depth` with normal `n`) changed this frame: a light or
 // object moved. Its refreshed pixel decides where it has history and shows p's surface, or
 // changed by more than RESOLVE_CHANGE_LIMIT anyway (the light changed nearby); otherwise the
-// refreshed pixels of the four cells beside it, changed. `on_surface`: the cell's refreshed
+// refreshed pixels of the four cells beside it, changed (also where the image's odd edge cuts
+// the cell and leaves it none). `on_surface`: the cell's refreshed
 // pixel shows p's surface: p follows its change `now - then`, or takes `now` where it changed
 // beyond the limit; a changed cell whose refreshed pixel shows another surface is shaded again.
 bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 now, out vec4 then) {
@@ -200,9 +204,13 @@ bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 no
             return changed;
         }
     }
+    // From the cell's place unclamped: where an odd edge cuts the cell, c is not refreshed
+    // but the cell before it is.
+    uint k = push.slice - 1u;
+    ivec2 own = (p / 2) * 2 + ivec2(k & 1u, k >> 1u);
     const ivec2 beside[4] = ivec2[](ivec2(-2, 0), ivec2(2, 0), ivec2(0, -2), ivec2(0, 2));
     for (int i = 0; i < 4; ++i) {
-        ivec2 s = c + beside[i];
+        ivec2 s = own + beside[i];
         vec4 sp, s_now, s_then;
         vec3 sn;
         if (all(greaterThanEqual(s, ivec2(0))) && all(lessThan(s, ivec2(push.extent)))

@@ -125,8 +125,9 @@ fn resolve_matches_the_cpu_twin() {
         .collect();
     let position = &r.position;
     // Held pixels that took their fresh light and that did not; refreshed pixels that took it
-    // (changed beyond the limit) and that blended it.
-    let mut branches = [0usize; 4];
+    // (changed beyond the limit) and that blended it; held pixels that took their cell's
+    // refreshed pixel's (changed beyond the limit, on its surface).
+    let mut branches = [0usize; 5];
     for (slice, has_history) in SLICE_CASES {
         let inputs = ResolveInputs {
             extent,
@@ -148,9 +149,13 @@ fn resolve_matches_the_cpu_twin() {
                 "slice {slice}, history {has_history}, texel {i}: cpu {c} gpu {g}"
             );
             if slice > 0 && has_history && position[i].w > 0.0 {
-                let refreshed = (i as u32 % extent[0]) & 1 == (slice - 1) & 1
-                    && (i as u32 / extent[0]) & 1 == (slice - 1) >> 1;
+                let (x, y, k) = (i as u32 % extent[0], i as u32 / extent[0], slice - 1);
+                let refreshed = x & 1 == k & 1 && y & 1 == k >> 1;
                 branches[2 * usize::from(refreshed) + usize::from(fresh[i] == *c)] += 1;
+                let cell_x = ((x / 2) * 2 + (k & 1)).min(extent[0] - 1);
+                let cell_y = ((y / 2) * 2 + (k >> 1)).min(extent[1] - 1);
+                let cell = fresh[(cell_y * extent[0] + cell_x) as usize];
+                branches[4] += usize::from(!refreshed && cell == *c && cell != fresh[i]);
             }
         }
     }
@@ -197,6 +202,24 @@ impl RandomFrame {
                 if background { 0.0 } else { depth },
             ));
             normal.push(Vec3::new(rng.next() - 0.5, rng.next() - 0.5, 1.0).normalize());
+        }
+        // Half the 2×2 cells on one surface (their pixels share the depth and normal of the
+        // cell's first), so held pixels can share their refreshed pixel's light.
+        let w = extent[0] as usize;
+        for cell_y in (0..extent[1] as usize).step_by(2) {
+            for cell_x in (0..w).step_by(2) {
+                if rng.next() < 0.5 {
+                    continue;
+                }
+                let first = cell_y * w + cell_x;
+                for (dx, dy) in [(1, 0), (0, 1), (1, 1)] {
+                    let (x, y) = (cell_x + dx, cell_y + dy);
+                    if x < w && y < extent[1] as usize {
+                        position[y * w + x].w = position[first].w;
+                        normal[y * w + x] = normal[first];
+                    }
+                }
+            }
         }
         // History geometry: mostly the receiver's own (kept), sometimes another depth or
         // normal.
@@ -322,7 +345,7 @@ fn reproject_gpu(
 
 /// The GPU reprojection of per-pixel records (IGI's SH, AAF's sums) equals its CPU twin for
 /// every slice, with and without the change test: copied where the history shows the surface
-/// (and the cell's refreshed record did not change), left as gathered at the refreshed pixels
+/// (and the block's refreshed records did not change), left as gathered at the refreshed pixels
 /// and the background, marked for the regather elsewhere.
 #[test]
 fn reproject_matches_the_cpu_twin() {
@@ -350,8 +373,8 @@ fn reproject_matches_the_cpu_twin() {
     let history_rgb: Vec<Vec3> = (0..n)
         .map(|_| Vec3::new(signals.next(), signals.next(), signals.next()))
         .collect();
-    // Within the change limit of their history, except in one block of RECORD_BLOCK² pixels
-    // (the bottom left), where the light tripled.
+    // Within the change limit of their history, except in the first block of RECORD_BLOCK²
+    // pixels, where the light tripled.
     let width = r.extent[0] as usize;
     let rgb: Vec<Vec3> = history_rgb
         .iter()
@@ -361,7 +384,7 @@ fn reproject_matches_the_cpu_twin() {
                 (i % width) as u32 / RECORD_BLOCK,
                 (i / width) as u32 / RECORD_BLOCK,
             );
-            v * if block == (0, 1) { 3.0 } else { 1.1 }
+            v * if block == (0, 0) { 3.0 } else { 1.1 }
         })
         .collect();
     let mut records_of = |rgb: &[Vec3], signal| -> Vec<u32> {
@@ -430,9 +453,9 @@ fn reproject_matches_the_cpu_twin() {
         }
     }
     // Every outcome happened: kept as gathered, copied from history, marked (also for a
-    // changed cell alone).
+    // changed block alone).
     assert!(counts.iter().all(|&c| c > 0), "outcomes {counts:?}");
-    assert!(changed_marks > 0, "no cell changed beyond the limit");
+    assert!(changed_marks > 0, "no block changed beyond the limit");
     common::assert_clean(&device);
 }
 
@@ -494,6 +517,12 @@ fn disocclusion_rejects_history() {
             Takes::Own => fresh[3],
             Takes::Cell => fresh[0],
         };
+        if let Takes::History = takes {
+            assert!(
+                expected != fresh[3] && expected != fresh[0],
+                "a kept history"
+            );
+        }
         assert!(
             (gpu[3] - expected).abs().max_element() <= 2e-3,
             "history geometry {geometry}, light {light}: gpu {} expected {expected}",

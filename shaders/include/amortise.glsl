@@ -15,9 +15,11 @@ const float RESOLVE_ALPHA = 0.5;
 const float RESOLVE_DEPTH_TOLERANCE = 0.1;
 // Smallest cosine between a pixel's normal and its history's.
 const float RESOLVE_NORMAL_COS = 0.9;
-// Largest change of a cell's refreshed pixel, relative to the larger of its light now and in
-// its history, before the cell's other pixels are shaded again the same frame (a light or an
-// object moved: paper 001's priority refresh of what it affects).
+// Largest change of a cell's refreshed pixel (or a block's summed records), relative to the
+// larger of its value now and in its history, before the cell's other pixels take the new
+// light the same frame (a light or an object moved: paper 001's priority refresh of what it
+// affects): the refreshed pixel's where they show its surface, their own shaded again
+// otherwise, and a block of records regathered.
 const float RESOLVE_CHANGE_LIMIT = 0.5;
 // Side of the square block of pixels whose refreshed records' signals the records' change test
 // sums (4×4 cells).

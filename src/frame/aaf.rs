@@ -105,10 +105,12 @@ impl PreparedAaf {
         sums.records.current = samples.sums;
         widths.records.current = samples.widths;
         let marks = amortise::reproject_records(rg, g.into(), &g.motion, &mut sums, amortised)?;
-        // Same surfaces, same marks: this pass's own are not read.
+        // Its marks (the same rejected history, no change test) are not read: the sums' marks,
+        // which add the changed blocks, rebeta and resample the widths there too.
         amortise::reproject_records(rg, g.into(), &g.motion, &mut widths, amortised)?;
         if amortised.slice != 0 {
-            // The pixels whose history was rejected are sampled now (what moved first).
+            // The pixels whose history was rejected or whose block changed are sampled now
+            // (what moved first).
             slice = AafSlice {
                 slice: amortise::REGATHER_SLICE,
                 marks: Some(marks),

@@ -131,7 +131,8 @@ impl PreparedHvl {
         let surfaces = inputs.receivers.into();
         let mut history = ResolveHistory::declare(rg, "hvl", inputs.receivers.extent);
         if slice != 0 {
-            // The receivers whose history was rejected are gathered now (what moved first).
+            // The receivers whose history was rejected, or whose changed cell's refreshed
+            // receiver shows another surface, are gathered now (what moved first).
             amortise::regather_mask(
                 rg,
                 surfaces,

@@ -138,7 +138,8 @@ impl PreparedIgi {
         history.records.current = igi::vpl_sh(rg, g, &lights, inputs.bvh, camera, params, first)?;
         let marks = amortise::reproject_records(rg, g.into(), &g.motion, &mut history, amortised)?;
         if amortised.slice != 0 {
-            // The pixels whose history was rejected gather their sets now (what moved first).
+            // The pixels whose history was rejected or whose block changed gather their sets
+            // now (what moved first).
             let again = IgiSlice {
                 slice: amortise::REGATHER_SLICE,
                 marks: Some(marks),

@@ -321,7 +321,8 @@ impl PreparedProxy<'_> {
         let surfaces = receivers.into();
         let mut history = ResolveHistory::declare(rg, "proxy", receivers.extent);
         if amortised.slice != 0 {
-            // The receivers whose history was rejected are shaded now (what moved first).
+            // The receivers whose history was rejected, or whose changed cell's refreshed
+            // receiver shows another surface, are shaded now (what moved first).
             amortise::regather_mask(rg, surfaces, &mut light, motion, &history, amortised)?;
             let again = ProxySlice {
                 slice: amortise::REGATHER_SLICE,

@@ -14,8 +14,9 @@
 //! records regathers every pixel of a block of [`RECORD_BLOCK`]² whose refreshed records'
 //! summed signal changed beyond the limit ([`RecordSignal`]). What a change does not reach
 //! stays amortised.
-//! Refreshed pixels blend fresh light into valid history ([`RESOLVE_ALPHA`]), the others keep
-//! theirs, changed by the change their cell's refreshed pixel makes. Tried and dropped for HVL (docs/quality.md): filling disocclusions from the
+//! Refreshed pixels blend fresh light into valid history ([`RESOLVE_ALPHA`]), or take it where
+//! it changed beyond the limit; the others keep theirs, changed by the change their cell's
+//! refreshed pixel makes. Tried and dropped for HVL (docs/quality.md): filling disocclusions from the
 //! cell's fresh value, pulling every pixel towards it each frame, and filling from the nearest
 //! of nine refreshed pixels; all flickered more than the per-frame gather. CPU twin:
 //! [`crate::reference::resolve::resolve_cpu`]. The GLSL side of a slice (which pixel a thread

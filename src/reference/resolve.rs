@@ -92,10 +92,15 @@ fn cell_changed(
             return (moved((c, cj)), on_surface.then_some((c, cj)));
         }
     }
+    // From the cell's place unclamped (an odd edge leaves a cut cell no refreshed pixel).
+    let (ox, oy) = (
+        i64::from((x / 2) * 2 + (k & 1)),
+        i64::from((y / 2) * 2 + (k >> 1)),
+    );
     let beside = [(-2, 0), (2, 0), (0, -2), (0, 2)]
         .into_iter()
         .any(|(dx, dy)| {
-            let (sx, sy) = (cx as i64 + dx, cy as i64 + dy);
+            let (sx, sy) = (ox + dx, oy + dy);
             (0..i64::from(w)).contains(&sx)
                 && (0..i64::from(h)).contains(&sy)
                 && refreshed_history(inp, sx as u32, sy as u32).is_some_and(moved)
@@ -112,10 +117,11 @@ fn block_changed(
 ) -> bool {
     let [w, h] = inp.extent;
     let k = inp.slice.saturating_sub(1);
-    let (ox, oy) = (
-        (x / RECORD_BLOCK) * RECORD_BLOCK,
-        (y / RECORD_BLOCK) * RECORD_BLOCK,
-    );
+    // Blocks cut by the image's edge moved inside it.
+    let origin = |v: u32, side: u32| {
+        (v / RECORD_BLOCK * RECORD_BLOCK).min(side.saturating_sub(RECORD_BLOCK))
+    };
+    let (ox, oy) = (origin(x, w), origin(y, h));
     let (mut now, mut then) = (Vec3::ZERO, Vec3::ZERO);
     for j in (0..RECORD_BLOCK).step_by(2) {
         for i in (0..RECORD_BLOCK).step_by(2) {
