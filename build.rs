@@ -10,6 +10,7 @@ mod shader_build;
 use std::path::PathBuf;
 
 fn main() {
+    git_revision();
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("shaders");
     println!("cargo::rerun-if-changed={}", root.display());
     let output = match shader_build::build_all(&root) {
@@ -31,5 +32,29 @@ fn main() {
     {
         eprintln!("error: cannot write {}: {error}", path.display());
         std::process::exit(1);
+    }
+}
+
+/// Sets `SHINE_GIT_REV` (what `shine profile --format json` reports): the short commit HEAD
+/// points to, or `unknown` outside a git checkout. Uncommitted changes are not marked: the
+/// script reruns when HEAD moves, not when a source file changes.
+fn git_revision() {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let git = |args: &[&str]| {
+        std::process::Command::new("git")
+            .args(args)
+            .current_dir(&root)
+            .output()
+            .ok()
+            .filter(|out| out.status.success())
+            .map(|out| String::from_utf8_lossy(&out.stdout).trim().to_string())
+    };
+    let revision = git(&["rev-parse", "--short=12", "HEAD"]).unwrap_or_else(|| "unknown".into());
+    println!("cargo::rustc-env=SHINE_GIT_REV={revision}");
+    if let Some(dir) = git(&["rev-parse", "--absolute-git-dir"]) {
+        println!("cargo::rerun-if-changed={dir}/HEAD");
+        if let Some(head) = git(&["symbolic-ref", "-q", "HEAD"]) {
+            println!("cargo::rerun-if-changed={dir}/{head}");
+        }
     }
 }

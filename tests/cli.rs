@@ -183,6 +183,24 @@ fn profile_reports_every_pass_as_json() {
     );
     let report: serde_json::Value = serde_json::from_str(&stdout).expect("JSON report");
     assert_eq!(report["frames"], 3, "{stdout}");
+    // What was measured: scene, resolution, device, driver, settings, revision.
+    let run_info = &report["run"];
+    assert_eq!(run_info["scene"], "builtin:cornell-box", "{stdout}");
+    assert_eq!(
+        (run_info["width"].as_u64(), run_info["height"].as_u64()),
+        (Some(32), Some(32))
+    );
+    assert_eq!(run_info["settings"]["width"], 32, "{stdout}");
+    for key in ["device", "driver", "revision"] {
+        let value = run_info[key].as_str().unwrap_or_default();
+        assert!(!value.is_empty(), "run.{key} empty: {stdout}");
+    }
+    // Three frames: their p95 is their slowest, and the report says so.
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("note: the p95 of 3 frames is their slowest"),
+        "{stderr}"
+    );
     // lavapipe is a CPU device: `auto` times each pass alone on the host clock.
     assert_eq!(report["clock"], "host", "{stdout}");
     let passes: Vec<_> = report["passes"]
@@ -207,6 +225,24 @@ fn profile_refuses_an_unknown_clock() {
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(
         stderr.contains("unknown --clock `sundial`: expected auto, gpu or host"),
+        "{stderr}"
+    );
+}
+
+/// `--clock gpu` on lavapipe (a CPU device whose timestamps miss compute work) is allowed but
+/// warned about.
+#[test]
+fn profile_warns_of_gpu_timestamps_on_a_cpu_device() {
+    let run = shine()
+        .args(["profile", "builtin:cornell-box", "--clock", "gpu"])
+        .args(["--frames", "1", "--warmup", "0"])
+        .args(["--width", "16", "--height", "16", "--gi", "none"])
+        .output()
+        .expect("run shine profile");
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("is a CPU device whose timestamps miss compute work"),
         "{stderr}"
     );
 }

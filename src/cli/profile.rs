@@ -9,7 +9,15 @@ use shine::frame::renderer::Renderer;
 use shine::gpu::{Device, DeviceDesc};
 use shine::gpu_scene::FrameUpdate;
 use shine::profile::report::{PassClock, ProfileReport, ReportFormat, write_chrome_trace};
+use shine::settings::Settings;
 use std::path::PathBuf;
+
+/// Fewest measured frames whose 95th percentile is not their slowest (the nearest-rank p95 of
+/// n frames is the ⌈0.95 n⌉-th, which is the n-th for every n below 20).
+pub const P95_MIN_FRAMES: u32 = 20;
+
+/// The git revision the binary was built from (`build.rs`; "unknown" outside a checkout).
+pub const REVISION: &str = env!("SHINE_GIT_REV");
 
 /// Arguments of `shine profile`.
 #[derive(clap::Args, Debug)]
@@ -53,6 +61,22 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
             return Err(format!("unknown --clock `{other}`: expected auto, gpu or host").into());
         }
     };
+    if clock == PassClock::Gpu
+        && PassClock::for_device(device.info().device_type) == PassClock::Host
+    {
+        eprintln!(
+            "warning: {} is a CPU device whose timestamps miss compute work: passes read near 0 ms \
+             with --clock gpu; --clock host (or auto) times each pass alone",
+            device.info().name
+        );
+    }
+    if args.frames < P95_MIN_FRAMES {
+        eprintln!(
+            "note: the p95 of {} frames is their slowest; measure at least {P95_MIN_FRAMES} frames \
+             for a p95 below the maximum",
+            args.frames
+        );
+    }
     let mut renderer = Renderer::new(&device)?;
     // A cold start (what every frame of an animated scene cost before the update path), timed
     // once for comparison with the measured frames' `update …` passes.
@@ -74,7 +98,11 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
         .filter(|t| t.frame >= first_frame + u64::from(args.warmup))
         .collect();
     let report = ProfileReport::from_timings(&measured, clock)?;
-    println!("{}", report.format(format)?);
+    if format == ReportFormat::Json {
+        println!("{}", with_run(&report, args, &settings, &device)?);
+    } else {
+        println!("{}", report.format(format)?);
+    }
     // Medians per pass; the frame's median is of whole frames.
     let update_ms: f64 = report
         .passes
@@ -92,4 +120,30 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
         eprintln!("wrote {}", path.display());
     }
     Ok(())
+}
+
+/// The JSON report with what was measured beside it, so a saved report can be compared with
+/// another: `run` holds the scene, resolution, device, driver, settings and git revision.
+fn with_run(
+    report: &ProfileReport,
+    args: &ProfileArgs,
+    settings: &Settings,
+    device: &Device,
+) -> Result<String, CliError> {
+    let json = |e: serde_json::Error| CliError::from(format!("profile JSON: {e}"));
+    let mut value = serde_json::to_value(report).map_err(json)?;
+    let info = device.info();
+    let run = serde_json::json!({
+        "scene": args.scene,
+        "width": settings.width,
+        "height": settings.height,
+        "device": info.name,
+        "driver": info.driver,
+        "revision": REVISION,
+        "settings": settings,
+    });
+    if let Some(object) = value.as_object_mut() {
+        object.insert("run".into(), run);
+    }
+    serde_json::to_string_pretty(&value).map_err(json)
 }
