@@ -51,10 +51,14 @@ fn git_revision() {
     };
     let revision = git(&["rev-parse", "--short=12", "HEAD"]).unwrap_or_else(|| "unknown".into());
     println!("cargo::rustc-env=SHINE_GIT_REV={revision}");
+    // Only files that exist: cargo reruns a script that names a missing one every build.
     if let Some(dir) = git(&["rev-parse", "--absolute-git-dir"]) {
-        println!("cargo::rerun-if-changed={dir}/HEAD");
-        if let Some(head) = git(&["symbolic-ref", "-q", "HEAD"]) {
-            println!("cargo::rerun-if-changed={dir}/{head}");
+        let head = git(&["symbolic-ref", "-q", "HEAD"]);
+        let watched = ["HEAD", head.as_deref().unwrap_or("HEAD"), "packed-refs"];
+        for file in watched.map(|f| PathBuf::from(&dir).join(f)) {
+            if file.is_file() {
+                println!("cargo::rerun-if-changed={}", file.display());
+            }
         }
     }
 }
