@@ -85,13 +85,6 @@ layout(push_constant) uniform Push {
     uint signal;
 } push;
 
-// The refreshed pixel of p's cell (clamped where an odd edge cuts the cell: callers check
-// that it is refreshed).
-ivec2 cell_pixel(ivec2 p) {
-    uint k = push.slice - 1u;
-    return min((p / 2) * 2 + ivec2(k & 1u, k >> 1u), ivec2(push.extent) - 1);
-}
-
 // Whether pixel p is refreshed this frame.
 bool refreshed(ivec2 p) {
     return amortise_refreshed(p, push.slice);
@@ -166,8 +159,7 @@ bool block_changed(ivec2 p) {
     // so each holds its full share of refreshed pixels.
     ivec2 origin = (p / AMORTISE_RECORD_BLOCK) * AMORTISE_RECORD_BLOCK;
     origin = max(min(origin, ivec2(push.extent) - AMORTISE_RECORD_BLOCK), ivec2(0));
-    uint k = push.slice - 1u;
-    ivec2 offset = ivec2(k & 1u, k >> 1u);
+    ivec2 offset = amortise_offset(push.slice);
     vec3 now = vec3(0.0);
     vec3 then = vec3(0.0);
     for (int j = 0; j < AMORTISE_RECORD_BLOCK; j += 2) {
@@ -189,12 +181,15 @@ bool block_changed(ivec2 p) {
 // object moved. Its refreshed pixel decides where it has history and shows p's surface, or
 // changed by more than RESOLVE_CHANGE_LIMIT anyway (the light changed nearby); otherwise the
 // refreshed pixels of the four cells beside it, changed (also where the image's odd edge cuts
-// the cell and leaves it none). `on_surface`: the cell's refreshed
-// pixel shows p's surface: p follows its change `now - then`, or takes `now` where it changed
-// beyond the limit; a changed cell whose refreshed pixel shows another surface is shaded again.
+// the cell and leaves it none). `on_surface`: the cell's refreshed pixel shows p's surface: p
+// follows its change `now - then`, or takes `now` where it changed beyond the limit; a changed
+// cell whose refreshed pixel shows another surface is shaded again.
 bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 now, out vec4 then) {
     on_surface = false;
-    ivec2 c = cell_pixel(p);
+    // The cell's refreshed pixel, clamped where an odd edge cuts the cell (it is then not
+    // refreshed; the cells beside its unclamped place decide).
+    ivec2 own = (p / 2) * 2 + amortise_offset(push.slice);
+    ivec2 c = min(own, ivec2(push.extent) - 1);
     vec4 cp;
     vec3 cn;
     if (refreshed_value(c, cp, cn, now, then)) {
@@ -204,10 +199,6 @@ bool cell_changed(ivec2 p, float depth, vec3 n, out bool on_surface, out vec4 no
             return changed;
         }
     }
-    // From the cell's place unclamped: where an odd edge cuts the cell, c is not refreshed
-    // but the cell before it is.
-    uint k = push.slice - 1u;
-    ivec2 own = (p / 2) * 2 + ivec2(k & 1u, k >> 1u);
     const ivec2 beside[4] = ivec2[](ivec2(-2, 0), ivec2(2, 0), ivec2(0, -2), ivec2(0, 2));
     for (int i = 0; i < 4; ++i) {
         ivec2 s = own + beside[i];

@@ -8,8 +8,8 @@ use common::{Rng, bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, up
 use glam::{Vec2, Vec3, Vec4};
 use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
 use shine::passes::amortise::{
-    RECORD_BLOCK, RecordHistory, RecordSignal, ResolveHistory, Slice, Surfaces, reproject_records,
-    resolve,
+    self, RECORD_BLOCK, RecordHistory, RecordSignal, ResolveHistory, Slice, Surfaces,
+    reproject_records, resolve,
 };
 use shine::passes::receivers::Receivers;
 use shine::reference::resolve::{ResolveInputs, reproject_cpu, resolve_cpu};
@@ -149,11 +149,12 @@ fn resolve_matches_the_cpu_twin() {
                 "slice {slice}, history {has_history}, texel {i}: cpu {c} gpu {g}"
             );
             if slice > 0 && has_history && position[i].w > 0.0 {
-                let (x, y, k) = (i as u32 % extent[0], i as u32 / extent[0], slice - 1);
-                let refreshed = x & 1 == k & 1 && y & 1 == k >> 1;
+                let (x, y) = (i as u32 % extent[0], i as u32 / extent[0]);
+                let refreshed = amortise::refreshed(slice, x, y);
                 branches[2 * usize::from(refreshed) + usize::from(fresh[i] == *c)] += 1;
-                let cell_x = ((x / 2) * 2 + (k & 1)).min(extent[0] - 1);
-                let cell_y = ((y / 2) * 2 + (k >> 1)).min(extent[1] - 1);
+                let [kx, ky] = amortise::slice_offset(slice);
+                let cell_x = ((x / 2) * 2 + kx).min(extent[0] - 1);
+                let cell_y = ((y / 2) * 2 + ky).min(extent[1] - 1);
                 let cell = fresh[(cell_y * extent[0] + cell_x) as usize];
                 branches[4] += usize::from(!refreshed && cell == *c && cell != fresh[i]);
             }

@@ -471,13 +471,12 @@ fn vpl_sh_gathers_a_slice_and_the_marked_pixels() {
             marked: &marked,
         };
         let got = run_gpu(&device, &g, &vpls, &bvh, &p, None, Some(run)).coefficients;
-        let k = slice - 1;
         for (i, (got, every)) in got.iter().zip(&every).enumerate() {
             let (x, y) = (i as u32 % w, i as u32 / w);
             let shaded = if slice == amortise::REGATHER_SLICE {
                 marked[i]
             } else {
-                (x & 1) == (k & 1) && (y & 1) == (k >> 1)
+                amortise::refreshed(slice, x, y)
             };
             if shaded {
                 assert_eq!(got, every, "slice {slice}, pixel ({x}, {y})");

@@ -25,6 +25,12 @@ const float RESOLVE_CHANGE_LIMIT = 0.5;
 // sums (4×4 cells).
 const int AMORTISE_RECORD_BLOCK = 8;
 
+// Where the refreshed pixel of every 2×2 cell is in slice 1 + k: (k & 1, k >> 1).
+ivec2 amortise_offset(uint slice) {
+    uint k = slice - 1u;
+    return ivec2(k & 1u, k >> 1u);
+}
+
 // The pixel thread `id` shades in `slice`: itself for 0 (every pixel) and the regather slice,
 // the pixel at offset (k & 1, k >> 1) of cell `id` for slice 1 + k (a quarter of the threads,
 // `slice_threads`).
@@ -32,8 +38,7 @@ ivec2 amortise_pixel(uvec2 id, uint slice) {
     if (slice == 0u || slice == AMORTISE_REGATHER_SLICE) {
         return ivec2(id);
     }
-    uint k = slice - 1u;
-    return 2 * ivec2(id) + ivec2(k & 1u, k >> 1u);
+    return 2 * ivec2(id) + amortise_offset(slice);
 }
 
 // Whether pixel p is the refreshed one of its cell in slice 1 + k (true for slice 0).
@@ -41,8 +46,7 @@ bool amortise_refreshed(ivec2 p, uint slice) {
     if (slice == 0u) {
         return true;
     }
-    uint k = slice - 1u;
-    return (uint(p.x) & 1u) == (k & 1u) && (uint(p.y) & 1u) == (k >> 1u);
+    return (p & 1) == amortise_offset(slice);
 }
 
 // Whether history at linear depth `depth_then` with normal `n_then` shows the same surface as

@@ -77,6 +77,19 @@ pub fn slice_of_frame(frame: u64) -> u32 {
     1 + (frame % u64::from(SLICES)) as u32
 }
 
+/// Where the refreshed pixel of every 2×2 cell is in slice 1 + k: (k & 1, k >> 1)
+/// (`amortise_offset` in shaders/include/amortise.glsl).
+pub fn slice_offset(slice: u32) -> [u32; 2] {
+    let k = slice.saturating_sub(1);
+    [k & 1, k >> 1]
+}
+
+/// Whether pixel (x, y) is the refreshed one of its cell in `slice` (true for slice 0;
+/// `amortise_refreshed`).
+pub fn refreshed(slice: u32, x: u32, y: u32) -> bool {
+    slice == 0 || [x & 1, y & 1] == slice_offset(slice)
+}
+
 /// Threads a pass dispatches to shade `slice` of an `extent` image: every pixel for slice 0
 /// and [`REGATHER_SLICE`], one per 2×2 cell otherwise (`amortise_pixel` maps them).
 pub fn slice_threads(extent: [u32; 2], slice: u32) -> [u32; 3] {

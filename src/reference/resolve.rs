@@ -3,7 +3,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
-use crate::passes::amortise::{RECORD_BLOCK, RESOLVE_ALPHA, RecordSignal, changed, same_surface};
+use crate::passes::amortise::{
+    RECORD_BLOCK, RESOLVE_ALPHA, RecordSignal, changed, refreshed, same_surface, slice_offset,
+};
 use crate::study::runner::f16_to_f32;
 
 /// The images `hvl_resolve` reads, row-major.
@@ -49,20 +51,14 @@ fn history_at(inp: &ResolveInputs<'_>, x: u32, y: u32, depth: f32, n: Vec3) -> O
     same_surface(depth, n, g.w, g.truncate()).then_some(j)
 }
 
-/// Whether pixel (x, y) is the refreshed one of its cell in slice 1 + k (`amortise_refreshed`).
-fn refreshed(slice: u32, x: u32, y: u32) -> bool {
-    let k = slice.saturating_sub(1);
-    (x & 1) == (k & 1) && (y & 1) == (k >> 1)
-}
-
 /// Refreshed pixel (cx, cy) and its history's index, where it has history
 /// (`refreshed_value` in the shader).
 fn refreshed_history(inp: &ResolveInputs<'_>, cx: u32, cy: u32) -> Option<(usize, usize)> {
-    let c = (cy * inp.extent[0] + cx) as usize;
-    let (cd, cn) = (inp.position[c].w, inp.normal[c].normalize());
     if !refreshed(inp.slice, cx, cy) {
         return None;
     }
+    let c = (cy * inp.extent[0] + cx) as usize;
+    let (cd, cn) = (inp.position[c].w, inp.normal[c].normalize());
     history_at(inp, cx, cy, cd, cn).map(|cj| (c, cj))
 }
 
@@ -77,26 +73,23 @@ fn cell_changed(
     value: impl Fn(usize, usize) -> (Vec3, Vec3),
 ) -> (bool, Option<(usize, usize)>) {
     let [w, h] = inp.extent;
-    let k = inp.slice.saturating_sub(1);
-    let (cx, cy) = (
-        ((x / 2) * 2 + (k & 1)).min(w - 1),
-        ((y / 2) * 2 + (k >> 1)).min(h - 1),
-    );
+    let [kx, ky] = slice_offset(inp.slice);
+    // The cell's refreshed pixel, clamped where an odd edge cuts the cell (it is then not
+    // refreshed; the cells beside its unclamped place decide).
+    let (ox, oy) = ((x / 2) * 2 + kx, (y / 2) * 2 + ky);
     let moved = |(c, cj): (usize, usize)| {
         let (now, then) = value(c, cj);
         changed(now, then)
     };
-    if let Some((c, cj)) = refreshed_history(inp, cx, cy) {
+    if let Some(own) = refreshed_history(inp, ox.min(w - 1), oy.min(h - 1)) {
+        let c = own.0;
         let on_surface = same_surface(depth, n, inp.position[c].w, inp.normal[c].normalize());
-        if on_surface || moved((c, cj)) {
-            return (moved((c, cj)), on_surface.then_some((c, cj)));
+        let changed = moved(own);
+        if on_surface || changed {
+            return (changed, on_surface.then_some(own));
         }
     }
-    // From the cell's place unclamped (an odd edge leaves a cut cell no refreshed pixel).
-    let (ox, oy) = (
-        i64::from((x / 2) * 2 + (k & 1)),
-        i64::from((y / 2) * 2 + (k >> 1)),
-    );
+    let (ox, oy) = (i64::from(ox), i64::from(oy));
     let beside = [(-2, 0), (2, 0), (0, -2), (0, 2)]
         .into_iter()
         .any(|(dx, dy)| {
@@ -116,7 +109,7 @@ fn block_changed(
     value: impl Fn(usize, usize) -> (Vec3, Vec3),
 ) -> bool {
     let [w, h] = inp.extent;
-    let k = inp.slice.saturating_sub(1);
+    let [kx, ky] = slice_offset(inp.slice);
     // Blocks cut by the image's edge moved inside it.
     let origin = |v: u32, side: u32| {
         (v / RECORD_BLOCK * RECORD_BLOCK).min(side.saturating_sub(RECORD_BLOCK))
@@ -125,7 +118,7 @@ fn block_changed(
     let (mut now, mut then) = (Vec3::ZERO, Vec3::ZERO);
     for j in (0..RECORD_BLOCK).step_by(2) {
         for i in (0..RECORD_BLOCK).step_by(2) {
-            let (cx, cy) = (ox + i + (k & 1), oy + j + (k >> 1));
+            let (cx, cy) = (ox + i + kx, oy + j + ky);
             if cx >= w || cy >= h {
                 continue;
             }
@@ -148,7 +141,6 @@ fn light_change<'a>(inp: &'a ResolveInputs<'a>) -> impl Fn(usize, usize) -> (Vec
 pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
     let [w, h] = inp.extent;
     let at = |x: u32, y: u32| (y * w + x) as usize;
-    let refreshed = |x, y| refreshed(inp.slice, x, y);
     let mut light = vec![Vec4::ZERO; (w * h) as usize];
     let mut geometry = vec![Vec4::ZERO; (w * h) as usize];
     for y in 0..h {
@@ -168,7 +160,7 @@ pub fn resolve_cpu(inp: &ResolveInputs<'_>) -> (Vec<Vec4>, Vec<Vec4>) {
             light[i] = match valid {
                 // Regathered this frame (`hvl_regather`).
                 None => fresh,
-                Some(j) if refreshed(x, y) => {
+                Some(j) if refreshed(inp.slice, x, y) => {
                     let history = inp.history_light[j];
                     if changed(fresh.truncate(), history.truncate()) {
                         fresh
@@ -218,8 +210,8 @@ fn record_signal(signal: RecordSignal, record: &[u32]) -> Vec3 {
 /// CPU twin of `*_reproject` (variant `records` of shaders/amortise.comp): `records` (`words`
 /// u32 per pixel, the refreshed pixels' gathered already) with every other pixel's records
 /// copied from `history_records` where its history shows its surface and, with `signal`, its
-/// block's refreshed records' summed signal did not change beyond the limit; and which pixels the pass marks
-/// for the regather. `inp.fresh` and `inp.history_light` are not read.
+/// block's refreshed records' summed signal did not change beyond the limit; and which pixels
+/// the pass marks for the regather. `inp.fresh` and `inp.history_light` are not read.
 pub fn reproject_cpu(
     inp: &ResolveInputs<'_>,
     history_records: &[u32],
@@ -228,14 +220,13 @@ pub fn reproject_cpu(
     signal: RecordSignal,
 ) -> (Vec<u32>, Vec<bool>) {
     let [w, h] = inp.extent;
-    let refreshed = |x, y| refreshed(inp.slice, x, y);
     let mut out = records.to_vec();
     let mut marks = vec![false; (w * h) as usize];
     for y in 0..h {
         for x in 0..w {
             let i = (y * w + x) as usize;
             let depth = inp.position[i].w;
-            if inp.slice == 0 || refreshed(x, y) || depth == 0.0 {
+            if inp.slice == 0 || refreshed(inp.slice, x, y) || depth == 0.0 {
                 continue;
             }
             let changed = block_changed(inp, (x, y), |c, cj| {
