@@ -248,6 +248,25 @@ void main() {
     SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
         win[l] = push.window_width > 0.0 ? sh_window_sinc(l, push.window_width) : 1.0;
     }
+#ifdef HVL_FULL
+    // dot(window * cap, F) of a cap ZH rotated to d (sh_rotate_zh) is
+    //   sum_l cap_l win_l sqrt(4 pi / (2l + 1)) sum_m Y_lm(d) F_lm,
+    // so the rows take the per-band factors once per receiver. In the receiver frame (omega_o in
+    // the xz half-plane) Lambert's F is zonal and the glossy F even in phi (shine_sh::brdf_table
+    // tests): only m = 0, and m >= 0, are kept.
+    float lambert_zh[SH_BANDS];
+    float glossy_even[SH_EVEN_COEFFS];
+    SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+        float k = win[l] * sh_zh_factor(l);
+        lambert_zh[l] = k * f_lambert[l * l + l];
+        SH_UNROLL for (int m = 0; m < SH_BANDS; ++m) {
+            if (m > l) {
+                continue;
+            }
+            glossy_even[l * (l + 1) / 2 + m] = k * f_glossy[l * l + l + m];
+        }
+    }
+#endif
     vec3 sum = vec3(0.0);
 #ifdef HVL_VISIBILITY
     vec3 origin = trace_offset(x, n);
@@ -272,50 +291,69 @@ void main() {
         if (!(r > 0.0)) {
             continue;
         }
-        vec3 hvl_normal = hvls.h[j].normal_distance.xyz;
         vec3 v = position_radius.xyz - x;
-        float dist = length(v);
-        if (dist < HVL_MIN_DISTANCE) {
+        float dist2 = dot(v, v);
+        if (dist2 < HVL_MIN_DISTANCE * HVL_MIN_DISTANCE) {
             continue;
         }
-        // The near field's share of the diffuse light is hvl_near.comp's.
-        float far = hvl_far_weight(dist, push.near_range);
-        vec3 wj = v / dist;
-        float a = hvl_cap_half_angle(dist, r);
-        float g = hvl_geometric_factor(wj, hvl_normal, n, r, a);
-        if (!(g > 0.0)) {
+        float inv_dist = inversesqrt(dist2);
+        float dist = dist2 * inv_dist;
+        vec3 wj = v * inv_dist;
+        // Eq. 21 in parts: the sender's cosine (n_j is unit, Hvl), then H (eq. 22).
+        vec3 hvl_normal = hvls.h[j].normal_distance.xyz;
+        float facing = -dot(hvl_normal, wj);
+        if (!(facing > 0.0)) {
             continue;
         }
+        float cos_r = dot(n, wj);
+        float cos_a;
+        float h = hvl_cap_terms(dist, r, cos_r, cos_a);
+        if (!(h > 0.0)) {
+            continue;
+        }
+        float g = hvl_geometric_factor_of(facing, h, r);
 #if defined(HVL_VISIBILITY) && !defined(HVL_SHADOW_SAMPLES)
         if (dist > r && trace_occluded_by(origin, hvl_shadow_target(position_radius, hvl_normal))) {
             continue;
         }
 #endif
+        // The near field's share of the diffuse light is hvl_near.comp's.
+        float far = hvl_far_weight(dist, push.near_range);
         float emission[8];
         SH_UNROLL for (int l = 0; l < 8; ++l) {
             emission[l] = hvls.h[j].emission[l];
         }
-        float e = max(0.0, hvl_zh_eval(emission, int(push.emission_bands), dot(normalize(hvl_normal), -wj)));
+        float e = max(0.0, hvl_zh_eval(emission, int(push.emission_bands), facing));
         if (push.disc_falloff != 0u) {
             e *= hvl_disc_falloff(dist, r);
         }
         vec3 lj = hvls.h[j].flux.rgb * (e * g);
-        float cos_a = cos(a);
-#ifdef HVL_FULL
-        float cap[SH_COEFFS];
-        sh_cap(normalize(vec3(dot(wj, t), dot(wj, b), dot(wj, n))), cos_a, cap);
-        SH_UNROLL for (int i = 0; i < SH_COEFFS; ++i) {
-            cap[i] *= win[int(sqrt(float(i) + 0.5))];
-        }
-        // The near field's traced light is diffuse: the glossy lobe keeps all of the HVL.
-        vec3 c = max(vec3(0.0), lj * (kd * (far * sh_dot(cap, f_lambert)) + ks * sh_dot(cap, f_glossy)));
-#else
         float cap[SH_BANDS];
         sh_cap_zh(cos_a, cap);
+#ifdef HVL_FULL
+        // wj in the receiver frame is unit already (t, b, n orthonormal).
+        float y[SH_EVEN_COEFFS];
+        sh_basis_even(vec3(dot(wj, t), dot(wj, b), cos_r), y);
+        float diffuse = 0.0;
+        float glossy = 0.0;
+        SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+            float band = 0.0;
+            SH_UNROLL for (int m = 0; m < SH_BANDS; ++m) {
+                if (m > l) {
+                    continue;
+                }
+                band += glossy_even[l * (l + 1) / 2 + m] * y[l * (l + 1) / 2 + m];
+            }
+            diffuse += cap[l] * lambert_zh[l] * y[l * (l + 1) / 2];
+            glossy += cap[l] * band;
+        }
+        // The near field's traced light is diffuse: the glossy lobe keeps all of the HVL.
+        vec3 c = max(vec3(0.0), lj * (kd * (far * diffuse) + ks * glossy));
+#else
         SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
             cap[l] *= win[l];
         }
-        vec3 c = max(vec3(0.0), lj * kd * (far * hvl_zh_dot(cap, cc, dot(n, wj)) / SH_PI));
+        vec3 c = max(vec3(0.0), lj * kd * (far * hvl_zh_dot(cap, cc, cos_r) / SH_PI));
 #endif
 #ifdef HVL_SHADOW_SAMPLES
         unshadowed_sum += c;
@@ -339,10 +377,13 @@ void main() {
         int base = int(uk);
         // Usually none or one (p falls below 1/K after the first few HVLs): the loop, which
         // lavapipe's loop limiter counts, runs only for the rare HVL that more reservoirs take.
+        // (m - base) mod K without an integer division (0 <= base < K, 0 <= m < K).
         if (takers > 0) {
-            pick[(rays - base) % rays] = j;
+            int k = rays - base;
+            pick[k == rays ? 0 : k] = j;
             for (int m = 1; m < takers; ++m) {
-                pick[(m - base + rays) % rays] = j;
+                k = m - base;
+                pick[k < 0 ? k + rays : k] = j;
             }
         }
 #else

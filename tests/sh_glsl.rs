@@ -1,13 +1,14 @@
 //! `shaders/include/sh.glsl` against shine-sh on the same inputs: every per-pixel function the
 //! GPU passes use (basis, cap ZH, ZH rotation, dot, evaluation, kernels, convolution, sinc
-//! window, HVL geometric factor, and for ≤ 4 bands the SH product and HYB exponential), for
+//! window, HVL geometric factor and cap terms, and for ≤ 4 bands the SH product and HYB exponential), for
 //! 2, 3, 4 and 6 bands (the basis alone is checked to 8 bands by tests/sh_eval.rs), run by `shaders/tests/sh_glsl.comp` on the Vulkan device.
 //!
 //! Case layout (floats): dir.xyz, cos a, Phong n, window width, HVL radius, HVL half-angle,
 //! HVL normal.xyz, HVL distance, receiver normal.xyz, 0, f[n²], g[n²]. Results, in order:
 //! basis(dir), cap ZH, cap SH around dir, dot(f, g), f at dir, clamped-cosine ZH, Phong ZH,
-//! convolve(f, Phong), sinc-windowed cap ZH, HVL geometric factor, HVL cap half-angle, then
-//! for ≤ 4 bands product(f, g) and exp_hyb(f).
+//! convolve(f, Phong), sinc-windowed cap ZH, HVL geometric factor, HVL cap half-angle, the
+//! basis at m ≥ 0 (sh_basis_even), HVL cap terms (cos a, H), then for ≤ 4 bands product(f, g)
+//! and exp_hyb(f).
 
 mod common;
 
@@ -193,6 +194,16 @@ fn expected(
     let a = hvl::cap_half_angle(case.hvl_distance, case.radius).expect("cap half-angle");
     // f32 asin in the shader: 1.4e-4 measured, so 1e-3 as for the geometric factor.
     put(&[a], 1e-3, "hvl cap half-angle");
+    let full = basis::eval_basis(case.dir.normalize(), bands).expect("basis");
+    let even: Vec<f32> = (0..bands)
+        .flat_map(|l| (0..=l).map(move |m| (l * l + l + m) as usize))
+        .map(|i| full[i])
+        .collect();
+    put(&even, F32, "basis m ≥ 0");
+    let cos_r = case.receiver_normal.normalize().dot(case.dir.normalize());
+    let (cos_a, h) = hvl::cap_terms(case.hvl_distance, case.radius, cos_r).expect("cap terms");
+    // f32 asin/acos across the horizon, as for the geometric factor.
+    put(&[cos_a, h], 1e-3, "hvl cap terms");
     if bands <= 4 {
         put(
             &tensor.product(&case.f, &case.g).expect("product"),

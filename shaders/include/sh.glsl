@@ -42,20 +42,27 @@ const float SH_SQRT_4PI = 3.54490770181103205;
 // Basis and reconstruction
 // ---------------------------------------------------------------------------------------------
 
-// shine_sh::basis::eval_basis (unit direction d). Normalised recurrence on
-// Q(l,m) = K(l,m) P(l,m)(z) / sin^m(theta), times Re/Im (x + i y)^m: no trigonometry, no
-// factorials.
-void sh_basis(vec3 d, out float y[SH_COEFFS]) {
-    float cm = 1.0;
-    float sm = 0.0;
+// Coefficients with m >= 0 of SH_BANDS bands, index l (l + 1) / 2 + m: the only ones a function
+// even in phi (symmetric under y -> -y) has, such as a BRDF lobe about an outgoing direction in
+// the xz half-plane (the receiver frame of paper 003 eq. 17).
+#define SH_EVEN_COEFFS (SH_BANDS * (SH_BANDS + 1) / 2)
+
+// The parts of shine_sh::basis::eval_basis (unit direction d): q[l (l + 1) / 2 + m] =
+// Q(l,m) = K(l,m) P(l,m)(z) / sin^m(theta) for m >= 0, and cm[m], sm[m] = Re, Im (x + i y)^m.
+// Normalised recurrence: no trigonometry, no factorials.
+void sh_basis_parts(vec3 d, out float q[SH_EVEN_COEFFS], out float cm[SH_BANDS], out float sm[SH_BANDS]) {
+    float c = 1.0;
+    float s = 0.0;
     float qmm = 0.28209479177387814;
     SH_UNROLL for (int m = 0; m < SH_BANDS; ++m) {
         if (m > 0) {
             qmm *= -sqrt(float(2 * m + 1) / float(2 * m));
-            float c = cm * d.x - sm * d.y;
-            sm = cm * d.y + sm * d.x;
-            cm = c;
+            float next = c * d.x - s * d.y;
+            s = c * d.y + s * d.x;
+            c = next;
         }
+        cm[m] = c;
+        sm[m] = s;
         float mf = float(m);
         float q_prev2 = 0.0;
         float q_prev = qmm;
@@ -64,28 +71,59 @@ void sh_basis(vec3 d, out float y[SH_COEFFS]) {
             if (l < m) {
                 continue;
             }
-            float q;
+            float ql;
             if (l == m) {
-                q = qmm;
+                ql = qmm;
             } else if (l == m + 1) {
-                q = sqrt(2.0 * mf + 3.0) * d.z * qmm;
+                ql = sqrt(2.0 * mf + 3.0) * d.z * qmm;
             } else {
                 float lf = float(l);
                 float a = sqrt((4.0 * lf * lf - 1.0) / (lf * lf - mf * mf));
                 float b = sqrt(((lf - 1.0) * (lf - 1.0) - mf * mf) / (4.0 * (lf - 1.0) * (lf - 1.0) - 1.0));
-                q = a * (d.z * q_prev - b * q_prev2);
+                ql = a * (d.z * q_prev - b * q_prev2);
             }
             if (l > m) {
                 q_prev2 = q_prev;
-                q_prev = q;
+                q_prev = ql;
             }
-            int base = l * l + l;
-            if (m == 0) {
-                y[base] = q;
-            } else {
-                y[base + m] = 1.41421356237309505 * q * cm;
-                y[base - m] = 1.41421356237309505 * q * sm;
+            q[l * (l + 1) / 2 + m] = ql;
+        }
+    }
+}
+
+// shine_sh::basis::eval_basis (unit direction d), from sh_basis_parts.
+void sh_basis(vec3 d, out float y[SH_COEFFS]) {
+    float q[SH_EVEN_COEFFS];
+    float cm[SH_BANDS];
+    float sm[SH_BANDS];
+    sh_basis_parts(d, q, cm, sm);
+    SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+        int base = l * l + l;
+        y[base] = q[l * (l + 1) / 2];
+        SH_UNROLL for (int m = 1; m < SH_BANDS; ++m) {
+            if (m > l) {
+                continue;
             }
+            float k = 1.41421356237309505 * q[l * (l + 1) / 2 + m];
+            y[base + m] = k * cm[m];
+            y[base - m] = k * sm[m];
+        }
+    }
+}
+
+// shine_sh::basis::eval_basis at the coefficients with m >= 0 only (index l (l + 1) / 2 + m).
+void sh_basis_even(vec3 d, out float y[SH_EVEN_COEFFS]) {
+    float q[SH_EVEN_COEFFS];
+    float cm[SH_BANDS];
+    float sm[SH_BANDS];
+    sh_basis_parts(d, q, cm, sm);
+    SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+        y[l * (l + 1) / 2] = q[l * (l + 1) / 2];
+        SH_UNROLL for (int m = 1; m < SH_BANDS; ++m) {
+            if (m > l) {
+                continue;
+            }
+            y[l * (l + 1) / 2 + m] = 1.41421356237309505 * q[l * (l + 1) / 2 + m] * cm[m];
         }
     }
 }
@@ -389,12 +427,38 @@ float hvl_cap_half_angle(float distance, float radius) {
     return SH_PI - 0.5 * SH_PI * distance / radius;
 }
 
+// shine_sh::hvl::cap_terms: returns H (eq. 22) and sets cos_a to the cosine of
+// hvl_cap_half_angle, without trigonometry outside the sphere for caps wholly above
+// (cos_angle >= r/d = sin a) or below (cos_angle <= -sin a) the receiver's horizon.
+float hvl_cap_terms(float distance, float radius, float cos_angle, out float cos_a) {
+    if (distance >= radius) {
+        float s = radius / distance;
+        cos_a = sqrt(max(0.0, 1.0 - s * s));
+        if (cos_angle >= s) {
+            return 1.0;
+        }
+        if (cos_angle <= -s) {
+            return 0.0;
+        }
+    }
+    float a = hvl_cap_half_angle(distance, radius);
+    if (distance < radius) {
+        cos_a = cos(a);
+    }
+    return hvl_hemisphere_cap_fraction(cos_angle, a);
+}
+
+// shine_sh::hvl::geometric_factor_of: eq. 21 from its parts, facing * H / (pi r^2)
+float hvl_geometric_factor_of(float facing, float h, float radius) {
+    return facing * h / (SH_PI * radius * radius);
+}
+
 // shine_sh::hvl::geometric_factor (eq. 21); directions are normalised here, radius > 0
 float hvl_geometric_factor(vec3 to_hvl, vec3 hvl_normal, vec3 receiver_normal, float radius, float half_angle) {
     vec3 w = normalize(to_hvl);
     float facing = max(0.0, dot(normalize(hvl_normal), -w));
     float h = hvl_hemisphere_cap_fraction(dot(normalize(receiver_normal), w), half_angle);
-    return facing * h / (SH_PI * radius * radius);
+    return hvl_geometric_factor_of(facing, h, radius);
 }
 
 // shine_sh::hvl::radius_r2 (eq. 24 and 26): d (gamma + gamma^3 / 3), gamma = sqrt(2) fov / sqrt(M)

@@ -13,9 +13,9 @@ layout(local_size_x = 32) in;
 
 #define IN_STRIDE (16 + 2 * SH_COEFFS)
 #if SH_BANDS <= 4
-#define OUT_STRIDE (5 * SH_COEFFS + 4 * SH_BANDS + 4)
+#define OUT_STRIDE (5 * SH_COEFFS + 4 * SH_BANDS + SH_EVEN_COEFFS + 6)
 #else
-#define OUT_STRIDE (3 * SH_COEFFS + 4 * SH_BANDS + 4)
+#define OUT_STRIDE (3 * SH_COEFFS + 4 * SH_BANDS + SH_EVEN_COEFFS + 6)
 #endif
 
 layout(set = 0, binding = 0, std430) readonly buffer Cases {
@@ -93,6 +93,15 @@ void main() {
 
     put(hvl_geometric_factor(dir, hvl_normal, receiver_normal, radius, half_angle));
     put(hvl_cap_half_angle(hvl_distance, radius));
+
+    float even[SH_EVEN_COEFFS];
+    sh_basis_even(d, even);
+    for (int k = 0; k < SH_EVEN_COEFFS; ++k) put(even[k]);
+
+    float cos_a_terms;
+    float h = hvl_cap_terms(hvl_distance, radius, dot(normalize(receiver_normal), d), cos_a_terms);
+    put(cos_a_terms);
+    put(h);
 
 #if SH_BANDS <= 4
     float prod[SH_COEFFS];

@@ -378,6 +378,42 @@ mod tests {
         );
     }
 
+    /// With ω_o in the xz half-plane every isotropic lobe is even in φ (symmetric under
+    /// y → −y), and the φ nodes of the quadrature are too: the coefficients with m < 0 vanish
+    /// at every θ_o. The HVL gather keeps only m ≥ 0 of the glossy rows (hvl_gather.comp).
+    #[test]
+    fn isotropic_tables_have_no_odd_part_in_phi() {
+        for sampling in [
+            HemisphereSampling::default(),
+            HemisphereSampling {
+                n_theta: 12,
+                n_phi: 24,
+            },
+        ] {
+            for model in [
+                BrdfModel::Ggx {
+                    alpha: 0.3,
+                    ior: 1.5,
+                },
+                BrdfModel::Phong {
+                    ks: 1.0,
+                    exponent: 20.0,
+                },
+            ] {
+                let table = BrdfTable::build_with(model, 5, sampling).unwrap();
+                let peak = table.f().iter().fold(0.0f32, |m, v| m.max(v.abs()));
+                for row in table.f().chunks(25) {
+                    for l in 1..5 {
+                        for m in 1..=(l as i32) {
+                            let odd = row[crate::index(l, -m)].abs();
+                            assert!(odd <= 1e-6 * peak, "{model:?} l {l} m -{m}: {odd}");
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     #[test]
     fn fresnel_limits() {
         assert!((fresnel_dielectric(1.0, 1.5) - 0.04).abs() < 1e-12);

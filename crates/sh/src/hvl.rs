@@ -56,6 +56,39 @@ pub fn cap_half_angle(distance: f32, radius: f32) -> Result<f32> {
     })
 }
 
+/// The cap an HVL fills seen from a receiver, as the gather needs it: `(cos a, H)`, the cosine
+/// of [`cap_half_angle`] and [`hemisphere_cap_fraction`] (eq. 22) at `cos_angle = n_x · ω_j`,
+/// without trigonometry where none is needed. Outside the sphere `sin a = r/d`, so
+/// `cos a = √(1 − (r/d)²)`; the cap lies wholly above the receiver's horizon (`H = 1`) when
+/// `n_x · ω_j ≥ sin a` (θ ≤ π/2 − a) and wholly below it (`H = 0`) when `n_x · ω_j ≤ −sin a`.
+/// Only caps across the horizon, and receivers inside the sphere, take the angles.
+pub fn cap_terms(distance: f32, radius: f32, cos_angle: f32) -> Result<(f32, f32)> {
+    let d = check_range("distance", f64::from(distance), 0.0, f64::MAX, "≥ 0")?;
+    let r = check_range("radius", f64::from(radius), 1e-30, f64::MAX, "> 0")?;
+    if d >= r {
+        let s = r / d;
+        let cos_a = (1.0 - s * s).max(0.0).sqrt() as f32;
+        let c = f64::from(cos_angle);
+        if c >= s {
+            return Ok((cos_a, 1.0));
+        }
+        if c <= -s {
+            return Ok((cos_a, 0.0));
+        }
+    }
+    let a = cap_half_angle(distance, radius)?;
+    Ok((
+        f64::from(a).cos() as f32,
+        hemisphere_cap_fraction(cos_angle, a),
+    ))
+}
+
+/// Eq. 21 from its parts: `facing · H / (π r²)` (`facing = max(0, n_j · -ω_j)`, `H` of eq.
+/// 22), as [`geometric_factor`] and the gather combine them.
+pub fn geometric_factor_of(facing: f32, h: f32, radius: f32) -> f32 {
+    (f64::from(facing) * f64::from(h) / (std::f64::consts::PI * f64::from(radius).powi(2))) as f32
+}
+
 /// Paper 003 eq. 21: `G_j(-ω_j) = max(0, n_j · -ω_j) H(n_x, ω_j) / (π r_j²)`.
 ///
 /// * `to_hvl`: direction from the receiver `x` to the HVL centre (`ω_j`, normalised here),
@@ -71,10 +104,10 @@ pub fn geometric_factor(
     let w = unit_dir(to_hvl)?;
     let nj = unit_dir(hvl_normal)?;
     let nx = unit_dir(receiver_normal)?;
-    let r = check_range("HVL radius", f64::from(radius), 1e-30, f64::MAX, "> 0")?;
+    check_range("HVL radius", f64::from(radius), 1e-30, f64::MAX, "> 0")?;
     let facing = (-nj.dot(w)).max(0.0);
-    let h = f64::from(hemisphere_cap_fraction(nx.dot(w) as f32, half_angle));
-    Ok((facing * h / (std::f64::consts::PI * r * r)) as f32)
+    let h = hemisphere_cap_fraction(nx.dot(w) as f32, half_angle);
+    Ok(geometric_factor_of(facing as f32, h, radius))
 }
 
 /// A neighbour of an HVL for heuristic r1: its world position `p_n` and distance `d_n` to the
@@ -292,6 +325,39 @@ mod tests {
         assert!(samples.windows(2).all(|w| w[1] <= w[0]));
         assert!(cap_half_angle(1.0, 0.0).is_err());
         assert!(cap_half_angle(-1.0, 0.5).is_err());
+    }
+
+    /// The shortcut of `cap_terms` gives what the angles give, inside and outside the sphere,
+    /// for caps above, across and below the horizon (and at their edges).
+    #[test]
+    fn cap_terms_match_the_half_angle_and_the_fraction() {
+        let r = 0.4f32;
+        for i in 0..=60 {
+            let d = r * (0.05 + 0.1 * i as f32);
+            let s = (r / d).min(1.0);
+            for c in [
+                -1.0,
+                -0.7,
+                -s,
+                -0.5 * s,
+                0.0,
+                0.3 * s,
+                s,
+                0.999 * s,
+                0.6,
+                1.0,
+            ] {
+                let (cos_a, h) = cap_terms(d, r, c).unwrap();
+                let a = cap_half_angle(d, r).unwrap();
+                let want = (a.cos(), hemisphere_cap_fraction(c, a));
+                assert!(
+                    (cos_a - want.0).abs() < 1e-6 && (h - want.1).abs() < 1e-5,
+                    "d {d} cos {c}: {:?} vs {want:?}",
+                    (cos_a, h)
+                );
+            }
+        }
+        assert!(cap_terms(1.0, 0.0, 0.5).is_err());
     }
 
     /// Exact fraction of a cap (half-angle `a` around direction at angle `theta` from the normal)
