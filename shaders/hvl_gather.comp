@@ -1,5 +1,8 @@
 // HVL gather (paper 003 §5.1, eq. 1, 3, 19-22): outgoing radiance towards the camera at each
-// receiver from every HVL of the cache (brute force, as the paper's prototype). As published,
+// receiver from every HVL of the cache (brute force, as the paper's prototype), read as the
+// records hvl_gather_prep.comp wrote (per-HVL terms computed once). Per pair, no trigonometry
+// unless the HVL's cap straddles the receiver's horizon (hvl_cap_terms), and the cap meets the
+// BRDF rows in their m >= 0 half only (see the receiver set-up in main). As published,
 // HVLs are unshadowed (§6). The `_vis` and `_shadows` variants (shine's extension) shadow them
 // through the BVH, aiming each shadow ray at the HVL's centre lifted off its surface by 1% of
 // its radius; a receiver inside an HVL's sphere is never shadowed from it.
@@ -90,9 +93,10 @@ layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
 layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_albedo;
 layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
 
-layout(set = 0, binding = 4, std430) readonly buffer Hvls {
-    Hvl h[];
-} hvls;
+// The cache as hvl_gather_prep.comp prepared it.
+layout(set = 0, binding = 4, std430) readonly buffer Records {
+    GatherHvl h[];
+} hvl_records;
 
 #ifdef HVL_FULL
 // shine::passes::brdf_tables::GatherBrdf::gpu_data: F of Lambert (albedo 1) then F of GGX at each
@@ -127,9 +131,9 @@ layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D unshadowed;
 // hides it.
 const float HVL_VISIBILITY_LIFT = 0.01;
 
-// Where a shadow ray to an HVL aims: its centre lifted along its normal.
+// Where a shadow ray to an HVL aims: its centre lifted along its (unit) normal.
 vec3 hvl_shadow_target(vec4 position_radius, vec3 hvl_normal) {
-    return position_radius.xyz + normalize(hvl_normal) * (HVL_VISIBILITY_LIFT * position_radius.w + 1e-4);
+    return position_radius.xyz + hvl_normal * (HVL_VISIBILITY_LIFT * position_radius.w + 1e-4);
 }
 
 // Whether the segment from origin to target is blocked.
@@ -286,7 +290,7 @@ void main() {
 #endif
     for (uint j = 0u; j < push.hvl_count; ++j) {
         // Field by field: naga cannot read the OpCopyLogical of a whole-struct load.
-        vec4 position_radius = hvls.h[j].position_radius;
+        vec4 position_radius = hvl_records.h[j].position_radius;
         float r = position_radius.w;
         if (!(r > 0.0)) {
             continue;
@@ -299,8 +303,9 @@ void main() {
         float inv_dist = inversesqrt(dist2);
         float dist = dist2 * inv_dist;
         vec3 wj = v * inv_dist;
-        // Eq. 21 in parts: the sender's cosine (n_j is unit, Hvl), then H (eq. 22).
-        vec3 hvl_normal = hvls.h[j].normal_distance.xyz;
+        // Eq. 21 in parts: the sender's cosine, then H (eq. 22).
+        vec4 normal_area = hvl_records.h[j].normal_area;
+        vec3 hvl_normal = normal_area.xyz;
         float facing = -dot(hvl_normal, wj);
         if (!(facing > 0.0)) {
             continue;
@@ -311,7 +316,8 @@ void main() {
         if (!(h > 0.0)) {
             continue;
         }
-        float g = hvl_geometric_factor_of(facing, h, r);
+        // hvl_geometric_factor_of(facing, h, r), its 1 / (pi r^2) from the record.
+        float g = facing * h * normal_area.w;
 #if defined(HVL_VISIBILITY) && !defined(HVL_SHADOW_SAMPLES)
         if (dist > r && trace_occluded_by(origin, hvl_shadow_target(position_radius, hvl_normal))) {
             continue;
@@ -319,15 +325,14 @@ void main() {
 #endif
         // The near field's share of the diffuse light is hvl_near.comp's.
         float far = hvl_far_weight(dist, push.near_range);
-        float emission[8];
-        SH_UNROLL for (int l = 0; l < 8; ++l) {
-            emission[l] = hvls.h[j].emission[l];
-        }
-        float e = max(0.0, hvl_zh_eval(emission, int(push.emission_bands), facing));
+        vec4 flux_e0 = hvl_records.h[j].flux_e0;
+        vec4 e14 = hvl_records.h[j].emission;
+        float e_poly[HVL_EMISSION_MAX_BANDS] = float[](flux_e0.w, e14.x, e14.y, e14.z, e14.w);
+        float e = max(0.0, hvl_poly_eval(e_poly, min(facing, 1.0)));
         if (push.disc_falloff != 0u) {
             e *= hvl_disc_falloff(dist, r);
         }
-        vec3 lj = hvls.h[j].flux.rgb * (e * g);
+        vec3 lj = flux_e0.rgb * (e * g);
         float cap[SH_BANDS];
         sh_cap_zh(cos_a, cap);
 #ifdef HVL_FULL
@@ -396,7 +401,7 @@ void main() {
     if (weight_total > 0.0) {
         for (int k = 0; k < rays; ++k) {
             uint j = pick[k];
-            vec3 target = hvl_shadow_target(hvls.h[j].position_radius, hvls.h[j].normal_distance.xyz);
+            vec3 target = hvl_shadow_target(hvl_records.h[j].position_radius, hvl_records.h[j].normal_area.xyz);
             visible += trace_occluded_by(origin, target) ? 0.0 : 1.0;
         }
     }

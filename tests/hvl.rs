@@ -16,8 +16,9 @@ use shine::graph::{Buffer, Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::hvl::shadows::{self, FilterTexel, ShadowSampling};
 use shine::passes::hvl::{
-    CONV_BANDS, CachePush, Distribution, Falloff, GatherPath, GatherPush, Hvl, HvlError, HvlParams,
-    MAX_HVLS, RadiusHeuristic, Window, gather_variants, hvl_cache, hvl_gather,
+    CONV_BANDS, CachePush, Distribution, Falloff, GatherHvl, GatherPath, GatherPush, Hvl, HvlError,
+    HvlParams, MAX_HVLS, PrepPush, RadiusHeuristic, Window, gather_variants, hvl_cache, hvl_gather,
+    hvl_gather_prep,
 };
 use shine::passes::receivers::Receivers;
 use shine::passes::rsm::{Rsm, RsmProjection};
@@ -394,17 +395,34 @@ fn close(a: f32, b: f32, rel: f32, abs: f32) -> bool {
 /// The Rust mirrors of the shader structs have the shaders' reflected sizes.
 #[test]
 fn records_and_push_constants_match_the_shaders() {
-    let spirv = shaders::HVL_GATHER_COMP_FULL_C3.spirv;
-    let module =
-        naga::front::spv::parse_u8_slice(bytemuck::cast_slice(spirv), &Default::default()).unwrap();
-    let hvl = module
-        .types
-        .iter()
-        .find(|(_, t)| t.name.as_deref() == Some("Hvl"))
-        .map(|(_, t)| t.inner.size(module.to_ctx()))
-        .expect("struct Hvl in hvl_gather.comp");
-    assert_eq!(hvl as usize, std::mem::size_of::<Hvl>());
+    let struct_size = |shader: &shine::gpu::ShaderDesc, name: &str| {
+        let module = naga::front::spv::parse_u8_slice(
+            bytemuck::cast_slice(shader.spirv),
+            &Default::default(),
+        )
+        .unwrap();
+        module
+            .types
+            .iter()
+            .find(|(_, t)| t.name.as_deref() == Some(name))
+            .map(|(_, t)| t.inner.size(module.to_ctx()) as usize)
+            .unwrap_or_else(|| panic!("struct {name} in {}", shader.name))
+    };
+    let prep = &shaders::HVL_GATHER_PREP_COMP;
+    assert_eq!(struct_size(prep, "Hvl"), std::mem::size_of::<Hvl>());
     assert_eq!(std::mem::size_of::<Hvl>(), 80);
+    assert_eq!(
+        struct_size(prep, "GatherHvl"),
+        std::mem::size_of::<GatherHvl>()
+    );
+    assert_eq!(
+        struct_size(&shaders::HVL_GATHER_COMP_FULL_C3, "GatherHvl"),
+        std::mem::size_of::<GatherHvl>()
+    );
+    assert_eq!(
+        prep.push_constant_size as usize,
+        std::mem::size_of::<PrepPush>()
+    );
     for shader in [
         &shaders::HVL_CACHE_COMP_BUILD,
         &shaders::HVL_CACHE_COMP_R1,
@@ -719,6 +737,59 @@ fn flux_cache_splits_the_budget_between_faces() {
             count as f32 * w / total,
             &format!("face {f} of {per_face:?}"),
         );
+    }
+    assert_clean(&device);
+}
+
+/// hvl_gather_prep against its CPU twin: valid and empty HVLs, emission of every band count
+/// (senders with bands 1-4 set), a non-unit normal normalised.
+#[test]
+fn gather_records_match_the_cpu_twin() {
+    let device = device();
+    let mut hvls =
+        reference::build_cache(&synthetic_rsm(1.0), &params(GatherPath::Full, 5, 3)).unwrap();
+    for h in &mut hvls {
+        for (l, k) in [(1, 0.5), (2, 0.25), (3, -0.1), (4, 0.05)] {
+            h.emission[l] = k * h.emission[0];
+        }
+    }
+    hvls[5].normal_distance[1] *= 3.0;
+    assert!(
+        hvls.iter().any(|h| h.position_radius[3] == 0.0),
+        "no empty cell"
+    );
+    for emission in 1..=5u32 {
+        let p = params(GatherPath::Full, 5, emission);
+        let buffer = transfer_storage(
+            &device,
+            "hvls",
+            std::mem::size_of_val(hvls.as_slice()) as u64,
+            Some(bytemuck::cast_slice(&hvls)),
+        );
+        let bytes = u64::from(p.count) * std::mem::size_of::<GatherHvl>() as u64;
+        let readback = transfer_storage(&device, "records_readback", bytes, None);
+        let mut executor = Executor::new(&device, 1).unwrap();
+        let mut rg = executor.begin_frame();
+        let handle = rg.import_gpu_buffer(&buffer, uploaded_state(), UNUSED_AFTER);
+        let records = hvl_gather_prep(&mut rg, &handle, &p);
+        let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
+        rg.copy_buffer("read_records", &records, &mut out);
+        common::run_graph(&device, &mut executor, rg);
+        let gpu: Vec<GatherHvl> =
+            bytemuck::cast_slice(&device.read_buffer(&readback).unwrap()).to_vec();
+        let cpu = reference::gather_records(&hvls, p.count as usize, emission as usize);
+        assert_eq!(gpu.len(), cpu.len());
+        for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+            let (g, c): (&[f32; 16], &[f32; 16]) = (bytemuck::cast_ref(g), bytemuck::cast_ref(c));
+            for k in 0..16 {
+                assert!(
+                    close(g[k], c[k], 1e-5, 1e-6),
+                    "emission {emission}, HVL {i}, float {k}: GPU {} vs CPU {}",
+                    g[k],
+                    c[k]
+                );
+            }
+        }
     }
     assert_clean(&device);
 }

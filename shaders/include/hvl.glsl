@@ -26,23 +26,66 @@ struct Hvl {
     float emission[8];
 };
 
+// One HVL as the gather reads it, std430, 64 bytes: shine::passes::hvl::GatherHvl, written
+// from the cache by hvl_gather_prep.comp with the per-HVL terms of the gather precomputed.
+struct GatherHvl {
+    // xyz: centre y_j; w: radius r_j, 0 for an empty cell (skipped)
+    vec4 position_radius;
+    // xyz: unit normal n_j; w: 1 / (pi r_j^2), eq. 21's denominator (hvl_geometric_factor_of)
+    vec4 normal_area;
+    // rgb: flux Phi_j; a: a_0 of the emission polynomial (hvl_zh_poly)
+    vec4 flux_e0;
+    // a_1..a_4 of the emission polynomial
+    vec4 emission;
+};
+
 // shine::reference::hvl::sender_emission_zh: ZH coefficient l of the Lambert sender's F'
 // (paper 003 eq. 20; albedo in the flux, cosine in G): 1/pi in every direction, band 0 only.
 float hvl_sender_emission(int l) {
     return l == 0 ? SH_SQRT_4PI / SH_PI : 0.0;
 }
 
-// shine::reference::hvl::zh_eval: a ZH vector (about axis a) evaluated at direction b,
-// cos_angle = a . b: sum_l zh_l sqrt((2l+1)/(4 pi)) P_l(cos_angle), first `bands` bands.
-float hvl_zh_eval(float zh[8], int bands, float cos_angle) {
-    float p[SH_BANDS + 1];
-    sh_legendre_all(clamp(cos_angle, -1.0, 1.0), p);
-    float s = 0.0;
-    // A constant trip count (unrolled under SH_LOOP_ATTRIBUTES), `bands` masks it.
-    SH_UNROLL for (int l = 0; l < HVL_EMISSION_LOOP; ++l) {
-        if (l < bands) {
-            s += zh[l] * sqrt(float(2 * l + 1) / (4.0 * SH_PI)) * p[l];
+// shine::reference::hvl::zh_poly: a ZH vector (about axis a) evaluated at direction b,
+// cos_angle = a . b, sum_l zh_l sqrt((2l+1)/(4 pi)) P_l(cos_angle) over the first `bands`
+// bands (shine::reference::hvl::zh_eval), as a polynomial in cos_angle: a[k] the coefficient
+// of cos_angle^k (P_l expanded by the recurrence of sh_legendre_all on coefficient rows).
+void hvl_zh_poly(float zh[8], int bands, out float a[HVL_EMISSION_MAX_BANDS]) {
+    float prev[HVL_EMISSION_MAX_BANDS];
+    float cur[HVL_EMISSION_MAX_BANDS];
+    SH_UNROLL for (int k = 0; k < HVL_EMISSION_MAX_BANDS; ++k) {
+        prev[k] = 0.0;
+        cur[k] = k == 0 ? 1.0 : 0.0;
+        a[k] = 0.0;
+    }
+    SH_UNROLL for (int l = 0; l < HVL_EMISSION_MAX_BANDS; ++l) {
+        // From P_(l-1) (cur) and P_(l-2) (prev): l P_l = (2l - 1) x P_(l-1) - (l - 1) P_(l-2).
+        if (l > 0) {
+            float lf = float(l - 1);
+            float next[HVL_EMISSION_MAX_BANDS];
+            SH_UNROLL for (int k = 0; k < HVL_EMISSION_MAX_BANDS; ++k) {
+                float shifted = 0.0;
+                if (k > 0) {
+                    shifted = cur[k - 1];
+                }
+                next[k] = ((2.0 * lf + 1.0) * shifted - lf * prev[k]) / (lf + 1.0);
+            }
+            SH_UNROLL for (int k = 0; k < HVL_EMISSION_MAX_BANDS; ++k) {
+                prev[k] = cur[k];
+                cur[k] = next[k];
+            }
         }
+        float w = l < bands ? zh[l] * sqrt(float(2 * l + 1) / (4.0 * SH_PI)) : 0.0;
+        SH_UNROLL for (int k = 0; k < HVL_EMISSION_MAX_BANDS; ++k) {
+            a[k] += w * cur[k];
+        }
+    }
+}
+
+// shine::reference::hvl::poly_eval: sum_k a[k] x^k (Horner)
+float hvl_poly_eval(float a[HVL_EMISSION_MAX_BANDS], float x) {
+    float s = a[HVL_EMISSION_MAX_BANDS - 1];
+    SH_UNROLL for (int k = HVL_EMISSION_MAX_BANDS - 2; k >= 0; --k) {
+        s = s * x + a[k];
     }
     return s;
 }

@@ -453,14 +453,6 @@ float hvl_geometric_factor_of(float facing, float h, float radius) {
     return facing * h / (SH_PI * radius * radius);
 }
 
-// shine_sh::hvl::geometric_factor (eq. 21); directions are normalised here, radius > 0
-float hvl_geometric_factor(vec3 to_hvl, vec3 hvl_normal, vec3 receiver_normal, float radius, float half_angle) {
-    vec3 w = normalize(to_hvl);
-    float facing = max(0.0, dot(normalize(hvl_normal), -w));
-    float h = hvl_hemisphere_cap_fraction(dot(normalize(receiver_normal), w), half_angle);
-    return hvl_geometric_factor_of(facing, h, radius);
-}
-
 // shine_sh::hvl::radius_r2 (eq. 24 and 26): d (gamma + gamma^3 / 3), gamma = sqrt(2) fov / sqrt(M)
 float hvl_radius_r2(float light_distance, float fov, float hvl_count) {
     float g = 1.41421356237309505 * fov / sqrt(hvl_count);

@@ -91,7 +91,10 @@ void main() {
     sh_apply_window_sinc_zh(zh, window);
     for (int l = 0; l < SH_BANDS; ++l) put(zh[l]);
 
-    put(hvl_geometric_factor(dir, hvl_normal, receiver_normal, radius, half_angle));
+    // shine_sh::hvl::geometric_factor (eq. 21) from its parts
+    float facing = max(0.0, dot(normalize(hvl_normal), -d));
+    float cap_fraction = hvl_hemisphere_cap_fraction(dot(normalize(receiver_normal), d), half_angle);
+    put(hvl_geometric_factor_of(facing, cap_fraction, radius));
     put(hvl_cap_half_angle(hvl_distance, radius));
 
     float even[SH_EVEN_COEFFS];

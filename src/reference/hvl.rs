@@ -10,17 +10,17 @@
 use glam::{DVec3, Vec3, Vec4};
 use shine_sh::brdf_table::BrdfModel;
 use shine_sh::hvl::{
-    HvlNeighbour, cap_half_angle, disc_falloff, geometric_factor, radius_r1, radius_r2,
-    radius_r2_orthographic,
+    HvlNeighbour, cap_half_angle, disc_falloff, geometric_factor, geometric_factor_of, radius_r1,
+    radius_r2, radius_r2_orthographic,
 };
 use shine_sh::kernels::clamped_cosine_zh;
-use shine_sh::legendre::legendre_all;
+use shine_sh::legendre::{legendre_all, legendre_monomials};
 use shine_sh::quadrature::SphereQuadrature;
 use shine_sh::zonal::{cap_sh, cap_zh};
 
 use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::{
-    Distribution, EMISSION_MAX_BANDS, Falloff, GatherPath, Hvl, HvlError, HvlParams,
+    Distribution, EMISSION_MAX_BANDS, Falloff, GatherHvl, GatherPath, Hvl, HvlError, HvlParams,
     RadiusHeuristic,
 };
 use crate::passes::rsm::RsmProjection;
@@ -136,7 +136,7 @@ pub fn sender_emission_zh(bands: usize) -> Result<Vec<f32>, HvlError> {
 }
 
 /// `Σ_l zh_l √((2l+1)/4π) P_l(cos_angle)`: the ZH vector `zh` about axis `a`, rotated to `a`
-/// (eq. 15) and evaluated at a direction `b` with `a·b = cos_angle` (GLSL `hvl_zh_eval`).
+/// (eq. 15) and evaluated at a direction `b` with `a·b = cos_angle` (GLSL: as a polynomial, `hvl_zh_poly`).
 pub fn zh_eval(zh: &[f32], cos_angle: f32) -> f32 {
     let mut p = vec![0.0f64; zh.len() + 1];
     legendre_all(f64::from(cos_angle.clamp(-1.0, 1.0)), &mut p);
@@ -146,6 +146,51 @@ pub fn zh_eval(zh: &[f32], cos_angle: f32) -> f32 {
             f64::from(z) * ((2 * l + 1) as f64 / (4.0 * std::f64::consts::PI)).sqrt() * p[l]
         })
         .sum::<f64>() as f32
+}
+
+/// [`zh_eval`] of the first `bands` bands of `zh` as a polynomial in `cos_angle`: `a[k]` is
+/// the coefficient of `cos_angle^k` (GLSL `hvl_zh_poly`: `hvl_gather_prep.comp` writes it once
+/// per HVL, so the gather evaluates a sender's emission with four multiply-adds).
+pub fn zh_poly(zh: &[f32], bands: usize) -> [f32; EMISSION_MAX_BANDS] {
+    let rows = legendre_monomials(EMISSION_MAX_BANDS);
+    let mut a = [0.0f64; EMISSION_MAX_BANDS];
+    for (l, (&z, row)) in zh.iter().zip(&rows).take(bands).enumerate() {
+        let w = f64::from(z) * ((2 * l + 1) as f64 / (4.0 * std::f64::consts::PI)).sqrt();
+        for (ak, c) in a.iter_mut().zip(row) {
+            *ak += w * c;
+        }
+    }
+    a.map(|v| v as f32)
+}
+
+/// The gather's records of the first `count` HVLs (`hvl_gather_prep.comp`): unit normal,
+/// `1 / (π r²)` and the emission polynomial of `emission_bands` bands; an empty cell (radius
+/// ≤ 0) gives a zero record.
+pub fn gather_records(hvls: &[Hvl], count: usize, emission_bands: usize) -> Vec<GatherHvl> {
+    hvls.iter()
+        .take(count)
+        .map(|h| {
+            let r = h.position_radius[3];
+            let a = zh_poly(&h.emission, emission_bands);
+            let valid = r > 0.0;
+            let normal = Vec4::from(h.normal_distance).truncate().normalize_or_zero();
+            GatherHvl {
+                position_radius: if valid { h.position_radius } else { [0.0; 4] },
+                normal_area: if valid {
+                    normal.extend(geometric_factor_of(1.0, 1.0, r)).to_array()
+                } else {
+                    [0.0; 4]
+                },
+                flux_e0: [h.flux[0], h.flux[1], h.flux[2], a[0]],
+                emission: [a[1], a[2], a[3], a[4]],
+            }
+        })
+        .collect()
+}
+
+/// `Σ_k a[k] x^k` by Horner's rule (GLSL `hvl_poly_eval`).
+pub fn poly_eval(a: &[f32], x: f32) -> f32 {
+    a.iter().rev().fold(0.0, |acc, &c| acc * x + c)
 }
 
 /// `Σ_l f_l g_l P_l(cos_angle)`: the SH dot product of two ZH vectors rotated (eq. 15) to axes
@@ -510,6 +555,23 @@ mod tests {
         let full = shine_sh::dot(&fa, &gb).unwrap();
         assert!((zh_dot(&f, &g, a.dot(b)) - full).abs() < 1e-5);
         assert!((zh_eval(&f, a.dot(b)) - evaluate(&fa, b).unwrap()).abs() < 1e-5);
+    }
+
+    /// The emission's polynomial form gives what the Legendre sum gives, band by band.
+    #[test]
+    fn emission_polynomial_matches_the_zonal_sum() {
+        let zh = [1.1f32, 0.6, -0.3, 0.2, -0.05];
+        for bands in 1..=EMISSION_MAX_BANDS {
+            let a = zh_poly(&zh, bands);
+            for i in 0..=20 {
+                let c = -1.0 + 0.1 * i as f32;
+                let want = zh_eval(&zh[..bands], c);
+                assert!(
+                    (poly_eval(&a, c) - want).abs() < 1e-5,
+                    "bands {bands} cos {c}"
+                );
+            }
+        }
     }
 
     /// A receiver crossing an HVL's rim (d = r) sees no jump, in both gather paths: the

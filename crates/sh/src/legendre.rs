@@ -33,6 +33,28 @@ pub fn legendre(l: usize, x: f64) -> f64 {
     p1
 }
 
+/// `P_0 ..= P_{n-1}` as polynomials: row `l` holds the coefficients of `x^0 ..= x^{n-1}` in
+/// `P_l(x)`, by the recurrence of [`legendre_all`] on coefficient rows.
+pub fn legendre_monomials(n: usize) -> Vec<Vec<f64>> {
+    let mut rows = vec![vec![0.0; n]; n];
+    for l in 0..n {
+        if l == 0 {
+            rows[0][0] = 1.0;
+            continue;
+        }
+        if l == 1 {
+            rows[1][1] = 1.0;
+            continue;
+        }
+        let k = (l - 1) as f64;
+        for i in 0..n {
+            let shifted = if i > 0 { rows[l - 1][i - 1] } else { 0.0 };
+            rows[l][i] = ((2.0 * k + 1.0) * shifted - k * rows[l - 2][i]) / (k + 1.0);
+        }
+    }
+    rows
+}
+
 /// `∫_{x}^{1} P_l(t) dt = (P_{l-1}(x) - P_{l+1}(x)) / (2l+1)` for `l ≥ 1`, and `1 - x` for `l = 0`.
 ///
 /// Paper 003 eq. 13 writes the same integral as `∫_0^a P_l(cos θ) sin θ dθ` with `x = cos a`.
@@ -48,6 +70,18 @@ pub fn legendre_integral_to_one(l: usize, x: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::quadrature::gauss_legendre;
+
+    #[test]
+    fn monomial_rows_evaluate_to_the_polynomials() {
+        let rows = legendre_monomials(6);
+        assert_eq!(rows[4], vec![0.375, 0.0, -3.75, 0.0, 4.375, 0.0]);
+        for &x in &[-1.0, -0.3, 0.0, 0.42, 1.0] {
+            for (l, row) in rows.iter().enumerate() {
+                let p: f64 = row.iter().rev().fold(0.0, |acc, c| acc * x + c);
+                assert!((p - legendre(l, x)).abs() < 1e-13);
+            }
+        }
+    }
 
     #[test]
     fn closed_forms_low_degree() {

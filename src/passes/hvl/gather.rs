@@ -4,11 +4,11 @@
 use glam::Vec3;
 
 use super::{
-    Falloff, GatherPath, GatherPush, HvlError, HvlParams, Window, cache_bytes, check_extent,
-    shadows,
+    Falloff, GatherHvl, GatherPath, GatherPush, HvlError, HvlParams, PrepPush, Window, cache_bytes,
+    check_extent, shadows,
 };
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::graph::{Buffer, Handle, Image, RenderGraph};
+use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::passes::amortise;
 use crate::passes::brdf_tables::{
     GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
@@ -175,6 +175,7 @@ fn record_gather(
     } else {
         "hvl_gather"
     };
+    let records = prepare(rg, &format!("{name}_prep"), inputs.hvls, params);
     let threads = amortise::slice_threads([w, h], slice);
     let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
     let mut unshadowed = sampled.then(|| receivers.light_image(rg, "hvl_unshadowed"));
@@ -183,7 +184,7 @@ fn record_gather(
         .read("recv_normal", &receivers.normal)
         .read("recv_albedo", &receivers.albedo)
         .read("recv_material", &receivers.material)
-        .read("hvls", inputs.hvls);
+        .read("hvl_records", &records);
     if params.path == GatherPath::Full {
         pass.read("brdf", inputs.brdf);
     }
@@ -197,4 +198,36 @@ fn record_gather(
         .push(&push)
         .dispatch(threads);
     unshadowed
+}
+
+/// Adds `hvl_gather_prep`: the first `params.count` HVLs of `hvls` as [`GatherHvl`] records in
+/// a new buffer, returned (per-HVL terms of the gather computed once; CPU twin
+/// [`crate::reference::hvl::gather_records`]). The gather passes add it themselves.
+pub fn hvl_gather_prep(
+    rg: &mut RenderGraph,
+    hvls: &Handle<Buffer>,
+    params: &HvlParams,
+) -> Handle<Buffer> {
+    prepare(rg, "hvl_gather_prep", hvls, params)
+}
+
+/// [`hvl_gather_prep`] under the pass name `name` (`hvl_regather_prep` beside `hvl_regather`).
+fn prepare(
+    rg: &mut RenderGraph,
+    name: &str,
+    hvls: &Handle<Buffer>,
+    params: &HvlParams,
+) -> Handle<Buffer> {
+    let bytes = u64::from(params.count.max(1)) * std::mem::size_of::<GatherHvl>() as u64;
+    let mut records = rg.create_buffer(&format!("{name}_records"), BufferDesc::new(bytes));
+    let push = PrepPush {
+        count: params.count,
+        emission_bands: params.emission_bands,
+    };
+    rg.compute(name, &crate::shaders::HVL_GATHER_PREP_COMP)
+        .read("hvls", hvls)
+        .write("hvl_records", &mut records)
+        .push(&push)
+        .dispatch([params.count, 1, 1]);
+    records
 }

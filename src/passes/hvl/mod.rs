@@ -87,7 +87,7 @@ mod grid;
 pub mod near;
 pub mod shadows;
 mod variants;
-pub use gather::{hvl_gather, hvl_regather};
+pub use gather::{hvl_gather, hvl_gather_prep, hvl_regather};
 pub use grid::HvlGrid;
 pub use variants::{gather_shader, gather_variants};
 
@@ -116,6 +116,33 @@ impl Hvl {
     pub fn is_valid(&self) -> bool {
         self.flux[3] != 0.0
     }
+}
+
+/// One HVL as the gather reads it (std430, 64 bytes; `struct GatherHvl` of
+/// `shaders/include/hvl.glsl`): what depends on the HVL alone, computed once per frame by
+/// `hvl_gather_prep` instead of once per receiver ([`crate::reference::hvl::gather_records`]).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GatherHvl {
+    /// xyz: centre `y_j`; w: radius `r_j`, 0 for an empty cell (skipped).
+    pub position_radius: [f32; 4],
+    /// xyz: unit normal `n_j`; w: `1 / (π r_j²)`, eq. 21's denominator.
+    pub normal_area: [f32; 4],
+    /// rgb: flux `Φ_j`; a: `a_0` of the emission polynomial
+    /// ([`crate::reference::hvl::zh_poly`]).
+    pub flux_e0: [f32; 4],
+    /// `a_1 ..= a_4` of the emission polynomial.
+    pub emission: [f32; 4],
+}
+
+/// Push constants of `shaders/hvl_gather_prep.comp`, 8 bytes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct PrepPush {
+    /// HVLs in the cache.
+    pub count: u32,
+    /// Bands of the HVL emission reconstructed (1–5).
+    pub emission_bands: u32,
 }
 
 /// Push constants of `shaders/hvl_cache.comp` (both stages), 48 bytes.
