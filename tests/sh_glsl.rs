@@ -196,7 +196,7 @@ fn expected(
     put(&[a], 1e-3, "hvl cap half-angle");
     let full = basis::eval_basis(case.dir.normalize(), bands).expect("basis");
     let even: Vec<f32> = (0..bands)
-        .flat_map(|l| (0..=l).map(move |m| (l * l + l + m) as usize))
+        .flat_map(|l| (0..=l).map(move |m| l * l + l + m))
         .map(|i| full[i])
         .collect();
     put(&even, F32, "basis m ≥ 0");
