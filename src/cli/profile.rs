@@ -9,6 +9,7 @@ use shine::frame::renderer::Renderer;
 use shine::gpu::{Device, DeviceDesc};
 use shine::gpu_scene::FrameUpdate;
 use shine::profile::report::{PassClock, ProfileReport, ReportFormat, write_chrome_trace};
+use shine::profile::roofline::{self, RooflineReport};
 use shine::settings::Settings;
 use std::path::PathBuf;
 
@@ -40,6 +41,11 @@ pub struct ProfileArgs {
     /// or `auto` (host on CPU devices such as lavapipe, whose timestamps miss compute work).
     #[arg(long, default_value = "auto")]
     clock: String,
+    /// Also set each pass that declares its work against the device's fp32 FMA peak and memory
+    /// bandwidth (measured once per device by micro-kernels and cached; see
+    /// docs/performance.md).
+    #[arg(long)]
+    roofline: bool,
     #[command(flatten)]
     settings: SettingsArgs,
 }
@@ -98,10 +104,20 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
         .filter(|t| t.frame >= first_frame + u64::from(args.warmup))
         .collect();
     let report = ProfileReport::from_timings(&measured, clock)?;
+    let roofline = match args.roofline {
+        true => Some(roofline_of(&report, &measured, &device)?),
+        false => None,
+    };
     if format == ReportFormat::Json {
-        println!("{}", with_run(&report, args, &settings, &device)?);
+        println!(
+            "{}",
+            with_run(&report, roofline.as_ref(), args, &settings, &device)?
+        );
     } else {
         println!("{}", report.format(format)?);
+        if let Some(r) = &roofline {
+            println!("{}", r.to_table());
+        }
     }
     // Medians per pass; the frame's median is of whole frames.
     let update_ms: f64 = report
@@ -122,10 +138,34 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// The roofline of the measured passes, with the device's peaks from the cache or measured now.
+fn roofline_of(
+    report: &ProfileReport,
+    measured: &[shine::graph::PassTiming],
+    device: &Device,
+) -> Result<RooflineReport, CliError> {
+    let dir = roofline::cache_dir();
+    if dir.is_none() {
+        eprintln!(
+            "note: no cache directory (SHINE_CACHE_DIR, XDG_CACHE_HOME or HOME): the peaks are measured every run"
+        );
+    }
+    let (peaks, fresh) = roofline::cached(device, dir.as_deref())?;
+    if fresh {
+        eprintln!(
+            "measured {}: {:.1} GFLOP/s fp32 FMA, {:.1} GB/s",
+            peaks.device, peaks.gflops, peaks.gbps
+        );
+    }
+    Ok(RooflineReport::new(report, measured, &peaks))
+}
+
 /// The JSON report with what was measured beside it, so a saved report can be compared with
-/// another: `run` holds the scene, resolution, device, driver, settings and git revision.
+/// another: `run` holds the scene, resolution, device, driver, settings and git revision, and
+/// `roofline` (with `--roofline`) the peaks and each declared pass against them.
 fn with_run(
     report: &ProfileReport,
+    roofline: Option<&RooflineReport>,
     args: &ProfileArgs,
     settings: &Settings,
     device: &Device,
@@ -144,6 +184,9 @@ fn with_run(
     });
     if let Some(object) = value.as_object_mut() {
         object.insert("run".into(), run);
+        if let Some(r) = roofline {
+            object.insert("roofline".into(), serde_json::to_value(r).map_err(json)?);
+        }
     }
     serde_json::to_string_pretty(&value).map_err(json)
 }

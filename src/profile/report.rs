@@ -456,6 +456,7 @@ mod tests {
             begin_ns: begin_ms * 1e6,
             end_ns: end_ms * 1e6,
             frame,
+            cost: None,
         }
     }
 

@@ -309,6 +309,12 @@ impl ComputePass<'_> {
         self
     }
 
+    /// Declares the pass's work per run ([`PassBuilder::cost`]).
+    pub fn cost(&mut self, cost: crate::PassCost) -> &mut Self {
+        self.pass.cost(cost);
+        self
+    }
+
     /// Run this pass only on frames where `frame % period == phase`.
     pub fn run_every(&mut self, period: u32, phase: u32) -> &mut Self {
         self.pass.run_every(period, phase);

@@ -449,6 +449,7 @@ pub(crate) fn compile(
             kind: decl.kind,
             barriers,
             resources: resources.clone(),
+            cost: decl.cost,
         });
     }
 

@@ -14,6 +14,7 @@ use crate::error::ExecuteError;
 use crate::gpu_resources::DeviceMemory;
 use crate::graph::RenderGraph;
 use crate::objects::GraphObjects;
+use crate::pass::PassCost;
 use crate::pipelines::PipelineCache;
 use crate::plan::Plan;
 use crate::record::{Recorder, check_area};
@@ -46,6 +47,9 @@ pub struct Executor {
     objects: GraphObjects,
     /// Timings read from a slot before its reuse, not returned by [`Executor::timings`] yet.
     timings: Vec<PassTiming>,
+    /// The declared work of every pass executed so far, by name, for the timestamp timings
+    /// (their scopes carry only names).
+    costs: std::collections::HashMap<String, PassCost>,
 }
 
 impl std::fmt::Debug for Executor {
@@ -76,6 +80,7 @@ impl Executor {
             pipelines: PipelineCache::default(),
             objects: GraphObjects::default(),
             timings: Vec::new(),
+            costs: std::collections::HashMap::new(),
         })
     }
 
@@ -167,6 +172,11 @@ impl Executor {
         if let Some(cb) = cb {
             slot.timestamps.pool.reset(cb);
         }
+        for pass in &plan.passes {
+            if let Some(cost) = pass.cost {
+                self.costs.insert(pass.name.clone(), cost);
+            }
+        }
         let mut host_timings = Vec::new();
         let start = std::time::Instant::now();
         for (position, pass) in plan.passes.iter().enumerate() {
@@ -207,6 +217,7 @@ impl Executor {
                     begin_ns,
                     end_ns: start.elapsed().as_secs_f64() * 1e9,
                     frame: self.frame,
+                    cost: pass.cost,
                 });
             }
         }
@@ -245,7 +256,11 @@ impl Executor {
                 None => break,
             }
         }
-        Ok(std::mem::take(&mut self.timings))
+        let mut timings = std::mem::take(&mut self.timings);
+        for t in &mut timings {
+            t.cost = t.cost.or_else(|| self.costs.get(&t.name).copied());
+        }
+        Ok(timings)
     }
 }
 

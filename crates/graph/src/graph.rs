@@ -3,7 +3,7 @@
 use crate::access::AnyAccess;
 use crate::error::GraphError;
 use crate::handle::{Buffer, Handle, Image, ResourceId, ResourceType};
-use crate::pass::{AccessRecord, Direction, PassDecl, PassId, PassKind, UpdateRate};
+use crate::pass::{AccessRecord, Direction, PassCost, PassDecl, PassId, PassKind, UpdateRate};
 use crate::resource::{AnyDesc, BufferDesc, BufferImport, ImageDesc, ImageImport, Lifetime};
 use crate::work::Work;
 use shine_gpu::vk;
@@ -283,6 +283,7 @@ impl RenderGraph {
             kind,
             accesses: Vec::new(),
             rate: UpdateRate::EVERY_FRAME,
+            cost: None,
         });
         self.works.push(Work::Declared);
         PassBuilder { graph: self, id }
@@ -305,6 +306,12 @@ impl PassBuilder<'_> {
     /// The pass being declared.
     pub fn id(&self) -> PassId {
         self.id
+    }
+
+    /// Declares the pass's work per run ([`PassCost`]), reported by the executor's timings.
+    pub fn cost(&mut self, cost: PassCost) -> &mut Self {
+        self.graph.passes[self.id.0 as usize].cost = Some(cost);
+        self
     }
 
     fn record(

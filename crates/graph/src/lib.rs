@@ -74,7 +74,7 @@ pub use execute::Executor;
 pub use gpu_resources::GpuResource;
 pub use graph::{History, PassBuilder, RenderGraph};
 pub use handle::{Buffer, Handle, Image, ResourceId, ResourceType};
-pub use pass::{PassId, PassKind, UpdateRate};
+pub use pass::{PassCost, PassId, PassKind, UpdateRate};
 pub use plan::{PassResource, Plan, PlannedPass, PlannedResource, ResourceKind, Usage};
 pub use raw::RawContext;
 pub use resource::{AnyDesc, BufferDesc, BufferImport, ExternalState, ImageDesc, ImageImport};

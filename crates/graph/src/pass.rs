@@ -43,6 +43,17 @@ impl UpdateRate {
     }
 }
 
+/// The work a pass does, declared by the code that records it (for `shine profile --roofline`):
+/// floating-point operations and bytes moved to or from memory per run, each counted by a
+/// formula documented beside the pass.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize)]
+pub struct PassCost {
+    /// Floating-point operations (a fused multiply-add counts two).
+    pub flops: u64,
+    /// Bytes read from and written to memory (not counting cache hits the formula rules out).
+    pub bytes: u64,
+}
+
 /// Whether an access record reads the version it names or writes the next one.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum Direction {
@@ -68,4 +79,5 @@ pub(crate) struct PassDecl {
     pub kind: PassKind,
     pub accesses: Vec<AccessRecord>,
     pub rate: UpdateRate,
+    pub cost: Option<PassCost>,
 }

@@ -6,7 +6,7 @@ use crate::access::AccessInfo;
 use crate::alias::MemoryPlan;
 use crate::barrier::Barrier;
 use crate::handle::ResourceId;
-use crate::pass::{PassId, PassKind};
+use crate::pass::{PassCost, PassId, PassKind};
 use crate::resource::AnyDesc;
 use crate::temporal::TemporalState;
 
@@ -69,6 +69,8 @@ pub struct PlannedPass {
     pub barriers: Vec<Barrier>,
     /// The resources it uses.
     pub resources: Vec<PassResource>,
+    /// Its declared work, if any.
+    pub cost: Option<PassCost>,
 }
 
 /// A compiled graph.

@@ -17,6 +17,8 @@ pub struct PassTiming {
     pub end_ns: f64,
     /// The frame number.
     pub frame: u64,
+    /// The pass's declared work ([`crate::PassBuilder::cost`]), if any.
+    pub cost: Option<crate::PassCost>,
 }
 
 /// The timestamp scopes of one frame slot and the frame they hold until it is read.
@@ -67,6 +69,7 @@ impl SlotTimestamps {
                     begin_ns: t.begin_ns,
                     end_ns: t.end_ns,
                     frame,
+                    cost: None,
                 })
                 .collect()
         }))

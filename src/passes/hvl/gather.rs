@@ -8,7 +8,7 @@ use super::{
     check_extent, shadows,
 };
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
+use crate::graph::{Buffer, BufferDesc, Handle, Image, PassCost, RenderGraph};
 use crate::passes::amortise;
 use crate::passes::brdf_tables::{
     GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
@@ -194,6 +194,10 @@ fn record_gather(
     if let Some(u) = unshadowed.as_mut() {
         pass.write("unshadowed", u);
     }
+    if slice != amortise::REGATHER_SLICE {
+        let [x, y, _] = threads;
+        pass.cost(gather_cost(params, u64::from(x) * u64::from(y)));
+    }
     pass.write("indirect", indirect)
         .push(&push)
         .dispatch(threads);
@@ -218,7 +222,7 @@ fn prepare(
     hvls: &Handle<Buffer>,
     params: &HvlParams,
 ) -> Handle<Buffer> {
-    let bytes = u64::from(params.count.max(1)) * std::mem::size_of::<GatherHvl>() as u64;
+    let bytes = records_bytes(params);
     let mut records = rg.create_buffer(&format!("{name}_records"), BufferDesc::new(bytes));
     let push = PrepPush {
         count: params.count,
@@ -228,6 +232,64 @@ fn prepare(
         .read("hvls", hvls)
         .write("hvl_records", &mut records)
         .push(&push)
+        .cost(PassCost {
+            // Per HVL: the emission polynomial (5 bands of 5 coefficients, 4 flops each, and
+            // the band weights), the normal's normalisation and 1 / (π r²): about 130.
+            flops: 130 * u64::from(params.count),
+            bytes: cache_bytes(params.count) + bytes,
+        })
         .dispatch([params.count, 1, 1]);
     records
+}
+
+/// Floating-point operations of one receiver–HVL pair, counted from `hvl_gather.comp` (a fused
+/// multiply-add is two, a square root, reciprocal or division one) for `b` convolution bands:
+///
+/// - common to both paths, 75: the vector to the HVL and its length (14), the two cosines (11),
+///   the cap terms outside the sphere (4), G (2), the near field's weight (7), the emission
+///   polynomial (9), the light L_j (4), the clamped contribution and its sum (24);
+/// - the cap's ZH, `7 (b - 1) + 2`: the Legendre recurrence (5 per band) and the ZH (2 per band);
+/// - full path: the direction in the receiver frame (10), the basis at m ≥ 0
+///   (`7 (b - 1) + 3.5 b (b - 1) / 2 + b (b - 1)`: the (x + iy)^m recurrence, the normalised
+///   Legendre recurrence, the √2 cos mφ factors) and the two products with the BRDF rows
+///   (`b (b + 1) + 5 b`);
+/// - zonal path: the Legendre recurrence at the receiver's cosine and the ZH product,
+///   `5 (b - 1) + 3 b`;
+/// - sampled shadows add the reservoir, 15 per pair.
+///
+/// Every pair is counted as lit: a SIMD group runs the whole path whenever one of its lanes
+/// does. The shadow rays' traversal is not counted (it depends on the scene's BVH).
+pub fn gather_pair_flops(path: GatherPath, b: u32, sampled_shadows: bool) -> u64 {
+    let b = u64::from(b);
+    let cap = 7 * (b - 1) + 2;
+    let specific = match path {
+        GatherPath::Full => {
+            10 + 7 * (b - 1) + (7 * b * (b - 1)) / 4 + b * (b - 1) + b * (b + 1) + 5 * b
+        }
+        GatherPath::Zonal => 5 * (b - 1) + 3 * b,
+    };
+    75 + cap + specific + if sampled_shadows { 15 } else { 0 }
+}
+
+/// The gather's [`PassCost`] over `receivers` receivers: `receivers × count ×`
+/// [`gather_pair_flops`]; bytes: per receiver its four G-buffer texels (16 + 8 + 4 + 4) and its
+/// RGBA16F output (8, and 8 more for the unshadowed sum of sampled shadows), plus the HVL
+/// records and the BRDF tables once (a few kilobytes every workgroup then reads from cache).
+pub fn gather_cost(params: &HvlParams, receivers: u64) -> PassCost {
+    let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
+    let pairs = receivers * u64::from(params.count);
+    let per_receiver = 32 + if sampled { 16 } else { 8 };
+    let tables = match params.path {
+        GatherPath::Full => GatherBrdf::gpu_bytes(params.conv_bands),
+        GatherPath::Zonal => 0,
+    };
+    PassCost {
+        flops: pairs * gather_pair_flops(params.path, params.conv_bands, sampled),
+        bytes: receivers * per_receiver + records_bytes(params) + tables,
+    }
+}
+
+/// Bytes of the [`GatherHvl`] records of `params.count` HVLs.
+fn records_bytes(params: &HvlParams) -> u64 {
+    u64::from(params.count.max(1)) * std::mem::size_of::<GatherHvl>() as u64
 }
