@@ -275,6 +275,35 @@ fn profile_roofline_sets_hvl_gather_against_the_peaks() {
     let _ = std::fs::remove_dir_all(&cache);
 }
 
+/// `render --help` and `profile --help` show every flag's default, the settings flags' from
+/// `Settings::default()`.
+#[test]
+fn help_shows_the_defaults() {
+    let defaults = shine::Settings::default();
+    for command in ["render", "profile"] {
+        let run = shine()
+            .args([command, "--help"])
+            .output()
+            .expect("run shine --help");
+        assert!(run.status.success());
+        let help = String::from_utf8_lossy(&run.stdout);
+        for expected in [
+            format!("Image width in pixels [default: {}]", defaults.width),
+            format!("Image height in pixels [default: {}]", defaults.height),
+            "[default: hvl]".to_owned(),
+            "[default: pbr-neutral]".to_owned(),
+        ] {
+            assert!(
+                help.contains(&expected),
+                "{command}: no `{expected}` in\n{help}"
+            );
+        }
+    }
+    let help = shine().args(["profile", "--help"]).output().expect("help");
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("Frames measured [default: 60]"), "{help}");
+}
+
 #[test]
 fn profile_refuses_an_unknown_clock() {
     let run = shine()

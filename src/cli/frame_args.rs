@@ -12,26 +12,30 @@ pub struct SettingsArgs {
     /// Settings file (TOML); flags override it.
     #[arg(long)]
     settings: Option<PathBuf>,
-    /// Image width in pixels.
-    #[arg(long)]
+    // The flags are options, so a settings file's value survives a flag not given; their help
+    // shows the default of `Settings::default()` (with_default).
+    #[arg(long, help = with_default("Image width in pixels", "width"))]
     width: Option<u32>,
-    /// Image height in pixels.
-    #[arg(long)]
+    #[arg(long, help = with_default("Image height in pixels", "height"))]
     height: Option<u32>,
-    /// Scene time in seconds (animations).
-    #[arg(long)]
+    #[arg(long, help = with_default("Scene time in seconds (animations)", "time"))]
     time: Option<f32>,
-    /// GI techniques: `hvl` (default), `igi`, `proxy`, `none`, combined with commas
-    /// (`hvl,proxy`), `aaf`.
-    #[arg(long)]
+    #[arg(long, help = with_default(
+        "GI techniques: `hvl`, `igi`, `proxy`, `aaf`, `none`, combined with commas (`hvl,proxy`)",
+        "gi",
+    ))]
     gi: Option<String>,
-    /// Tonemapping: none, aces, pbr-neutral (default), agx.
-    #[arg(long)]
+    #[arg(long, help = with_default(
+        "Tonemapping: none, aces, pbr-neutral, agx",
+        "output.tonemap",
+    ))]
     tonemap: Option<String>,
-    /// Linear exposure factor of the EXR, and a compensation on top of the automatic
-    /// exposure of the PNG (`output.auto_exposure`, on by default; `--set
-    /// output.auto_exposure=false` exposes the PNG by this factor alone).
-    #[arg(long)]
+    #[arg(long, help = with_default(
+        "Linear exposure factor of the EXR, and a compensation on top of the automatic exposure \
+         of the PNG (`output.auto_exposure`, on by default; `--set output.auto_exposure=false` \
+         exposes the PNG by this factor alone)",
+        "output.exposure",
+    ))]
     exposure: Option<f32>,
     /// Supersampling N (1-4): render at N times the size and box-filter down before
     /// tonemapping (`output.ssaa`; antialiased captures). 0: automatic, 2 while the rendered
@@ -83,6 +87,23 @@ impl EnvironmentArgs {
                 .retain(|w| !w.contains("default directional sun"));
         }
         Ok(())
+    }
+}
+
+/// `what` followed by `[default: V]`, V the setting `key` (a dotted TOML key) of
+/// `Settings::default()`: the help of an optional settings flag shows the one default there is.
+pub fn with_default(what: &str, key: &str) -> String {
+    let defaults = serde_json::to_value(Settings::default()).unwrap_or_default();
+    let value = key
+        .split('.')
+        .try_fold(&defaults, |v, part| v.get(part))
+        .map(|v| match v {
+            serde_json::Value::String(s) => s.clone(),
+            other => other.to_string(),
+        });
+    match value {
+        Some(v) => format!("{what} [default: {v}]"),
+        None => what.to_owned(),
     }
 }
 

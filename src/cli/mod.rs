@@ -4,6 +4,7 @@ mod compare;
 mod frame_args;
 mod info;
 mod profile;
+mod progress;
 mod reference;
 mod render;
 mod scene;

@@ -92,9 +92,21 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
     let cold_ms = cold.elapsed().as_secs_f64() * 1e3;
     // Frames advance the scene clock as a sequence does (`shine render --frames`).
     let time = settings.time;
-    let timings = renderer.render_timed(&settings, args.warmup + args.frames, clock, &|k| {
+    let total = args.warmup + args.frames;
+    let bar = super::progress::bar(
+        u64::from(total),
+        "{bar:40} {pos}/{len} frames ({msg}), {elapsed} elapsed, {eta} left",
+    );
+    let timings = renderer.render_timed(&settings, total, clock, &|k| {
+        bar.set_position(u64::from(k));
+        bar.set_message(if k < args.warmup {
+            "warm-up"
+        } else {
+            "measured"
+        });
         FrameUpdate::at(time + k as f32 / DEFAULT_FPS)
     })?;
+    bar.finish_and_clear();
     for warning in renderer.warnings() {
         eprintln!("warning: {warning}");
     }

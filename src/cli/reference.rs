@@ -84,12 +84,9 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
     let scene = load_scene(&args.scene, &args.environment)?;
     let device = Device::new(&DeviceDesc::from_env())?;
     let mut tracer = PathTracer::new(&device, &scene, args.time, &params)?;
-    let bar = indicatif::ProgressBar::new(u64::from(args.spp));
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:40} {pos}/{len} spp, {elapsed} elapsed, {eta} left",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = super::progress::bar(
+        u64::from(args.spp),
+        "{bar:40} {pos}/{len} spp, {elapsed} elapsed, {eta} left",
     );
     let start = Instant::now();
     let step = tracer.samples_per_dispatch();

@@ -25,8 +25,10 @@ pub struct RenderArgs {
     /// name needs a frame field, %d or %04d (out/frame_%04d.png), and every frame is written.
     #[arg(short, long)]
     output: PathBuf,
-    /// Frames to render; frame k shows the scene at --time + k / --fps.
-    #[arg(long)]
+    #[arg(long, help = super::frame_args::with_default(
+        "Frames to render; frame k shows the scene at --time + k / --fps",
+        "frames",
+    ))]
     frames: Option<u32>,
     /// Frames per second of the scene clock.
     #[arg(long, default_value_t = DEFAULT_FPS)]
@@ -68,12 +70,7 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     let first_camera = scene.camera_world(0, &first_world);
     let projection = scene.cameras.first().map(|c| c.projection);
     let progress = (frames > 1).then(|| {
-        let bar = indicatif::ProgressBar::new(u64::from(frames));
-        bar.set_style(
-            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {eta} left")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-        );
-        bar
+        super::progress::bar(u64::from(frames), "{bar:40} {pos}/{len} frames, {eta} left")
     });
     let mut last_wall = std::time::Duration::ZERO;
     for k in 0..frames {

@@ -248,12 +248,9 @@ impl Progress for Bars {
         if let Some(bar) = self.bar.take() {
             bar.finish_and_clear();
         }
-        let bar = indicatif::ProgressBar::new(total);
-        bar.set_style(
-            indicatif::ProgressStyle::with_template(
-                "{prefix:>12} {bar:40} {pos}/{len} {msg}, {elapsed} elapsed, {eta} left",
-            )
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        let bar = super::progress::bar(
+            total,
+            "{prefix:>12} {bar:40} {pos}/{len} {msg}, {elapsed} elapsed, {eta} left",
         );
         bar.set_prefix(name.to_owned());
         self.bar = Some(bar);
