@@ -1,12 +1,17 @@
 //! Benchmarks: basis evaluation, cap projection (ZH eq. 14 + rotation eq. 15) and the HYB
-//! exponential at 3, 5 and 9 bands.
+//! exponential at 3, 5 and 9 bands; the tables built when a renderer starts: a GGX BRDF table
+//! (the HVL gather's, default sampling) and the triple-product tensor, at 3 and 5 bands.
+//!
+//! `cargo bench -p shine-sh --bench sh`.
 
 use std::hint::black_box;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use shine_sh::basis::eval_basis_into;
+use shine_sh::brdf_table::{BrdfModel, BrdfTable};
 use shine_sh::exp_log::ShExp;
+use shine_sh::product::TripleProduct;
 use shine_sh::zonal::{cap_sh, sphere_half_angle};
 
 fn benches(c: &mut Criterion) {
@@ -45,6 +50,25 @@ fn benches(c: &mut Criterion) {
         });
     }
     group.finish();
+    let mut tables = c.benchmark_group("tables");
+    tables.sample_size(10);
+    for bands in [3usize, 5] {
+        let ggx = BrdfModel::Ggx {
+            alpha: 0.25,
+            ior: 1.5,
+        };
+        tables.bench_with_input(
+            BenchmarkId::new("brdf_table_ggx", bands),
+            &bands,
+            |b, &n| b.iter(|| BrdfTable::build(black_box(ggx), n)),
+        );
+        tables.bench_with_input(
+            BenchmarkId::new("triple_product", bands),
+            &bands,
+            |b, &n| b.iter(|| TripleProduct::new(black_box(n))),
+        );
+    }
+    tables.finish();
 }
 
 criterion_group!(sh, benches);
