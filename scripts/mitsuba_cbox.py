@@ -2,8 +2,8 @@
 (scripts/bench.sh): samples per second of one variant, printed as JSON.
 
 Usage: python3 scripts/mitsuba_cbox.py VARIANT WIDTH HEIGHT SPP MAX_DEPTH
-(VARIANT: scalar_rgb or llvm_ad_rgb). The first render is a warm-up (the LLVM variant
-compiles its kernels then); the second is timed.
+(VARIANT: scalar_rgb or llvm_ad_rgb). The first render, at the same sample count, is a
+warm-up (the LLVM variant compiles its kernels then); the second is timed.
 """
 
 import json
@@ -22,7 +22,7 @@ def main():
     scene_dict["sensor"]["film"]["height"] = height
     scene_dict["integrator"] = {"type": "path", "max_depth": depth}
     scene = mi.load_dict(scene_dict)
-    mi.render(scene, spp=1)
+    mi.render(scene, spp=spp)
     start = time.perf_counter()
     image = mi.render(scene, spp=spp)
     # Dr.Jit evaluates lazily: wait for the render to finish.

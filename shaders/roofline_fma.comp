@@ -24,7 +24,8 @@ layout(push_constant) uniform Push {
 
 void main() {
     uint id = gl_GlobalInvocationID.x;
-    vec4 x0 = vec4(float(id) * 1e-9);
+    // Four different lanes: a compiler cannot merge them into one.
+    vec4 x0 = vec4(float(id) * 1e-9) + vec4(0.0, 0.25, 0.5, 0.75);
     vec4 x1 = x0 + 1.0;
     vec4 x2 = x0 + 2.0;
     vec4 x3 = x0 + 3.0;

@@ -67,6 +67,13 @@ fn splat_pipeline() -> GraphicsPipelineDesc {
     }
 }
 
+/// The work the splat graph's `gather` declares (the others declare none): every timing of it
+/// carries it.
+const GATHER_COST: PassCost = PassCost {
+    flops: 8 * (W * H) as u64,
+    bytes: 32 * (W * H) as u64,
+};
+
 /// compute (emit triangles) → raster (additive splats) → compute (gather into a buffer).
 fn splat_graph(executor: &Executor, result: &shine::gpu::Buffer) -> RenderGraph {
     let mut rg = executor.begin_frame();
@@ -94,8 +101,20 @@ fn splat_graph(executor: &Executor, result: &shine::gpu::Buffer) -> RenderGraph 
         .read("splats", &splats)
         .write("result", &mut out)
         .push(&[W, H])
+        .cost(GATHER_COST)
         .dispatch([W, H, 1]);
     rg
+}
+
+/// Whether `timings` carry the declared cost of `gather` and none for the other passes.
+fn costs_follow_the_passes(timings: &[PassTiming]) -> bool {
+    timings.iter().all(|t| {
+        t.cost
+            == match t.name.as_str() {
+                "gather" => Some(GATHER_COST),
+                _ => None,
+            }
+    })
 }
 
 /// What the splat graph computes, on the CPU.
@@ -151,6 +170,7 @@ fn compute_raster_compute_matches_the_cpu_and_reruns_bit_identically() {
         ]
     );
     assert!(timings.iter().all(|t| t.end_ns >= t.begin_ns));
+    assert!(costs_follow_the_passes(&timings), "{timings:?}");
     assert_clean(&device);
 }
 
@@ -167,6 +187,7 @@ fn serialized_execution_computes_the_same_and_times_each_pass() {
     assert_eq!(floats(&device, &result), splat_expected());
     let names: Vec<&str> = timings.iter().map(|t| t.name.as_str()).collect();
     assert_eq!(names, ["emit", "splat", "gather"]);
+    assert!(costs_follow_the_passes(&timings), "{timings:?}");
     for pair in timings.windows(2) {
         assert!(pair[0].begin_ns <= pair[0].end_ns && pair[0].end_ns <= pair[1].begin_ns);
     }

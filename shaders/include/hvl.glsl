@@ -11,9 +11,6 @@
 // Most emission bands an HVL record stores (paper 003 §3: 0-5 bands for the emission).
 #define HVL_EMISSION_MAX_BANDS 5
 
-// Emission bands a gather can reconstruct: at most HVL_EMISSION_MAX_BANDS and SH_BANDS.
-#define HVL_EMISSION_LOOP (SH_BANDS < HVL_EMISSION_MAX_BANDS ? SH_BANDS : HVL_EMISSION_MAX_BANDS)
-
 // One HVL of the cache, std430, 80 bytes: shine::passes::hvl::Hvl.
 struct Hvl {
     // xyz: world position y_j of the HVL centre; w: radius r_j (scaled), 0 for an empty cell

@@ -106,6 +106,7 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
         });
         FrameUpdate::at(time + k as f32 / DEFAULT_FPS)
     })?;
+    bar.set_position(u64::from(total));
     bar.finish_and_clear();
     for warning in renderer.warnings() {
         eprintln!("warning: {warning}");
@@ -162,14 +163,18 @@ fn roofline_of(
             "note: no cache directory (SHINE_CACHE_DIR, XDG_CACHE_HOME or HOME): the peaks are measured every run"
         );
     }
-    let (peaks, fresh) = roofline::cached(device, dir.as_deref())?;
-    if fresh {
+    let lookup = roofline::cached(device, dir.as_deref())?;
+    let peaks = &lookup.peaks;
+    if lookup.measured {
         eprintln!(
             "measured {}: {:.1} GFLOP/s fp32 FMA, {:.1} GB/s",
             peaks.device, peaks.gflops, peaks.gbps
         );
     }
-    Ok(RooflineReport::new(report, measured, &peaks))
+    if let Some(e) = &lookup.not_cached {
+        eprintln!("warning: {e}; the peaks will be measured again next time");
+    }
+    Ok(RooflineReport::new(report, measured, peaks))
 }
 
 /// The JSON report with what was measured beside it, so a saved report can be compared with

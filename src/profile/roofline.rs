@@ -8,8 +8,9 @@
 //! [`Peaks`] are cached per device and driver ([`cache_dir`]), so later profiles start at once.
 //!
 //! Passes declare their work ([`PassCost`], a formula beside each pass), and the report divides
-//! it by the pass's median time: achieved GFLOP/s and GB/s, their shares of the peaks, and the
-//! arithmetic intensity (flop per byte) that says which limit applies.
+//! it by the time the pass took over the measured frames: achieved GFLOP/s and GB/s, their
+//! shares of the peaks, and the arithmetic intensity (flop per byte) that says which limit
+//! applies.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -209,10 +210,22 @@ pub fn cache_dir() -> Option<PathBuf> {
         .or_else(|| var("HOME").map(|d| d.join(".cache").join("shine")))
 }
 
-/// The cached peaks of `device` in `dir`, or measured and added to the cache there (written
-/// whole to a temporary file, then renamed, so a reader never sees half a file). Returns them
-/// and whether they were measured now. A missing or unreadable cache is measured again.
-pub fn cached(device: &Device, dir: Option<&Path>) -> Result<(Peaks, bool), RooflineError> {
+/// What [`cached`] found.
+#[derive(Debug)]
+pub struct Lookup {
+    /// The device's peaks.
+    pub peaks: Peaks,
+    /// Whether they were measured now (not in the cache).
+    pub measured: bool,
+    /// Why peaks measured now could not be cached (they are still good for this run).
+    pub not_cached: Option<RooflineError>,
+}
+
+/// The cached peaks of `device` in `dir`, or measured and added to the cache there. A missing
+/// or unreadable cache, or an entry with a peak that is not positive, is measured again; a
+/// cache that cannot be written leaves the measured peaks usable ([`Lookup::not_cached`]).
+/// Errors only when the micro-kernels fail.
+pub fn cached(device: &Device, dir: Option<&Path>) -> Result<Lookup, RooflineError> {
     let info = device.info();
     let path = dir.map(|d| d.join(CACHE_FILE));
     let mut entries: Vec<Peaks> = path
@@ -222,38 +235,61 @@ pub fn cached(device: &Device, dir: Option<&Path>) -> Result<(Peaks, bool), Roof
         .unwrap_or_default();
     let same =
         |p: &Peaks| p.device == info.name && p.driver == info.driver && p.version == KERNEL_VERSION;
-    if let Some(found) = entries.iter().find(|p| same(p)) {
-        return Ok((found.clone(), false));
+    let usable = |p: &Peaks| p.gflops > 0.0 && p.gbps > 0.0;
+    if let Some(found) = entries.iter().find(|p| same(p) && usable(p)) {
+        return Ok(Lookup {
+            peaks: found.clone(),
+            measured: false,
+            not_cached: None,
+        });
     }
     let peaks = measure(device)?;
-    if let (Some(dir), Some(path)) = (dir, path) {
-        entries.retain(|p| !same(p));
-        entries.push(peaks.clone());
-        let cache_error = |source| RooflineError::Cache {
-            path: path.clone(),
-            source,
-        };
-        std::fs::create_dir_all(dir).map_err(cache_error)?;
-        let json = serde_json::to_vec_pretty(&entries).map_err(|e| cache_error(e.into()))?;
-        let partial = dir.join(format!("{CACHE_FILE}.{}.partial", std::process::id()));
-        std::fs::write(&partial, json).map_err(cache_error)?;
-        std::fs::rename(&partial, &path).map_err(cache_error)?;
-    }
-    Ok((peaks, true))
+    let not_cached = match (dir, path) {
+        (Some(dir), Some(path)) => {
+            entries.retain(|p| !same(p));
+            entries.push(peaks.clone());
+            store(dir, &path, &entries).err()
+        }
+        _ => None,
+    };
+    Ok(Lookup {
+        peaks,
+        measured: true,
+        not_cached,
+    })
 }
 
-/// One pass against the peaks.
+/// Writes `entries` to `path` in `dir` whole: to a temporary file, then renamed, so a reader
+/// never sees half a file (the temporary file is removed if that fails).
+fn store(dir: &Path, path: &Path, entries: &[Peaks]) -> Result<(), RooflineError> {
+    let cache_error = |source| RooflineError::Cache {
+        path: path.to_owned(),
+        source,
+    };
+    std::fs::create_dir_all(dir).map_err(cache_error)?;
+    let json = serde_json::to_vec_pretty(entries).map_err(|e| cache_error(e.into()))?;
+    let partial = dir.join(format!("{CACHE_FILE}.{}.partial", std::process::id()));
+    let written = std::fs::write(&partial, json).and_then(|()| std::fs::rename(&partial, path));
+    if written.is_err() {
+        let _ = std::fs::remove_file(&partial);
+    }
+    written.map_err(cache_error)
+}
+
+/// One pass against the peaks: the declared work of every measured run of it over their summed
+/// time (a pass whose work changes between frames, an amortised gather's full and sliced
+/// frames, is weighed by what each run did).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PassRoofline {
     /// The pass name.
     pub name: String,
-    /// Its declared work per run.
+    /// Its declared work, summed over the measured runs.
     pub flops: u64,
-    /// Its declared memory traffic per run, bytes.
+    /// Its declared memory traffic, summed over the measured runs, bytes.
     pub bytes: u64,
-    /// Flops over its median time, GFLOP/s.
+    /// Flops over time, GFLOP/s.
     pub gflops: f64,
-    /// Bytes over its median time, GB/s.
+    /// Bytes over time, GB/s.
     pub gbps: f64,
     /// `gflops` over the FMA peak, in [0, 1] for a correct count.
     pub flop_share: f64,
@@ -276,17 +312,25 @@ pub struct RooflineReport {
 }
 
 impl RooflineReport {
-    /// The passes of `report` whose `timings` carry a cost, against `peaks`.
+    /// The passes of `report` (in its order) whose `timings` carry a cost, against `peaks`.
     pub fn new(report: &ProfileReport, timings: &[PassTiming], peaks: &Peaks) -> Self {
-        let cost_of = |name: &str| -> Option<PassCost> {
-            timings.iter().find(|t| t.name == name).and_then(|t| t.cost)
-        };
         let passes = report
             .passes
             .iter()
             .filter_map(|p| {
-                let cost = cost_of(&p.name)?;
-                let seconds = (p.time.median_ms / 1e3).max(1e-12);
+                let (mut work, mut seconds) = (PassCost::default(), 0.0);
+                for t in timings.iter().filter(|t| t.name == p.name) {
+                    let cost = t.cost?;
+                    work.flops += cost.flops;
+                    work.bytes += cost.bytes;
+                    seconds += (t.end_ns - t.begin_ns) / 1e9;
+                }
+                let cost = work;
+                let seconds = if cost.flops + cost.bytes > 0 {
+                    seconds.max(1e-12)
+                } else {
+                    return None;
+                };
                 let gflops = cost.flops as f64 / seconds / 1e9;
                 let gbps = cost.bytes as f64 / seconds / 1e9;
                 Some(PassRoofline {
@@ -355,10 +399,10 @@ mod tests {
     use super::*;
     use crate::profile::report::PassClock;
 
-    /// Achieved rates are the declared work over the median time; passes without a declared
-    /// cost are left out; the ridge is the peaks' ratio.
+    /// Achieved rates are the declared work of the runs over their summed time; passes without
+    /// a declared cost are left out; the ridge is the peaks' ratio.
     #[test]
-    fn shares_are_the_declared_work_over_the_median_time() {
+    fn shares_are_the_declared_work_over_the_time_it_took() {
         let cost = PassCost {
             flops: 2_000_000_000,
             bytes: 4_000_000,
@@ -373,7 +417,7 @@ mod tests {
         let timings: Vec<PassTiming> = (0..3)
             .flat_map(|f| {
                 [
-                    timing("gather", f, [4.0, 5.0, 40.0][f as usize], Some(cost)),
+                    timing("gather", f, [4.0, 5.0, 11.0][f as usize], Some(cost)),
                     timing("blit", f, 1.0, None),
                 ]
             })
@@ -389,11 +433,12 @@ mod tests {
         let roofline = RooflineReport::new(&report, &timings, &peaks);
         assert_eq!(roofline.passes.len(), 1);
         let gather = &roofline.passes[0];
-        // Median 5 ms: 400 GFLOP/s, 0.8 GB/s.
-        assert!((gather.gflops - 400.0).abs() < 1e-9);
-        assert!((gather.flop_share - 0.4).abs() < 1e-12);
-        assert!((gather.gbps - 0.8).abs() < 1e-12);
-        assert!((gather.byte_share - 0.08).abs() < 1e-12);
+        // 6 GFLOP and 12 MB in 20 ms: 300 GFLOP/s, 0.6 GB/s.
+        assert_eq!((gather.flops, gather.bytes), (6_000_000_000, 12_000_000));
+        assert!((gather.gflops - 300.0).abs() < 1e-9);
+        assert!((gather.flop_share - 0.3).abs() < 1e-12);
+        assert!((gather.gbps - 0.6).abs() < 1e-12);
+        assert!((gather.byte_share - 0.06).abs() < 1e-12);
         assert!((gather.intensity - 500.0).abs() < 1e-12);
         assert!((roofline.ridge - 100.0).abs() < 1e-12);
         assert!(roofline.to_table().contains("gather"));

@@ -14,7 +14,6 @@ use crate::error::ExecuteError;
 use crate::gpu_resources::DeviceMemory;
 use crate::graph::RenderGraph;
 use crate::objects::GraphObjects;
-use crate::pass::PassCost;
 use crate::pipelines::PipelineCache;
 use crate::plan::Plan;
 use crate::record::{Recorder, check_area};
@@ -47,9 +46,6 @@ pub struct Executor {
     objects: GraphObjects,
     /// Timings read from a slot before its reuse, not returned by [`Executor::timings`] yet.
     timings: Vec<PassTiming>,
-    /// The declared work of every pass executed so far, by name, for the timestamp timings
-    /// (their scopes carry only names).
-    costs: std::collections::HashMap<String, PassCost>,
 }
 
 impl std::fmt::Debug for Executor {
@@ -80,7 +76,6 @@ impl Executor {
             pipelines: PipelineCache::default(),
             objects: GraphObjects::default(),
             timings: Vec::new(),
-            costs: std::collections::HashMap::new(),
         })
     }
 
@@ -170,12 +165,7 @@ impl Executor {
         self.timings.extend(slot.timestamps.take_before_reuse()?);
         slot.descriptors.reset()?;
         if let Some(cb) = cb {
-            slot.timestamps.pool.reset(cb);
-        }
-        for pass in &plan.passes {
-            if let Some(cost) = pass.cost {
-                self.costs.insert(pass.name.clone(), cost);
-            }
+            slot.timestamps.reset(cb);
         }
         let mut host_timings = Vec::new();
         let start = std::time::Instant::now();
@@ -192,7 +182,7 @@ impl Executor {
             let recorder = Recorder::new(&self.device, pass_cb, &plan, &objects);
             recorder.barriers(&pass.barriers);
             if cb.is_some() {
-                slot.timestamps.pool.begin(pass_cb, &pass.name)?;
+                slot.timestamps.begin(pass_cb, &pass.name, pass.cost)?;
             }
             self.device.begin_label(pass_cb, &pass.name);
             let work = std::mem::replace(&mut graph.works[pass.id.0 as usize], Work::Declared);
@@ -256,11 +246,7 @@ impl Executor {
                 None => break,
             }
         }
-        let mut timings = std::mem::take(&mut self.timings);
-        for t in &mut timings {
-            t.cost = t.cost.or_else(|| self.costs.get(&t.name).copied());
-        }
-        Ok(timings)
+        Ok(std::mem::take(&mut self.timings))
     }
 }
 

@@ -27,6 +27,8 @@ pub(crate) struct SlotTimestamps {
     pub pool: TimestampPool,
     /// The frame recorded with this slot whose timings were not read yet.
     unread: Option<u64>,
+    /// The declared work of each scope's pass, in the order the scopes were begun.
+    costs: Vec<Option<crate::PassCost>>,
 }
 
 impl SlotTimestamps {
@@ -35,7 +37,26 @@ impl SlotTimestamps {
         Ok(Self {
             pool: TimestampPool::new(device, SCOPES_PER_FRAME)?,
             unread: None,
+            costs: Vec::new(),
         })
+    }
+
+    /// Resets the scopes at the start of a frame's recording into `cb`.
+    pub fn reset(&mut self, cb: shine_gpu::vk::CommandBuffer) {
+        self.pool.reset(cb);
+        self.costs.clear();
+    }
+
+    /// Opens the scope of pass `name`, whose declared work is `cost`.
+    pub fn begin(
+        &mut self,
+        cb: shine_gpu::vk::CommandBuffer,
+        name: &str,
+        cost: Option<crate::PassCost>,
+    ) -> Result<(), shine_gpu::Error> {
+        self.pool.begin(cb, name)?;
+        self.costs.push(cost);
+        Ok(())
     }
 
     /// The scopes now hold `frame`'s passes, to be read by [`SlotTimestamps::take`].
@@ -61,15 +82,17 @@ impl SlotTimestamps {
         }
         // Read (or unreadable): it counts as read either way.
         self.unread = None;
+        let costs = &self.costs;
         Ok(read?.map(|timings| {
             timings
                 .into_iter()
-                .map(|t| PassTiming {
+                .enumerate()
+                .map(|(i, t)| PassTiming {
                     name: t.name,
                     begin_ns: t.begin_ns,
                     end_ns: t.end_ns,
                     frame,
-                    cost: None,
+                    cost: costs.get(i).copied().flatten(),
                 })
                 .collect()
         }))

@@ -260,7 +260,7 @@ fn prepare(
 /// Every pair is counted as lit: a SIMD group runs the whole path whenever one of its lanes
 /// does. The shadow rays' traversal is not counted (it depends on the scene's BVH).
 pub fn gather_pair_flops(path: GatherPath, b: u32, sampled_shadows: bool) -> u64 {
-    let b = u64::from(b);
+    let b = u64::from(b.max(1));
     let cap = 7 * (b - 1) + 2;
     let specific = match path {
         GatherPath::Full => {
