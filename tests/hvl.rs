@@ -340,10 +340,11 @@ fn gpu_gather(
         rg.import_gpu_buffer(&hvl_buffer, uploaded_state(), UNUSED_AFTER);
     let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
     let bvh_handles = bvh.map(|b| b.import(&mut rg, uploaded_state()));
+    let records = hvl_gather_prep(&mut rg, &hvl_handle, params).unwrap();
     let indirect = hvl_gather(
         &mut rg,
         &recv,
-        &hvl_handle,
+        &records,
         &brdf_handle,
         bvh_handles.as_ref(),
         camera,
@@ -771,7 +772,7 @@ fn gather_records_match_the_cpu_twin() {
         let mut executor = Executor::new(&device, 1).unwrap();
         let mut rg = executor.begin_frame();
         let handle = rg.import_gpu_buffer(&buffer, uploaded_state(), UNUSED_AFTER);
-        let records = hvl_gather_prep(&mut rg, &handle, &p);
+        let records = hvl_gather_prep(&mut rg, &handle, &p).unwrap();
         let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
         rg.copy_buffer("read_records", &records, &mut out);
         common::run_graph(&device, &mut executor, rg);
@@ -1127,8 +1128,9 @@ fn indirect_is_linear_in_flux_and_zero_without_flux() {
         let recv = recv_images.import(&mut rg, RECV);
         let brdf_handle = rg.import_gpu_buffer(&brdf_buffer, uploaded_state(), UNUSED_AFTER);
         let hvls = hvl_cache(&mut rg, &[rsm_handles], &p).unwrap();
+        let records = hvl_gather_prep(&mut rg, &hvls, &p).unwrap();
         let indirect =
-            hvl_gather(&mut rg, &recv, &hvls, &brdf_handle, None, CAMERA, &p, 0).unwrap();
+            hvl_gather(&mut rg, &recv, &records, &brdf_handle, None, CAMERA, &p, 0).unwrap();
         read_indirect(&mut rg, &indirect, &readback);
         common::run_graph(&device, &mut executor, rg);
         let out = common::decode_rgba16f(&device.read_buffer(&readback).unwrap());

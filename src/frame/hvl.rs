@@ -113,12 +113,13 @@ impl PreparedHvl {
         params.shadows.seed = inputs.seed;
         params.near_range = inputs.near_range;
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
+        let records = hvl::hvl_gather_prep(rg, &hvls, &params)?;
         let bvh = params.visibility.then_some(inputs.bvh);
         let slice = self.amortised.map_or(0, |s| s.slice);
         let mut gathered = hvl::hvl_gather(
             rg,
             inputs.receivers,
-            &hvls,
+            &records,
             &self.brdf,
             bvh,
             inputs.camera,
@@ -144,7 +145,7 @@ impl PreparedHvl {
             hvl::hvl_regather(
                 rg,
                 inputs.receivers,
-                &hvls,
+                &records,
                 &self.brdf,
                 bvh,
                 inputs.camera,

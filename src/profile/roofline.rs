@@ -27,9 +27,9 @@ use crate::shaders;
 pub const FMA_THREADS: u32 = 1 << 20;
 /// Floating-point operations per loop iteration of the FMA kernel per invocation (32 vec4
 /// FMAs).
-pub const FMA_FLOPS_PER_STEP: u64 = 256;
+pub const FMA_FLOPS_PER_ITERATION: u64 = 256;
 /// Most loop iterations per invocation: llvmpipe ends an invocation's loops after 65 535.
-pub const FMA_MAX_STEPS: u32 = 65_535;
+pub const FMA_MAX_ITERATIONS: u32 = 65_535;
 /// vec4 elements of each buffer of the copy kernel: 64 MiB, far beyond any cache.
 pub const COPY_ELEMENTS: u32 = 1 << 22;
 /// Most copies in one submission.
@@ -145,11 +145,11 @@ fn measure_fma(device: &Device) -> Result<f64, RooflineError> {
             cmd.dispatch_threads(&pipeline, [FMA_THREADS, 1, 1]);
             Ok(())
         })?;
-        if seconds >= MIN_RUN_S || iterations >= FMA_MAX_STEPS {
-            let flops = u64::from(FMA_THREADS) * u64::from(iterations) * FMA_FLOPS_PER_STEP;
+        if seconds >= MIN_RUN_S || iterations >= FMA_MAX_ITERATIONS {
+            let flops = u64::from(FMA_THREADS) * u64::from(iterations) * FMA_FLOPS_PER_ITERATION;
             return Ok(flops as f64 / seconds / 1e9);
         }
-        iterations = (iterations * 2).min(FMA_MAX_STEPS);
+        iterations = (iterations * 2).min(FMA_MAX_ITERATIONS);
     }
 }
 
@@ -318,19 +318,18 @@ impl RooflineReport {
             .passes
             .iter()
             .filter_map(|p| {
-                let (mut work, mut seconds) = (PassCost::default(), 0.0);
+                // Every run of the pass must have declared its work.
+                let (mut cost, mut seconds) = (PassCost::default(), 0.0);
                 for t in timings.iter().filter(|t| t.name == p.name) {
-                    let cost = t.cost?;
-                    work.flops += cost.flops;
-                    work.bytes += cost.bytes;
+                    let run = t.cost?;
+                    cost.flops += run.flops;
+                    cost.bytes += run.bytes;
                     seconds += (t.end_ns - t.begin_ns) / 1e9;
                 }
-                let cost = work;
-                let seconds = if cost.flops + cost.bytes > 0 {
-                    seconds.max(1e-12)
-                } else {
+                if cost.flops + cost.bytes == 0 {
                     return None;
-                };
+                }
+                let seconds = seconds.max(1e-12);
                 let gflops = cost.flops as f64 / seconds / 1e9;
                 let gbps = cost.bytes as f64 / seconds / 1e9;
                 Some(PassRoofline {

@@ -17,7 +17,9 @@ use crate::passes::receivers::Receivers;
 use shadows::Shadowing;
 
 /// Adds the `hvl_gather` pass: the `indirect` image (RGBA16F, receiver resolution, outgoing
-/// radiance towards `camera` from all `params.count` HVLs of `hvls`, 0 on background), returned.
+/// radiance towards `camera` from all `params.count` HVLs, 0 on background), returned.
+/// `records` holds the HVLs as [`hvl_gather_prep`] prepared them (once a frame, for the gather
+/// and the regather).
 /// `brdf` holds [`GatherBrdf::gpu_data`] at `params.conv_bands` bands (unused by the zonal
 /// path); `bvh` is needed when `params.visibility` is set. `slice` 0 shades every receiver,
 /// 1 + k one per 2×2 cell (the others are left undefined: `hvl_resolve` fills them). Sampled
@@ -26,14 +28,14 @@ use shadows::Shadowing;
 pub fn hvl_gather(
     rg: &mut RenderGraph,
     receivers: &Receivers,
-    hvls: &Handle<Buffer>,
+    records: &Handle<Buffer>,
     brdf: &Handle<Buffer>,
     bvh: Option<&TraceBuffers>,
     camera: Vec3,
     params: &HvlParams,
     slice: u32,
 ) -> Result<Handle<Image>, HvlError> {
-    let (shader, inputs) = GatherInputs::checked(receivers, hvls, brdf, bvh, camera, params)?;
+    let (shader, inputs) = GatherInputs::checked(receivers, records, brdf, bvh, camera, params)?;
     let mut indirect = receivers.light_image(rg, "indirect");
     Ok(
         match record_gather(rg, shader, &inputs, params, &mut indirect, slice) {
@@ -51,20 +53,20 @@ pub fn hvl_gather(
 }
 
 /// Adds `hvl_regather`: the gather at the receivers `hvl_regather_mask` marked in `target`
-/// (alpha -1), written there (amortised frames, [`amortise`]); sampled shadows take each
-/// receiver's own ratio there, unfiltered.
+/// (alpha -1), written there (amortised frames, [`amortise`]), from the same `records` as the
+/// frame's `hvl_gather`; sampled shadows take each receiver's own ratio there, unfiltered.
 #[allow(clippy::too_many_arguments)]
 pub fn hvl_regather(
     rg: &mut RenderGraph,
     receivers: &Receivers,
-    hvls: &Handle<Buffer>,
+    records: &Handle<Buffer>,
     brdf: &Handle<Buffer>,
     bvh: Option<&TraceBuffers>,
     camera: Vec3,
     params: &HvlParams,
     target: &mut Handle<Image>,
 ) -> Result<(), HvlError> {
-    let (shader, inputs) = GatherInputs::checked(receivers, hvls, brdf, bvh, camera, params)?;
+    let (shader, inputs) = GatherInputs::checked(receivers, records, brdf, bvh, camera, params)?;
     record_gather(
         rg,
         shader,
@@ -79,7 +81,7 @@ pub fn hvl_regather(
 /// What a gather pass reads.
 struct GatherInputs<'a> {
     receivers: &'a Receivers,
-    hvls: &'a Handle<Buffer>,
+    records: &'a Handle<Buffer>,
     brdf: &'a Handle<Buffer>,
     bvh: Option<&'a TraceBuffers>,
     camera: Vec3,
@@ -90,7 +92,7 @@ impl<'a> GatherInputs<'a> {
     /// buffer sizes, a BVH when `params.visibility` is set.
     fn checked(
         receivers: &'a Receivers,
-        hvls: &'a Handle<Buffer>,
+        records: &'a Handle<Buffer>,
         brdf: &'a Handle<Buffer>,
         bvh: Option<&'a TraceBuffers>,
         camera: Vec3,
@@ -110,11 +112,11 @@ impl<'a> GatherInputs<'a> {
         ] {
             check_extent(name, image, receivers.extent)?;
         }
-        let need = cache_bytes(params.count);
-        if hvls.desc().size < need {
+        let need = records_bytes(params);
+        if records.desc().size < need {
             return Err(HvlError::Size {
-                name: "hvls",
-                actual: format!("{} bytes", hvls.desc().size),
+                name: "hvl_records",
+                actual: format!("{} bytes", records.desc().size),
                 expected: format!("at least {need} bytes for {} HVLs", params.count),
             });
         }
@@ -131,7 +133,7 @@ impl<'a> GatherInputs<'a> {
         }
         let inputs = Self {
             receivers,
-            hvls,
+            records,
             brdf,
             bvh,
             camera,
@@ -175,7 +177,6 @@ fn record_gather(
     } else {
         "hvl_gather"
     };
-    let records = prepare(rg, &format!("{name}_prep"), inputs.hvls, params);
     let threads = amortise::slice_threads([w, h], slice);
     let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
     let mut unshadowed = sampled.then(|| receivers.light_image(rg, "hvl_unshadowed"));
@@ -184,7 +185,7 @@ fn record_gather(
         .read("recv_normal", &receivers.normal)
         .read("recv_albedo", &receivers.albedo)
         .read("recv_material", &receivers.material)
-        .read("hvl_records", &records);
+        .read("hvl_records", inputs.records);
     if params.path == GatherPath::Full {
         pass.read("brdf", inputs.brdf);
     }
@@ -205,30 +206,29 @@ fn record_gather(
 }
 
 /// Adds `hvl_gather_prep`: the first `params.count` HVLs of `hvls` as [`GatherHvl`] records in
-/// a new buffer, returned (per-HVL terms of the gather computed once; CPU twin
-/// [`crate::reference::hvl::gather_records`]). The gather passes add it themselves.
+/// a new buffer, returned (per-HVL terms of the gather computed once a frame, read by
+/// [`hvl_gather`] and [`hvl_regather`]; CPU twin [`crate::reference::hvl::gather_records`]).
 pub fn hvl_gather_prep(
     rg: &mut RenderGraph,
     hvls: &Handle<Buffer>,
     params: &HvlParams,
-) -> Handle<Buffer> {
-    prepare(rg, "hvl_gather_prep", hvls, params)
-}
-
-/// [`hvl_gather_prep`] under the pass name `name` (`hvl_regather_prep` beside `hvl_regather`).
-fn prepare(
-    rg: &mut RenderGraph,
-    name: &str,
-    hvls: &Handle<Buffer>,
-    params: &HvlParams,
-) -> Handle<Buffer> {
+) -> Result<Handle<Buffer>, HvlError> {
+    params.validate_gather()?;
+    let need = cache_bytes(params.count);
+    if hvls.desc().size < need {
+        return Err(HvlError::Size {
+            name: "hvls",
+            actual: format!("{} bytes", hvls.desc().size),
+            expected: format!("at least {need} bytes for {} HVLs", params.count),
+        });
+    }
     let bytes = records_bytes(params);
-    let mut records = rg.create_buffer(&format!("{name}_records"), BufferDesc::new(bytes));
+    let mut records = rg.create_buffer("hvl_records", BufferDesc::new(bytes));
     let push = PrepPush {
         count: params.count,
         emission_bands: params.emission_bands,
     };
-    rg.compute(name, &crate::shaders::HVL_GATHER_PREP_COMP)
+    rg.compute("hvl_gather_prep", &crate::shaders::HVL_GATHER_PREP_COMP)
         .read("hvls", hvls)
         .write("hvl_records", &mut records)
         .push(&push)
@@ -239,7 +239,7 @@ fn prepare(
             bytes: cache_bytes(params.count) + bytes,
         })
         .dispatch([params.count, 1, 1]);
-    records
+    Ok(records)
 }
 
 /// Floating-point operations of one receiver–HVL pair, counted from `hvl_gather.comp` (a fused
