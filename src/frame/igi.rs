@@ -25,6 +25,8 @@ use crate::passes::rsm::Rsm;
 pub struct IgiTechnique {
     brdf: BrdfTables,
     schedule: Schedule,
+    /// The device's `maxStorageBufferRange` ([`IgiParams::storage_limit`]).
+    storage_limit: u64,
 }
 
 /// An IGI frame ready to be declared: its parameters and, for the GGX resolve, its tables
@@ -55,6 +57,7 @@ impl IgiTechnique {
         Self {
             brdf: BrdfTables::new(device, "igi brdf tables"),
             schedule: Schedule::default(),
+            storage_limit: u64::from(device.info().max_storage_buffer_range),
         }
     }
 
@@ -80,9 +83,10 @@ impl IgiTechnique {
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
-        params: IgiParams,
+        mut params: IgiParams,
         extent: [u32; 2],
     ) -> Result<PreparedIgi, RenderError> {
+        params.storage_limit = self.storage_limit;
         // The SH history's layout: another order or mode is no history.
         let words = params.coefficients() * igi::COEFFICIENT_WORDS;
         let amortised = self.schedule.next(rg.frame(), extent, params.slices, words);

@@ -11,7 +11,7 @@ use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::HvlParams;
 use crate::passes::hvl::near::NearField;
 use crate::passes::hvl::shadows::ShadowSampling;
-use crate::passes::igi::IgiParams;
+use crate::passes::igi::{self, IgiParams};
 use crate::passes::proxy::{Accumulation, ProxyParams, paper_expansion};
 use crate::passes::sky::SkyParams;
 use crate::passes::specular::SpecularParams;
@@ -174,6 +174,8 @@ impl FrameParams {
                 normal_threshold: i.normal_threshold,
                 specular_limit,
                 slices: i.slices,
+                // The device's limit replaces it when the frame is prepared.
+                storage_limit: igi::MAX_STORAGE_BUFFER,
             }),
             proxy: gi.contains(GiTechnique::Proxy).then_some(ProxySetup {
                 pass: ProxyParams {

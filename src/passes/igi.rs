@@ -76,7 +76,8 @@ use crate::passes::hvl::{self, HvlError, HvlParams};
 use crate::passes::rsm::Rsm;
 use crate::shaders;
 
-/// Largest storage buffer every Vulkan device allows (`maxStorageBufferRange` ≥ 2²⁷ bytes).
+/// Largest storage buffer every Vulkan device allows (`maxStorageBufferRange` ≥ 2²⁷ bytes):
+/// [`IgiParams::storage_limit`]'s default, which the frame replaces with its device's limit.
 pub const MAX_STORAGE_BUFFER: u64 = 1 << 27;
 
 /// Bytes per stored rgb coefficient of `vpl_sh` (two u32 of packed halves).
@@ -151,6 +152,9 @@ pub struct IgiParams {
     /// sets of one pixel per 2×2 cell per frame and the others keep theirs, reprojected
     /// ([`IgiSlice`], `igi_reproject`: [`amortise::reproject_records`]).
     pub slices: u32,
+    /// Bytes one storage buffer may hold on the device (`maxStorageBufferRange`; lavapipe's
+    /// is [`MAX_STORAGE_BUFFER`], NVIDIA's 4 GiB): bounds the per-pixel SH buffer.
+    pub storage_limit: u64,
 }
 
 /// Which pixels one `vpl_sh` dispatch gathers, and into which buffer: paper 001's amortised
@@ -183,6 +187,7 @@ impl Default for IgiParams {
             normal_threshold: 0.9,
             specular_limit: 0.0,
             slices: 1,
+            storage_limit: MAX_STORAGE_BUFFER,
         }
     }
 }
@@ -239,7 +244,7 @@ pub enum IgiError {
     OutOfRange(#[from] super::OutOfRange),
     /// The per-pixel SH buffer would exceed one storage buffer.
     #[error(
-        "IGI per-pixel radiance of {width}×{height} pixels × {coefficients} coefficients needs {bytes} bytes, more than the {MAX_STORAGE_BUFFER} bytes of one storage buffer: lower igi.sh_order or the resolution"
+        "IGI per-pixel radiance of {width}×{height} pixels × {coefficients} coefficients needs {bytes} bytes, more than the {limit} bytes of one storage buffer on this device: lower igi.sh_order or the resolution"
     )]
     TooLarge {
         /// Image width.
@@ -250,6 +255,8 @@ pub enum IgiError {
         coefficients: u32,
         /// Bytes needed.
         bytes: u64,
+        /// Bytes one storage buffer may hold ([`IgiParams::storage_limit`]).
+        limit: u64,
     },
     /// The VPL construction (the HVL cache pass) refused its inputs.
     #[error(transparent)]
@@ -311,12 +318,13 @@ impl IgiParams {
             * u64::from(extent[1])
             * u64::from(coefficients)
             * COEFFICIENT_BYTES;
-        if bytes > MAX_STORAGE_BUFFER {
+        if bytes > self.storage_limit {
             return Err(IgiError::TooLarge {
                 width: extent[0],
                 height: extent[1],
                 coefficients,
                 bytes,
+                limit: self.storage_limit,
             });
         }
         Ok(bytes)
@@ -555,6 +563,12 @@ mod tests {
             p.sh_bytes([1920, 1080]),
             Err(IgiError::TooLarge { .. })
         ));
+        // A device with a larger limit (NVIDIA's 4 GiB) takes the 1080p frame.
+        let large = IgiParams {
+            storage_limit: 1 << 32,
+            ..p
+        };
+        assert_eq!(large.sh_bytes([1920, 1080]), Ok(1920 * 1080 * 16 * 8));
         let bad = IgiParams {
             pattern: [0, 4],
             ..IgiParams::default()

@@ -153,14 +153,24 @@ impl Buffer {
         &self.name
     }
 
-    /// The persistently mapped bytes, for host-visible buffers.
+    /// The persistently mapped bytes of a host-visible buffer: exactly [`Buffer::size`] of
+    /// them, although the allocation behind may be larger (drivers round a buffer's memory
+    /// requirements up: NVIDIA's by up to its alignment).
     pub fn mapped(&self) -> Option<&[u8]> {
-        self.allocation.as_ref().and_then(|a| a.mapped_slice())
+        let size = self.size as usize;
+        self.allocation
+            .as_ref()
+            .and_then(|a| a.mapped_slice())
+            .map(|s| &s[..size])
     }
 
-    /// The persistently mapped bytes, mutable, for host-visible buffers.
+    /// The persistently mapped bytes, mutable: [`Buffer::mapped`]'s.
     pub fn mapped_mut(&mut self) -> Option<&mut [u8]> {
-        self.allocation.as_mut().and_then(|a| a.mapped_slice_mut())
+        let size = self.size as usize;
+        self.allocation
+            .as_mut()
+            .and_then(|a| a.mapped_slice_mut())
+            .map(|s| &mut s[..size])
     }
 }
 
