@@ -6,7 +6,9 @@
 // Path: the camera ray hits vertex 0; at every vertex the punctual lights are sampled
 // (next-event estimation, shadow rays through trace.glsl) and the BRDF is importance-sampled
 // (Lambert + GGX mixture, brdf.glsl) for the next ray, which gathers emission and the
-// environment where it lands. A contribution that scattered once is direct, more than once is
+// environment where it lands. With PT_LIGHT_SAMPLING the emissive triangles and the
+// environment are also sampled at every vertex (light_sampling.glsl), and both estimates of
+// their light are weighted by the power heuristic. A contribution that scattered once is direct, more than once is
 // indirect; what the camera sees unscattered (emission, background) is direct. `bounces` B
 // vertices after the first scatter further (B = 1: one-bounce indirect, what the GI techniques
 // compute). No Russian roulette, no clamping; a non-finite sample is dropped.
@@ -44,10 +46,26 @@ layout(push_constant) uniform Push {
 #define PATH_LIGHT_COUNT push.config.y
 #define PATH_FLAGS push.config.z
 #include "path.glsl"
+#define LIGHT_TABLES_BINDING 14
+#include "light_sampling.glsl"
 
 vec3 unproject(vec2 ndc, float z) {
     vec4 p = push.inv_view_proj * vec4(ndc, z, 1.0);
     return p.xyz / p.w;
+}
+
+// One light sample's contribution at x (times the path's throughput): the BRDF, the cosine
+// and the radiance over the light's density, weighted against BRDF sampling; 0 when l is
+// below either normal or the shadow ray from `from` meets something before `t_max`.
+vec3 light_contribution(Vertex x, vec3 v, vec3 from, vec3 l, float t_max, vec3 radiance, float pdf) {
+    float nl = dot(x.s.normal, l);
+    if (!(pdf > 0.0) || nl <= 0.0 || dot(x.geometric_normal, l) <= 0.0 || all(equal(radiance, vec3(0.0)))) {
+        return vec3(0.0);
+    }
+    if (trace_occluded(from, l, 0.0, t_max)) {
+        return vec3(0.0);
+    }
+    return brdf(x, l, v) * radiance * nl / pdf * light_mis(pdf, brdf_sample_pdf(x, l, v));
 }
 
 void main() {
@@ -58,6 +76,9 @@ void main() {
     }
     uint bounces = push.config.x;
     uint flags = push.config.z;
+    bool sample_lights = (flags & PT_LIGHT_SAMPLING) != 0u;
+    bool sample_emitters = sample_lights && (flags & PT_EMISSIVE_LIGHTING) != 0u && light_emitter_count() > 0u;
+    bool sample_environment = sample_lights && light_environment_on();
     vec3 sum_direct = vec3(0.0);
     vec3 sum_indirect = vec3(0.0);
     for (uint s = 0u; s < push.frame.w; ++s) {
@@ -71,11 +92,14 @@ void main() {
         vec3 throughput = vec3(1.0);
         vec3 direct = vec3(0.0);
         vec3 indirect = vec3(0.0);
+        // The solid-angle density of the BRDF sample that chose `dir` (after the camera ray).
+        float last_pdf = 0.0;
         // `scatters`: surface interactions before the current ray (0 for the camera ray).
         for (uint scatters = 0u; ; ++scatters) {
             TraceHit hit;
             if (!trace_closest(origin, dir, 0.0, PT_FAR, hit)) {
-                vec3 env = throughput * environment_radiance(dir);
+                float w = scatters > 0u && sample_environment ? light_mis(last_pdf, light_environment_pdf(dir)) : 1.0;
+                vec3 env = w * throughput * environment_radiance(dir);
                 if (scatters <= 1u) {
                     direct += env;
                 } else {
@@ -87,17 +111,33 @@ void main() {
             vec3 v = -dir;
             if (scatters == 0u) {
                 direct += x.s.emissive;
-            } else if ((flags & PT_EMISSIVE_LIGHTING) != 0u) {
+            } else if ((flags & PT_EMISSIVE_LIGHTING) != 0u && any(greaterThan(x.s.emissive, vec3(0.0)))) {
+                float w = sample_emitters ? light_mis(last_pdf, light_triangle_pdf(hit.triangle, origin, x.position)) : 1.0;
                 if (scatters == 1u) {
-                    direct += throughput * x.s.emissive;
+                    direct += w * throughput * x.s.emissive;
                 } else {
-                    indirect += throughput * x.s.emissive;
+                    indirect += w * throughput * x.s.emissive;
                 }
             }
             if (scatters > bounces) {
                 break;
             }
             vec3 nee = throughput * punctual_lights(x, v);
+            vec3 from = trace_offset(x.position, x.geometric_normal);
+            if (sample_emitters) {
+                vec3 l;
+                float d;
+                vec3 radiance;
+                float pdf = light_sample_triangle(from, vec3(rand(), rand(), rand()), l, d, radiance);
+                nee += throughput * light_contribution(x, v, from, l, d * (1.0 - 1e-4), radiance, pdf);
+            }
+            if (sample_environment) {
+                vec3 l;
+                float pdf = light_sample_environment(vec3(rand(), rand(), rand()), l);
+                if (pdf > 0.0) {
+                    nee += throughput * light_contribution(x, v, from, l, PT_FAR, environment_radiance(l), pdf);
+                }
+            }
             if (scatters == 0u) {
                 direct += nee;
             } else {
@@ -111,17 +151,18 @@ void main() {
             if ((flags & PT_LAMBERT_ONLY) != 0u) {
                 l = sample_cosine(n, xi.xy);
                 weight = x.s.base_color;
+                last_pdf = max(dot(n, l), 0.0) / BRDF_PI;
             } else {
                 float p_specular = brdf_specular_probability(x.s.base_color, x.s.metallic);
                 l = brdf_sample(n, v, p_specular, x.s.roughness, xi);
-                float pdf = brdf_pdf(n, l, v, p_specular, x.s.roughness);
-                weight = pdf > 0.0 ? brdf(x, l, v) * max(dot(n, l), 0.0) / pdf : vec3(0.0);
+                last_pdf = brdf_pdf(n, l, v, p_specular, x.s.roughness);
+                weight = last_pdf > 0.0 ? brdf(x, l, v) * max(dot(n, l), 0.0) / last_pdf : vec3(0.0);
             }
             if (dot(n, l) <= 0.0 || dot(x.geometric_normal, l) <= 0.0 || all(equal(weight, vec3(0.0)))) {
                 break;
             }
             throughput *= weight;
-            origin = trace_offset(x.position, x.geometric_normal);
+            origin = from;
             dir = l;
         }
         if (any(isnan(direct)) || any(isinf(direct)) || any(isnan(indirect)) || any(isinf(indirect))) {

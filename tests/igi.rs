@@ -676,6 +676,7 @@ fn room_reference() -> &'static ReferenceImages {
             jitter: false,
             emissive_lighting: false,
             lambert_only: false,
+            light_sampling: true,
             seed: 0,
         };
         let images = render_reference(&device, &spot_room(), 0.0, &params, REFERENCE_SPP)

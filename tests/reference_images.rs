@@ -53,6 +53,7 @@ fn reference(bounces: u32, spp: u32) -> shine::reference::ReferenceImages {
         jitter: false,
         emissive_lighting: false,
         lambert_only: false,
+        light_sampling: true,
         seed: 0,
     };
     let images = render_reference(&device, &scene, 0.0, &params, spp).expect("reference");
@@ -169,6 +170,7 @@ fn spheres_proxy_frame_against_the_path_traced_reference() {
         jitter: false,
         emissive_lighting: false,
         lambert_only: false,
+        light_sampling: true,
         seed: 0,
     };
     let reference = render_reference(&device, &scene, 0.0, &params, 256).expect("reference");

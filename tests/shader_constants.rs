@@ -3,7 +3,9 @@
 
 use shine::capture::tonemap::Tonemap;
 use shine::passes::hvl::EMISSION_MAX_BANDS;
-use shine::passes::path_trace::{FLAG_EMISSIVE_LIGHTING, FLAG_JITTER, FLAG_LAMBERT_ONLY};
+use shine::passes::path_trace::{
+    FLAG_EMISSIVE_LIGHTING, FLAG_JITTER, FLAG_LAMBERT_ONLY, FLAG_LIGHT_SAMPLING,
+};
 use shine::passes::proxy::{MAX_PROXIES, TABLE_ENTRIES, TILE_WORDS};
 use shine_scene::{Light, LightKind, NO_TEXTURE};
 use std::path::Path;
@@ -44,6 +46,7 @@ fn path_trace_flags_match_the_shader() {
         ("PT_JITTER", FLAG_JITTER),
         ("PT_EMISSIVE_LIGHTING", FLAG_EMISSIVE_LIGHTING),
         ("PT_LAMBERT_ONLY", FLAG_LAMBERT_ONLY),
+        ("PT_LIGHT_SAMPLING", FLAG_LIGHT_SAMPLING),
     ] {
         assert_eq!(glsl_uint("include/path.glsl", name), rust, "{name}");
     }

@@ -25,6 +25,7 @@ DEFINE_LOAD_LIGHT(lights)
 const uint PT_JITTER = 1u;
 const uint PT_EMISSIVE_LIGHTING = 2u;
 const uint PT_LAMBERT_ONLY = 4u;
+const uint PT_LIGHT_SAMPLING = 8u;
 const float PT_FAR = 1e30;
 
 #include "random.glsl"
@@ -61,6 +62,15 @@ vec3 brdf(Vertex x, vec3 l, vec3 v) {
         return x.s.base_color / BRDF_PI;
     }
     return brdf_metallic_roughness(x.s.normal, l, v, x.s.base_color, x.s.metallic, x.s.roughness);
+}
+
+// Solid-angle density of `sample_direction`'s choice of l at x (the BRDF's importance sampling).
+float brdf_sample_pdf(Vertex x, vec3 l, vec3 v) {
+    if ((PATH_FLAGS & PT_LAMBERT_ONLY) != 0u) {
+        return max(dot(x.s.normal, l), 0.0) / BRDF_PI;
+    }
+    float p_specular = brdf_specular_probability(x.s.base_color, x.s.metallic);
+    return brdf_pdf(x.s.normal, l, v, p_specular, x.s.roughness);
 }
 
 // Next-event estimation: every punctual light, shadowed by a ray through the BVH.

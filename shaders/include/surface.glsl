@@ -25,6 +25,17 @@ struct Surface {
     vec3 emissive;
 };
 
+// Emitted radiance of material `i` at `uv` (both sides emit): the emissive factor times its
+// texture.
+vec3 surface_emission(uint i, vec2 uv) {
+    vec3 e = materials.m[i].emissive;
+    uint emissive_tex = materials.m[i].emissive_texture;
+    if (emissive_tex != NO_TEXTURE) {
+        e *= SURFACE_SAMPLE(srgb_textures, vec3(uv, float(emissive_tex))).rgb;
+    }
+    return e;
+}
+
 Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 uv, bool front) {
     // Field by field: a whole-struct copy out of a buffer is OpCopyLogical, which naga
     // cannot read.
@@ -43,11 +54,7 @@ Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 u
         s.roughness *= mr.g;
         s.metallic *= mr.b;
     }
-    s.emissive = materials.m[i].emissive;
-    uint emissive_tex = materials.m[i].emissive_texture;
-    if (emissive_tex != NO_TEXTURE) {
-        s.emissive *= SURFACE_SAMPLE(srgb_textures, vec3(uv, float(emissive_tex))).rgb;
-    }
+    s.emissive = surface_emission(i, uv);
     uint normal_tex = materials.m[i].normal_texture;
     float normal_scale = materials.m[i].normal_scale;
     vec3 n = normalize(geometric_normal);

@@ -47,6 +47,10 @@ pub struct ReferenceArgs {
     /// are seen but light nothing (the lights the raster GI techniques use).
     #[arg(long)]
     punctual_only: bool,
+    /// Find the emissive surfaces' and the environment's light only by BRDF-sampled rays (no
+    /// next-event estimation or MIS for them): the same mean with more noise, for comparisons
+    #[arg(long)]
+    no_light_sampling: bool,
     /// Trace through pixel centres (as the raster passes sample) instead of jittering.
     #[arg(long)]
     no_jitter: bool,
@@ -79,6 +83,7 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
         jitter: !args.no_jitter,
         emissive_lighting: !args.punctual_only,
         lambert_only: false,
+        light_sampling: !args.no_light_sampling,
         seed: args.seed,
     };
     let scene = load_scene(&args.scene, &args.environment)?;

@@ -26,6 +26,17 @@ pub fn direction(u: f32, v: f32) -> Vec3 {
     )
 }
 
+/// Texture coordinates of a unit direction (the module's mapping, `environment_radiance` in
+/// environment.glsl; the inverse of [`direction`]).
+pub fn texcoord(d: Vec3) -> glam::Vec2 {
+    let u = if d.x.abs() + d.z.abs() > 0.0 {
+        d.x.atan2(-d.z) / std::f32::consts::TAU + 0.5
+    } else {
+        0.5
+    };
+    glam::Vec2::new(u, d.y.clamp(-1.0, 1.0).acos() / std::f32::consts::PI)
+}
+
 /// Bakes `environment` (or black) into RGBA32F texels, rows from +Y (v = 0) down.
 pub fn bake(environment: Option<&Environment>) -> Vec<[f32; 4]> {
     let (w, h) = (ENVIRONMENT_WIDTH, ENVIRONMENT_HEIGHT);

@@ -37,6 +37,10 @@ pub const FLAG_JITTER: u32 = 1;
 pub const FLAG_EMISSIVE_LIGHTING: u32 = 2;
 /// Diagnostic: every surface is Lambertian with albedo = base colour (white-furnace tests).
 pub const FLAG_LAMBERT_ONLY: u32 = 4;
+/// Next-event estimation for the emissive triangles and the environment, weighted against
+/// BRDF sampling by multiple importance sampling (`light_sampling.glsl`); off: their light is
+/// found only by BRDF-sampled rays.
+pub const FLAG_LIGHT_SAMPLING: u32 = 8;
 
 /// What one `path_trace` dispatch computes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,11 +65,14 @@ pub struct PathTraceParams {
 
 /// Adds one progressive `path_trace` dispatch accumulating into `accumulation` (at least
 /// `ACCUMULATION_PLANES × width × height × 16` bytes), tracing the scene's BVH and lit by
-/// `environment` (RGBA32F equirectangular, src/gpu_scene/environment.rs) on escape.
+/// `environment` (RGBA32F equirectangular, src/gpu_scene/environment.rs) on escape;
+/// `light_tables` holds [`crate::reference::light_tables::LightTables::words`].
+#[allow(clippy::too_many_arguments)]
 pub fn path_trace(
     rg: &mut RenderGraph,
     scene: &SceneHandles,
     environment: &Handle<Image>,
+    light_tables: &Handle<Buffer>,
     accumulation: &mut Handle<Buffer>,
     params: &PathTraceParams,
     texture_sampler: vk::Sampler,
@@ -94,6 +101,7 @@ pub fn path_trace(
         .read("lights", &scene.lights)
         .read("environment", environment)
         .sampler("environment_sampler", environment_sampler)
+        .read("light_tables", light_tables)
         .write("accumulation", accumulation)
         .push(&constants)
         .dispatch([w, h, 1]);

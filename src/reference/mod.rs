@@ -18,14 +18,18 @@ pub mod accumulate;
 pub mod hvl;
 pub mod hvl_flux;
 pub mod igi;
+pub mod light_tables;
 pub mod proxy;
 pub mod resolve;
 
 use crate::capture::image_io::HdrImage;
 use crate::frame::RenderError;
+use crate::gpu_scene::environment::{ENVIRONMENT_HEIGHT, ENVIRONMENT_WIDTH};
+use crate::gpu_scene::geometry::Geometry;
 use crate::gpu_scene::{FrameUpdate, GpuScene};
 use crate::passes::gbuffer;
 use crate::passes::path_trace::{self, PathTraceParams};
+use light_tables::LightTables;
 use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, Sampler, vk};
 use shine_graph::{Executor, ExternalState};
 use shine_scene::Scene;
@@ -58,6 +62,10 @@ pub struct ReferenceParams {
     pub emissive_lighting: bool,
     /// Diagnostic: every surface Lambertian with albedo = base colour (white furnace).
     pub lambert_only: bool,
+    /// Sample the emissive triangles and the environment at every path vertex, weighted
+    /// against BRDF sampling by multiple importance sampling ([`light_tables`]). Off: their
+    /// light is found only by the BRDF's rays (the same mean, more noise). Default on.
+    pub light_sampling: bool,
     /// Seed of the random numbers (different seeds give independent estimates).
     pub seed: u32,
 }
@@ -71,6 +79,7 @@ impl Default for ReferenceParams {
             jitter: true,
             emissive_lighting: true,
             lambert_only: false,
+            light_sampling: true,
             seed: 0,
         }
     }
@@ -102,6 +111,7 @@ impl ReferenceParams {
         bit(self.jitter, path_trace::FLAG_JITTER)
             | bit(self.emissive_lighting, path_trace::FLAG_EMISSIVE_LIGHTING)
             | bit(self.lambert_only, path_trace::FLAG_LAMBERT_ONLY)
+            | bit(self.light_sampling, path_trace::FLAG_LIGHT_SAMPLING)
     }
 }
 
@@ -125,6 +135,7 @@ pub struct PathTracer {
     executor: Executor,
     scene: GpuScene,
     environment: Image,
+    light_tables: Buffer,
     texture_sampler: Sampler,
     environment_sampler: Sampler,
     accumulation: Buffer,
@@ -145,6 +156,11 @@ impl PathTracer {
         let gpu_scene = GpuScene::upload(device, scene, t)?;
         let environment =
             crate::gpu_scene::environment::upload(device, scene.environment.as_ref())?;
+        let light_tables = Buffer::storage_with_data(
+            device,
+            "light tables",
+            bytemuck::cast_slice(light_tables_of(scene, &gpu_scene)?.words()),
+        )?;
         let sampler = |u, v| {
             Sampler::new(
                 device,
@@ -176,6 +192,7 @@ impl PathTracer {
             executor: Executor::new(device, 1)?,
             scene: gpu_scene,
             environment,
+            light_tables,
             texture_sampler: sampler(
                 vk::SamplerAddressMode::REPEAT,
                 vk::SamplerAddressMode::REPEAT,
@@ -237,6 +254,11 @@ impl PathTracer {
         let handles = self.scene.declare(&mut rg)?;
         let frame = &self.scene.state;
         let environment = rg.import_gpu_image(&self.environment, sampled, sampled);
+        let light_tables = rg.import_gpu_buffer(
+            &self.light_tables,
+            crate::gpu_scene::BUFFER_READ,
+            crate::gpu_scene::BUFFER_READ,
+        );
         let mut accumulation = rg.import_gpu_buffer(&self.accumulation, accumulated, accumulated);
         if self.samples == 0 {
             rg.fill_buffer("clear accumulation", &mut accumulation, 0);
@@ -258,6 +280,7 @@ impl PathTracer {
             &mut rg,
             &handles,
             &environment,
+            &light_tables,
             &mut accumulation,
             &params,
             self.texture_sampler.raw(),
@@ -304,6 +327,23 @@ impl PathTracer {
     pub fn scene(&self) -> &GpuScene {
         &self.scene
     }
+}
+
+/// The light-sampling tables of `scene` as `gpu_scene` holds it (its instances where they
+/// are now; skinning and morphs only move the triangles' areas, which the shader measures
+/// itself).
+fn light_tables_of(scene: &Scene, gpu_scene: &GpuScene) -> Result<LightTables, RenderError> {
+    let geometry = Geometry::flatten(scene)?;
+    let emissive: Vec<[f32; 3]> = scene.materials.iter().map(|m| m.emissive).collect();
+    let env = crate::gpu_scene::environment::bake(scene.environment.as_ref());
+    Ok(LightTables::new(
+        &geometry.source,
+        &geometry.indices,
+        &gpu_scene.instance_matrices(),
+        &emissive,
+        &env,
+        [ENVIRONMENT_WIDTH, ENVIRONMENT_HEIGHT],
+    ))
 }
 
 /// Renders a reference of `scene` at time `t` with `samples` samples per pixel.

@@ -324,6 +324,7 @@ pub fn run(
                 jitter: false,
                 emissive_lighting: false,
                 lambert_only: false,
+                light_sampling: true,
                 seed: config.seed,
             },
             config.path_tracer_spp,

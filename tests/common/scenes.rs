@@ -170,6 +170,7 @@ pub fn pixel_centre_reference(size: u32, seed: u32) -> shine::reference::Referen
         jitter: false,
         emissive_lighting: false,
         lambert_only: false,
+        light_sampling: true,
         seed,
     }
 }

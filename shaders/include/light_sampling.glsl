@@ -1,0 +1,136 @@
+// Next-event estimation for the area lights of the reference path tracer: emissive triangles
+// and the environment, sampled from the tables of src/reference/light_tables.rs (layout there)
+// and weighted against BRDF sampling by the power heuristic (Veach 1997, §9.2.2, β = 2).
+//
+// The includer includes path.glsl (vertices, indices, materials, random numbers) and
+// environment.glsl first, and defines LIGHT_TABLES_BINDING.
+#ifndef LIGHT_SAMPLING_GLSL
+#define LIGHT_SAMPLING_GLSL
+
+layout(set = 0, binding = LIGHT_TABLES_BINDING, std430) readonly buffer LightTables {
+    uint w[];
+} light_tables;
+
+const float LIGHT_PI = 3.14159265358979323846;
+
+uint light_emitter_count() {
+    return light_tables.w[0];
+}
+
+bool light_environment_on() {
+    return light_tables.w[2] != 0u;
+}
+
+float light_word(uint k) {
+    return uintBitsToFloat(light_tables.w[k]);
+}
+
+// The first i < count whose CDF value (at `offset`) exceeds xi: the bin xi falls in.
+uint light_search(uint offset, uint count, float xi) {
+    uint lo = 0u;
+    uint hi = count - 1u;
+    while (lo < hi) {
+        uint mid = (lo + hi) / 2u;
+        if (light_word(offset + mid) > xi) {
+            hi = mid;
+        } else {
+            lo = mid + 1u;
+        }
+    }
+    return lo;
+}
+
+// The probability of bin i of the CDF at `offset`.
+float light_bin(uint offset, uint i) {
+    return light_word(offset + i) - (i > 0u ? light_word(offset + i - 1u) : 0.0);
+}
+
+// The power heuristic's weight of a strategy of density a against one of density b.
+float light_mis(float a, float b) {
+    if (!(a > 0.0)) {
+        return 0.0;
+    }
+    float r = b / a;
+    return 1.0 / (1.0 + r * r);
+}
+
+// Solid-angle density, seen from `x`, of picking emissive triangle `tri` (of the world
+// vertices) and the point `y` on it (0 for a triangle that is never picked).
+float light_triangle_pdf(uint tri, vec3 x, vec3 y) {
+    float p = light_word(light_tables.w[6] + tri);
+    if (p <= 0.0) {
+        return 0.0;
+    }
+    vec3 p0 = vertices.v[4u * indices.i[3u * tri]].xyz;
+    vec3 ng = cross(vertices.v[4u * indices.i[3u * tri + 1u]].xyz - p0, vertices.v[4u * indices.i[3u * tri + 2u]].xyz - p0);
+    float twice_area = length(ng);
+    vec3 d = y - x;
+    float dist2 = dot(d, d);
+    float cos_y = abs(dot(ng, d)) / (twice_area * sqrt(dist2));
+    return cos_y > 0.0 ? p * dist2 / (0.5 * twice_area * cos_y) : 0.0;
+}
+
+// Picks an emissive triangle and a uniform point on it; returns the direction from `x`, the
+// distance, the emitted radiance towards x and the solid-angle density (0: nothing sampled).
+float light_sample_triangle(vec3 x, vec3 xi, out vec3 l, out float dist, out vec3 radiance) {
+    uint count = light_emitter_count();
+    uint k = light_search(light_tables.w[4], count, xi.x);
+    uint tri = light_tables.w[light_tables.w[5] + k];
+    uint i0 = indices.i[3u * tri];
+    uint i1 = indices.i[3u * tri + 1u];
+    uint i2 = indices.i[3u * tri + 2u];
+    // Uniform on the triangle: b1 = 1 − √ξ₁, b2 = √ξ₁ ξ₂.
+    float s = sqrt(xi.y);
+    vec3 b = vec3(1.0 - s, s * (1.0 - xi.z), s * xi.z);
+    vec3 p0 = vertices.v[4u * i0].xyz;
+    vec3 p1 = vertices.v[4u * i1].xyz;
+    vec3 p2 = vertices.v[4u * i2].xyz;
+    vec3 y = b.x * p0 + b.y * p1 + b.z * p2;
+    vec3 d = y - x;
+    dist = length(d);
+    l = d / max(dist, 1e-20);
+    float pdf = light_triangle_pdf(tri, x, y);
+    vec2 uv = b.x * vertices.v[4u * i0 + 3u].xy + b.y * vertices.v[4u * i1 + 3u].xy + b.z * vertices.v[4u * i2 + 3u].xy;
+    radiance = surface_emission(floatBitsToUint(vertices.v[4u * i0].w), uv);
+    return pdf;
+}
+
+// Solid-angle density of sampling direction `dir` (unit) from the environment tables; the
+// twin of shine::reference::light_tables::environment_pdf.
+float light_environment_pdf(vec3 dir) {
+    uint w = light_tables.w[2];
+    uint h = light_tables.w[3];
+    if (w == 0u) {
+        return 0.0;
+    }
+    float sin_theta = sqrt(max(1.0 - dir.y * dir.y, 0.0));
+    if (sin_theta <= 0.0) {
+        return 0.0;
+    }
+    float u = abs(dir.x) + abs(dir.z) > 0.0 ? atan(dir.x, -dir.z) / (2.0 * LIGHT_PI) + 0.5 : 0.5;
+    float v = acos(clamp(dir.y, -1.0, 1.0)) / LIGHT_PI;
+    uint i = min(uint(u * float(w)), w - 1u);
+    uint j = min(uint(v * float(h)), h - 1u);
+    uint marginal = light_tables.w[7];
+    float p = light_bin(marginal, j) * light_bin(marginal + h + j * w, i);
+    return p * float(w * h) / (2.0 * LIGHT_PI * LIGHT_PI * sin_theta);
+}
+
+// Samples a direction from the environment tables: a row, a texel, a uniform point of it.
+// Returns the solid-angle density (0: nothing sampled).
+float light_sample_environment(vec3 xi, out vec3 l) {
+    uint w = light_tables.w[2];
+    uint h = light_tables.w[3];
+    uint marginal = light_tables.w[7];
+    uint j = light_search(marginal, h, xi.x);
+    uint i = light_search(marginal + h + j * w, w, xi.y);
+    // The point within the texel: a fresh number (the search's leftovers are correlated).
+    float u = (float(i) + xi.z) / float(w);
+    float v = (float(j) + rand()) / float(h);
+    float phi = (u - 0.5) * 2.0 * LIGHT_PI;
+    float theta = v * LIGHT_PI;
+    l = vec3(sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi));
+    return light_environment_pdf(l);
+}
+
+#endif
