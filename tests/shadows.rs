@@ -100,6 +100,11 @@ fn scene(lights: &[LightNode]) -> Scene {
 
 /// Renders `lights` (direct light only) and returns linear radiance (red channel) per pixel.
 fn render(lights: &[LightNode]) -> Vec<f32> {
+    render_with_tiles(lights, 512)
+}
+
+/// [`render`] with shadow-map tiles of `tile` texels.
+fn render_with_tiles(lights: &[LightNode], tile: u32) -> Vec<f32> {
     let device = common::device();
     let mut renderer = Renderer::new(&device).expect("renderer");
     renderer.set_scene(&scene(lights), 0.0).expect("upload");
@@ -109,7 +114,7 @@ fn render(lights: &[LightNode]) -> Vec<f32> {
         gi: GiTechniques::none(),
         ..Settings::default()
     };
-    settings.shadow.size = 512;
+    settings.shadow.size = tile;
     let frame = renderer.render(&settings).expect("frame");
     drop(renderer);
     common::assert_clean(&device);
@@ -239,6 +244,28 @@ fn a_spot_light_shadows() {
         |x, z| occluder_shadow(x, z) || wall_shadow(x, z),
         // Inside the inner cone (tan 1.2 × 2 m ≈ 5.1 m), clear of the cone's falloff.
         |x, z| lamp_lit(x, z) && x * x + z * z < 4.4 * 4.4,
+    );
+}
+
+/// A spot of 86° half-angle (the Cornell lamp's kind) at slots of 256 texels: shadowed
+/// through cube faces of 128 (`WIDE_SPOT_HALF_ANGLE`), its shadows stay sharp enough for the
+/// check. One map over the whole cone (166°, the widest it takes) had 13 cm texels on this
+/// floor and a PCF kernel about as wide as the occluder's shadow band: it failed.
+#[test]
+fn a_wide_spot_light_shadows_through_cube_faces() {
+    let spot = LightNode {
+        light: json!({"type": "spot", "color": [1.0, 1.0, 1.0], "intensity": 10.0,
+                      "spot": {"innerConeAngle": 1.45, "outerConeAngle": 1.5}}),
+        position: LAMP,
+        direction: Vec3::NEG_Y,
+    };
+    let image = render_with_tiles(&[spot], 256);
+    check(
+        "wide spot",
+        &image,
+        lamp_lambert(10.0),
+        |x, z| occluder_shadow(x, z) || wall_shadow(x, z),
+        lamp_lit,
     );
 }
 

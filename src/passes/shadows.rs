@@ -5,7 +5,9 @@
 //! * **One atlas.** lavapipe indexes arrays of textures only with constants, so every map is a
 //!   square tile of one D32 image: a spot light has one tile (its outer cone), a directional
 //!   light one (an orthographic box around the scene), a point light six (cube faces +x, -x,
-//!   +y, -y, +z, -z). Each tile is one raster pass restricted to its rectangle
+//!   +y, -y, +z, -z). A spot wider than [`WIDE_SPOT_HALF_ANGLE`] has six faces too, at half
+//!   the side and four to a tile: one perspective map over its whole cone spreads its texels
+//!   thin (the Cornell box's 90° lamp had stair-stepped shadows at 1080p). Each tile is one raster pass restricted to its rectangle
 //!   ([`shine_graph::RasterPass::area`]), so clears and draws never touch the other tiles.
 //! * **Tile size** is the `shadow.size` setting for every tile; when the atlas would exceed the
 //!   device's largest 2D image the tiles are halved until it fits (with a warning).
@@ -27,6 +29,22 @@ pub const TILE_SIZE: std::ops::RangeInclusive<u32> = 64..=16384;
 
 /// Default shadow-map tile side in texels.
 pub const DEFAULT_TILE_SIZE: u32 = 2048;
+
+/// Outer cone half-angle (radians) beyond which a spot light is shadowed through six cube
+/// faces like a point light. A single map's texel on a plane across the spot's axis grows
+/// with the tangent of the half-angle it covers: at 45° it matches a cube face; at the Cornell
+/// lamp's 83° (the map's widest, clamped) it is 8× larger.
+pub const WIDE_SPOT_HALF_ANGLE: f32 = std::f32::consts::FRAC_PI_4;
+
+/// Whether `light` is shadowed through six cube faces: a point light, or a spot light wider
+/// than [`WIDE_SPOT_HALF_ANGLE`].
+pub fn uses_cube_faces(light: &shine_scene::Light) -> bool {
+    match light.light_kind() {
+        Some(LightKind::Point) => true,
+        Some(LightKind::Spot) => light.outer_cone_angle > WIDE_SPOT_HALF_ANGLE,
+        _ => false,
+    }
+}
 
 /// Default PCF radius in texels (a 3×3 kernel).
 pub const DEFAULT_FILTER_RADIUS: f32 = 1.5;
@@ -68,7 +86,7 @@ pub struct ShadowViewRecord {
 pub struct LightShadowRecord {
     /// Index of the light's first view.
     pub first_view: u32,
-    /// Number of views: 0 (unshadowed), 1 (spot, directional) or 6 (point).
+    /// Number of views: 0 (unshadowed), 1 (spot, directional) or 6 (point, wide spot).
     pub view_count: u32,
     /// Padding.
     pub pad: [u32; 2],
@@ -77,14 +95,17 @@ pub struct LightShadowRecord {
 /// Where every light's shadow views lie in the atlas.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShadowLayout {
-    /// Side of every tile in texels.
+    /// Side of a slot of the atlas's grid in texels: a spot's or directional light's tile, a
+    /// point light's face; a wide spot's face is half of it ([`uses_cube_faces`]).
     pub tile: u32,
-    /// Tiles per atlas row.
+    /// Slots per atlas row.
     pub columns: u32,
-    /// Tile rows.
+    /// Slot rows.
     pub rows: u32,
     /// Every view: the light it belongs to, its pass name and its view.
     pub views: Vec<(u32, String, View)>,
+    /// Every view's tile: texel origin and side.
+    pub tiles: Vec<([u32; 2], u32)>,
     /// Per light of the scene, in light order.
     pub lights: Vec<LightShadowRecord>,
     /// Set when the tiles had to shrink below the asked size.
@@ -103,8 +124,50 @@ pub struct ShadowLayoutError {
     pub max_dimension: u32,
 }
 
+/// How a light's views fill the atlas's slots.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Slots {
+    /// No shadow (a light of unknown kind).
+    None,
+    /// One view in one slot (a spot or directional light).
+    One,
+    /// Six cube faces in six slots (a point light).
+    Cube,
+    /// Six cube faces at half the slot's side, four to a slot (a wide spot: it lights only
+    /// part of the sphere, and its faces at half size already have 4× the texel density of
+    /// one map over its cone at full size).
+    HalfCube,
+}
+
+impl Slots {
+    fn of(light: &shine_scene::Light) -> Self {
+        match light.light_kind() {
+            Some(LightKind::Point) => Self::Cube,
+            _ if uses_cube_faces(light) => Self::HalfCube,
+            Some(_) => Self::One,
+            None => Self::None,
+        }
+    }
+
+    fn count(self) -> u32 {
+        match self {
+            Self::None => 0,
+            Self::One => 1,
+            Self::Cube => 6,
+            Self::HalfCube => 2,
+        }
+    }
+}
+
+/// The half-angle tangent of a cube face of `side` texels whose central 90° leaves a margin of
+/// `pcf_radius` + 2 texels (at most a quarter of the side) on each side.
+fn face_tan_half(side: u32, pcf_radius: u32) -> f32 {
+    let margin = ((pcf_radius + 2) as f32).min(side as f32 / 4.0);
+    side as f32 / (side as f32 - 2.0 * margin)
+}
+
 impl ShadowLayout {
-    /// The views of every light of `frame` in tiles of `tile` texels (smaller if the atlas
+    /// The views of every light of `frame` in slots of `tile` texels (smaller if the atlas
     /// would exceed `max_dimension`), with a margin of `pcf_radius` + 2 texels around each
     /// cube face.
     pub fn new(
@@ -113,14 +176,8 @@ impl ShadowLayout {
         pcf_radius: u32,
         max_dimension: u32,
     ) -> Result<Self, ShadowLayoutError> {
-        // Views per light: six cube faces for a point light, one for a spot or directional
-        // light, none for a light of unknown kind.
-        let count = |kind: Option<LightKind>| match kind {
-            Some(LightKind::Point) => 6,
-            Some(_) => 1,
-            None => 0,
-        };
-        let total: u32 = frame.lights.iter().map(|l| count(l.light_kind())).sum();
+        let slots: Vec<Slots> = frame.lights.iter().map(Slots::of).collect();
+        let total: u32 = slots.iter().map(|s| s.count()).sum();
         let n = total.max(1);
         let columns = (f64::from(n).sqrt().ceil()) as u32;
         let rows = n.div_ceil(columns);
@@ -134,29 +191,42 @@ impl ShadowLayout {
                 });
             }
         }
-        // The cube faces' margin in texels of the final tile (at most a quarter of it).
-        let margin = ((pcf_radius + 2) as f32).min(side as f32 / 4.0);
-        let tan_half = side as f32 / (side as f32 - 2.0 * margin);
-        let mut views = Vec::with_capacity(total as usize);
+        let slot_origin = |k: u32| [(k % columns) * side, (k / columns) * side];
+        let mut views = Vec::with_capacity(6 * frame.lights.len());
+        let mut tiles = Vec::with_capacity(6 * frame.lights.len());
         let mut lights = Vec::with_capacity(frame.lights.len());
-        for (i, light) in frame.lights.iter().enumerate() {
+        let mut slot = 0u32;
+        for (i, (light, kind)) in frame.lights.iter().zip(&slots).enumerate() {
             let first_view = views.len() as u32;
             let index = i as u32;
-            match light.light_kind() {
-                Some(LightKind::Point) => {
-                    for (axis, up, face) in CUBE_FACES {
-                        let eye = Vec3::from(light.position);
+            let eye = Vec3::from(light.position);
+            match kind {
+                Slots::Cube | Slots::HalfCube => {
+                    let half = *kind == Slots::HalfCube;
+                    let face_side = if half { side / 2 } else { side };
+                    let tan_half = face_tan_half(face_side, pcf_radius);
+                    for (f, (axis, up, face)) in CUBE_FACES.into_iter().enumerate() {
+                        let f = f as u32;
+                        let origin = if half {
+                            let [x, y] = slot_origin(slot + f / 4);
+                            [x + (f % 2) * face_side, y + (f % 4 / 2) * face_side]
+                        } else {
+                            slot_origin(slot + f)
+                        };
                         let view = cube_face(frame, eye, axis, up, tan_half);
                         views.push((index, format!("shadow light {i} {face}"), view));
+                        tiles.push((origin, face_side));
                     }
                 }
-                Some(_) => {
+                Slots::One => {
                     if let Some(view) = light_view(frame, i, side) {
                         views.push((index, format!("shadow light {i}"), view));
+                        tiles.push((slot_origin(slot), side));
                     }
                 }
-                None => {}
+                Slots::None => {}
             }
+            slot += kind.count();
             lights.push(LightShadowRecord {
                 first_view,
                 view_count: views.len() as u32 - first_view,
@@ -175,6 +245,7 @@ impl ShadowLayout {
             columns,
             rows,
             views,
+            tiles,
             lights,
         })
     }
@@ -184,35 +255,26 @@ impl ShadowLayout {
         [self.columns * self.tile, self.rows * self.tile]
     }
 
-    /// Texel origin of tile `k`.
-    pub fn tile_origin(&self, k: u32) -> [u32; 2] {
-        [
-            (k % self.columns) * self.tile,
-            (k / self.columns) * self.tile,
-        ]
-    }
-
     /// The views as the direct pass reads them (at least one record, so the buffer exists).
     pub fn view_records(&self) -> Vec<ShadowViewRecord> {
         let [w, h] = self.atlas_extent();
         let mut records: Vec<ShadowViewRecord> = self
             .views
             .iter()
-            .enumerate()
-            .map(|(k, (_, _, view))| {
-                let [x, y] = self.tile_origin(k as u32);
+            .zip(&self.tiles)
+            .map(|((_, _, view), ([x, y], side))| {
                 let texel = if view.orthographic {
-                    view.extent / self.tile as f32
+                    view.extent / *side as f32
                 } else {
-                    2.0 * (0.5 * view.extent).tan() / self.tile as f32
+                    2.0 * (0.5 * view.extent).tan() / *side as f32
                 };
                 ShadowViewRecord {
                     view_proj: view.view_proj().to_cols_array_2d(),
                     tile: [
-                        x as f32 / w as f32,
-                        y as f32 / h as f32,
-                        self.tile as f32 / w as f32,
-                        self.tile as f32 / h as f32,
+                        *x as f32 / w as f32,
+                        *y as f32 / h as f32,
+                        *side as f32 / w as f32,
+                        *side as f32 / h as f32,
                     ],
                     params: [texel, f32::from(u8::from(view.orthographic)), 0.0, 0.0],
                 }
@@ -294,10 +356,10 @@ pub fn shadow_atlas(
             .depth(&mut depth, DepthLoad::Clear(1.0))
             .push(&super::gbuffer::ViewConstants::default());
     }
-    for (k, (_, name, view)) in layout.views.iter().enumerate() {
+    for ((_, name, view), (origin, side)) in layout.views.iter().zip(&layout.tiles) {
         rg.raster(name, shadow_pipeline())
             .depth(&mut depth, DepthLoad::Clear(1.0))
-            .area(layout.tile_origin(k as u32), [layout.tile, layout.tile])
+            .area(*origin, [*side, *side])
             .vertex_buffer(&scene.vertices)
             .index_buffer(&scene.indices, vk::IndexType::UINT32)
             .push(&view.constants(None))
