@@ -248,19 +248,37 @@ fn light_sampling_keeps_the_white_furnace() {
     common::assert_clean(&device);
 }
 
-/// Under a sky bright at the zenith and dark below (the environment's sampling tables far
-/// from uniform), a convex sphere's mean radiance is the same with light sampling as with
-/// BRDF sampling alone (within 1.5%; two 2048-spp runs of each agree within 0.3%), and its
-/// error at 8 spp against a 1024-spp answer is not larger.
+/// Under a sky with a sun (a 4×2-texel block of a 64×32 map, 400 times the sky's radiance,
+/// 30° from the zenith: the sampling tables' peak ratio far above ENVIRONMENT_PEAK_RATIO), a
+/// convex sphere's mean radiance is the same with light sampling as with BRDF sampling alone
+/// (within 2.5%: BRDF sampling's rarely hit sun leaves its 4096-spp runs 0.5% apart; light
+/// sampling's agree within 0.02%), and light sampling cuts the error at 8 spp at least in half
+/// (measured: 4×).
 #[test]
-fn environment_sampling_keeps_the_mean_under_a_sky() {
+fn environment_sampling_keeps_the_mean_under_a_sun() {
     let device = common::device();
+    let (w, h) = (64u32, 32u32);
+    let texels: Vec<[f32; 3]> = (0..w * h)
+        .map(|k| {
+            let (i, j) = (k % w, k / w);
+            if (20..24).contains(&i) && (5..7).contains(&j) {
+                [200.0, 190.0, 170.0]
+            } else {
+                [0.4, 0.5, 0.7]
+            }
+        })
+        .collect();
     let env = Environment {
-        zenith: Vec3::splat(6.0),
-        horizon: Vec3::splat(0.5),
-        ground: Vec3::splat(0.02),
+        zenith: Vec3::ZERO,
+        horizon: Vec3::ZERO,
+        ground: Vec3::ZERO,
         intensity: 1.0,
-        map: None,
+        map: Some(shine_scene::environment::EquirectMap {
+            width: w,
+            height: h,
+            texels: std::sync::Arc::new(texels),
+            uri: "sun".into(),
+        }),
     };
     let camera = Mat4::from_translation(Vec3::new(0.0, 0.0, 3.0));
     let scene = one_mesh_scene(
@@ -278,7 +296,7 @@ fn environment_sampling_keeps_the_mean_under_a_sky() {
         };
         render_reference(&device, &scene, 0.0, &p, spp).expect("reference")
     };
-    let (on, off) = (run(true, 1024, 1), run(false, 1024, 2));
+    let (on, off) = (run(true, 1024, 1), run(false, 4096, 2));
     // The sphere's pixels, away from its silhouette: camera rays passing within 0.95 of the
     // centre.
     let rays = common::scenes::pixel_rays(&device, &scene, 32);
@@ -293,7 +311,7 @@ fn environment_sampling_keeps_the_mean_under_a_sky() {
     );
     assert!(m_on > 0.1, "sphere mean {m_on}");
     assert!(
-        (m_on / m_off - 1.0).abs() < 0.015,
+        (m_on / m_off - 1.0).abs() < 0.025,
         "sphere mean {m_on} with light sampling, {m_off} without"
     );
     let (few_on, few_off) = (run(true, 8, 4), run(false, 8, 4));
@@ -302,7 +320,7 @@ fn environment_sampling_keeps_the_mean_under_a_sky() {
         rmse(&few_off.full, &on.full).expect("rmse"),
     );
     assert!(
-        e_on <= e_off,
+        e_on < 0.5 * e_off,
         "8-spp RMSE {e_on} with light sampling, {e_off} without"
     );
     common::assert_clean(&device);
