@@ -106,6 +106,10 @@ pub struct ShadowLayout {
     pub views: Vec<(u32, String, View)>,
     /// Every view's tile: texel origin and side.
     pub tiles: Vec<([u32; 2], u32)>,
+    /// Per view, whether the scene is drawn into it: a wide spot's face that lies wholly
+    /// outside its cone is only cleared (the direct pass may pick it, for points the spot
+    /// does not light).
+    pub drawn: Vec<bool>,
     /// Per light of the scene, in light order.
     pub lights: Vec<LightShadowRecord>,
     /// Set when the tiles had to shrink below the asked size.
@@ -194,6 +198,7 @@ impl ShadowLayout {
         let slot_origin = |k: u32| [(k % columns) * side, (k / columns) * side];
         let mut views = Vec::with_capacity(6 * frame.lights.len());
         let mut tiles = Vec::with_capacity(6 * frame.lights.len());
+        let mut drawn = Vec::with_capacity(6 * frame.lights.len());
         let mut lights = Vec::with_capacity(frame.lights.len());
         let mut slot = 0u32;
         for (i, (light, kind)) in frame.lights.iter().zip(&slots).enumerate() {
@@ -205,6 +210,9 @@ impl ShadowLayout {
                     let half = *kind == Slots::HalfCube;
                     let face_side = if half { side / 2 } else { side };
                     let tan_half = face_tan_half(face_side, pcf_radius);
+                    // The face's frustum lies within this angle of its axis (its corners).
+                    let face_half_angle = (std::f32::consts::SQRT_2 * tan_half).atan();
+                    let spot = Vec3::from(light.direction).normalize_or(Vec3::NEG_Y);
                     for (f, (axis, up, face)) in CUBE_FACES.into_iter().enumerate() {
                         let f = f as u32;
                         let origin = if half {
@@ -216,12 +224,15 @@ impl ShadowLayout {
                         let view = cube_face(frame, eye, axis, up, tan_half);
                         views.push((index, format!("shadow light {i} {face}"), view));
                         tiles.push((origin, face_side));
+                        let apart = axis.dot(spot).clamp(-1.0, 1.0).acos();
+                        drawn.push(!half || apart < light.outer_cone_angle + face_half_angle);
                     }
                 }
                 Slots::One => {
                     if let Some(view) = light_view(frame, i, side) {
                         views.push((index, format!("shadow light {i}"), view));
                         tiles.push((slot_origin(slot), side));
+                        drawn.push(true);
                     }
                 }
                 Slots::None => {}
@@ -246,6 +257,7 @@ impl ShadowLayout {
             rows,
             views,
             tiles,
+            drawn,
             lights,
         })
     }
@@ -356,7 +368,15 @@ pub fn shadow_atlas(
             .depth(&mut depth, DepthLoad::Clear(1.0))
             .push(&super::gbuffer::ViewConstants::default());
     }
-    for ((_, name, view), (origin, side)) in layout.views.iter().zip(&layout.tiles) {
+    let views_and_tiles = layout.views.iter().zip(&layout.tiles).zip(&layout.drawn);
+    for (((_, name, view), (origin, side)), drawn) in views_and_tiles {
+        if !drawn {
+            rg.raster(&format!("{name} clear"), shadow_pipeline())
+                .depth(&mut depth, DepthLoad::Clear(1.0))
+                .area(*origin, [*side, *side])
+                .push(&super::gbuffer::ViewConstants::default());
+            continue;
+        }
         rg.raster(name, shadow_pipeline())
             .depth(&mut depth, DepthLoad::Clear(1.0))
             .area(*origin, [*side, *side])
@@ -378,4 +398,30 @@ pub fn shadow_atlas(
 /// slope factor); the direct pass adds a normal offset on top.
 fn shadow_pipeline() -> GraphicsPipelineDesc {
     scene_pipeline(&shaders::GBUFFER_VERT_PLAIN, None, &[], Some((1.0, 1.5)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::gpu_scene::{FrameState, FrameUpdate};
+
+    /// The Cornell lamp (a spot of 90° half-angle pointing down) gets six half-size faces in
+    /// two slots, four to the first; its +y face, wholly above the cone, is only cleared.
+    #[test]
+    fn a_wide_spot_has_half_size_faces_and_skips_the_one_outside_its_cone() {
+        let scene = shine_scene::Scene::builtin("cornell-box").expect("builtin");
+        let frame = FrameState::evaluate(&scene, &FrameUpdate::default());
+        let layout = ShadowLayout::new(&frame, 512, 1, 16384).expect("layout");
+        assert_eq!(layout.lights[0].view_count, 6);
+        assert_eq!((layout.columns, layout.rows), (2, 1));
+        let names: Vec<&str> = layout.views.iter().map(|(_, n, _)| n.as_str()).collect();
+        assert_eq!(names[2], "shadow light 0 +y");
+        assert_eq!(layout.drawn, [true, true, false, true, true, true]);
+        let origins: Vec<[u32; 2]> = layout.tiles.iter().map(|(o, _)| *o).collect();
+        assert_eq!(
+            origins,
+            [[0, 0], [256, 0], [0, 256], [256, 256], [512, 0], [768, 0]]
+        );
+        assert!(layout.tiles.iter().all(|(_, side)| *side == 256));
+    }
 }

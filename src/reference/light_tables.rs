@@ -328,7 +328,13 @@ mod tests {
         }
         let (w, h) = (64u32, 32u32);
         let sun: Vec<[f32; 4]> = (0..w * h)
-            .map(|k| if k == 10 * w + 20 { [500.0; 4] } else { [0.5, 0.6, 0.8, 1.0] })
+            .map(|k| {
+                if k == 10 * w + 20 {
+                    [500.0; 4]
+                } else {
+                    [0.5, 0.6, 0.8, 1.0]
+                }
+            })
             .collect();
         assert!(LightTables::new(&[], &[], &[], &[], &sun, [w, h]).environment);
     }
