@@ -6,10 +6,11 @@
 // Path: the camera ray hits vertex 0; at every vertex the punctual lights are sampled
 // (next-event estimation, shadow rays through trace.glsl) and the BRDF is importance-sampled
 // (Lambert + GGX mixture, brdf.glsl) for the next ray, which gathers emission and the
-// environment where it lands. With PT_LIGHT_SAMPLING the emissive triangles and the
-// environment are also sampled at every vertex (light_sampling.glsl), and both estimates of
-// their light are weighted by the power heuristic. A contribution that scattered once is direct, more than once is
-// indirect; what the camera sees unscattered (emission, background) is direct. `bounces` B
+// environment where it lands. With PT_LIGHT_SAMPLING the emissive triangles (when they light
+// the scene: PT_EMISSIVE_LIGHTING) and the environment (when its tables say it has peaks) are
+// also sampled at every vertex (light_sampling.glsl), and both estimates of their light are
+// weighted by the power heuristic. A contribution that scattered once is direct, more than
+// once is indirect; what the camera sees unscattered (emission, background) is direct. `bounces` B
 // vertices after the first scatter further (B = 1: one-bounce indirect, what the GI techniques
 // compute). No Russian roulette, no clamping; a non-finite sample is dropped.
 #version 460

@@ -7,8 +7,9 @@
 //!   light one (an orthographic box around the scene), a point light six (cube faces +x, -x,
 //!   +y, -y, +z, -z). A spot wider than [`WIDE_SPOT_HALF_ANGLE`] has six faces too, at half
 //!   the side and four to a tile: one perspective map over its whole cone spreads its texels
-//!   thin (the Cornell box's 90° lamp had stair-stepped shadows at 1080p). Each tile is one raster pass restricted to its rectangle
-//!   ([`shine_graph::RasterPass::area`]), so clears and draws never touch the other tiles.
+//!   thin (the Cornell box's 90° lamp had stair-stepped shadows at 1080p). Each tile is one
+//!   raster pass restricted to its rectangle ([`shine_graph::RasterPass::area`]), so clears
+//!   and draws never touch the other tiles.
 //! * **Tile size** is the `shadow.size` setting for every tile; when the atlas would exceed the
 //!   device's largest 2D image the tiles are halved until it fits (with a warning).
 //! * **Cube faces overlap.** A point-light face covers slightly more than 90° (its central 90°
@@ -31,10 +32,10 @@ pub const TILE_SIZE: std::ops::RangeInclusive<u32> = 64..=16384;
 pub const DEFAULT_TILE_SIZE: u32 = 2048;
 
 /// Outer cone half-angle (radians) beyond which a spot light is shadowed through six cube
-/// faces like a point light. A single map's texel on a plane across the spot's axis grows
-/// with the tangent of the half-angle it covers: at 45° it matches a cube face; at the Cornell
-/// lamp's 83° (the map's widest, clamped) it is 8× larger.
-pub const WIDE_SPOT_HALF_ANGLE: f32 = std::f32::consts::FRAC_PI_4;
+/// faces of half the slot's side. One map's texel near its axis is 2 tan(outer) / side, a half
+/// face's about 4 / side: the faces are finer beyond tan(outer) = 2 (63.4°). At the Cornell
+/// lamp's 90° (the single map's fov clamped to 166°) they are 4× finer.
+pub const WIDE_SPOT_HALF_ANGLE: f32 = 1.107_148_8; // atan(2)
 
 /// Whether `light` is shadowed through six cube faces: a point light, or a spot light wider
 /// than [`WIDE_SPOT_HALF_ANGLE`].
@@ -137,9 +138,9 @@ enum Slots {
     One,
     /// Six cube faces in six slots (a point light).
     Cube,
-    /// Six cube faces at half the slot's side, four to a slot (a wide spot: it lights only
-    /// part of the sphere, and its faces at half size already have 4× the texel density of
-    /// one map over its cone at full size).
+    /// Six cube faces at half the slot's side, four to a slot (a spot wider than
+    /// [`WIDE_SPOT_HALF_ANGLE`], where half-size faces are already finer than one map over
+    /// its cone).
     HalfCube,
 }
 

@@ -41,7 +41,7 @@ pub const HEADER_WORDS: usize = 8;
 pub struct LightTables {
     /// Emissive triangles that can be picked.
     pub emitters: u32,
-    /// Whether the environment is sampled (it has radiance somewhere).
+    /// Whether the environment is sampled (it has peaks: [`ENVIRONMENT_PEAK_RATIO`]).
     pub environment: bool,
     words: Vec<u32>,
 }
@@ -67,11 +67,13 @@ impl LightTables {
             .filter(|(_, w)| **w > 0.0)
             .map(|(i, w)| (i as u32, *w))
             .collect();
-        let total: f64 = picked.iter().map(|(_, w)| f64::from(*w)).sum();
         let emitter_cdf = cdf(picked.iter().map(|(_, w)| *w));
+        // Each triangle's probability is its bin of the f32 CDF the shader searches, not w /
+        // total: the two differ by the CDF's rounding, and the MIS weights need the first.
         let mut probability = vec![0.0f32; triangles];
-        for (i, w) in &picked {
-            probability[*i as usize] = (f64::from(*w) / total) as f32;
+        for (k, (i, _)) in picked.iter().enumerate() {
+            let below = if k > 0 { emitter_cdf[k - 1] } else { 0.0 };
+            probability[*i as usize] = emitter_cdf[k] - below;
         }
         let texel_weights = environment_weights(environment, width, height);
         let env_total: f64 = texel_weights.iter().map(|w| f64::from(*w)).sum();
