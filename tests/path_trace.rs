@@ -60,6 +60,34 @@ fn params(size: u32, bounces: u32) -> ReferenceParams {
     }
 }
 
+/// Asserts that the mean `on` of a light-sampled image and `off` of one without agree within
+/// `tolerance` (relative).
+fn assert_same_mean(what: &str, on: f64, off: f64, tolerance: f64) {
+    assert!(
+        (on / off - 1.0).abs() < tolerance,
+        "{what}: mean {on} with light sampling, {off} without"
+    );
+}
+
+/// Asserts that `spp` samples (seed `seed`) of `run(light_sampling, spp, seed)` are at least
+/// twice as close to `truth` with light sampling as without.
+fn assert_light_sampling_halves_the_error(
+    run: impl Fn(bool, u32, u32) -> ReferenceImages,
+    spp: u32,
+    seed: u32,
+    truth: &ReferenceImages,
+) {
+    let (on, off) = (run(true, spp, seed), run(false, spp, seed));
+    let (e_on, e_off) = (
+        rmse(&on.full, &truth.full).expect("rmse"),
+        rmse(&off.full, &truth.full).expect("rmse"),
+    );
+    assert!(
+        e_on < 0.5 * e_off,
+        "{spp}-spp RMSE {e_on} with light sampling, {e_off} without"
+    );
+}
+
 /// Mean of the red channel over the texels `keep` selects (by their index).
 fn mean_red(image: &shine::capture::image_io::HdrImage, keep: impl Fn(usize) -> bool) -> f64 {
     let picked: Vec<f64> = image
@@ -310,19 +338,8 @@ fn environment_sampling_keeps_the_mean_under_a_sun() {
         mean_red(&off.full, on_sphere),
     );
     assert!(m_on > 0.1, "sphere mean {m_on}");
-    assert!(
-        (m_on / m_off - 1.0).abs() < 0.025,
-        "sphere mean {m_on} with light sampling, {m_off} without"
-    );
-    let (few_on, few_off) = (run(true, 8, 4), run(false, 8, 4));
-    let (e_on, e_off) = (
-        rmse(&few_on.full, &on.full).expect("rmse"),
-        rmse(&few_off.full, &on.full).expect("rmse"),
-    );
-    assert!(
-        e_on < 0.5 * e_off,
-        "8-spp RMSE {e_on} with light sampling, {e_off} without"
-    );
+    assert_same_mean("sphere", m_on, m_off, 0.025);
+    assert_light_sampling_halves_the_error(run, 8, 4, &on);
     common::assert_clean(&device);
 }
 
@@ -351,21 +368,14 @@ fn emitter_sampling_keeps_the_mean_and_cuts_the_noise() {
         ("full", &on.full, &off.full, 0.015),
         ("indirect", &on.indirect, &off.indirect, 0.025),
     ] {
-        let (ma, mb) = (mean_red(a, |_| true), mean_red(b, |_| true));
-        assert!(
-            (ma / mb - 1.0).abs() < tolerance,
-            "{what}: mean {ma} with light sampling, {mb} without"
+        assert_same_mean(
+            what,
+            mean_red(a, |_| true),
+            mean_red(b, |_| true),
+            tolerance,
         );
     }
-    let (few_on, few_off) = (run(true, 16, 3), run(false, 16, 3));
-    let (e_on, e_off) = (
-        rmse(&few_on.full, &on.full).expect("rmse"),
-        rmse(&few_off.full, &on.full).expect("rmse"),
-    );
-    assert!(
-        e_on < 0.5 * e_off,
-        "16-spp RMSE {e_on} with light sampling, {e_off} without"
-    );
+    assert_light_sampling_halves_the_error(run, 16, 3, &on);
     common::assert_clean(&device);
 }
 

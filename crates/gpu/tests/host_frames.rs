@@ -1,20 +1,10 @@
 //! Deferred destruction on a host's frame clock (`Device::begin_host_frame`), on a real device
 //! (lavapipe in CI) with the validation layer when installed.
 
-use shine_gpu::{Buffer, BufferDesc, Device, DeviceDesc, MemoryLocation, Validation, vk};
+mod common;
 
-fn device() -> Device {
-    let validation = if std::env::var_os("CI").is_some() {
-        Validation::Required
-    } else {
-        Validation::IfAvailable
-    };
-    Device::new(&DeviceDesc {
-        validation,
-        ..DeviceDesc::from_env()
-    })
-    .unwrap_or_else(|e| panic!("GPU tests need a Vulkan 1.3 device: {e}"))
-}
+use common::device;
+use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
 
 fn buffer(device: &Device) -> Buffer {
     Buffer::new(

@@ -3,20 +3,10 @@
 //! callers copy whole slices into the mapping. Lavapipe allocates exactly what is asked, so
 //! only a rounding driver (NVIDIA's) fails this without the fix; the device check runs it there.
 
-use shine_gpu::{Buffer, BufferDesc, Device, DeviceDesc, MemoryLocation, Validation, vk};
+mod common;
 
-fn device() -> Device {
-    let validation = if std::env::var_os("CI").is_some() {
-        Validation::Required
-    } else {
-        Validation::IfAvailable
-    };
-    Device::new(&DeviceDesc {
-        validation,
-        ..DeviceDesc::from_env()
-    })
-    .unwrap_or_else(|e| panic!("GPU tests need a Vulkan 1.3 device: {e}"))
-}
+use common::device;
+use shine_gpu::{Buffer, BufferDesc, MemoryLocation, vk};
 
 #[test]
 fn mapped_bytes_are_the_buffer_size_not_the_allocation() {
