@@ -27,10 +27,11 @@ echo "[3/3] Mitsuba 3 (if installed)" >&2
 if python3 -c "import mitsuba" 2> /dev/null; then
     for variant in scalar_rgb llvm_ad_rgb; do
         # max_depth 3: the emitter seen, direct light, one bounce (shine's --bounces 1).
-        # A subshell: a variant that aborts (llvm_ad_rgb against an old system LLVM) is
-        # reported below, without the shell's own message.
-        if ! (python3 scripts/mitsuba_cbox.py "$variant" 256 256 64 3 >> "$out/mitsuba.jsonl" \
-            2> "$out/mitsuba-$variant.log") 2> /dev/null; then
+        # An inner shell that does not exec python (`; exit $?`): a variant that aborts
+        # (llvm_ad_rgb against an old system LLVM) has the shell's "Aborted" go to its log,
+        # and is reported below.
+        if ! bash -c 'python3 scripts/mitsuba_cbox.py "$@"; exit $?' _ "$variant" 256 256 64 3 \
+            >> "$out/mitsuba.jsonl" 2> "$out/mitsuba-$variant.log"; then
             echo "  mitsuba $variant failed: see $out/mitsuba-$variant.log" >&2
         fi
     done
