@@ -11,8 +11,6 @@ layout(set = 0, binding = LIGHT_TABLES_BINDING, std430) readonly buffer LightTab
     uint w[];
 } light_tables;
 
-const float LIGHT_PI = 3.14159265358979323846;
-
 uint light_emitter_count() {
     return light_tables.w[0];
 }
@@ -54,20 +52,33 @@ float light_mis(float a, float b) {
     return 1.0 / (1.0 + r * r);
 }
 
-// Solid-angle density, seen from `x`, of picking emissive triangle `tri` (of the world
-// vertices) and the point `y` on it (0 for a triangle that is never picked).
-float light_triangle_pdf(uint tri, vec3 x, vec3 y) {
-    float p = light_word(light_tables.w[6] + tri);
-    if (p <= 0.0) {
-        return 0.0;
-    }
-    vec3 p0 = vertices.v[4u * indices.i[3u * tri]].xyz;
-    vec3 ng = cross(vertices.v[4u * indices.i[3u * tri + 1u]].xyz - p0, vertices.v[4u * indices.i[3u * tri + 2u]].xyz - p0);
+// Solid-angle density, seen from `x`, of picking with probability p the triangle (p0, p1, p2)
+// and the point `y` on it.
+float light_area_pdf(float p, vec3 p0, vec3 p1, vec3 p2, vec3 x, vec3 y) {
+    vec3 ng = cross(p1 - p0, p2 - p0);
     float twice_area = length(ng);
     vec3 d = y - x;
     float dist2 = dot(d, d);
     float cos_y = abs(dot(ng, d)) / (twice_area * sqrt(dist2));
     return cos_y > 0.0 ? p * dist2 / (0.5 * twice_area * cos_y) : 0.0;
+}
+
+// The probability of picking triangle `tri` (0 for one that is never picked).
+float light_triangle_probability(uint tri) {
+    return light_word(light_tables.w[6] + tri);
+}
+
+// Solid-angle density, seen from `x`, of picking emissive triangle `tri` (of the world
+// vertices) and the point `y` on it: the MIS weight of a BRDF-sampled ray that hit it.
+float light_triangle_pdf(uint tri, vec3 x, vec3 y) {
+    float p = light_triangle_probability(tri);
+    if (p <= 0.0) {
+        return 0.0;
+    }
+    vec3 p0 = vertices.v[4u * indices.i[3u * tri]].xyz;
+    vec3 p1 = vertices.v[4u * indices.i[3u * tri + 1u]].xyz;
+    vec3 p2 = vertices.v[4u * indices.i[3u * tri + 2u]].xyz;
+    return light_area_pdf(p, p0, p1, p2, x, y);
 }
 
 // Picks an emissive triangle and a uniform point on it; returns the direction from `x`, the
@@ -89,7 +100,7 @@ float light_sample_triangle(vec3 x, vec3 xi, out vec3 l, out float dist, out vec
     vec3 d = y - x;
     dist = length(d);
     l = d / max(dist, 1e-20);
-    float pdf = light_triangle_pdf(tri, x, y);
+    float pdf = light_area_pdf(light_triangle_probability(tri), p0, p1, p2, x, y);
     vec2 uv = b.x * vertices.v[4u * i0 + 3u].xy + b.y * vertices.v[4u * i1 + 3u].xy + b.z * vertices.v[4u * i2 + 3u].xy;
     radiance = surface_emission(floatBitsToUint(vertices.v[4u * i0].w), uv);
     return pdf;
@@ -107,13 +118,12 @@ float light_environment_pdf(vec3 dir) {
     if (sin_theta <= 0.0) {
         return 0.0;
     }
-    float u = abs(dir.x) + abs(dir.z) > 0.0 ? atan(dir.x, -dir.z) / (2.0 * LIGHT_PI) + 0.5 : 0.5;
-    float v = acos(clamp(dir.y, -1.0, 1.0)) / LIGHT_PI;
-    uint i = min(uint(u * float(w)), w - 1u);
-    uint j = min(uint(v * float(h)), h - 1u);
+    vec2 uv = environment_texcoord(dir);
+    uint i = min(uint(uv.x * float(w)), w - 1u);
+    uint j = min(uint(uv.y * float(h)), h - 1u);
     uint marginal = light_tables.w[7];
     float p = light_bin(marginal, j) * light_bin(marginal + h + j * w, i);
-    return p * float(w * h) / (2.0 * LIGHT_PI * LIGHT_PI * sin_theta);
+    return p * float(w * h) / (2.0 * ENVIRONMENT_PI * ENVIRONMENT_PI * sin_theta);
 }
 
 // Samples a direction from the environment tables: a row, a texel, a uniform point of it.
@@ -125,11 +135,7 @@ float light_sample_environment(vec3 xi, out vec3 l) {
     uint j = light_search(marginal, h, xi.x);
     uint i = light_search(marginal + h + j * w, w, xi.y);
     // The point within the texel: a fresh number (the search's leftovers are correlated).
-    float u = (float(i) + xi.z) / float(w);
-    float v = (float(j) + rand()) / float(h);
-    float phi = (u - 0.5) * 2.0 * LIGHT_PI;
-    float theta = v * LIGHT_PI;
-    l = vec3(sin(theta) * sin(phi), cos(theta), -sin(theta) * cos(phi));
+    l = environment_direction(vec2((float(i) + xi.z) / float(w), (float(j) + rand()) / float(h)));
     return light_environment_pdf(l);
 }
 

@@ -54,6 +54,12 @@ pub fn upload(
     device: &Device,
     environment: Option<&Environment>,
 ) -> Result<Image, shine_gpu::Error> {
+    upload_baked(device, &bake(environment))
+}
+
+/// Uploads texels [`bake`] made (for a caller that reads them too, like the path tracer's
+/// light tables).
+pub fn upload_baked(device: &Device, texels: &[[f32; 4]]) -> Result<Image, shine_gpu::Error> {
     let image = Image::new(
         device,
         &ImageDesc::new_2d(
@@ -65,7 +71,7 @@ pub fn upload(
     )?;
     device.upload_image(
         &image,
-        bytemuck::cast_slice(&bake(environment)),
+        bytemuck::cast_slice(texels),
         vk::ImageLayout::SHADER_READ_ONLY_OPTIMAL,
     )?;
     Ok(image)

@@ -37,16 +37,6 @@ pub const DEFAULT_TILE_SIZE: u32 = 2048;
 /// lamp's 90° (the single map's fov clamped to 166°) they are 4× finer.
 pub const WIDE_SPOT_HALF_ANGLE: f32 = 1.107_148_8; // atan(2)
 
-/// Whether `light` is shadowed through six cube faces: a point light, or a spot light wider
-/// than [`WIDE_SPOT_HALF_ANGLE`].
-pub fn uses_cube_faces(light: &shine_scene::Light) -> bool {
-    match light.light_kind() {
-        Some(LightKind::Point) => true,
-        Some(LightKind::Spot) => light.outer_cone_angle > WIDE_SPOT_HALF_ANGLE,
-        _ => false,
-    }
-}
-
 /// Default PCF radius in texels (a 3×3 kernel).
 pub const DEFAULT_FILTER_RADIUS: f32 = 1.5;
 
@@ -97,7 +87,7 @@ pub struct LightShadowRecord {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShadowLayout {
     /// Side of a slot of the atlas's grid in texels: a spot's or directional light's tile, a
-    /// point light's face; a wide spot's face is half of it ([`uses_cube_faces`]).
+    /// point light's face; a wide spot's face is half of it ([`WIDE_SPOT_HALF_ANGLE`]).
     pub tile: u32,
     /// Slots per atlas row.
     pub columns: u32,
@@ -148,7 +138,9 @@ impl Slots {
     fn of(light: &shine_scene::Light) -> Self {
         match light.light_kind() {
             Some(LightKind::Point) => Self::Cube,
-            _ if uses_cube_faces(light) => Self::HalfCube,
+            Some(LightKind::Spot) if light.outer_cone_angle > WIDE_SPOT_HALF_ANGLE => {
+                Self::HalfCube
+            }
             Some(_) => Self::One,
             None => Self::None,
         }

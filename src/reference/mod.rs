@@ -154,12 +154,12 @@ impl PathTracer {
     ) -> Result<Self, RenderError> {
         params.validate()?;
         let gpu_scene = GpuScene::upload(device, scene, t)?;
-        let environment =
-            crate::gpu_scene::environment::upload(device, scene.environment.as_ref())?;
+        let texels = crate::gpu_scene::environment::bake(scene.environment.as_ref());
+        let environment = crate::gpu_scene::environment::upload_baked(device, &texels)?;
         let light_tables = Buffer::storage_with_data(
             device,
             "light tables",
-            bytemuck::cast_slice(light_tables_of(scene, &gpu_scene)?.words()),
+            bytemuck::cast_slice(light_tables_of(scene, &gpu_scene, &texels)?.words()),
         )?;
         let sampler = |u, v| {
             Sampler::new(
@@ -331,17 +331,20 @@ impl PathTracer {
 
 /// The light-sampling tables of `scene` as `gpu_scene` holds it (its instances where they
 /// are now; skinning and morphs only move the triangles' areas, which the shader measures
-/// itself).
-fn light_tables_of(scene: &Scene, gpu_scene: &GpuScene) -> Result<LightTables, RenderError> {
+/// itself) under its baked environment `env`.
+fn light_tables_of(
+    scene: &Scene,
+    gpu_scene: &GpuScene,
+    env: &[[f32; 4]],
+) -> Result<LightTables, RenderError> {
     let geometry = Geometry::flatten(scene)?;
     let emissive: Vec<[f32; 3]> = scene.materials.iter().map(|m| m.emissive).collect();
-    let env = crate::gpu_scene::environment::bake(scene.environment.as_ref());
     Ok(LightTables::new(
         &geometry.source,
         &geometry.indices,
         &gpu_scene.instance_matrices(),
         &emissive,
-        &env,
+        env,
         [ENVIRONMENT_WIDTH, ENVIRONMENT_HEIGHT],
     ))
 }
