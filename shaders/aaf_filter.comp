@@ -1,6 +1,8 @@
-// AAF screen-space filter (paper 004 §5, src/passes/aaf.rs): a separable gaussian of the
-// per-pixel mean incident radiance, standard deviation beta (world units, the aaf_beta pass) of
-// the CENTRE pixel, over world-space distances between the pixels' positions. A neighbour
+// AAF screen-space filter (paper 004 §5, src/passes/aaf.rs): a separable filter of the per-pixel
+// mean incident radiance with gaussian weights of standard deviation beta (world units, the
+// aaf_beta pass) of the CENTRE pixel, over world-space distances between the pixels' positions:
+// per pass, a weighted least-squares polynomial fit of degree `degree` along the axis
+// (AafFit in aaf.glsl; degree 0 is the paper's normalised gaussian). A neighbour
 // counts only when its shading normal is within the normal threshold of the centre's (paper
 // 004: 10 degrees) and it lies within `plane_tolerance` pixel footprints of the centre's tangent
 // plane, so no light leaks across surfaces. `x` filters rows into `filtered`; `y` filters
@@ -38,7 +40,7 @@ layout(set = 0, binding = 5, rgba8) readonly uniform image2D gb_material;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D indirect;
 #endif
 
-// shine::passes::aaf::FilterPush (48 bytes).
+// shine::passes::aaf::FilterPush (64 bytes).
 layout(push_constant) uniform Push {
     // xyz: camera position; w: cos of the normal threshold.
     vec4 camera;
@@ -51,7 +53,13 @@ layout(push_constant) uniform Push {
     uint max_radius;
     // 1: filter; 0: pass the mean through.
     uint enabled;
-    uint pad;
+    // The specular pass's roughness limit (0: none).
+    float specular_limit;
+    // Degree of the local polynomial fit (0: the paper's gaussian).
+    uint degree;
+    uint pad0;
+    uint pad1;
+    uint pad2;
 } push;
 
 vec3 mean_at(uint q) {
@@ -86,8 +94,7 @@ void main() {
         int limit = int(push.extent.y);
         int coordinate = ixy.y;
 #endif
-        vec3 sum = vec3(0.0);
-        float weight = 0.0;
+        AafFit fit = aaf_fit_new();
         for (int k = -int(radius); k <= int(radius); ++k) {
             int c = coordinate + k;
             if (c < 0 || c >= limit) {
@@ -103,11 +110,10 @@ void main() {
             if (dot(n, nq) < push.camera.w || abs(dot(n, offset)) > push.plane_tolerance * d) {
                 continue;
             }
-            float w = exp(-dot(offset, offset) / (2.0 * beta * beta));
-            sum += w * mean_at(uint(q.y) * push.extent.x + uint(q.x));
-            weight += w;
+            float u = sign(float(k)) * length(offset) / beta;
+            aaf_fit_add(fit, u, mean_at(uint(q.y) * push.extent.x + uint(q.x)));
         }
-        result = weight > 0.0 ? sum / weight : result;
+        result = aaf_fit_value(fit, push.degree, result);
     }
 #ifdef AAF_X
     filtered.m[p] = vec4(result, 0.0);
@@ -115,9 +121,9 @@ void main() {
     vec3 out_radiance = vec3(0.0);
     if (position.w > 0.0) {
         vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
-        float metallic = imageLoad(gb_material, ixy).g;
+        vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
         vec3 v = normalize(push.camera.xyz - position.xyz);
-        out_radiance = aaf_demodulation(albedo, metallic, dot(n, v)) * result;
+        out_radiance = aaf_demodulation(albedo, roughness_metallic.x, roughness_metallic.y, dot(n, v), push.specular_limit) * result;
     }
     imageStore(indirect, ixy, vec4(out_radiance, 0.0));
 #endif

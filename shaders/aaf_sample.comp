@@ -6,7 +6,9 @@
 // traces a ray through the BVH; where it hits, the radiance leaving the hit towards the pixel is
 // next-event estimation to the punctual lights (path.glsl), continued for `bounces` - 1 further
 // BRDF-sampled vertices. Misses, emission and the environment add nothing (the raster GI
-// convention: punctual lights only).
+// convention: punctual lights only). Each hit's BRDF is evaluated no sharper than
+// config.w's roughness (path regularisation: a point light's highlight on a mirror-like hit
+// is a caustic no gathering ray samples).
 //
 // `first`: `samples` stratified samples (a k x k grid of strata, k = floor(sqrt(samples)), the
 // rest uniform); writes the sums and the nearest/farthest hit distances (z_min, z_max; 0, 0
@@ -35,7 +37,8 @@ layout(push_constant) uniform Push {
     uvec4 frame;
     // x: bounces B, y: samples of the first pass, z: the pixels sampled (0: every pixel;
     // 1 + k: the pixel at (k & 1, k >> 1) of every 2x2 cell; AMORTISE_REGATHER_SLICE: those
-    // `marks` marks; src/passes/amortise.rs), w: unused.
+    // `marks` marks; src/passes/amortise.rs), w: the bits of the least roughness at the hits
+    // (AafParams::hit_roughness_min, path regularisation).
     uvec4 config;
     // xyz: camera position, w: the specular pass's roughness limit (0: none).
     vec4 camera;
@@ -79,6 +82,7 @@ vec3 incident(vec3 dir, TraceHit hit, uint bounces) {
     vec3 throughput = vec3(1.0);
     for (uint vertex = 1u; ; ++vertex) {
         Vertex x = shade(hit, dir);
+        x.s.roughness = max(x.s.roughness, uintBitsToFloat(push.config.w));
         vec3 v = -dir;
         radiance += throughput * punctual_lights(x, v);
         if (vertex >= bounces) {
@@ -136,7 +140,7 @@ void main() {
     vec3 v = normalize(push.camera.xyz - position.xyz);
     vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
     vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
-    vec3 w = aaf_demodulation(albedo, roughness_metallic.y, dot(n, v));
+    vec3 w = aaf_demodulation(albedo, roughness_metallic.x, roughness_metallic.y, dot(n, v), push.camera.w);
     uint strata = uint(floor(sqrt(float(push.config.y))));
     float z_min = PT_FAR;
     float z_max = 0.0;

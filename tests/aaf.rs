@@ -228,14 +228,26 @@ fn run_gpu(device: &Device, s: &Synthetic, params: &AafParams) -> GpuResult {
 }
 
 /// β and the sample count of every pixel equal shine-sh's eq. 15, 16 and 21 (through the CPU
-/// twin), and the filtered, albedo-modulated light equals the CPU twin of the filter.
+/// twin), and the filtered, albedo-modulated light equals the CPU twin of the filter: the
+/// default quadratic fit, and the paper's gaussian with a traced specular pass's limit.
 #[test]
 fn beta_spp_and_filter_match_the_cpu_twin() {
     let device = device();
     let s = synthetic();
-    let params = AafParams::default();
-    let gpu = run_gpu(&device, &s, &params);
-    assert_clean(&device);
+    let paper = AafParams {
+        filter_degree: 0,
+        specular_limit: 0.5,
+        ..AafParams::default()
+    };
+    for params in [AafParams::default(), paper] {
+        matches_the_cpu_twin(&device, &s, &params);
+    }
+}
+
+fn matches_the_cpu_twin(device: &Device, s: &Synthetic, params: &AafParams) {
+    let params = *params;
+    let gpu = run_gpu(device, s, &params);
+    assert_clean(device);
     let footprint = aaf::footprint(&camera(), EXTENT[1]);
     let (mut filtered_pixels, mut clamped_spp) = (0, 0);
     for (p, got) in gpu.widths.iter().enumerate() {
@@ -280,22 +292,44 @@ fn beta_spp_and_filter_match_the_cpu_twin() {
         } else {
             let n = t.normal.normalize();
             let v = (EYE - t.position.truncate()).normalize();
-            demodulation(s.albedo[p].truncate(), s.material[p].y, n.dot(v)) * filtered[p]
+            let [roughness, metallic] = [s.material[p].x, s.material[p].y];
+            demodulation(
+                s.albedo[p].truncate(),
+                roughness,
+                metallic,
+                n.dot(v),
+                params.specular_limit,
+            ) * filtered[p]
         };
         let error = (*got - want).abs().max_element() / want.max_element().max(1e-3);
         worst = worst.max(error);
         changed += usize::from((filtered[p] - t.mean).length() > 1e-3 * t.mean.length());
     }
-    assert!(worst < 2e-3, "filter: worst relative error {worst}");
-    assert!(changed > 200, "the filter changed only {changed} pixels");
+    let degree = params.filter_degree;
+    assert!(
+        worst < 2e-3,
+        "degree {degree}: worst relative error {worst}"
+    );
+    assert!(
+        changed > 200,
+        "degree {degree}: changed only {changed} pixels"
+    );
 }
 
 /// The corner between the dim floor and the bright wall: the normal threshold and the
-/// tangent-plane test keep the wall's light off the floor.
+/// tangent-plane test keep the wall's light off the floor, whatever the fit's degree.
 #[test]
 fn the_filter_does_not_leak_across_surfaces() {
+    for filter_degree in shine_sh::aaf::FILTER_DEGREES {
+        does_not_leak(&AafParams {
+            filter_degree,
+            ..AafParams::default()
+        });
+    }
+}
+
+fn does_not_leak(params: &AafParams) {
     let s = synthetic();
-    let params = AafParams::default();
     let footprint = aaf::footprint(&camera(), EXTENT[1]);
     let texels: Vec<FilterTexel> = (0..s.position.len())
         .map(|p| FilterTexel {
@@ -306,13 +340,14 @@ fn the_filter_does_not_leak_across_surfaces() {
             mean: s.sums[p].truncate() / s.sums[p].w,
         })
         .collect();
-    let filtered = filter_cpu(&texels, EXTENT[0] as usize, footprint, &params);
+    let filtered = filter_cpu(&texels, EXTENT[0] as usize, footprint, params);
     for (p, t) in texels.iter().enumerate() {
         if t.position.w > 0.0 && t.normal.y > 0.5 {
             // Floor samples are at most 0.2 × 2 = 0.4; wall samples reach 10.
             assert!(
                 filtered[p].max_element() <= 0.4,
-                "floor pixel {p}: {}",
+                "degree {}, floor pixel {p}: {}",
+                params.filter_degree,
                 filtered[p]
             );
         }

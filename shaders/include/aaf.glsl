@@ -36,16 +36,67 @@ float aaf_samples_per_pixel(float omega_h, float z_min, float z_max, float d, fl
     return gamma * a * a * omega_h * omega_h * b * b;
 }
 
-// The receiver's demodulation weight w = kd + ks (brdf_indirect_weights at n.v, never below
-// 1e-3): the samples store the BRDF-weighted radiance over w, the filter smooths that, and the
-// result is multiplied by w again (paper 004 filters irradiance before albedo modulation; w
-// extends it to the specular part of the metallic-roughness BRDF).
+// The receiver's demodulation weight w = kd + ks (1 - specular_trace_weight) (brdf_indirect_weights
+// at n.v, never below 1e-3): the weight of the BRDF share the samples carry (the traced specular
+// pass takes the rest). The samples store the BRDF-weighted radiance over w, the filter smooths
+// that, and the result is multiplied by w again (paper 004 filters irradiance before albedo
+// modulation; w extends it to the specular part of the metallic-roughness BRDF).
 // CPU twin: shine::reference::aaf::demodulation.
-vec3 aaf_demodulation(vec3 albedo, float metallic, float n_dot_v) {
+vec3 aaf_demodulation(vec3 albedo, float roughness, float metallic, float n_dot_v, float specular_limit) {
     vec3 kd;
     vec3 ks;
     brdf_indirect_weights(albedo, metallic, n_dot_v, kd, ks);
-    return max(kd + ks, vec3(1e-3));
+    return max(kd + ks * (1.0 - specular_trace_weight(roughness, specular_limit)), vec3(1e-3));
+}
+
+// shine_sh::aaf::FIT_CONDITION_MIN
+const float AAF_FIT_CONDITION_MIN = 1e-4;
+
+// shine_sh::aaf::LocalFit: one separable filter pass at one pixel as a weighted least-squares
+// polynomial fit in u (signed world distance along the axis, in units of beta) with the paper's
+// gaussian weights; degree 0 is paper 004's normalised gaussian (eq. 16).
+struct AafFit {
+    float s0, s1, s2, s3, s4;
+    vec3 t0, t1, t2;
+};
+
+AafFit aaf_fit_new() {
+    return AafFit(0.0, 0.0, 0.0, 0.0, 0.0, vec3(0.0), vec3(0.0), vec3(0.0));
+}
+
+void aaf_fit_add(inout AafFit f, float u, vec3 y) {
+    float w = exp(-0.5 * u * u);
+    float w1 = w * u;
+    float w2 = w1 * u;
+    float w3 = w2 * u;
+    f.s0 += w;
+    f.s1 += w1;
+    f.s2 += w2;
+    f.s3 += w3;
+    f.s4 += w3 * u;
+    f.t0 += w * y;
+    f.t1 += w1 * y;
+    f.t2 += w2 * y;
+}
+
+// The fit at u = 0 of the highest well-conditioned degree up to `degree`, clamped at 0;
+// `fallback` without neighbours.
+vec3 aaf_fit_value(AafFit f, uint degree, vec3 fallback) {
+    if (f.s0 <= 0.0) {
+        return fallback;
+    }
+    float det2 = f.s0 * (f.s2 * f.s4 - f.s3 * f.s3) - f.s1 * (f.s1 * f.s4 - f.s2 * f.s3)
+        + f.s2 * (f.s1 * f.s3 - f.s2 * f.s2);
+    if (degree >= 2u && det2 > AAF_FIT_CONDITION_MIN * f.s0 * f.s2 * f.s4) {
+        vec3 a = f.t0 * (f.s2 * f.s4 - f.s3 * f.s3) - f.t1 * (f.s1 * f.s4 - f.s2 * f.s3)
+            + f.t2 * (f.s1 * f.s3 - f.s2 * f.s2);
+        return max(a / det2, vec3(0.0));
+    }
+    float det1 = f.s0 * f.s2 - f.s1 * f.s1;
+    if (degree >= 1u && det1 > AAF_FIT_CONDITION_MIN * f.s0 * f.s2) {
+        return max((f.t0 * f.s2 - f.t1 * f.s1) / det1, vec3(0.0));
+    }
+    return max(f.t0 / f.s0, vec3(0.0));
 }
 
 #endif

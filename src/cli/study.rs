@@ -6,6 +6,7 @@
 use super::CliError;
 use super::frame_args::{EnvironmentArgs, load_scene};
 use shine::gpu::{Device, DeviceDesc};
+use shine::passes::aaf::AafParams;
 use shine::study::aaf::AafStudyConfig;
 use shine::study::report::StudyFormat;
 use shine::study::temporal::{self, TemporalConfig, TemporalMode};
@@ -96,7 +97,7 @@ pub struct AafStudyArgs {
     #[arg(long, default_value_t = 128)]
     truth_chunk: u32,
     /// The uniform curves' spp levels, increasing, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4, 8, 16, 32, 64, 128, 256])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4, 8, 16, 32, 64, 128, 256, 512])]
     spp: Vec<u32>,
     /// AAF's μ values (the AAF curve), comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [0.25, 0.5, 0.9, 2.0, 4.0, 8.0])]
@@ -117,6 +118,13 @@ pub struct AafStudyArgs {
     /// Scene time in seconds (animations).
     #[arg(long, default_value_t = 0.0)]
     time: f32,
+    /// Degree of the filter's local polynomial fit (0: paper 004's gaussian).
+    #[arg(long, default_value_t = shine_sh::aaf::FILTER_DEGREE)]
+    filter_degree: u32,
+    /// Roughness limit of the traced specular pass whose lobes AAF leaves out (0: AAF takes
+    /// every lobe; default: a default frame's).
+    #[arg(long, default_value_t = aaf::frame_defaults().specular_limit)]
+    specular_limit: f32,
     #[command(flatten)]
     environment: EnvironmentArgs,
 }
@@ -220,6 +228,11 @@ fn run_aaf(args: &AafStudyArgs) -> Result<(), CliError> {
         repeats: args.repeats,
         path_tracer_spp: args.path_tracer_spp,
         seed: args.seed,
+        params: AafParams {
+            filter_degree: args.filter_degree,
+            specular_limit: args.specular_limit,
+            ..aaf::frame_defaults()
+        },
         ..AafStudyConfig::default()
     };
     // Refuse bad numbers before loading anything.

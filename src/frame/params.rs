@@ -209,6 +209,7 @@ impl FrameParams {
                     bounces: a.bounces,
                     adaptive: a.adaptive,
                     filter: a.filter,
+                    filter_degree: a.filter_degree,
                     specular_limit,
                     slices: a.slices,
                     ..AafParams::default()

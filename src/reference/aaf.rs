@@ -5,11 +5,12 @@
 use glam::{Vec3, Vec4};
 use shine_sh::ShError;
 use shine_sh::aaf::{
-    PixelFootprint, filter_bandwidth, filter_width, receiver_bandlimit, samples_per_pixel,
+    LocalFit, PixelFootprint, filter_bandwidth, filter_width, receiver_bandlimit, samples_per_pixel,
 };
 
 use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE};
 use crate::passes::brdf_tables::indirect_weights;
+use crate::passes::specular::trace_weight;
 
 /// What `aaf_beta` writes for one pixel: `(β, samples)` from its linear depth (0 on
 /// background), its first-pass `(z_min, z_max)` (0, 0 without a hit: the scene's size is taken
@@ -45,12 +46,19 @@ pub fn beta_cpu(
     ])
 }
 
-/// The receiver's demodulation weight `w = kd + ks` (`aaf_demodulation` of
-/// `shaders/include/aaf.glsl`), never below 1e-3: the filter's output is `w` times the filtered
-/// mean.
-pub fn demodulation(albedo: Vec3, metallic: f32, n_dot_v: f32) -> Vec3 {
+/// The receiver's demodulation weight `w = kd + ks (1 − trace_weight)` (`aaf_demodulation` of
+/// `shaders/include/aaf.glsl`), never below 1e-3: the weight of the BRDF share the samples
+/// carry, the traced specular pass of roughness limit `specular_limit` taking the rest. The
+/// filter's output is `w` times the filtered mean.
+pub fn demodulation(
+    albedo: Vec3,
+    roughness: f32,
+    metallic: f32,
+    n_dot_v: f32,
+    specular_limit: f32,
+) -> Vec3 {
     let (kd, ks) = indirect_weights(albedo, metallic, n_dot_v);
-    (kd + ks).max(Vec3::splat(1e-3))
+    (kd + ks * (1.0 - trace_weight(roughness, specular_limit))).max(Vec3::splat(1e-3))
 }
 
 /// One pixel of the G-buffer as the filter sees it.
@@ -103,8 +111,7 @@ fn filter_axis(
             let n = centre.normal.normalize();
             let d = centre.position.w * footprint[0] + footprint[1];
             let radius = MAX_RADIUS.min((2.0 * centre.beta / d).ceil() as u32) as i64;
-            let mut sum = Vec3::ZERO;
-            let mut weight = 0.0f32;
+            let mut fit = LocalFit::default();
             for k in -radius..=radius {
                 let (qx, qy) = (x + axis[0] * k, y + axis[1] * k);
                 if qx < 0 || qy < 0 || qx >= width as i64 || qy >= height as i64 {
@@ -120,15 +127,11 @@ fn filter_axis(
                 {
                     continue;
                 }
-                let w = (-offset.length_squared() / (2.0 * centre.beta * centre.beta)).exp();
-                sum += w * q.mean;
-                weight += w;
+                let u = (k as f32).signum() * offset.length() / centre.beta;
+                fit.add(u, q.mean.to_array());
             }
-            if weight > 0.0 {
-                sum / weight
-            } else {
-                centre.mean
-            }
+            fit.value(params.filter_degree)
+                .map_or(centre.mean, Vec3::from_array)
         })
         .collect()
 }

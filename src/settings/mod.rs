@@ -152,6 +152,10 @@ pub struct AafSettings {
     pub adaptive: bool,
     /// The screen-space filter; off: the unfiltered Monte-Carlo mean. Default true.
     pub filter: bool,
+    /// Degree of the filter's local polynomial fit with the paper's gaussian weights: 0 is
+    /// paper 004's gaussian, 1 linear, 2 quadratic (keeps the light's peaks and edges the
+    /// gaussian flattens; docs/quality.md). Range 0..=2, default 2.
+    pub filter_degree: u32,
     /// Pixels per refresh (paper 001): 1 samples every pixel every frame; 4 samples one pixel
     /// per 2×2 cell per frame and reprojects the others' sums from the previous frames
     /// (`aaf_reproject`, src/passes/amortise.rs). Default 1.
@@ -171,6 +175,7 @@ impl Default for AafSettings {
             bounces: p.bounces,
             adaptive: p.adaptive,
             filter: p.filter,
+            filter_degree: p.filter_degree,
             slices: p.slices,
         }
     }
@@ -760,11 +765,12 @@ mod tests {
         assert!(aaf.gi.contains(GiTechnique::Aaf));
         assert_eq!(aaf.aaf.mu, 2.0);
         type Edit = fn(&mut Settings);
-        let cases: [(&str, &str, Edit); 5] = [
+        let cases: [(&str, &str, Edit); 6] = [
             ("aaf.mu", "0.0", |s| s.aaf.mu = 0.0),
             ("aaf.mu", "-1.0", |s| s.aaf.mu = -1.0),
             ("aaf.spp_min", "8", |s| s.aaf.spp_min = 8),
             ("aaf.omega_h", "0.0", |s| s.aaf.omega_h = 0.0),
+            ("aaf.filter_degree", "3", |s| s.aaf.filter_degree = 3),
             ("aaf.spp_max", "8", |s| {
                 s.aaf.spp_max = 8;
             }),

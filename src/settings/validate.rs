@@ -267,6 +267,11 @@ impl Settings {
         check("aaf.spp_min", a.spp_min, &aaf::SPP_MIN)?;
         check("aaf.spp_max", a.spp_max, &aaf::SPP_MAX)?;
         check("aaf.bounces", a.bounces, &aaf::BOUNCES)?;
+        check(
+            "aaf.filter_degree",
+            a.filter_degree,
+            &shine_sh::aaf::FILTER_DEGREES,
+        )?;
         check_slices("aaf.slices", a.slices)
     }
 }

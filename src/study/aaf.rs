@@ -66,8 +66,8 @@ pub struct AafStudyConfig {
     pub path_tracer_spp: u32,
     /// The first seed; every render takes the next.
     pub seed: u32,
-    /// AAF's other parameters (paper 004's by default); `mu`, `adaptive`, `filter`,
-    /// `first_samples` and `seed` are set per render.
+    /// AAF's other parameters (a default `--gi aaf` frame's: [`frame_defaults`]); `mu`,
+    /// `adaptive`, `filter`, `first_samples` and `seed` are set per render.
     pub params: AafParams,
 }
 
@@ -78,14 +78,29 @@ impl Default for AafStudyConfig {
             time: 0.0,
             truth_spp: 2048,
             truth_chunk: 128,
-            uniform_spp: (0..=8).map(|k| 1 << k).collect(),
+            uniform_spp: (0..=9).map(|k| 1 << k).collect(),
             mus: vec![0.25, 0.5, 0.9, 2.0, 4.0, 8.0],
             mu: shine_sh::aaf::DEFAULT_MU,
             repeats: 1,
             path_tracer_spp: 256,
             seed: 1,
-            params: AafParams::default(),
+            params: frame_defaults(),
         }
+    }
+}
+
+/// The AAF parameters of a default `--gi aaf` frame: [`AafParams::default`] with the traced
+/// specular pass's roughness limit, so the study judges the share of the light AAF computes in
+/// the frame (the pass traces the lobes sharper than the limit: the room's chrome and gold).
+pub fn frame_defaults() -> AafParams {
+    let specular = crate::settings::SpecularSettings::default();
+    AafParams {
+        specular_limit: if specular.enabled {
+            specular.limit
+        } else {
+            0.0
+        },
+        ..AafParams::default()
     }
 }
 
@@ -133,7 +148,9 @@ impl AafStudyConfig {
         if self.path_tracer_spp > 1 << 16 {
             return bad("--path-tracer-spp is at most 65536".into());
         }
-        Ok(())
+        self.params
+            .validate()
+            .or_else(|e| bad(format!("the AAF parameters: {e}")))
     }
 
     /// The AAF curve's μ values, sorted, with the study's μ among them.

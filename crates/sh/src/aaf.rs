@@ -150,6 +150,79 @@ pub fn samples_per_pixel(
     Ok((f64::from(gamma) * a * a * h * h * b * b) as f32)
 }
 
+/// Degree of the filter's local polynomial fit by default: 2, a weighted quadratic about the
+/// centre pixel. Degree 0 is paper 004's filter (eq. 16, a normalised gaussian: the fit of a
+/// constant). See [`LocalFit`].
+pub const FILTER_DEGREE: u32 = 2;
+/// The fit degrees the filter takes: 0 (paper), 1 (linear), 2 (quadratic).
+pub const FILTER_DEGREES: std::ops::RangeInclusive<u32> = 0..=2;
+/// A fit is used only when its moment matrix's determinant is at least this share of the
+/// product of its diagonal; below it the fit drops a degree (too few or too clustered
+/// neighbours to pin a slope or a curvature).
+pub const FIT_CONDITION_MIN: f32 = 1e-4;
+
+/// One separable pass of the filter at one pixel, as a weighted least-squares fit of a
+/// polynomial in `u` (the signed world distance from the centre along the pass's axis, in units
+/// of β) to the neighbours' values, with the paper's gaussian weights `exp(−u²/2)`: the filtered
+/// value is the fit at `u = 0`. Degree 0 is the paper's normalised gaussian. A gaussian flattens
+/// every peak and valley of the light by `O(β²)` (its bias) and, where the normal and plane tests
+/// or the image's border cut its support to one side, tilts it by `O(β)`; the quadratic fit is
+/// exact for light that varies quadratically along the axis, on either side. GLSL twin:
+/// `AafFit` in `shaders/include/aaf.glsl`.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct LocalFit {
+    /// `Σ w u^k`, k = 0..4.
+    s: [f32; 5],
+    /// `Σ w u^k y`, k = 0..2, per channel.
+    t: [[f32; 3]; 3],
+}
+
+impl LocalFit {
+    /// Adds a neighbour at `u` (in units of β) with value `y` and the gaussian weight of `u`.
+    pub fn add(&mut self, u: f32, y: [f32; 3]) {
+        let w = (-0.5 * u * u).exp();
+        let mut power = w;
+        for k in 0..5 {
+            self.s[k] += power;
+            if k < 3 {
+                for (t, y) in self.t[k].iter_mut().zip(y) {
+                    *t += power * y;
+                }
+            }
+            power *= u;
+        }
+    }
+
+    /// The fitted value at `u = 0` of the highest degree up to `degree` whose fit is well
+    /// conditioned ([`FIT_CONDITION_MIN`]), clamped at 0 (light is never negative; a fit
+    /// extrapolated over noise can dip below); `None` without neighbours.
+    pub fn value(&self, degree: u32) -> Option<[f32; 3]> {
+        let [s0, s1, s2, s3, s4] = self.s;
+        let [t0, t1, t2] = self.t;
+        if s0 <= 0.0 {
+            return None;
+        }
+        let solve = |a: [f32; 3], b: [f32; 3], c: [f32; 3], det: f32| {
+            std::array::from_fn(|i| ((a[i] + b[i] + c[i]) / det).max(0.0))
+        };
+        let scale = |t: [f32; 3], k: f32| t.map(|v| v * k);
+        let det2 = s0 * (s2 * s4 - s3 * s3) - s1 * (s1 * s4 - s2 * s3) + s2 * (s1 * s3 - s2 * s2);
+        if degree >= 2 && det2 > FIT_CONDITION_MIN * s0 * s2 * s4 {
+            return Some(solve(
+                scale(t0, s2 * s4 - s3 * s3),
+                scale(t1, -(s1 * s4 - s2 * s3)),
+                scale(t2, s1 * s3 - s2 * s2),
+                det2,
+            ));
+        }
+        let det1 = s0 * s2 - s1 * s1;
+        if degree >= 1 && det1 > FIT_CONDITION_MIN * s0 * s2 {
+            return Some(solve(scale(t0, s2), scale(t1, -s1), [0.0; 3], det1));
+        }
+        Some(solve(t0, [0.0; 3], [0.0; 3], s0))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -201,5 +274,46 @@ mod tests {
         assert!(samples_per_pixel(2.8, px, 0.3, 2.0, 1.0).unwrap() > n);
         let bad = PixelFootprint { z_max: 0.1, ..px };
         assert!(samples_per_pixel(2.8, bad, 0.3, 1.0, 1.0).is_err());
+    }
+
+    #[test]
+    fn the_quadratic_fit_is_exact_for_quadratic_light_even_one_sided() {
+        let light = |u: f32| 2.0 + 0.5 * u - 0.3 * u * u;
+        for side in [-3..=3, 0..=4] {
+            let mut fit = LocalFit::default();
+            for k in side {
+                let u = 0.7 * k as f32;
+                fit.add(u, [light(u), 2.0 * light(u), 0.0]);
+            }
+            let v = fit.value(2).unwrap();
+            assert!(
+                (v[0] - 2.0).abs() < 1e-4 && (v[1] - 4.0).abs() < 1e-4,
+                "{v:?}"
+            );
+            assert_eq!(v[2], 0.0);
+            // The paper's gaussian (degree 0) is biased: by the curvature, or by the slope
+            // where the neighbours lie on one side.
+            let g = fit.value(0).unwrap();
+            assert!((g[0] - 2.0).abs() > 0.05, "{g:?}");
+        }
+    }
+
+    #[test]
+    fn an_ill_conditioned_fit_drops_a_degree() {
+        let mut none = LocalFit::default();
+        assert_eq!(none.value(2), None);
+        none.add(0.0, [1.0; 3]);
+        assert_eq!(none.value(2), Some([1.0; 3]));
+        // Two neighbours pin a line, not a parabola: the linear fit through them.
+        let mut two = LocalFit::default();
+        two.add(0.5, [3.0; 3]);
+        two.add(1.0, [4.0; 3]);
+        let v = two.value(2).unwrap();
+        assert!((v[0] - 2.0).abs() < 1e-4, "{v:?}");
+        // A fit extrapolated below zero is clamped.
+        let mut down = LocalFit::default();
+        down.add(0.5, [1.0; 3]);
+        down.add(1.0, [3.0; 3]);
+        assert_eq!(down.value(1), Some([0.0; 3]));
     }
 }
