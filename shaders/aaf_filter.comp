@@ -4,8 +4,9 @@
 // per pass, a weighted least-squares polynomial fit of degree `degree` along the axis
 // (AafFit in aaf.glsl; degree 0 is the paper's normalised gaussian). A neighbour
 // counts only when its shading normal is within the normal threshold of the centre's (paper
-// 004: 10 degrees) and it lies within `plane_tolerance` pixel footprints of the centre's tangent
-// plane, so no light leaks across surfaces. `x` filters rows into `filtered`; `y` filters
+// 004: 10 degrees) and it lies within `plane_tolerance` pixel footprints of the centre's
+// geometric tangent plane (a normal map's tilt would push coplanar neighbours off a shading
+// plane), so no light leaks across surfaces. `x` filters rows into `filtered`; `y` filters
 // columns and multiplies by the receiver's demodulation weight w (aaf.glsl) into the indirect
 // image. With `enabled` = 0 the mean passes through unfiltered (uniform Monte Carlo).
 // CPU twin: shine::reference::aaf::filter_cpu.
@@ -20,6 +21,7 @@ layout(local_size_x = 8, local_size_y = 8) in;
 
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D gb_position;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D gb_normal;
+layout(set = 0, binding = 7, rgba16f) readonly uniform image2D gb_geometric_normal;
 layout(set = 0, binding = 2, std430) readonly buffer Filter {
     vec2 f[];
 } filter_widths;
@@ -82,6 +84,7 @@ void main() {
     vec3 result = mean_at(p);
     float beta = filter_widths.f[p].x;
     vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
+    vec3 ng = normalize(imageLoad(gb_geometric_normal, ixy).xyz);
     if (push.enabled != 0u && position.w > 0.0 && beta > 0.0) {
         float d = position.w * push.footprint.x + push.footprint.y;
         uint radius = min(push.max_radius, uint(ceil(2.0 * beta / d)));
@@ -107,7 +110,7 @@ void main() {
             }
             vec3 nq = normalize(imageLoad(gb_normal, q).xyz);
             vec3 offset = xq.xyz - position.xyz;
-            if (dot(n, nq) < push.camera.w || abs(dot(n, offset)) > push.plane_tolerance * d) {
+            if (dot(n, nq) < push.camera.w || abs(dot(ng, offset)) > push.plane_tolerance * d) {
                 continue;
             }
             float u = sign(float(k)) * length(offset) / beta;

@@ -56,6 +56,7 @@ fn hash(i: u32) -> f32 {
 struct Synthetic {
     position: Vec<Vec4>,
     normal: Vec<Vec4>,
+    geometric_normal: Vec<Vec4>,
     albedo: Vec<Vec4>,
     material: Vec<Vec4>,
     depths: Vec<[f32; 2]>,
@@ -70,6 +71,7 @@ fn synthetic() -> Synthetic {
     let mut s = Synthetic {
         position: Vec::new(),
         normal: Vec::new(),
+        geometric_normal: Vec::new(),
         albedo: Vec::new(),
         material: Vec::new(),
         depths: Vec::new(),
@@ -108,7 +110,15 @@ fn synthetic() -> Synthetic {
                 [0.0, 0.0]
             });
             s.position.push(position);
-            s.normal.push(q16(normal));
+            s.geometric_normal.push(q16(normal));
+            // A normal map: every third pixel's shading normal tilted by about 6°, within the
+            // normal threshold; the tangent-plane test takes the geometric normal.
+            let tilt = if p % 3 == 1 {
+                Vec4::new(normal.y, normal.x, 0.0, 0.0) * 0.1
+            } else {
+                Vec4::ZERO
+            };
+            s.normal.push(q16((normal + tilt).normalize_or_zero()));
             s.albedo
                 .push(q8(Vec4::new(0.2 + 0.6 * u, 0.5, 0.8 - 0.5 * v, 1.0)));
             let metallic = match i % 7 {
@@ -146,6 +156,13 @@ fn run_gpu(device: &Device, s: &Synthetic, params: &AafParams) -> GpuResult {
         vk::Format::R16G16B16A16_SFLOAT,
         e,
         &bytes_f16(&s.normal),
+    );
+    let geometric_normal = storage_image_with(
+        device,
+        "gb_geometric_normal",
+        vk::Format::R16G16B16A16_SFLOAT,
+        e,
+        &bytes_f16(&s.geometric_normal),
     );
     let albedo = storage_image_with(
         device,
@@ -189,7 +206,7 @@ fn run_gpu(device: &Device, s: &Synthetic, params: &AafParams) -> GpuResult {
         albedo: import(&mut rg, &albedo),
         material: import(&mut rg, &material),
         emissive: unused(&mut rg, "unused emissive", vk::Format::R16G16B16A16_SFLOAT),
-        geometric_normal: unused(&mut rg, "unused normal", vk::Format::R16G16B16A16_SFLOAT),
+        geometric_normal: import(&mut rg, &geometric_normal),
         motion: unused(
             &mut rg,
             "unused motion",
@@ -279,6 +296,7 @@ fn matches_the_cpu_twin(device: &Device, s: &Synthetic, params: &AafParams) {
         .map(|p| FilterTexel {
             position: s.position[p],
             normal: s.normal[p].truncate(),
+            geometric_normal: s.geometric_normal[p].truncate(),
             beta: gpu.widths[p][0],
             mean: s.sums[p].truncate() / s.sums[p].w,
         })
@@ -335,6 +353,7 @@ fn does_not_leak(params: &AafParams) {
         .map(|p| FilterTexel {
             position: s.position[p],
             normal: s.normal[p].truncate(),
+            geometric_normal: s.geometric_normal[p].truncate(),
             // Wide enough to reach across the whole image.
             beta: 10.0,
             mean: s.sums[p].truncate() / s.sums[p].w,

@@ -24,9 +24,9 @@
 //!    fit of a polynomial of degree [`AafParams::filter_degree`] along the axis to the mean
 //!    incident radiance ([`shine_sh::aaf::LocalFit`]), with the paper's gaussian weights of
 //!    standard deviation `β` of the centre pixel over world-space distances, neighbours only
-//!    within the normal threshold (paper: 10°) and near the centre's tangent plane; then the
-//!    receiver's weight `w` (the albedo modulation after filtering). Degree 0 is the paper's
-//!    normalised gaussian (eq. 16).
+//!    within the normal threshold (paper: 10°) and near the centre's geometric tangent plane;
+//!    then the receiver's weight `w` (the albedo modulation after filtering). Degree 0 is the
+//!    paper's normalised gaussian (eq. 16).
 //!
 //! # Decisions and deviations from paper 004
 //!
@@ -38,7 +38,9 @@
 //!   cosine-weighted directions (noisy) and filtered with their glossy β.
 //! * The filter's world-distance test (not in the paper, which tests normals only): a neighbour
 //!   farther than [`PLANE_TOLERANCE`] pixel footprints from the centre's tangent plane is left
-//!   out, so light does not leak between parallel surfaces at different depths.
+//!   out, so light does not leak between parallel surfaces at different depths. The plane is
+//!   the geometric one: a normal map's tilted shading normal put coplanar neighbours a few
+//!   pixels away off its plane and cut the room's tiled floor into tile-sized filters.
 //! * The gaussian is cut at 2β or [`MAX_RADIUS`] pixels, whichever is smaller.
 //! * **The filter fits a quadratic by default** (`filter_degree = 2`; 0 is the paper's
 //!   gaussian). The paper's gaussian passes frequencies at half its bandwidth `Ω_x^r` at 61%
@@ -556,6 +558,7 @@ pub fn aaf_filter(
     rg.compute("aaf_filter_x", &shaders::AAF_FILTER_COMP_X)
         .read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
+        .read("gb_geometric_normal", &g.geometric_normal)
         .read("filter_widths", widths)
         .read("sums", sums)
         .write("filtered", &mut rows)
@@ -568,6 +571,7 @@ pub fn aaf_filter(
     rg.compute("aaf_filter_y", &shaders::AAF_FILTER_COMP_Y)
         .read("gb_position", &g.position)
         .read("gb_normal", &g.normal)
+        .read("gb_geometric_normal", &g.geometric_normal)
         .read("filter_widths", widths)
         .read("filtered", &rows)
         .read("gb_albedo", &g.albedo)

@@ -66,8 +66,10 @@ pub fn demodulation(
 pub struct FilterTexel {
     /// xyz world position, w linear depth (0 on background).
     pub position: Vec4,
-    /// Shading normal (normalised here).
+    /// Shading normal (normalised here): the normal threshold.
     pub normal: Vec3,
+    /// Geometric normal (normalised here): the tangent-plane test.
+    pub geometric_normal: Vec3,
     /// β of the pixel (world units; 0: no filter).
     pub beta: f32,
     /// The mean incident radiance to filter.
@@ -109,6 +111,7 @@ fn filter_axis(
                 return centre.mean;
             }
             let n = centre.normal.normalize();
+            let ng = centre.geometric_normal.normalize();
             let d = centre.position.w * footprint[0] + footprint[1];
             let radius = MAX_RADIUS.min((2.0 * centre.beta / d).ceil() as u32) as i64;
             let mut fit = LocalFit::default();
@@ -123,7 +126,7 @@ fn filter_axis(
                 }
                 let offset = q.position.truncate() - centre.position.truncate();
                 if n.dot(q.normal.normalize()) < cos_threshold
-                    || n.dot(offset).abs() > PLANE_TOLERANCE * d
+                    || ng.dot(offset).abs() > PLANE_TOLERANCE * d
                 {
                     continue;
                 }
