@@ -97,7 +97,7 @@ pub struct AafStudyArgs {
     #[arg(long, default_value_t = 128)]
     truth_chunk: u32,
     /// The uniform curves' spp levels, increasing, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4, 8, 16, 32, 64, 128, 256, 512])]
+    #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4, 8, 16, 32, 64, 128, 256])]
     spp: Vec<u32>,
     /// AAF's μ values (the AAF curve), comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [0.25, 0.5, 0.9, 2.0, 4.0, 8.0])]

@@ -78,7 +78,7 @@ impl Default for AafStudyConfig {
             time: 0.0,
             truth_spp: 2048,
             truth_chunk: 128,
-            uniform_spp: (0..=9).map(|k| 1 << k).collect(),
+            uniform_spp: (0..=8).map(|k| 1 << k).collect(),
             mus: vec![0.25, 0.5, 0.9, 2.0, 4.0, 8.0],
             mu: shine_sh::aaf::DEFAULT_MU,
             repeats: 1,
