@@ -233,7 +233,6 @@ fn run_aaf(args: &AafStudyArgs) -> Result<(), CliError> {
             specular_limit: args.specular_limit,
             ..aaf::frame_defaults()
         },
-        ..AafStudyConfig::default()
     };
     // Refuse bad numbers before loading anything.
     config.validate()?;
