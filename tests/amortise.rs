@@ -722,8 +722,10 @@ fn a_turning_camera_regathers_what_it_had_not_seen() {
 /// affects) instead of following over four frames: a cell from its refreshed pixel (or shaded
 /// again where that shows another surface), a block of records regathered. Measured: HVL 0.224,
 /// 0.154 with one unsampled shadow test per HVL (a held receiver takes its cell's light, at
-/// half resolution for one frame), IGI 0.499, AAF 0.126 (bounds about 1.5× that); without the
-/// change test 2.75, 2.89, 3.44 and 3.23.
+/// half resolution for one frame), IGI 0.499, AAF 0.282 (bounds about 1.5× that); without the
+/// change test 2.75, 2.89, 3.44 and 3.23. AAF read 0.126 with the paper's gaussian filter
+/// (`aaf.filter_degree = 0`) and 0.222 with a linear fit: the quadratic fit smooths less at
+/// 32², and the two images differ by more of their noise.
 #[test]
 fn a_light_that_jumps_is_followed_at_once() {
     let device = common::device();
@@ -732,7 +734,7 @@ fn a_light_that_jumps_is_followed_at_once() {
         ("hvl", "hvl.slices", None, 0.33),
         ("hvl", "hvl.slices", Some(("hvl.shadow_rays", "0")), 0.23),
         ("igi", "igi.slices", None, 0.75),
-        ("aaf", "aaf.slices", None, 0.19),
+        ("aaf", "aaf.slices", None, 0.42),
     ] {
         let mut pairs = vec![("gi", gi), ("output.component", "indirect")];
         pairs.extend(extra);

@@ -54,6 +54,12 @@ fn tiny_aaf_study_reports_every_number_and_writes_the_pictures() {
     let report: Value = serde_json::from_slice(&out.stdout).expect("study prints JSON");
 
     assert_eq!(report["extent"], serde_json::json!([32, 32]));
+    // A default frame's AAF: the quadratic fit, the specular pass's limit.
+    assert_eq!(
+        report["setup"]["filter_degree"],
+        shine_sh::aaf::FILTER_DEGREE
+    );
+    assert!(finite(&report, "/setup/specular_limit") > 0.0);
     assert!(finite(&report, "/truth/mean") > 0.0);
     assert!(finite(&report, "/truth/noise_relative_rmse") > 0.0);
     assert!(finite(&report, "/truth/pixels") > 0.0);

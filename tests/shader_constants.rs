@@ -226,3 +226,11 @@ fn exposure_floor_matches_the_shader() {
         shine::passes::exposure::LUMINANCE_FLOOR
     );
 }
+
+#[test]
+fn aaf_fit_condition_matches_the_shader() {
+    assert_eq!(
+        glsl_float("include/aaf.glsl", "AAF_FIT_CONDITION_MIN"),
+        shine_sh::aaf::FIT_CONDITION_MIN
+    );
+}

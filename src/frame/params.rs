@@ -109,14 +109,12 @@ impl FrameParams {
         let h = &settings.hvl;
         let i = &settings.igi;
         let p = &settings.proxy;
-        let specular = (settings.specular.enabled
-            && settings.specular.limit > 0.0
-            && !gi.is_none())
-        .then(|| SpecularParams {
-            samples: settings.specular.samples,
-            limit: settings.specular.limit,
-            ..SpecularParams::default()
-        });
+        let specular =
+            (settings.specular.traced_limit() > 0.0 && !gi.is_none()).then(|| SpecularParams {
+                samples: settings.specular.samples,
+                limit: settings.specular.limit,
+                ..SpecularParams::default()
+            });
         let specular_limit = specular.map_or(0.0, |s| s.limit);
         let upsample = UpsampleParams {
             depth_sigma: settings.upsample.depth_epsilon,

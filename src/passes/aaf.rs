@@ -5,8 +5,9 @@
 //!    [`AafParams::first_samples`] stratified, cosine-weighted rays about the shading normal
 //!    through the BVH; each hit's outgoing radiance `L` is next-event estimation to the
 //!    punctual lights (one bounce; [`AafParams::bounces`] > 1 continues the path by BRDF
-//!    sampling, as the path tracer). A sample adds `π f(l, v) L / w`: `f` the receiver's BRDF,
-//!    `w = kd + ks` its demodulation weight, so that for a Lambertian receiver the mean is the
+//!    sampling, as the path tracer). A sample adds `π f(l, v) L / w`: `f` the receiver's BRDF
+//!    less the share the traced specular pass takes, `w = kd + ks (1 − trace_weight)` the
+//!    weight of what is left (its demodulation weight), so that for a Lambertian receiver the mean is the
 //!    irradiance over π, the quantity the paper filters. The nearest and farthest hit
 //!    distances are `z_min`, `z_max`.
 //! 2. **Filter width and sampling rate** (`aaf_beta.comp`, GLSL twin of [`shine_sh::aaf`] in
@@ -32,7 +33,7 @@
 //!
 //! * Direct light stays the raster's; AAF computes the indirect term only. The receiver's whole
 //!   metallic-roughness BRDF weights the samples (with cosine-weighted directions), demodulated
-//!   by `w = kd + ks` (`brdf_indirect_weights`, as HVL and IGI) so the filter smooths what is
+//!   by `w` (`brdf_indirect_weights`, as HVL and IGI) so the filter smooths what is
 //!   smooth: without the specular part the cornell box lost 16% of its indirect energy against
 //!   the path tracer (rough dielectrics, F0 = 0.04). Sharp metallic lobes are sampled with
 //!   cosine-weighted directions (noisy) and filtered with their glossy β.
@@ -48,9 +49,11 @@
 //!   image's border leave neighbours on one side only, it also tilts the light by `O(β)`. The
 //!   Cornell box's ceiling, lit from the floor's spot, lost its peak to that bias: at 128² the
 //!   gaussian's error floor (filtered uniform Monte Carlo at 256 spp) was 0.27 of the mean,
-//!   the quadratic fit's is 0.09, and the samples saved at equal error rose from 1.3× to more
-//!   than 5× (docs/quality.md). The weights, β, the sampling rates and the tests are the
-//!   paper's. Fitted values below zero are clamped to zero.
+//!   the quadratic fit's is 0.09, and the samples saved at equal error rose from 1.3× to 6.1×
+//!   (5.3× from 3.3× on the animated scene). It is not better everywhere: in the room, whose
+//!   normal-mapped floor cuts the filters into small pieces, a quadratic over few neighbours
+//!   removes less noise than the gaussian (2.45× against 3.18×; docs/quality.md). The weights,
+//!   β and the sampling rates are the paper's. Fitted values below zero are clamped to zero.
 //! * **Demodulation by the share sampled**: `w = kd + ks (1 − trace_weight)`, the part of the
 //!   BRDF the samples carry when the frame's specular pass traces the sharper lobes
 //!   ([`AafParams::specular_limit`]); with `kd + ks` a glossy tile and its rough grout held
@@ -90,11 +93,12 @@ pub const Z_MIN_FRACTION: RangeInclusive<f32> = 1e-4..=1.0;
 pub const PLANE_TOLERANCE: f32 = 2.0;
 /// Largest filter radius in pixels (the gaussian is cut at 2β).
 pub const MAX_RADIUS: u32 = 32;
-/// Default [`AafParams::hit_roughness_min`]: the default limit of the traced specular pass
-/// ([`crate::passes::specular::LIMIT`]), the roughness below which the frame leaves lobes to
-/// rays rather than to the GI; the room's chrome (0.05) and gold (0.15) would otherwise make
-/// the AAF study's 2048-spp truth noisier (relative RMSE 3.2) than any estimate it judges.
-pub const HIT_ROUGHNESS_MIN: f32 = crate::passes::specular::LIMIT;
+/// Default [`AafParams::hit_roughness_min`] (not the paper's: its scenes have no mirror-like
+/// reflectors). At 0.5 the room's chrome (0.05) and gold (0.15) no longer make caustic
+/// fireflies: its 2048-spp study truth went from a relative noise of 3.2 to 0.08. A fixed
+/// constant, not tied to the specular pass's limit (that pass traces lobes seen from the camera,
+/// never at AAF's hits).
+pub const HIT_ROUGHNESS_MIN: f32 = 0.5;
 
 /// Parameters of the AAF passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -144,7 +148,9 @@ pub struct AafParams {
 }
 
 impl Default for AafParams {
-    /// Paper 004's values (§4.3, §6).
+    /// Paper 004's values (§4.3, §6), except two that are shine's: the filter's quadratic fit
+    /// ([`shine_sh::aaf::FILTER_DEGREE`]; 0 is the paper's) and the hits' least roughness
+    /// ([`HIT_ROUGHNESS_MIN`]).
     fn default() -> Self {
         Self {
             first_samples: 16,
@@ -272,7 +278,7 @@ pub struct BetaPush {
     pub pad: [u32; 3],
 }
 
-/// Push constants of `shaders/aaf_filter.comp` (48 bytes).
+/// Push constants of `shaders/aaf_filter.comp` (64 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FilterPush {
@@ -525,7 +531,8 @@ fn beta_push(
 }
 
 /// Adds `aaf_filter_x` and `aaf_filter_y`: the separable filter of the mean of `sums` (vec4
-/// per pixel: rgb sum, count) with the widths of [`aaf_beta`], then the receivers' `kd`.
+/// per pixel: rgb sum, count) with the widths of [`aaf_beta`], then the receivers'
+/// demodulation weight `w`.
 /// Returns the indirect light (RGBA16F).
 pub fn aaf_filter(
     rg: &mut RenderGraph,

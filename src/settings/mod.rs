@@ -129,7 +129,7 @@ impl Default for HistorySettings {
 }
 
 /// `[aaf]`: axis-aligned filtering of path-traced indirect light (paper 004,
-/// `src/passes/aaf.rs`). Defaults are the paper's.
+/// `src/passes/aaf.rs`). Defaults are the paper's, except the filter's fit (`filter_degree`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AafSettings {
@@ -154,7 +154,8 @@ pub struct AafSettings {
     pub filter: bool,
     /// Degree of the filter's local polynomial fit with the paper's gaussian weights: 0 is
     /// paper 004's gaussian, 1 linear, 2 quadratic (keeps the light's peaks and edges the
-    /// gaussian flattens; docs/quality.md). Range 0..=2, default 2.
+    /// gaussian flattens, but removes less noise where the filter has few neighbours, as on a
+    /// normal-mapped floor; docs/quality.md). Range 0..=2, default 2.
     pub filter_degree: u32,
     /// Pixels per refresh (paper 001): 1 samples every pixel every frame; 4 samples one pixel
     /// per 2×2 cell per frame and reprojects the others' sums from the previous frames

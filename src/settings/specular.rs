@@ -30,3 +30,15 @@ impl Default for SpecularSettings {
         }
     }
 }
+
+impl SpecularSettings {
+    /// The roughness limit of the traced pass in a frame with indirect light: `limit` when the
+    /// pass is enabled, 0 (no pass) otherwise. The GI techniques leave the lobes below it out.
+    pub fn traced_limit(&self) -> f32 {
+        if self.enabled {
+            self.limit.max(0.0)
+        } else {
+            0.0
+        }
+    }
+}

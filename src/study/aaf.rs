@@ -2,8 +2,8 @@
 //! error.
 //!
 //! 1. **Truth**: uniform Monte Carlo of the same quantity AAF estimates (the AAF passes with
-//!    `adaptive = false, filter = false`: `kd` × the mean of cosine-weighted one-bounce
-//!    samples), `truth_spp` per pixel as independent chunks of `truth_chunk` (one seed each),
+//!    `adaptive = false, filter = false`: `w` × the mean of cosine-weighted one-bounce
+//!    samples, with a default frame's specular limit and hit regularisation), `truth_spp` per pixel as independent chunks of `truth_chunk` (one seed each),
 //!    averaged. The chunks' spread gives the truth's own noise ([`metrics::TruthAccumulator`]).
 //! 2. **Curves** (Fig. 10): the relative RMSE and energy ratio of uniform unfiltered Monte Carlo
 //!    at each spp level, of uniform Monte Carlo through AAF's filter, and of AAF (adaptive and
@@ -23,7 +23,7 @@ use shine_scene::Scene;
 use super::metrics::{self, TruthAccumulator};
 use super::plot::{self, Curve};
 use super::report::{
-    AafStudyReport, AgainstPathTracer, Bars, CurvePoint, Curves, EqualError, Maps, Truth,
+    AafStudyReport, AgainstPathTracer, Bars, CurvePoint, Curves, EqualError, Maps, Setup, Truth,
 };
 use super::runner::{AAF_PASSES, AafFrame, AafRunner, Bench, Measured, Target};
 use super::{Progress, StudyError};
@@ -93,13 +93,8 @@ impl Default for AafStudyConfig {
 /// specular pass's roughness limit, so the study judges the share of the light AAF computes in
 /// the frame (the pass traces the lobes sharper than the limit: the room's chrome and gold).
 pub fn frame_defaults() -> AafParams {
-    let specular = crate::settings::SpecularSettings::default();
     AafParams {
-        specular_limit: if specular.enabled {
-            specular.limit
-        } else {
-            0.0
-        },
+        specular_limit: crate::settings::SpecularSettings::default().traced_limit(),
         ..AafParams::default()
     }
 }
@@ -421,6 +416,11 @@ pub fn run(
         extent: config.extent,
         device: device.info().name.clone(),
         repeats: config.repeats,
+        setup: Setup {
+            filter_degree: config.params.filter_degree,
+            specular_limit: config.params.specular_limit,
+            hit_roughness_min: config.params.hit_roughness_min,
+        },
         truth: Truth {
             spp: config.truth_spp,
             chunk: config.truth_chunk,

@@ -162,6 +162,17 @@ pub struct Maps {
     pub uniform_image_spp: u32,
 }
 
+/// The AAF parameters the study's renders share.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Setup {
+    /// Degree of the filter's local polynomial fit (0: the paper's gaussian).
+    pub filter_degree: u32,
+    /// Roughness limit of the traced specular pass whose lobes AAF leaves out (0: none).
+    pub specular_limit: f32,
+    /// Least roughness of the BRDF at the samples' hits.
+    pub hit_roughness_min: f32,
+}
+
 /// Everything `shine study aaf` measured.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct AafStudyReport {
@@ -173,6 +184,9 @@ pub struct AafStudyReport {
     pub device: String,
     /// Renders per curve point (errors averaged, times the least).
     pub repeats: u32,
+    /// The AAF parameters every render shares (the filter's fit, the specular limit, the
+    /// hits' least roughness): they change every number.
+    pub setup: Setup,
     /// The truth.
     pub truth: Truth,
     /// The error curves.
@@ -211,8 +225,14 @@ impl AafStudyReport {
         let t = &self.truth;
         let _ = writeln!(
             s,
-            "AAF study: {} at {w}×{h} on {} ({} render(s) per point)",
-            self.scene, self.device, self.repeats
+            "AAF study: {} at {w}×{h} on {} ({} render(s) per point); filter degree {}, \
+             specular limit {}, hit roughness ≥ {}",
+            self.scene,
+            self.device,
+            self.repeats,
+            self.setup.filter_degree,
+            self.setup.specular_limit,
+            self.setup.hit_roughness_min
         );
         let _ = writeln!(
             s,

@@ -1,5 +1,6 @@
 //! Paper 004 (axis-aligned filtering for diffuse/glossy indirect light): transfer-function
-//! bandlimits, filter widths and per-pixel sampling rates (eq. 15–21, appendix eq. 24 and 26).
+//! bandlimits, filter widths and per-pixel sampling rates (eq. 15–21, appendix eq. 24 and 26),
+//! and the filter's local polynomial fit with the paper's gaussian weights ([`LocalFit`]).
 //!
 //! Units: frequencies in cycles per unit of the `v` parameterisation (bandlimits) or per world
 //! unit (spatial); `z_min`/`z_max` are world-space distances to the nearest/farthest reflector;
