@@ -61,11 +61,11 @@ bool inside(ivec2 p) {
 // history cannot bleed into a dark object over it, as it does in linear HDR; the indirect
 // light's history blends linear radiance (energy-true). `from_blend` inverts `to_blend`.
 vec3 to_blend(vec3 x) {
-    return push.geometry != 0u ? x : x / (1.0 + dot(x, TAA_LUMA));
+    return push.geometry != 0u ? x : x / (1.0 + luminance(x));
 }
 
 vec3 from_blend(vec3 x) {
-    return push.geometry != 0u ? x : x / max(1.0 - dot(x, TAA_LUMA), TAA_MIN_INVERSE);
+    return push.geometry != 0u ? x : x / max(1.0 - luminance(x), TAA_MIN_INVERSE);
 }
 
 // TAA's disocclusion test at a pixel: whether history geometry `g` (normal, linear depth; 0:

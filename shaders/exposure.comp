@@ -10,6 +10,8 @@
 //! variant reduce_indirect EXPOSURE_REDUCE=1 INDIRECT=1
 //! variant resolve EXPOSURE_RESOLVE=1
 #version 460
+#extension GL_GOOGLE_include_directive : require
+#include "color.glsl"
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
@@ -77,8 +79,7 @@ void main() {
 #if INDIRECT
         radiance += imageLoad(indirect_full, ivec2(pixel)).rgb;
 #endif
-        // Rec. 709 luminance (shine::passes::accumulate::TAA_LUMA)
-        float l = dot(radiance, vec3(0.2126, 0.7152, 0.0722));
+        float l = luminance(radiance);
         if (!isnan(l) && !isinf(l)) {
             v = vec2(log(EXPOSURE_LUMINANCE_FLOOR + max(l, 0.0)), 1.0);
         }

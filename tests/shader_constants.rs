@@ -163,7 +163,7 @@ fn agx_constants_match_the_shader() {
 #[test]
 fn accumulate_constant_matches_the_shader() {
     use shine::passes::accumulate::{
-        ACCUMULATE_MIN_WEIGHT, TAA_LUMA, TAA_MIN_INVERSE, TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
+        ACCUMULATE_MIN_WEIGHT, TAA_MIN_INVERSE, TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
     };
     let file = "include/accumulate.glsl";
     assert_eq!(
@@ -175,17 +175,6 @@ fn accumulate_constant_matches_the_shader() {
     assert_eq!(
         glsl_float(file, "TAA_MOVING_FRAMES"),
         TAA_MOVING_FRAMES as f32
-    );
-    let source = std::fs::read_to_string(
-        Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("shaders")
-            .join(file),
-    )
-    .expect("shader source");
-    let [r, g, b] = TAA_LUMA;
-    assert!(
-        source.contains(&format!("const vec3 TAA_LUMA = vec3({r}, {g}, {b});")),
-        "TAA_LUMA differs from {TAA_LUMA:?}"
     );
 }
 
@@ -232,5 +221,22 @@ fn aaf_fit_condition_matches_the_shader() {
     assert_eq!(
         glsl_float("include/aaf.glsl", "AAF_FIT_CONDITION_MIN"),
         shine_sh::aaf::FIT_CONDITION_MIN
+    );
+}
+
+#[test]
+fn rec709_luma_matches_the_shader() {
+    let file = "include/color.glsl";
+    let source = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("shaders")
+            .join(file),
+    )
+    .expect("shader source");
+    let [r, g, b] = shine::capture::tonemap::REC709_LUMA;
+    assert!(
+        source.contains(&format!("const vec3 REC709_LUMA = vec3({r}, {g}, {b});")),
+        "REC709_LUMA differs from {:?}",
+        [r, g, b]
     );
 }

@@ -1,8 +1,9 @@
 // The constants of shaders/accumulate.comp; Rust twins: shine::passes::accumulate
-// (ACCUMULATE_MIN_WEIGHT, TAA_STILL_PIXELS, TAA_MOVING_FRAMES, TAA_LUMA,
-// TAA_MIN_INVERSE), tied by tests/shader_constants.rs.
+// (ACCUMULATE_MIN_WEIGHT, TAA_STILL_PIXELS, TAA_MOVING_FRAMES, TAA_MIN_INVERSE), tied by
+// tests/shader_constants.rs. TAA's blend space is x / (1 + luminance(x)) (color.glsl).
 #ifndef ACCUMULATE_GLSL
 #define ACCUMULATE_GLSL
+#include "color.glsl"
 
 // Smallest bilinear weight of a pixel's history taps that show its surface: below it the
 // history is rejected (disocclusion) and restarts.
@@ -15,8 +16,6 @@ const float TAA_STILL_PIXELS = 0.01;
 // Longest history of a moving pixel under TAA.
 const float TAA_MOVING_FRAMES = 2.0;
 
-// Luma weights (Rec. 709) of TAA's blend space x / (1 + luma(x)).
-const vec3 TAA_LUMA = vec3(0.2126, 0.7152, 0.0722);
 // Smallest 1 - luma of a blend-space value when it is mapped back (its luma is below 1 for
 // every finite radiance; this keeps rounding from dividing by 0).
 const float TAA_MIN_INVERSE = 1e-4;

@@ -2,6 +2,7 @@
 // Reitz D, height-correlated Smith visibility, Schlick Fresnel), as in the glTF spec appendix B.
 #ifndef BRDF_GLSL
 #define BRDF_GLSL
+#include "color.glsl"
 
 const float BRDF_PI = 3.14159265358979323846;
 
@@ -96,9 +97,8 @@ vec3 sample_ggx_half(vec3 n, float a, vec2 xi) {
 // Probability of sampling the specular lobe: its normal-incidence weight (F0 luminance)
 // against the diffuse weight, kept within [0.1, 0.9] while both lobes exist.
 float brdf_specular_probability(vec3 base_color, float metallic) {
-    const vec3 Y = vec3(0.2126, 0.7152, 0.0722);
-    float ws = dot(mix(vec3(0.04), base_color, metallic), Y);
-    float wd = dot(base_color, Y) * (1.0 - metallic);
+    float ws = luminance(mix(vec3(0.04), base_color, metallic));
+    float wd = luminance(base_color) * (1.0 - metallic);
     if (wd <= 0.0) {
         return 1.0;
     }

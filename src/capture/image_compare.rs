@@ -8,7 +8,7 @@
 //! - **RMSE**: root mean square of the per-channel differences over the R, G, B channels of
 //!   every pixel (alpha ignored).
 //! - **PSNR**: `20 log10(L / RMSE)` dB (infinite for identical images).
-//! - **SSIM** (Wang et al. 2004): on luminance `Y = 0.2126 R + 0.7152 G + 0.0722 B`, with an
+//! - **SSIM** (Wang et al. 2004): on Rec. 709 luminance (`tonemap::luminance`), with an
 //!   11×11 Gaussian window of σ = 1.5 (normalised), `C1 = (K1 L)²`, `C2 = (K2 L)²`,
 //!   `K1 = 0.01`, `K2 = 0.03`, averaged over every window position that lies fully inside the
 //!   image (no padding); images smaller than the window are refused.
@@ -19,6 +19,7 @@
 //!   binding's default 67 pixels per degree (a 0.7 m viewing distance from a 24" monitor).
 
 use crate::capture::image_io::{HdrImage, LdrImage};
+use crate::capture::tonemap;
 
 /// Dynamic range `L` of the clamped values.
 pub const DYNAMIC_RANGE: f64 = 1.0;
@@ -142,10 +143,11 @@ pub fn psnr_of_rmse(rmse: f64) -> f64 {
 }
 
 fn luminance(image: &HdrImage) -> Vec<f64> {
+    let [r, g, b] = tonemap::REC709_LUMA.map(f64::from);
     image
         .texels
         .iter()
-        .map(|t| 0.2126 * clamped(t[0]) + 0.7152 * clamped(t[1]) + 0.0722 * clamped(t[2]))
+        .map(|t| r * clamped(t[0]) + g * clamped(t[1]) + b * clamped(t[2]))
         .collect()
 }
 

@@ -37,6 +37,16 @@ use glam::Vec3;
 /// docs/quality.md). `--tonemap agx` is one flag away.
 pub const DEFAULT_TONEMAP: Tonemap = Tonemap::PbrNeutral;
 
+/// Rec. 709 luminance weights of linear RGB (ITU-R BT.709): exposure metering, TAA's blend
+/// space, SSIM, the path tracer's emitter weights, the BRDF sampler's lobe choice. GLSL twin:
+/// `REC709_LUMA` in shaders/include/color.glsl.
+pub const REC709_LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
+
+/// Rec. 709 luminance of linear RGB ([`REC709_LUMA`]; GLSL `luminance`).
+pub fn luminance(rgb: Vec3) -> f32 {
+    rgb.dot(Vec3::from(REC709_LUMA))
+}
+
 /// Linear exposure factors a frame takes (`output.exposure`).
 pub const EXPOSURE: std::ops::RangeInclusive<f32> = 1e-6..=1e6;
 

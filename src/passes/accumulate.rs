@@ -36,10 +36,6 @@ pub const TAA_STILL_PIXELS: f32 = 0.01;
 /// (a thin walking figure washed out into the window behind it with 16 frames).
 pub const TAA_MOVING_FRAMES: u32 = 2;
 
-/// Luma weights (Rec. 709) of TAA's blend space x / (1 + luma(x)) (Karis 2014): a bright
-/// background's history cannot bleed into a dark object over it, as it does in linear HDR
-/// (`TAA_LUMA` in shaders/include/accumulate.glsl).
-pub const TAA_LUMA: [f32; 3] = [0.2126, 0.7152, 0.0722];
 /// Smallest 1 − luma of a blend-space value when it is mapped back to radiance
 /// (`TAA_MIN_INVERSE`).
 pub const TAA_MIN_INVERSE: f32 = 1e-4;
@@ -75,7 +71,10 @@ pub struct AccumulateParams {
     /// The indirect light's history: linear radiance, the background passes through. Without
     /// it, TAA: the background accumulates too, a still pixel ([`TAA_STILL_PIXELS`]) keeps
     /// history of any surface of its 3×3 neighbourhood, and the blend is in the space
-    /// x / (1 + luma(x)) ([`TAA_LUMA`]). Both restart where the history shows another surface.
+    /// x / (1 + luma(x)) (Karis 2014: a bright background's history cannot bleed into a dark
+    /// object over it, as it does in linear HDR; luma:
+    /// [`crate::capture::tonemap::luminance`]). Both restart where the history shows another
+    /// surface.
     pub geometry: bool,
 }
 

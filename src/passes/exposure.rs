@@ -14,8 +14,8 @@ use std::ops::RangeInclusive;
 
 use glam::Vec3;
 
+use crate::capture::tonemap::luminance;
 use crate::graph::{Buffer, BufferDesc, Handle, History, Image, RenderGraph};
-use crate::passes::accumulate::TAA_LUMA;
 use crate::shaders;
 
 /// The key `a` of Reinhard et al. 2002 (eq. 2): the log-average maps to middle grey.
@@ -127,7 +127,7 @@ pub fn exposure(
 pub fn log_average(radiance: impl IntoIterator<Item = Vec3>) -> Option<f64> {
     let (mut sum, mut count) = (0.0f64, 0u64);
     for r in radiance {
-        let l = r.dot(Vec3::from(TAA_LUMA));
+        let l = luminance(r);
         if l.is_finite() {
             sum += f64::from(LUMINANCE_FLOOR + l.max(0.0)).ln();
             count += 1;

@@ -3,9 +3,9 @@
 
 use glam::{Vec2, Vec3, Vec4};
 
+use crate::capture::tonemap::luminance;
 use crate::passes::accumulate::{
-    ACCUMULATE_MIN_WEIGHT, AccumulateParams, TAA_LUMA, TAA_MIN_INVERSE, TAA_MOVING_FRAMES,
-    TAA_STILL_PIXELS,
+    ACCUMULATE_MIN_WEIGHT, AccumulateParams, TAA_MIN_INVERSE, TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
 };
 use crate::passes::amortise::same_surface;
 
@@ -35,7 +35,7 @@ fn to_blend(x: Vec3, params: &AccumulateParams) -> Vec3 {
     if params.geometry {
         x
     } else {
-        x / (1.0 + x.dot(Vec3::from(TAA_LUMA)))
+        x / (1.0 + luminance(x))
     }
 }
 
@@ -44,7 +44,7 @@ fn from_blend(x: Vec3, params: &AccumulateParams) -> Vec3 {
     if params.geometry {
         x
     } else {
-        x / (1.0 - x.dot(Vec3::from(TAA_LUMA))).max(TAA_MIN_INVERSE)
+        x / (1.0 - luminance(x)).max(TAA_MIN_INVERSE)
     }
 }
 

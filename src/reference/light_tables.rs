@@ -22,8 +22,8 @@
 
 use glam::{Mat4, Vec3};
 
+use crate::capture::tonemap::luminance;
 use crate::gpu_scene::Vertex;
-use crate::passes::accumulate::TAA_LUMA;
 
 /// The environment is sampled only when its largest texel weight is at least this many times
 /// the mean one. A smooth sky is found about as well by the BRDF's cosine-weighted rays, and
@@ -140,7 +140,7 @@ fn triangle_weights(
     matrices: &[Mat4],
     emissive: &[[f32; 3]],
 ) -> Vec<f32> {
-    let luminance = |e: &[f32; 3]| (0..3).map(|k| TAA_LUMA[k] * e[k].max(0.0)).sum::<f32>();
+    let emitted = |e: &[f32; 3]| luminance(Vec3::from(*e).max(Vec3::ZERO));
     indices
         .chunks_exact(3)
         .map(|t| {
@@ -151,7 +151,7 @@ fn triangle_weights(
             else {
                 return 0.0;
             };
-            let e = emissive.get(v[0].material as usize).map_or(0.0, luminance);
+            let e = emissive.get(v[0].material as usize).map_or(0.0, emitted);
             let Some(m) = matrices.get(v[0].instance as usize) else {
                 return 0.0;
             };
@@ -175,10 +175,10 @@ fn environment_weights(texels: &[[f32; 4]], width: u32, height: u32) -> Vec<f32>
     if texels.len() != w * h {
         return Vec::new();
     }
-    let luminance: Vec<f32> = texels
+    let texel_luminance: Vec<f32> = texels
         .iter()
         .map(|t| {
-            let y: f32 = (0..3).map(|k| TAA_LUMA[k] * t[k].max(0.0)).sum();
+            let y = luminance(Vec3::from_slice(&t[..3]).max(Vec3::ZERO));
             if y.is_finite() { y } else { 0.0 }
         })
         .collect();
@@ -190,7 +190,7 @@ fn environment_weights(texels: &[[f32; 4]], width: u32, height: u32) -> Vec<f32>
                 let jj = (j as i64 + dj).clamp(0, h as i64 - 1) as usize;
                 for di in [-1i64, 0, 1] {
                     let ii = (i as i64 + di).rem_euclid(w as i64) as usize;
-                    largest = largest.max(luminance[jj * w + ii]);
+                    largest = largest.max(texel_luminance[jj * w + ii]);
                 }
             }
             let theta = (j as f32 + 0.5) / h as f32 * std::f32::consts::PI;

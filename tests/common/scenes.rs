@@ -175,14 +175,15 @@ pub fn pixel_centre_reference(size: u32, seed: u32) -> shine::reference::Referen
     }
 }
 
-/// Rec. 709 luminance of `image` at `pixels` (the passes' `TAA_LUMA` weights).
+/// Rec. 709 luminance of `image` at `pixels` (`shine::capture::tonemap::luminance`).
 pub fn luminance(image: &shine::capture::image_io::HdrImage, pixels: &[usize]) -> Vec<f64> {
-    let w = shine::passes::accumulate::TAA_LUMA;
     pixels
         .iter()
         .map(|&p| {
             let t = image.texels[p];
-            f64::from(w[0] * t[0] + w[1] * t[1] + w[2] * t[2])
+            f64::from(shine::capture::tonemap::luminance(glam::Vec3::new(
+                t[0], t[1], t[2],
+            )))
         })
         .collect()
 }
