@@ -99,6 +99,8 @@ pub const MAX_RADIUS: u32 = 32;
 /// constant, not tied to the specular pass's limit (that pass traces lobes seen from the camera,
 /// never at AAF's hits).
 pub const HIT_ROUGHNESS_MIN: f32 = 0.5;
+/// The hits' least roughnesses the parameters take (0: no regularisation).
+pub const HIT_ROUGHNESS_RANGE: RangeInclusive<f32> = 0.0..=1.0;
 
 /// Parameters of the AAF passes.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -203,7 +205,11 @@ impl AafParams {
             self.filter_degree,
             &shine_sh::aaf::FILTER_DEGREES,
         )?;
-        check("hit_roughness_min", self.hit_roughness_min, &(0.0..=1.0))?;
+        check(
+            "hit_roughness_min",
+            self.hit_roughness_min,
+            &HIT_ROUGHNESS_RANGE,
+        )?;
         check(
             "specular_limit",
             self.specular_limit,
