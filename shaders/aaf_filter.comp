@@ -1,14 +1,18 @@
 // AAF screen-space filter (paper 004 §5, src/passes/aaf.rs): a separable filter of the per-pixel
-// mean incident radiance with gaussian weights of standard deviation beta (world units, the
-// aaf_beta pass) of the CENTRE pixel, over world-space distances between the pixels' positions:
-// per pass, a weighted least-squares polynomial fit of degree `degree` along the axis
-// (AafFit in aaf.glsl; degree 0 is the paper's normalised gaussian). A neighbour
-// counts only when its shading normal is within the normal threshold of the centre's (paper
-// 004: 10 degrees) and it lies within `plane_tolerance` pixel footprints of the centre's
-// geometric tangent plane (a normal map's tilt would push coplanar neighbours off a shading
-// plane), so no light leaks across surfaces. `x` filters rows into `filtered`; `y` filters
-// columns and multiplies by the receiver's demodulation weight w (aaf.glsl) into the indirect
-// image. With `enabled` = 0 the mean passes through unfiltered (uniform Monte Carlo).
+// mean incident radiance, its diffuse and specular parts apart (aaf_sample.comp), with gaussian
+// weights of standard deviation beta (world units, the aaf_beta pass) of the CENTRE pixel, over
+// world-space distances between the pixels' positions: per pass and part, a weighted
+// least-squares polynomial fit of degree `degree` along the axis (AafFit in aaf.glsl; degree 0
+// is the paper's normalised gaussian). A neighbour counts only when its shading normal is
+// within the normal threshold of the centre's (paper 004: 10 degrees) and it lies within
+// `plane_tolerance` pixel footprints of the centre's geometric tangent plane (a normal map's
+// tilt would push coplanar neighbours off a shading plane), so no light leaks across surfaces.
+// The diffuse part takes every such neighbour whose kd carries light (the diffuse mean is the
+// irradiance over pi whatever the material); the specular part only those whose roughness is
+// within `roughness_tolerance` of the centre's (the mean of a lobe depends on its width).
+// `x` filters rows into `filtered`; `y` filters columns and weights the parts by the receiver's
+// kd and ks (1 - specular_trace_weight) (brdf_indirect_weights) into the indirect image. With
+// `enabled` = 0 the means pass through unfiltered (uniform Monte Carlo).
 // CPU twin: shine::reference::aaf::filter_cpu.
 //! variant x AAF_X=1
 //! variant y AAF_Y=1
@@ -22,14 +26,17 @@ layout(local_size_x = 8, local_size_y = 8) in;
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D gb_position;
 layout(set = 0, binding = 1, rgba16f) readonly uniform image2D gb_normal;
 layout(set = 0, binding = 7, rgba16f) readonly uniform image2D gb_geometric_normal;
+layout(set = 0, binding = 5, rgba8) readonly uniform image2D gb_material;
 layout(set = 0, binding = 2, std430) readonly buffer Filter {
     vec2 f[];
 } filter_widths;
 #ifdef AAF_X
-// rgb: sum of the samples' radiance, a: samples.
+// The sampling passes' sums (AAF_SUMS_STRIDE vec4 per pixel, aaf_sample.comp).
 layout(set = 0, binding = 3, std430) readonly buffer Sums {
     vec4 s[];
 } sums;
+// AAF_SUMS_STRIDE vec4 per pixel: the filtered diffuse mean, then the filtered specular mean
+// and 1 where the diffuse mean holds light.
 layout(set = 0, binding = 4, std430) buffer Filtered {
     vec4 m[];
 } filtered;
@@ -38,7 +45,6 @@ layout(set = 0, binding = 3, std430) readonly buffer Filtered {
     vec4 m[];
 } filtered;
 layout(set = 0, binding = 4, rgba8) readonly uniform image2D gb_albedo;
-layout(set = 0, binding = 5, rgba8) readonly uniform image2D gb_material;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D indirect;
 #endif
 
@@ -59,17 +65,29 @@ layout(push_constant) uniform Push {
     float specular_limit;
     // Degree of the local polynomial fit (0: the paper's gaussian).
     uint degree;
+    // Largest roughness difference between a pixel and the neighbours its specular part takes.
+    float roughness_tolerance;
     uint pad0;
     uint pad1;
-    uint pad2;
 } push;
 
-vec3 mean_at(uint q) {
+// Pixel q's diffuse mean, specular mean and whether the diffuse mean holds light.
+struct Means {
+    vec3 diffuse;
+    vec3 specular;
+    bool lit;
+};
+
+Means means_at(uint q) {
+    uint k = AAF_SUMS_STRIDE * q;
 #ifdef AAF_X
-    vec4 s = sums.s[q];
-    return s.w > 0.0 ? s.rgb / s.w : vec3(0.0);
+    vec4 s = sums.s[k];
+    vec4 specular = sums.s[k + 1u];
+    float inverse = s.w > 0.0 ? 1.0 / s.w : 0.0;
+    return Means(s.rgb * inverse, specular.rgb * inverse, specular.w > 0.0);
 #else
-    return filtered.m[q].rgb;
+    vec4 specular = filtered.m[k + 1u];
+    return Means(filtered.m[k].rgb, specular.rgb, specular.w > 0.0);
 #endif
 }
 
@@ -81,10 +99,11 @@ void main() {
     uint p = pixel.y * push.extent.x + pixel.x;
     ivec2 ixy = ivec2(pixel);
     vec4 position = imageLoad(gb_position, ixy);
-    vec3 result = mean_at(p);
+    Means result = means_at(p);
     float beta = filter_widths.f[p].x;
     vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
     vec3 ng = normalize(imageLoad(gb_geometric_normal, ixy).xyz);
+    vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
     if (push.enabled != 0u && position.w > 0.0 && beta > 0.0) {
         float d = position.w * push.footprint.x + push.footprint.y;
         uint radius = min(push.max_radius, uint(ceil(2.0 * beta / d)));
@@ -97,7 +116,8 @@ void main() {
         int limit = int(push.extent.y);
         int coordinate = ixy.y;
 #endif
-        AafFit fit = aaf_fit_new();
+        AafFit diffuse = aaf_fit_new();
+        AafFit specular = aaf_fit_new();
         for (int k = -int(radius); k <= int(radius); ++k) {
             int c = coordinate + k;
             if (c < 0 || c >= limit) {
@@ -114,19 +134,31 @@ void main() {
                 continue;
             }
             float u = sign(float(k)) * length(offset) / beta;
-            aaf_fit_add(fit, u, mean_at(uint(q.y) * push.extent.x + uint(q.x)));
+            Means m = means_at(uint(q.y) * push.extent.x + uint(q.x));
+            if (m.lit) {
+                aaf_fit_add(diffuse, u, m.diffuse);
+            }
+            if (abs(imageLoad(gb_material, q).r - roughness_metallic.x) <= push.roughness_tolerance) {
+                aaf_fit_add(specular, u, m.specular);
+            }
         }
-        result = aaf_fit_value(fit, push.degree, result);
+        result.diffuse = aaf_fit_value(diffuse, push.degree, result.diffuse);
+        result.specular = aaf_fit_value(specular, push.degree, result.specular);
+        result.lit = result.lit || diffuse.s0 > 0.0;
     }
 #ifdef AAF_X
-    filtered.m[p] = vec4(result, 0.0);
+    filtered.m[AAF_SUMS_STRIDE * p] = vec4(result.diffuse, 0.0);
+    filtered.m[AAF_SUMS_STRIDE * p + 1u] = vec4(result.specular, result.lit ? 1.0 : 0.0);
 #else
     vec3 out_radiance = vec3(0.0);
     if (position.w > 0.0) {
         vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
-        vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
         vec3 v = normalize(push.camera.xyz - position.xyz);
-        out_radiance = aaf_demodulation(albedo, roughness_metallic.x, roughness_metallic.y, dot(n, v), push.specular_limit) * result;
+        vec3 kd;
+        vec3 ks;
+        brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, v), kd, ks);
+        float traced = specular_trace_weight(roughness_metallic.x, push.specular_limit);
+        out_radiance = kd * result.diffuse + ks * (1.0 - traced) * result.specular;
     }
     imageStore(indirect, ixy, vec4(out_radiance, 0.0));
 #endif

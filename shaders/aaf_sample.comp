@@ -1,8 +1,12 @@
 // AAF sampling (paper 004 §5, src/passes/aaf.rs): Monte-Carlo estimate of the indirect light
 // leaving every G-buffer pixel towards the camera, with directions cosine-weighted about the
-// shading normal: a sample carrying radiance L from direction l adds pi f(l, v) L / w, f the
-// receiver's metallic-roughness BRDF and w its demodulation weight (aaf.glsl; for a Lambertian
-// receiver the mean is the irradiance over pi, the quantity paper 004 filters). Each sample
+// shading normal, diffuse and glossy parts apart (paper 004 §6): a sample carrying radiance L
+// from direction l adds pi f_d(l, v) L / kd to the diffuse sum and pi f_s(l, v) L / ks to the
+// specular one, f_d + f_s the receiver's metallic-roughness BRDF and kd, ks its demodulation
+// weights (brdf_indirect_weights, never below AAF_WEIGHT_MIN; for a Lambertian receiver the diffuse mean is the irradiance over pi, the
+// quantity paper 004 filters). The directions of a pixel's samples are the points of a
+// digitally shifted (0, 2)-sequence (sobol_02), stratified whatever their count (the paper
+// stratifies both passes). Each sample
 // traces a ray through the BVH; where it hits, the radiance leaving the hit towards the pixel is
 // next-event estimation to the punctual lights (path.glsl), continued for `bounces` - 1 further
 // BRDF-sampled vertices. Misses, emission and the environment add nothing (the raster GI
@@ -10,8 +14,7 @@
 // config.w's roughness (path regularisation: a point light's highlight on a mirror-like hit
 // is a caustic no gathering ray samples).
 //
-// `first`: `samples` stratified samples (a k x k grid of strata, k = floor(sqrt(samples)), the
-// rest uniform); writes the sums and the nearest/farthest hit distances (z_min, z_max; 0, 0
+// `first`: the first `samples` samples; writes the sums and the nearest/farthest hit distances (z_min, z_max; 0, 0
 // without a hit). `second`: the pixel's remaining samples up to the count of the aaf_beta pass
 // (eq. 21), added to the first pass's sums.
 //! variant first AAF_FIRST=1
@@ -40,7 +43,7 @@ layout(push_constant) uniform Push {
     // `marks` marks; src/passes/amortise.rs), w: the bits of the least roughness at the hits
     // (AafParams::hit_roughness_min, path regularisation).
     uvec4 config;
-    // xyz: camera position, w: the specular pass's roughness limit (0: none).
+    // xyz: camera position, w: padding.
     vec4 camera;
 } push;
 
@@ -53,7 +56,8 @@ layout(set = 0, binding = 10, rgba16f) readonly uniform image2D gb_normal;
 layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_normal;
 layout(set = 0, binding = 15, rgba8) readonly uniform image2D gb_albedo;
 layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
-// rgb: sum of the samples' radiance, a: samples taken.
+// AAF_SUMS_STRIDE vec4 per pixel: the diffuse sum (rgb) and the samples taken (a), then the
+// specular sum (rgb) and 1 where kd carries light (a; AAF_WEIGHT_MIN).
 layout(set = 0, binding = 12, std430) buffer Sums {
     vec4 s[];
 } sums;
@@ -66,6 +70,7 @@ layout(set = 0, binding = 13, std430) buffer Depths {
     vec2 z[];
 } depths;
 #else
+// The first pass's sums, laid out as `sums`.
 layout(set = 0, binding = 13, std430) readonly buffer FirstSums {
     vec4 s[];
 } first_sums;
@@ -116,19 +121,23 @@ void main() {
         return;
     }
     uint p = pixel.y * extent.x + pixel.x;
+    uint record = AAF_SUMS_STRIDE * p;
     ivec2 ixy = ivec2(pixel);
     vec4 position = imageLoad(gb_position, ixy);
 #ifdef AAF_FIRST
     uint begin = 0u;
     uint end = push.config.y;
     vec4 sum = vec4(0.0);
+    vec3 specular_sum = vec3(0.0);
 #else
-    vec4 sum = first_sums.s[p];
+    vec4 sum = first_sums.s[record];
+    vec3 specular_sum = first_sums.s[record + 1u].rgb;
     uint begin = uint(sum.w);
     uint end = max(begin, uint(filter_widths.f[p].y));
 #endif
     if (position.w == 0.0) {
-        sums.s[p] = vec4(0.0);
+        sums.s[record] = vec4(0.0);
+        sums.s[record + 1u] = vec4(0.0);
 #ifdef AAF_FIRST
         depths.z[p] = vec2(0.0);
 #endif
@@ -140,18 +149,16 @@ void main() {
     vec3 v = normalize(push.camera.xyz - position.xyz);
     vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
     vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
-    vec3 w = aaf_demodulation(albedo, roughness_metallic.x, roughness_metallic.y, dot(n, v), push.camera.w);
-    uint strata = uint(floor(sqrt(float(push.config.y))));
+    vec3 kd;
+    vec3 ks;
+    brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, v), kd, ks);
+    uint pixel_seed = pcg(pcg(pixel.x ^ pcg(push.frame.w ^ 0x9e3779b9u)) + pixel.y);
+    uvec2 shift = uvec2(pixel_seed, pcg(pixel_seed));
     float z_min = PT_FAR;
     float z_max = 0.0;
     for (uint s = begin; s < end; ++s) {
+        vec2 xi = sobol_02(s, shift);
         rng_state = pcg(pcg(pcg(pixel.x ^ pcg(push.frame.w)) + pixel.y) + s);
-        vec2 xi = vec2(rand(), rand());
-#ifdef AAF_FIRST
-        if (s < strata * strata) {
-            xi = (vec2(float(s % strata), float(s / strata)) + xi) / float(strata);
-        }
-#endif
         vec3 l = sample_cosine(n, xi);
         sum.w += 1.0;
         TraceHit hit;
@@ -163,13 +170,16 @@ void main() {
         vec3 f_d;
         vec3 f_s;
         brdf_metallic_roughness_parts(n, l, v, albedo, roughness_metallic.y, roughness_metallic.x, f_d, f_s);
-        vec3 f = f_d + f_s * (1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w));
-        vec3 radiance = incident(l, hit, push.config.x) * BRDF_PI * f / w;
-        if (!any(isnan(radiance)) && !any(isinf(radiance))) {
-            sum.rgb += radiance;
+        vec3 radiance = incident(l, hit, push.config.x) * BRDF_PI;
+        vec3 diffuse = radiance * f_d / max(kd, vec3(AAF_WEIGHT_MIN));
+        vec3 specular = radiance * f_s / max(ks, vec3(AAF_WEIGHT_MIN));
+        if (!any(isnan(diffuse)) && !any(isinf(diffuse)) && !any(isnan(specular)) && !any(isinf(specular))) {
+            sum.rgb += diffuse;
+            specular_sum += specular;
         }
     }
-    sums.s[p] = sum;
+    sums.s[record] = sum;
+    sums.s[record + 1u] = vec4(specular_sum, aaf_carries_light(kd) ? 1.0 : 0.0);
 #ifdef AAF_FIRST
     depths.z[p] = z_max > 0.0 ? vec2(z_min, z_max) : vec2(0.0);
 #endif

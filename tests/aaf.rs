@@ -15,7 +15,7 @@ use shine::graph::{Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::passes::aaf::{self, AafParams};
 use shine::passes::composite::Component;
 use shine::passes::gbuffer::{GBuffer, View};
-use shine::reference::aaf::{FilterTexel, beta_cpu, demodulation, filter_cpu};
+use shine::reference::aaf::{FilterTexel, Means, beta_cpu, filter_cpu, weights};
 use shine::reference::{ReferenceParams, render_reference};
 use shine::settings::{GiTechniques, Settings};
 use shine_scene::Scene;
@@ -51,8 +51,25 @@ fn hash(i: u32) -> f32 {
     (x >> 8) as f32 / (1u32 << 24) as f32
 }
 
+/// Pixel `p`'s means as the filter reads them from the synthetic sums.
+fn means(s: &Synthetic, p: usize) -> Means {
+    let [diffuse, specular] = [s.sums[2 * p], s.sums[2 * p + 1]];
+    Means {
+        diffuse: diffuse.truncate() / diffuse.w,
+        specular: specular.truncate() / diffuse.w,
+        lit: specular.w > 0.0,
+    }
+}
+
+/// Whether the filter moved a pixel's diffuse or specular mean by more than 0.1%.
+fn moved(filtered: &Means, raw: &Means) -> bool {
+    (filtered.diffuse - raw.diffuse).length() > 1e-3 * raw.diffuse.length()
+        || (filtered.specular - raw.specular).length() > 1e-3 * raw.specular.length()
+}
+
 /// The synthetic frame: per pixel, the G-buffer texels, the first pass's (z_min, z_max) and the
-/// sampling sums (rgb, count).
+/// sampling sums ([`aaf::SUMS_STRIDE`] vec4: diffuse sum and count, specular sum and the
+/// diffuse part's flag).
 struct Synthetic {
     position: Vec<Vec4>,
     normal: Vec<Vec4>,
@@ -101,7 +118,16 @@ fn synthetic() -> Synthetic {
             };
             let count = 16.0 + (hash(p) * 40.0).floor();
             let noise = Vec3::new(hash(3 * p + 1), hash(3 * p + 2), hash(3 * p + 3)) * 2.0;
+            let metallic = match i % 7 {
+                2 => 1.0,
+                5 => 0.5,
+                _ => 0.0,
+            };
             s.sums.push((radiance * noise * count).extend(count));
+            // Metals carry no diffuse light: their diffuse sums are left out of the filter.
+            let lit = if metallic < 1.0 { 1.0 } else { 0.0 };
+            s.sums
+                .push((radiance * (0.5 + hash(p + 3000)) * count).extend(lit));
             let hit = position.w > 0.0 && p % 17 != 5;
             let z_min = 0.05 + hash(p + 1000);
             s.depths.push(if hit {
@@ -121,11 +147,6 @@ fn synthetic() -> Synthetic {
             s.normal.push(q16((normal + tilt).normalize_or_zero()));
             s.albedo
                 .push(q8(Vec4::new(0.2 + 0.6 * u, 0.5, 0.8 - 0.5 * v, 1.0)));
-            let metallic = match i % 7 {
-                2 => 1.0,
-                5 => 0.5,
-                _ => 0.0,
-            };
             s.material
                 .push(q8(Vec4::new(0.2 + 0.6 * v, metallic, 0.0, 0.0)));
         }
@@ -187,7 +208,7 @@ fn run_gpu(device: &Device, s: &Synthetic, params: &AafParams) -> GpuResult {
     let sums = transfer_storage(
         device,
         "sums",
-        pixels * 16,
+        pixels * aaf::SUMS_BYTES,
         Some(bytemuck::cast_slice(&s.sums)),
     );
     let widths_readback = transfer_storage(device, "widths readback", pixels * 8, None);
@@ -299,8 +320,9 @@ fn matches_the_cpu_twin(device: &Device, s: &Synthetic, params: &AafParams) {
             position: s.position[p],
             normal: s.normal[p].truncate(),
             geometric_normal: s.geometric_normal[p].truncate(),
+            roughness: s.material[p].x,
             beta: gpu.widths[p][0],
-            mean: s.sums[p].truncate() / s.sums[p].w,
+            means: means(s, p),
         })
         .collect();
     let filtered = filter_cpu(&texels, EXTENT[0] as usize, footprint, &params);
@@ -313,17 +335,18 @@ fn matches_the_cpu_twin(device: &Device, s: &Synthetic, params: &AafParams) {
             let n = t.normal.normalize();
             let v = (EYE - t.position.truncate()).normalize();
             let [roughness, metallic] = [s.material[p].x, s.material[p].y];
-            demodulation(
+            let [kd, ks] = weights(
                 s.albedo[p].truncate(),
                 roughness,
                 metallic,
                 n.dot(v),
                 params.specular_limit,
-            ) * filtered[p]
+            );
+            kd * filtered[p].diffuse + ks * filtered[p].specular
         };
         let error = (*got - want).abs().max_element() / want.max_element().max(1e-3);
         worst = worst.max(error);
-        changed += usize::from((filtered[p] - t.mean).length() > 1e-3 * t.mean.length());
+        changed += usize::from(moved(&filtered[p], &t.means));
     }
     let degree = params.filter_degree;
     assert!(
@@ -358,9 +381,10 @@ fn does_not_leak(params: &AafParams) {
             position: s.position[p],
             normal: s.normal[p].truncate(),
             geometric_normal: s.geometric_normal[p].truncate(),
+            roughness: s.material[p].x,
             // Wide enough to reach across the whole image.
             beta: 10.0,
-            mean: s.sums[p].truncate() / s.sums[p].w,
+            means: means(&s, p),
         })
         .collect();
     let filtered = filter_cpu(&texels, EXTENT[0] as usize, footprint, params);
@@ -387,7 +411,7 @@ fn does_not_leak(params: &AafParams) {
             filtered[p], filtered_alone[p],
             "degree {degree}, floor pixel {p}: the wall's light leaked in"
         );
-        changed += usize::from((filtered[p] - t.mean).length() > 1e-3 * t.mean.length());
+        changed += usize::from(moved(&filtered[p], &t.means));
     }
     assert!(
         changed > 100,

@@ -225,6 +225,18 @@ fn aaf_fit_condition_matches_the_shader() {
 }
 
 #[test]
+fn aaf_sums_layout_and_weight_floor_match_the_shader() {
+    assert_eq!(
+        u64::from(glsl_uint("include/aaf.glsl", "AAF_SUMS_STRIDE")),
+        shine::passes::aaf::SUMS_STRIDE
+    );
+    assert_eq!(
+        glsl_float("include/aaf.glsl", "AAF_WEIGHT_MIN"),
+        shine::reference::aaf::WEIGHT_MIN
+    );
+}
+
+#[test]
 fn rec709_luma_matches_the_shader() {
     let file = "include/color.glsl";
     let source = std::fs::read_to_string(

@@ -36,17 +36,16 @@ float aaf_samples_per_pixel(float omega_h, float z_min, float z_max, float d, fl
     return gamma * a * a * omega_h * omega_h * b * b;
 }
 
-// The receiver's demodulation weight w = kd + ks (1 - specular_trace_weight) (brdf_indirect_weights
-// at n.v, never below 1e-3): the weight of the BRDF share the samples carry (the traced specular
-// pass takes the rest). The samples store the BRDF-weighted radiance over w, the filter smooths
-// that, and the result is multiplied by w again (paper 004 filters irradiance before albedo
-// modulation; w extends it to the specular part of the metallic-roughness BRDF).
-// CPU twin: shine::reference::aaf::demodulation.
-vec3 aaf_demodulation(vec3 albedo, float roughness, float metallic, float n_dot_v, float specular_limit) {
-    vec3 kd;
-    vec3 ks;
-    brdf_indirect_weights(albedo, metallic, n_dot_v, kd, ks);
-    return max(kd + ks * (1.0 - specular_trace_weight(roughness, specular_limit)), vec3(1e-3));
+// shine::passes::aaf::SUMS_STRIDE: vec4 per pixel of the sampling passes' sums.
+const uint AAF_SUMS_STRIDE = 2u;
+
+// shine::reference::aaf::WEIGHT_MIN: the least demodulation weight divided by; a pixel whose kd
+// is below it on every channel (a metal) carries no diffuse light.
+const float AAF_WEIGHT_MIN = 1e-3;
+
+// Whether the diffuse weight kd carries light (AAF_WEIGHT_MIN).
+bool aaf_carries_light(vec3 kd) {
+    return any(greaterThanEqual(kd, vec3(AAF_WEIGHT_MIN)));
 }
 
 // shine_sh::aaf::FIT_CONDITION_MIN

@@ -18,4 +18,21 @@ float rand() {
     return float(rng_state >> 8) * (1.0 / 16777216.0);
 }
 
+// Point i of the first two dimensions of the Sobol sequence, a (0, 2)-sequence in base 2: every
+// prefix of 2^k points puts one point in each of the 2^k elementary intervals of area 2^-k (for
+// 16 points: a 4 x 4 grid, 2 x 8, 8 x 2, ...), so a pixel's samples stay stratified whatever
+// their count. Dimension 1 is the base-2 radical inverse; dimension 2's generator matrix is
+// the Pascal matrix mod 2 (v_{k+1} = v_k ^ (v_k >> 1)). `shift`: a random digital shift (XOR),
+// which keeps the stratification.
+vec2 sobol_02(uint i, uvec2 shift) {
+    uint y = 0u;
+    for (uint k = i, v = 1u << 31; k != 0u; k >>= 1u, v ^= v >> 1u) {
+        if ((k & 1u) != 0u) {
+            y ^= v;
+        }
+    }
+    uvec2 bits = uvec2(bitfieldReverse(i), y) ^ shift;
+    return vec2(bits >> 8u) * (1.0 / 16777216.0);
+}
+
 #endif

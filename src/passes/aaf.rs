@@ -5,11 +5,13 @@
 //!    [`AafParams::first_samples`] stratified, cosine-weighted rays about the shading normal
 //!    through the BVH; each hit's outgoing radiance `L` is next-event estimation to the
 //!    punctual lights (one bounce; [`AafParams::bounces`] > 1 continues the path by BRDF
-//!    sampling, as the path tracer). A sample adds `π f(l, v) L / w`: `f` the receiver's BRDF
-//!    less the share the traced specular pass takes, `w = kd + ks (1 − trace_weight)` the
-//!    weight of what is left (its demodulation weight), so that for a Lambertian receiver the mean is the
-//!    irradiance over π, the quantity the paper filters. The nearest and farthest hit
-//!    distances are `z_min`, `z_max`.
+//!    sampling, as the path tracer). A sample adds `π f_d(l, v) L / kd` to the pixel's diffuse
+//!    sum and `π f_s(l, v) L / ks` to its specular sum (`f_d + f_s` the receiver's BRDF, `kd`,
+//!    `ks` its demodulation weights), so that for a Lambertian receiver the diffuse mean is the
+//!    irradiance over π, the quantity the paper filters. The directions are a digitally
+//!    shifted (0, 2)-sequence per pixel (`sobol_02`, shaders/include/random.glsl): the first 16
+//!    form a 4×4 stratification and every sample count stays stratified. The nearest and
+//!    farthest hit distances are `z_min`, `z_max`.
 //! 2. **Filter width and sampling rate** (`aaf_beta.comp`, GLSL twin of [`shine_sh::aaf`] in
 //!    `shaders/include/aaf.glsl`): `Ω_x^r = μ min(Ω_h/z_min, α/d)` (eq. 15), `β = 2/Ω_x^r`
 //!    (eq. 16), `n = γ (μ Ω_h d/z_min + α)² Ω_h² (1 + μ z_max/z_min)²` (eq. 21) clamped to
@@ -20,20 +22,21 @@
 //!    by `metallic` towards the appendix's Blinn-Phong bandlimit `3.6 + 0.084 m` (eq. 24) with
 //!    `m = 2/α² − 2` from the GGX roughness (Walter et al. 2007), `m ≤ 50` (the fit's range).
 //! 3. **Second pass** (variant `second`): each pixel's remaining `n − first_samples` samples,
-//!    added to the first pass's sums.
+//!    the sequence's next points, added to the first pass's sums.
 //! 4. **Filter** (`aaf_filter.comp`, variants `x` then `y`): per pass, a weighted least-squares
-//!    fit of a polynomial of degree [`AafParams::filter_degree`] along the axis to the mean
-//!    incident radiance ([`shine_sh::aaf::LocalFit`]), with the paper's gaussian weights of
-//!    standard deviation `β` of the centre pixel over world-space distances, neighbours only
-//!    within the normal threshold (paper: 10°) and near the centre's geometric tangent plane;
-//!    then the receiver's weight `w` (the albedo modulation after filtering). Degree 0 is the
-//!    paper's normalised gaussian (eq. 16).
+//!    fit of a polynomial of degree [`AafParams::filter_degree`] along the axis to the diffuse
+//!    and, apart, the specular means ([`shine_sh::aaf::LocalFit`]), with the paper's gaussian
+//!    weights of standard deviation `β` of the centre pixel over world-space distances,
+//!    neighbours only within the normal threshold (paper: 10°) and near the centre's geometric
+//!    tangent plane, the specular means only of neighbours within [`ROUGHNESS_TOLERANCE`] of the
+//!    centre's roughness; then the receiver's weights `kd` and `ks (1 − trace_weight)` (the
+//!    albedo modulation after filtering). Degree 0 is the paper's normalised gaussian (eq. 16).
 //!
 //! # Decisions and deviations from paper 004
 //!
 //! * Direct light stays the raster's; AAF computes the indirect term only. The receiver's whole
 //!   metallic-roughness BRDF weights the samples (with cosine-weighted directions), demodulated
-//!   by `w` (`brdf_indirect_weights`, as HVL and IGI) so the filter smooths what is
+//!   by `kd` and `ks` (`brdf_indirect_weights`, as HVL and IGI) so the filter smooths what is
 //!   smooth: without the specular part the cornell box lost 16% of its indirect energy against
 //!   the path tracer (rough dielectrics, F0 = 0.04). Sharp metallic lobes are sampled with
 //!   cosine-weighted directions (noisy) and filtered with their glossy β.
@@ -54,10 +57,14 @@
 //!   normal-mapped floor cuts the filters into small pieces, a quadratic over few neighbours
 //!   removes less noise than the gaussian (2.45× against 3.18×; docs/quality.md). The weights,
 //!   β and the sampling rates are the paper's. Fitted values below zero are clamped to zero.
-//! * **Demodulation by the share sampled**: `w = kd + ks (1 − trace_weight)`, the part of the
-//!   BRDF the samples carry when the frame's specular pass traces the sharper lobes
-//!   ([`AafParams::specular_limit`]); with `kd + ks` a glossy tile and its rough grout held
-//!   different demodulated light and the filter mixed them.
+//! * **Diffuse and specular apart** (as the paper's §6 computes rates and filters "separately
+//!   for the diffuse and glossy components"): the diffuse mean is the same light whatever the
+//!   material, so a glossy tile and its rough grout share it; their specular means differ (a
+//!   lobe's mean depends on its width) and are filtered only among similar roughnesses. The
+//!   specular part is weighted by `ks (1 − trace_weight)`, the share the frame's traced specular
+//!   pass leaves ([`AafParams::specular_limit`]). One mean demodulated by `kd + ks (1 −
+//!   trace_weight)`, as before, mixed the grout's and the tiles' different weightings of the
+//!   light: the room's filtered error floor was 0.124, now 0.086 (docs/quality.md).
 //! * **Path regularisation at the hits** ([`AafParams::hit_roughness_min`]): a hit's BRDF is
 //!   evaluated no sharper than roughness 0.5, so a point light's highlight on chrome does not
 //!   turn into caustic fireflies that no sample count averages out.
@@ -93,6 +100,11 @@ pub const Z_MIN_FRACTION: RangeInclusive<f32> = 1e-4..=1.0;
 pub const PLANE_TOLERANCE: f32 = 2.0;
 /// Largest filter radius in pixels (the gaussian is cut at 2β).
 pub const MAX_RADIUS: u32 = 32;
+/// Largest roughness difference between a pixel and a neighbour whose specular mean its filter
+/// takes: the mean of a glossy lobe depends on the lobe's width (the room's glazed tiles, 0.2 to
+/// 0.35, and their grout, 0.9, hold different specular means). The diffuse means need no such
+/// test.
+pub const ROUGHNESS_TOLERANCE: f32 = 0.1;
 /// Default [`AafParams::hit_roughness_min`] (not the paper's: its scenes have no mirror-like
 /// reflectors). At 0.5 the room's chrome (0.05) and gold (0.15) no longer make caustic
 /// fireflies: its 2048-spp study truth went from a relative noise of 3.2 to 0.08. A fixed
@@ -262,7 +274,7 @@ pub struct SamplePush {
     /// Bounces, samples of the first pass, the pixels sampled ([`AafSlice::slice`]), the bits
     /// of [`AafParams::hit_roughness_min`].
     pub config: [u32; 4],
-    /// xyz camera position, w the specular pass's roughness limit (0: none).
+    /// xyz camera position, w padding.
     pub camera: [f32; 4],
 }
 
@@ -304,8 +316,10 @@ pub struct FilterPush {
     pub specular_limit: f32,
     /// [`AafParams::filter_degree`].
     pub degree: u32,
+    /// [`ROUGHNESS_TOLERANCE`].
+    pub roughness_tolerance: f32,
     /// Padding.
-    pub pad: [u32; 3],
+    pub pad: [u32; 2],
 }
 
 /// The scene as the AAF rays see it.
@@ -378,8 +392,12 @@ pub struct AafRecords {
     pub widths: Handle<Buffer>,
 }
 
+/// vec4 per pixel of [`AafRecords::sums`] (`AAF_SUMS_STRIDE` of aaf.glsl): the diffuse sum
+/// (rgb) and the samples taken, then the specular sum (rgb) and 1 where the receiver's `kd`
+/// carries light ([`crate::reference::aaf::WEIGHT_MIN`]).
+pub const SUMS_STRIDE: u64 = 2;
 /// Bytes per pixel of [`AafRecords::sums`].
-pub const SUMS_BYTES: u64 = 16;
+pub const SUMS_BYTES: u64 = 16 * SUMS_STRIDE;
 /// Bytes per pixel of [`AafRecords::widths`] (and of the depths).
 pub const WIDTHS_BYTES: u64 = 8;
 
@@ -418,7 +436,7 @@ pub fn aaf_sample(
             slice.slice,
             params.hit_roughness_min.to_bits(),
         ],
-        camera: camera.eye.extend(params.specular_limit).to_array(),
+        camera: camera.eye.extend(0.0).to_array(),
     };
     let into = match slice.into {
         Some(r) => r,
@@ -536,9 +554,9 @@ fn beta_push(
     }
 }
 
-/// Adds `aaf_filter_x` and `aaf_filter_y`: the separable filter of the mean of `sums` (vec4
-/// per pixel: rgb sum, count) with the widths of [`aaf_beta`], then the receivers'
-/// demodulation weight `w`.
+/// Adds `aaf_filter_x` and `aaf_filter_y`: the separable filter of the diffuse and specular
+/// means of `sums` ([`SUMS_STRIDE`] vec4 per pixel) with the widths of [`aaf_beta`], then the
+/// receivers' weights ([`crate::reference::aaf::weights`]).
 /// Returns the indirect light (RGBA16F).
 pub fn aaf_filter(
     rg: &mut RenderGraph,
@@ -562,11 +580,12 @@ pub fn aaf_filter(
         enabled: u32::from(params.filter),
         specular_limit: params.specular_limit,
         degree: params.filter_degree,
-        pad: [0; 3],
+        roughness_tolerance: ROUGHNESS_TOLERANCE,
+        pad: [0; 2],
     };
     let mut rows = rg.create_buffer(
         "aaf_rows",
-        BufferDesc::new(u64::from(w) * u64::from(h) * 16),
+        BufferDesc::new(u64::from(w) * u64::from(h) * SUMS_BYTES),
     );
     rg.compute("aaf_filter_x", &shaders::AAF_FILTER_COMP_X)
         .read("gb_position", &g.position)
@@ -574,6 +593,7 @@ pub fn aaf_filter(
         .read("gb_geometric_normal", &g.geometric_normal)
         .read("filter_widths", widths)
         .read("sums", sums)
+        .read("gb_material", &g.material)
         .write("filtered", &mut rows)
         .push(&push)
         .dispatch([w, h, 1]);

@@ -1,6 +1,6 @@
 //! CPU twin of the AAF filter-width and filter passes (paper 004, `src/passes/aaf.rs`):
 //! [`beta_cpu`] is `aaf_beta.comp` through shine-sh's formulas, [`filter_cpu`] the two passes
-//! of `aaf_filter.comp` before the albedo modulation. `tests/aaf.rs` ties them to the GPU.
+//! of `aaf_filter.comp` before the receivers' weights ([`weights`]). `tests/aaf.rs` ties them to the GPU.
 
 use glam::{Vec3, Vec4};
 use shine_sh::ShError;
@@ -8,7 +8,7 @@ use shine_sh::aaf::{
     LocalFit, PixelFootprint, filter_bandwidth, filter_width, receiver_bandlimit, samples_per_pixel,
 };
 
-use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE};
+use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE, ROUGHNESS_TOLERANCE};
 use crate::passes::brdf_tables::indirect_weights;
 use crate::passes::specular::trace_weight;
 
@@ -46,19 +46,25 @@ pub fn beta_cpu(
     ])
 }
 
-/// The receiver's demodulation weight `w = kd + ks (1 − trace_weight)` (`aaf_demodulation` of
-/// `shaders/include/aaf.glsl`), never below 1e-3: the weight of the BRDF share the samples
-/// carry, the traced specular pass of roughness limit `specular_limit` taking the rest. The
-/// filter's output is `w` times the filtered mean.
-pub fn demodulation(
+/// The least demodulation weight the samples are divided by (`AAF_WEIGHT_MIN` of
+/// `shaders/include/aaf.glsl`): a pixel whose `kd` is below it on every channel (a metal)
+/// carries no diffuse light, and the filter leaves its diffuse mean out.
+pub const WEIGHT_MIN: f32 = 1e-3;
+
+/// The receiver's weights of the filtered diffuse and specular means (the second pass of
+/// `aaf_filter.comp`): `kd` and `ks (1 − trace_weight)`, `kd` and `ks` from
+/// [`indirect_weights`] at `n_dot_v` and the traced specular pass of roughness limit
+/// `specular_limit` taking the rest of the glossy lobe. The indirect light is the sum of the
+/// products.
+pub fn weights(
     albedo: Vec3,
     roughness: f32,
     metallic: f32,
     n_dot_v: f32,
     specular_limit: f32,
-) -> Vec3 {
+) -> [Vec3; 2] {
     let (kd, ks) = indirect_weights(albedo, metallic, n_dot_v);
-    (kd + ks * (1.0 - trace_weight(roughness, specular_limit))).max(Vec3::splat(1e-3))
+    [kd, ks * (1.0 - trace_weight(roughness, specular_limit))]
 }
 
 /// One pixel of the G-buffer as the filter sees it.
@@ -70,25 +76,39 @@ pub struct FilterTexel {
     pub normal: Vec3,
     /// Geometric normal (normalised here): the tangent-plane test.
     pub geometric_normal: Vec3,
+    /// Perceptual roughness: the specular means' test ([`ROUGHNESS_TOLERANCE`]).
+    pub roughness: f32,
     /// β of the pixel (world units; 0: no filter).
     pub beta: f32,
-    /// The mean incident radiance to filter.
-    pub mean: Vec3,
+    /// The means to filter.
+    pub means: Means,
+}
+
+/// A pixel's mean incident light, demodulated, in the diffuse and specular parts the filter
+/// smooths apart.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Means {
+    /// The diffuse mean (the samples' `π f_d L / kd`).
+    pub diffuse: Vec3,
+    /// The specular mean (the samples' `π f_s L / ks`).
+    pub specular: Vec3,
+    /// Whether the diffuse mean holds light (`kd` at least [`WEIGHT_MIN`] on some channel).
+    pub lit: bool,
 }
 
 /// The two passes of `aaf_filter.comp` (rows, then columns) over a `width`-wide image, before
-/// the albedo modulation: the filtered mean per pixel.
+/// the receivers' weights: the filtered means per pixel.
 pub fn filter_cpu(
     texels: &[FilterTexel],
     width: usize,
     footprint: [f32; 2],
     params: &AafParams,
-) -> Vec<Vec3> {
+) -> Vec<Means> {
     let rows = filter_axis(texels, width, footprint, params, [1, 0]);
     let columns: Vec<FilterTexel> = texels
         .iter()
         .zip(&rows)
-        .map(|(t, m)| FilterTexel { mean: *m, ..*t })
+        .map(|(t, m)| FilterTexel { means: *m, ..*t })
         .collect();
     filter_axis(&columns, width, footprint, params, [0, 1])
 }
@@ -100,7 +120,7 @@ fn filter_axis(
     footprint: [f32; 2],
     params: &AafParams,
     axis: [i64; 2],
-) -> Vec<Vec3> {
+) -> Vec<Means> {
     let height = texels.len() / width.max(1);
     let cos_threshold = params.normal_threshold_degrees.to_radians().cos();
     (0..texels.len())
@@ -108,13 +128,13 @@ fn filter_axis(
             let centre = &texels[p];
             let (x, y) = ((p % width) as i64, (p / width) as i64);
             if !params.filter || centre.position.w == 0.0 || centre.beta <= 0.0 {
-                return centre.mean;
+                return centre.means;
             }
             let n = centre.normal.normalize();
             let ng = centre.geometric_normal.normalize();
             let d = centre.position.w * footprint[0] + footprint[1];
             let radius = MAX_RADIUS.min((2.0 * centre.beta / d).ceil() as u32) as i64;
-            let mut fit = LocalFit::default();
+            let (mut diffuse, mut specular) = (LocalFit::default(), LocalFit::default());
             for k in -radius..=radius {
                 let (qx, qy) = (x + axis[0] * k, y + axis[1] * k);
                 if qx < 0 || qy < 0 || qx >= width as i64 || qy >= height as i64 {
@@ -131,10 +151,22 @@ fn filter_axis(
                     continue;
                 }
                 let u = (k as f32).signum() * offset.length() / centre.beta;
-                fit.add(u, q.mean.to_array());
+                if q.means.lit {
+                    diffuse.add(u, q.means.diffuse.to_array());
+                }
+                if (q.roughness - centre.roughness).abs() <= ROUGHNESS_TOLERANCE {
+                    specular.add(u, q.means.specular.to_array());
+                }
             }
-            fit.value(params.filter_degree)
-                .map_or(centre.mean, Vec3::from_array)
+            let value = |fit: &LocalFit, own: Vec3| {
+                fit.value(params.filter_degree)
+                    .map_or(own, Vec3::from_array)
+            };
+            Means {
+                diffuse: value(&diffuse, centre.means.diffuse),
+                specular: value(&specular, centre.means.specular),
+                lit: centre.means.lit || diffuse.has_neighbours(),
+            }
         })
         .collect()
 }

@@ -114,7 +114,7 @@ impl AafRunner {
         };
         let readback = Readback {
             indirect: buffer("study indirect", 8)?,
-            sums: buffer("study sums", 16)?,
+            sums: buffer("study sums", crate::passes::aaf::SUMS_BYTES)?,
             widths: buffer("study widths", 8)?,
             position: buffer("study position", 16)?,
         };
@@ -214,7 +214,10 @@ impl AafRunner {
         let halves: Vec<u16> = bytemuck::pod_collect_to_vec(&read(&rb.indirect)?);
         let sums: Vec<[f32; 4]> = bytemuck::pod_collect_to_vec(&read(&rb.sums)?);
         let widths: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&read(&rb.widths)?);
-        if halves.len() != pixels * 4 || sums.len() != pixels || widths.len() != pixels {
+        if halves.len() != pixels * 4
+            || sums.len() != pixels * crate::passes::aaf::SUMS_STRIDE as usize
+            || widths.len() != pixels
+        {
             return Err(StudyError::Invalid(format!(
                 "readback of a {w}×{h} frame has the wrong size"
             )));
@@ -228,7 +231,11 @@ impl AafRunner {
                 .chunks_exact(4)
                 .map(|t| [f16_to_f32(t[0]), f16_to_f32(t[1]), f16_to_f32(t[2])])
                 .collect(),
-            samples: sums.iter().map(|s| s[3]).collect(),
+            samples: sums
+                .iter()
+                .step_by(crate::passes::aaf::SUMS_STRIDE as usize)
+                .map(|s| s[3])
+                .collect(),
             beta: widths.iter().map(|f| f[0]).collect(),
             passes,
             wall_ms: start.elapsed().as_secs_f64() * 1e3,

@@ -179,6 +179,11 @@ pub struct LocalFit {
 }
 
 impl LocalFit {
+    /// Whether any neighbour was added.
+    pub fn has_neighbours(&self) -> bool {
+        self.s[0] > 0.0
+    }
+
     /// Adds a neighbour at `u` (in units of β) with value `y` and the gaussian weight of `u`.
     pub fn add(&mut self, u: f32, y: [f32; 3]) {
         let w = (-0.5 * u * u).exp();
