@@ -23,7 +23,8 @@ float rand() {
 // 16 points: a 4 x 4 grid, 2 x 8, 8 x 2, ...), so a pixel's samples stay stratified whatever
 // their count. Dimension 1 is the base-2 radical inverse; dimension 2's generator matrix is
 // the Pascal matrix mod 2 (v_{k+1} = v_k ^ (v_k >> 1)). `shift`: a random digital shift (XOR),
-// which keeps the stratification.
+// which keeps the stratification. 24 bits per coordinate. Rust twin:
+// shine_sh::sequence::sobol_02 (tests/sequence_glsl.rs).
 vec2 sobol_02(uint i, uvec2 shift) {
     uint y = 0u;
     for (uint k = i, v = 1u << 31; k != 0u; k >>= 1u, v ^= v >> 1u) {

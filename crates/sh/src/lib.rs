@@ -71,6 +71,7 @@ pub mod product;
 pub mod proxy_indirect;
 pub mod quadrature;
 pub mod rotation;
+pub mod sequence;
 pub mod sphere_blocker;
 pub mod zonal;
 
