@@ -1,5 +1,6 @@
 // AAF screen-space filter (paper 004 §5, src/passes/aaf.rs): a separable filter of the per-pixel
-// mean incident radiance, its diffuse and specular parts apart (aaf_sample.comp), with gaussian
+// mean incident radiance, its diffuse and specular parts apart (aaf_sample.comp), the diffuse
+// part as an irradiance vector V (aaf.glsl) evaluated at each pixel's shading normal, with gaussian
 // weights of standard deviation beta (world units, the aaf_beta pass) of the CENTRE pixel, over
 // world-space distances between the pixels' positions: per pass and part, a weighted
 // least-squares polynomial fit of degree `degree` along the axis (AafFit in aaf.glsl; degree 0
@@ -8,8 +9,11 @@
 // `plane_tolerance` pixel footprints of the centre's geometric tangent plane (a normal map's
 // tilt would push coplanar neighbours off a shading plane), so no light leaks across surfaces.
 // The diffuse part takes every such neighbour whose kd carries light (the diffuse mean is the
-// irradiance over pi whatever the material); the specular part only those whose roughness is
-// within `roughness_tolerance` of the centre's (the mean of a lobe depends on its width).
+// irradiance over pi whatever the material), testing geometric normals (a normal map's detail
+// is in V . n, not in which neighbours count); the specular part only neighbours within the
+// threshold of the shading normal whose roughness is within `roughness_tolerance` of the
+// centre's (the mean of a lobe depends on its width). With `irradiance_vector` = 0 the diffuse
+// part is the paper's scalar mean (V = mean n of the centre) with shading normals tested.
 // `x` filters rows into `filtered`; `y` filters columns and weights the parts by the receiver's
 // kd and ks (1 - specular_trace_weight) (brdf_indirect_weights) into the indirect image. With
 // `enabled` = 0 the means pass through unfiltered (uniform Monte Carlo).
@@ -35,8 +39,8 @@ layout(set = 0, binding = 2, std430) readonly buffer Filter {
 layout(set = 0, binding = 3, std430) readonly buffer Sums {
     vec4 s[];
 } sums;
-// AAF_SUMS_STRIDE vec4 per pixel: the filtered diffuse mean, then the filtered specular mean
-// and 1 where the diffuse mean holds light.
+// AAF_ROWS_STRIDE vec4 per pixel: the filtered irradiance vector's x, y, z columns (rgb), then
+// the filtered specular mean and 1 where the diffuse part holds light.
 layout(set = 0, binding = 4, std430) buffer Filtered {
     vec4 m[];
 } filtered;
@@ -67,27 +71,43 @@ layout(push_constant) uniform Push {
     uint degree;
     // Largest roughness difference between a pixel and the neighbours its specular part takes.
     float roughness_tolerance;
-    uint pad0;
-    uint pad1;
+    // 1: the diffuse part as an irradiance vector, geometric normals tested; 0: the paper's
+    // scalar mean, shading normals tested.
+    uint irradiance_vector;
+    uint pad;
 } push;
 
-// Pixel q's diffuse mean, specular mean and whether the diffuse mean holds light.
+// Pixel q's diffuse part as an irradiance vector (columns x, y, z), its specular mean and
+// whether the diffuse part holds light; nq is q's shading normal and n the centre's. Without
+// irradiance_vector, the diffuse part is q's scalar mean along n (V = mean n).
 struct Means {
-    vec3 diffuse;
+    mat3 diffuse;
     vec3 specular;
     bool lit;
 };
 
-Means means_at(uint q) {
-    uint k = AAF_SUMS_STRIDE * q;
+Means means_at(uint q, vec3 nq, vec3 n) {
 #ifdef AAF_X
+    uint k = AAF_SUMS_STRIDE * q;
     vec4 s = sums.s[k];
     vec4 specular = sums.s[k + 1u];
     float inverse = s.w > 0.0 ? 1.0 / s.w : 0.0;
-    return Means(s.rgb * inverse, specular.rgb * inverse, specular.w > 0.0);
+    vec3 mean = s.rgb * inverse;
+    mat3 diffuse = outerProduct(mean, n);
+    if (push.irradiance_vector != 0u) {
+        float tangent = AAF_TANGENT_SCALE * inverse;
+        diffuse = outerProduct(mean, nq)
+            + tangent * mat3(sums.s[k + 2u].rgb, sums.s[k + 3u].rgb, sums.s[k + 4u].rgb);
+    }
+    return Means(diffuse, specular.rgb * inverse, specular.w > 0.0);
 #else
-    vec4 specular = filtered.m[k + 1u];
-    return Means(filtered.m[k].rgb, specular.rgb, specular.w > 0.0);
+    uint k = AAF_ROWS_STRIDE * q;
+    mat3 diffuse = mat3(filtered.m[k].rgb, filtered.m[k + 1u].rgb, filtered.m[k + 2u].rgb);
+    if (push.irradiance_vector == 0u) {
+        diffuse = outerProduct(diffuse * nq, n);
+    }
+    vec4 specular = filtered.m[k + 3u];
+    return Means(diffuse, specular.rgb, specular.w > 0.0);
 #endif
 }
 
@@ -99,9 +119,9 @@ void main() {
     uint p = pixel.y * push.extent.x + pixel.x;
     ivec2 ixy = ivec2(pixel);
     vec4 position = imageLoad(gb_position, ixy);
-    Means result = means_at(p);
     float beta = filter_widths.f[p].x;
     vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
+    Means result = means_at(p, n, n);
     vec3 ng = normalize(imageLoad(gb_geometric_normal, ixy).xyz);
     vec2 roughness_metallic = imageLoad(gb_material, ixy).rg;
     if (push.enabled != 0u && position.w > 0.0 && beta > 0.0) {
@@ -128,27 +148,38 @@ void main() {
             if (xq.w == 0.0) {
                 continue;
             }
-            vec3 nq = normalize(imageLoad(gb_normal, q).xyz);
             vec3 offset = xq.xyz - position.xyz;
-            if (dot(n, nq) < push.camera.w || abs(dot(ng, offset)) > push.plane_tolerance * d) {
+            if (abs(dot(ng, offset)) > push.plane_tolerance * d) {
+                continue;
+            }
+            vec3 nq = normalize(imageLoad(gb_normal, q).xyz);
+            bool shading_close = dot(n, nq) >= push.camera.w;
+            bool diffuse_close = push.irradiance_vector != 0u
+                ? dot(ng, normalize(imageLoad(gb_geometric_normal, q).xyz)) >= push.camera.w
+                : shading_close;
+            bool specular_close = shading_close
+                && abs(imageLoad(gb_material, q).r - roughness_metallic.x) <= push.roughness_tolerance;
+            if (!diffuse_close && !specular_close) {
                 continue;
             }
             float u = sign(float(k)) * length(offset) / beta;
-            Means m = means_at(uint(q.y) * push.extent.x + uint(q.x));
-            if (m.lit) {
+            Means m = means_at(uint(q.y) * push.extent.x + uint(q.x), nq, n);
+            if (diffuse_close && m.lit) {
                 aaf_fit_add(diffuse, u, m.diffuse);
             }
-            if (abs(imageLoad(gb_material, q).r - roughness_metallic.x) <= push.roughness_tolerance) {
-                aaf_fit_add(specular, u, m.specular);
+            if (specular_close) {
+                aaf_fit_add(specular, u, mat3(m.specular, vec3(0.0), vec3(0.0)));
             }
         }
         result.diffuse = aaf_fit_value(diffuse, push.degree, result.diffuse);
-        result.specular = aaf_fit_value(specular, push.degree, result.specular);
+        result.specular = aaf_fit_value(specular, push.degree, mat3(result.specular, vec3(0.0), vec3(0.0)))[0];
         result.lit = result.lit || diffuse.s0 > 0.0;
     }
 #ifdef AAF_X
-    filtered.m[AAF_SUMS_STRIDE * p] = vec4(result.diffuse, 0.0);
-    filtered.m[AAF_SUMS_STRIDE * p + 1u] = vec4(result.specular, result.lit ? 1.0 : 0.0);
+    for (uint k = 0u; k < 3u; ++k) {
+        filtered.m[AAF_ROWS_STRIDE * p + k] = vec4(result.diffuse[k], 0.0);
+    }
+    filtered.m[AAF_ROWS_STRIDE * p + 3u] = vec4(result.specular, result.lit ? 1.0 : 0.0);
 #else
     vec3 out_radiance = vec3(0.0);
     if (position.w > 0.0) {
@@ -158,7 +189,7 @@ void main() {
         vec3 ks;
         brdf_indirect_weights(albedo, roughness_metallic.y, dot(n, v), kd, ks);
         float traced = specular_trace_weight(roughness_metallic.x, push.specular_limit);
-        out_radiance = kd * result.diffuse + ks * (1.0 - traced) * result.specular;
+        out_radiance = kd * max(result.diffuse * n, vec3(0.0)) + ks * (1.0 - traced) * max(result.specular, vec3(0.0));
     }
     imageStore(indirect, ixy, vec4(out_radiance, 0.0));
 #endif

@@ -57,7 +57,9 @@ layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_nor
 layout(set = 0, binding = 15, rgba8) readonly uniform image2D gb_albedo;
 layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
 // AAF_SUMS_STRIDE vec4 per pixel: the diffuse sum (rgb) and the samples taken (a), then the
-// specular sum (rgb) and 1 where kd carries light (a; AAF_WEIGHT_MIN).
+// specular sum (rgb) and 1 where kd carries light (a; AAF_WEIGHT_MIN), then the sums of the
+// diffuse samples times the x, y and z of their direction's part tangent to the shading normal
+// (rgb each; the irradiance vector's tangent part, aaf.glsl).
 layout(set = 0, binding = 12, std430) buffer Sums {
     vec4 s[];
 } sums;
@@ -129,15 +131,18 @@ void main() {
     uint end = push.config.y;
     vec4 sum = vec4(0.0);
     vec3 specular_sum = vec3(0.0);
+    mat3 tangent_sum = mat3(0.0);
 #else
     vec4 sum = first_sums.s[record];
     vec3 specular_sum = first_sums.s[record + 1u].rgb;
+    mat3 tangent_sum = mat3(first_sums.s[record + 2u].rgb, first_sums.s[record + 3u].rgb, first_sums.s[record + 4u].rgb);
     uint begin = uint(sum.w);
     uint end = max(begin, uint(filter_widths.f[p].y));
 #endif
     if (position.w == 0.0) {
-        sums.s[record] = vec4(0.0);
-        sums.s[record + 1u] = vec4(0.0);
+        for (uint k = 0u; k < AAF_SUMS_STRIDE; ++k) {
+            sums.s[record + k] = vec4(0.0);
+        }
 #ifdef AAF_FIRST
         depths.z[p] = vec2(0.0);
 #endif
@@ -176,10 +181,15 @@ void main() {
         if (!any(isnan(diffuse)) && !any(isinf(diffuse)) && !any(isnan(specular)) && !any(isinf(specular))) {
             sum.rgb += diffuse;
             specular_sum += specular;
+            vec3 t = l - n * dot(n, l);
+            tangent_sum += mat3(diffuse * t.x, diffuse * t.y, diffuse * t.z);
         }
     }
     sums.s[record] = sum;
     sums.s[record + 1u] = vec4(specular_sum, aaf_carries_light(kd) ? 1.0 : 0.0);
+    for (uint k = 0u; k < 3u; ++k) {
+        sums.s[record + 2u + k] = vec4(tangent_sum[k], 0.0);
+    }
 #ifdef AAF_FIRST
     depths.z[p] = z_max > 0.0 ? vec2(z_min, z_max) : vec2(0.0);
 #endif

@@ -15,7 +15,7 @@ use shine::graph::{Executor, ExternalState, Handle, Image, RenderGraph};
 use shine::passes::aaf::{self, AafParams};
 use shine::passes::composite::Component;
 use shine::passes::gbuffer::{GBuffer, View};
-use shine::reference::aaf::{FilterTexel, Means, beta_cpu, filter_cpu, weights};
+use shine::reference::aaf::{FilterTexel, Filtered, Means, beta_cpu, filter_cpu, weights};
 use shine::reference::{ReferenceParams, render_reference};
 use shine::settings::{GiTechniques, Settings};
 use shine_scene::Scene;
@@ -53,23 +53,26 @@ fn hash(i: u32) -> f32 {
 
 /// Pixel `p`'s means as the filter reads them from the synthetic sums.
 fn means(s: &Synthetic, p: usize) -> Means {
-    let [diffuse, specular] = [s.sums[2 * p], s.sums[2 * p + 1]];
+    let record = &s.sums[aaf::SUMS_STRIDE as usize * p..][..aaf::SUMS_STRIDE as usize];
+    let count = record[0].w;
     Means {
-        diffuse: diffuse.truncate() / diffuse.w,
-        specular: specular.truncate() / diffuse.w,
-        lit: specular.w > 0.0,
+        diffuse: record[0].truncate() / count,
+        tangent: std::array::from_fn(|k| record[2 + k].truncate() / count),
+        specular: record[1].truncate() / count,
+        lit: record[1].w > 0.0,
     }
 }
 
-/// Whether the filter moved a pixel's diffuse or specular mean by more than 0.1%.
-fn moved(filtered: &Means, raw: &Means) -> bool {
-    (filtered.diffuse - raw.diffuse).length() > 1e-3 * raw.diffuse.length()
+/// Whether the filter moved a pixel's diffuse mean (at its shading normal `n`) or its specular
+/// mean by more than 0.1%.
+fn moved(filtered: &Filtered, raw: &Means, n: Vec3) -> bool {
+    (filtered.diffuse_at(n) - raw.diffuse).length() > 1e-3 * raw.diffuse.length()
         || (filtered.specular - raw.specular).length() > 1e-3 * raw.specular.length()
 }
 
 /// The synthetic frame: per pixel, the G-buffer texels, the first pass's (z_min, z_max) and the
 /// sampling sums ([`aaf::SUMS_STRIDE`] vec4: diffuse sum and count, specular sum and the
-/// diffuse part's flag).
+/// diffuse part's flag, the diffuse samples' tangent sums along x, y and z).
 struct Synthetic {
     position: Vec<Vec4>,
     normal: Vec<Vec4>,
@@ -128,6 +131,15 @@ fn synthetic() -> Synthetic {
             let lit = if metallic < 1.0 { 1.0 } else { 0.0 };
             s.sums
                 .push((radiance * (0.5 + hash(p + 3000)) * count).extend(lit));
+            // Tangent sums: signed, up to a third of the diffuse sum.
+            for axis in 0..3 {
+                let t = Vec3::new(
+                    hash(p + 4000 + 3 * axis),
+                    hash(p + 5000 + 3 * axis),
+                    hash(p + 6000 + 3 * axis),
+                ) - 0.5;
+                s.sums.push((radiance * t * 0.6 * count).extend(0.0));
+            }
             let hit = position.w > 0.0 && p % 17 != 5;
             let z_min = 0.05 + hash(p + 1000);
             s.depths.push(if hit {
@@ -274,6 +286,7 @@ fn beta_spp_and_filter_match_the_cpu_twin() {
     let s = synthetic();
     let paper = AafParams {
         filter_degree: 0,
+        irradiance_vector: false,
         specular_limit: 0.5,
         ..AafParams::default()
     };
@@ -342,11 +355,11 @@ fn matches_the_cpu_twin(device: &Device, s: &Synthetic, params: &AafParams) {
                 n.dot(v),
                 params.specular_limit,
             );
-            kd * filtered[p].diffuse + ks * filtered[p].specular
+            kd * filtered[p].diffuse_at(n) + ks * filtered[p].specular.max(Vec3::ZERO)
         };
         let error = (*got - want).abs().max_element() / want.max_element().max(1e-3);
         worst = worst.max(error);
-        changed += usize::from(moved(&filtered[p], &t.means));
+        changed += usize::from(moved(&filtered[p], &t.means, t.normal.normalize()));
     }
     let degree = params.filter_degree;
     assert!(
@@ -360,14 +373,18 @@ fn matches_the_cpu_twin(device: &Device, s: &Synthetic, params: &AafParams) {
 }
 
 /// The corner between the dim floor and the bright wall: the normal threshold and the
-/// tangent-plane test keep the wall's light off the floor, whatever the fit's degree.
+/// tangent-plane test keep the wall's light off the floor, whatever the fit's degree, with the
+/// irradiance vector (geometric normals tested) or the paper's scalar mean (shading normals).
 #[test]
 fn the_filter_does_not_leak_across_surfaces() {
     for filter_degree in shine_sh::aaf::FILTER_DEGREES {
-        does_not_leak(&AafParams {
-            filter_degree,
-            ..AafParams::default()
-        });
+        for irradiance_vector in [true, false] {
+            does_not_leak(&AafParams {
+                filter_degree,
+                irradiance_vector,
+                ..AafParams::default()
+            });
+        }
     }
 }
 
@@ -411,7 +428,7 @@ fn does_not_leak(params: &AafParams) {
             filtered[p], filtered_alone[p],
             "degree {degree}, floor pixel {p}: the wall's light leaked in"
         );
-        changed += usize::from(moved(&filtered[p], &t.means));
+        changed += usize::from(moved(&filtered[p], &t.means, t.normal.normalize()));
     }
     assert!(
         changed > 100,

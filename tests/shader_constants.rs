@@ -231,8 +231,16 @@ fn aaf_sums_layout_and_weight_floor_match_the_shader() {
         shine::passes::aaf::SUMS_STRIDE
     );
     assert_eq!(
+        u64::from(glsl_uint("include/aaf.glsl", "AAF_ROWS_STRIDE")),
+        shine::passes::aaf::ROWS_STRIDE
+    );
+    assert_eq!(
         glsl_float("include/aaf.glsl", "AAF_WEIGHT_MIN"),
         shine::reference::aaf::WEIGHT_MIN
+    );
+    assert_eq!(
+        glsl_float("include/aaf.glsl", "AAF_TANGENT_SCALE"),
+        shine_sh::aaf::TANGENT_SCALE
     );
 }
 

@@ -37,7 +37,15 @@ float aaf_samples_per_pixel(float omega_h, float z_min, float z_max, float d, fl
 }
 
 // shine::passes::aaf::SUMS_STRIDE: vec4 per pixel of the sampling passes' sums.
-const uint AAF_SUMS_STRIDE = 2u;
+const uint AAF_SUMS_STRIDE = 5u;
+// shine::passes::aaf::ROWS_STRIDE: vec4 per pixel of the filter's rows.
+const uint AAF_ROWS_STRIDE = 4u;
+
+// shine_sh::aaf::TANGENT_SCALE (8/3): the irradiance vector over pi of a pixel is
+// V = M0 n + AAF_TANGENT_SCALE M1t, M0 the mean of its cosine-weighted samples about n and M1t
+// the mean of the samples times their direction's part tangent to n; V . m is the mean at a
+// nearby normal m.
+const float AAF_TANGENT_SCALE = 2.6666667;
 
 // shine::reference::aaf::WEIGHT_MIN: the least demodulation weight divided by; a pixel whose kd
 // is below it on every channel (a metal) carries no diffuse light.
@@ -53,17 +61,18 @@ const float AAF_FIT_CONDITION_MIN = 1e-4;
 
 // shine_sh::aaf::LocalFit: one separable filter pass at one pixel as a weighted least-squares
 // polynomial fit in u (signed world distance along the axis, in units of beta) with the paper's
-// gaussian weights; degree 0 is paper 004's normalised gaussian (eq. 16).
+// gaussian weights; degree 0 is paper 004's normalised gaussian (eq. 16). Nine channels: the
+// irradiance vector's x, y, z columns (rgb each), or an rgb value in column 0.
 struct AafFit {
     float s0, s1, s2, s3, s4;
-    vec3 t0, t1, t2;
+    mat3 t0, t1, t2;
 };
 
 AafFit aaf_fit_new() {
-    return AafFit(0.0, 0.0, 0.0, 0.0, 0.0, vec3(0.0), vec3(0.0), vec3(0.0));
+    return AafFit(0.0, 0.0, 0.0, 0.0, 0.0, mat3(0.0), mat3(0.0), mat3(0.0));
 }
 
-void aaf_fit_add(inout AafFit f, float u, vec3 y) {
+void aaf_fit_add(inout AafFit f, float u, mat3 y) {
     float w = exp(-0.5 * u * u);
     float w1 = w * u;
     float w2 = w1 * u;
@@ -78,24 +87,22 @@ void aaf_fit_add(inout AafFit f, float u, vec3 y) {
     f.t2 += w2 * y;
 }
 
-// The fit at u = 0 of the highest well-conditioned degree up to `degree`, clamped at 0;
-// `fallback` without neighbours.
-vec3 aaf_fit_value(AafFit f, uint degree, vec3 fallback) {
+// The fit at u = 0 of the highest well-conditioned degree up to `degree`, not clamped (the
+// irradiance vector's components are signed); `fallback` without neighbours.
+mat3 aaf_fit_value(AafFit f, uint degree, mat3 fallback) {
     if (f.s0 <= 0.0) {
         return fallback;
     }
+    vec3 c = vec3(1.0 / f.s0, 0.0, 0.0);
     float det2 = f.s0 * (f.s2 * f.s4 - f.s3 * f.s3) - f.s1 * (f.s1 * f.s4 - f.s2 * f.s3)
         + f.s2 * (f.s1 * f.s3 - f.s2 * f.s2);
-    if (degree >= 2u && det2 > AAF_FIT_CONDITION_MIN * f.s0 * f.s2 * f.s4) {
-        vec3 a = f.t0 * (f.s2 * f.s4 - f.s3 * f.s3) - f.t1 * (f.s1 * f.s4 - f.s2 * f.s3)
-            + f.t2 * (f.s1 * f.s3 - f.s2 * f.s2);
-        return max(a / det2, vec3(0.0));
-    }
     float det1 = f.s0 * f.s2 - f.s1 * f.s1;
-    if (degree >= 1u && det1 > AAF_FIT_CONDITION_MIN * f.s0 * f.s2) {
-        return max((f.t0 * f.s2 - f.t1 * f.s1) / det1, vec3(0.0));
+    if (degree >= 2u && det2 > AAF_FIT_CONDITION_MIN * f.s0 * f.s2 * f.s4) {
+        c = vec3(f.s2 * f.s4 - f.s3 * f.s3, f.s2 * f.s3 - f.s1 * f.s4, f.s1 * f.s3 - f.s2 * f.s2) / det2;
+    } else if (degree >= 1u && det1 > AAF_FIT_CONDITION_MIN * f.s0 * f.s2) {
+        c = vec3(f.s2 / det1, -f.s1 / det1, 0.0);
     }
-    return max(f.t0 / f.s0, vec3(0.0));
+    return c.x * f.t0 + c.y * f.t1 + c.z * f.t2;
 }
 
 #endif

@@ -121,6 +121,10 @@ pub struct AafStudyArgs {
     /// Degree of the filter's local polynomial fit (0: paper 004's gaussian).
     #[arg(long, default_value_t = shine_sh::aaf::FILTER_DEGREE)]
     filter_degree: u32,
+    /// Filter the diffuse part as an irradiance vector (`aaf.irradiance_vector`; false: the
+    /// paper's scalar mean).
+    #[arg(long, default_value_t = aaf::frame_defaults().irradiance_vector, action = clap::ArgAction::Set)]
+    irradiance_vector: bool,
     /// Roughness limit of the traced specular pass whose lobes AAF leaves out (0: AAF takes
     /// every lobe; default: a default frame's).
     #[arg(long, default_value_t = aaf::frame_defaults().specular_limit)]
@@ -230,6 +234,7 @@ fn run_aaf(args: &AafStudyArgs) -> Result<(), CliError> {
         seed: args.seed,
         params: AafParams {
             filter_degree: args.filter_degree,
+            irradiance_vector: args.irradiance_vector,
             specular_limit: args.specular_limit,
             ..aaf::frame_defaults()
         },

@@ -208,6 +208,7 @@ impl FrameParams {
                     adaptive: a.adaptive,
                     filter: a.filter,
                     filter_degree: a.filter_degree,
+                    irradiance_vector: a.irradiance_vector,
                     specular_limit,
                     slices: a.slices,
                     ..AafParams::default()

@@ -53,10 +53,10 @@
 //!   Cornell box's ceiling, lit from the floor's spot, lost its peak to that bias: at 128² the
 //!   gaussian's error floor (filtered uniform Monte Carlo at 256 spp) was 0.27 of the mean,
 //!   the quadratic fit's is 0.09, and the samples saved at equal error rose from 1.3× to 6.1×
-//!   (5.3× from 3.3× on the animated scene). It is not better everywhere: in the room, whose
-//!   normal-mapped floor cuts the filters into small pieces, a quadratic over few neighbours
-//!   removes less noise than the gaussian (2.45× against 3.18×; docs/quality.md). The weights,
-//!   β and the sampling rates are the paper's. Fitted values below zero are clamped to zero.
+//!   (5.3× from 3.3× on the animated scene). Where the tests cut the filters into small pieces
+//!   a quadratic over few neighbours removes less noise than the gaussian: the room's
+//!   normal-mapped floor did so until the irradiance vector (below). The weights, β and the
+//!   sampling rates are the paper's. The light evaluated from the fits is clamped at zero.
 //! * **Diffuse and specular apart** (as the paper's §6 computes rates and filters "separately
 //!   for the diffuse and glossy components"): the diffuse mean is the same light whatever the
 //!   material, so a glossy tile and its rough grout share it; their specular means differ (a
@@ -65,6 +65,16 @@
 //!   pass leaves ([`AafParams::specular_limit`]). One mean demodulated by `kd + ks (1 −
 //!   trace_weight)`, as before, mixed the grout's and the tiles' different weightings of the
 //!   light: the room's filtered error floor was 0.124, now 0.086 (docs/quality.md).
+//! * **The diffuse part as an irradiance vector** ([`AafParams::irradiance_vector`], on by
+//!   default): each pixel's `V = M₀ n + (8/3) M₁ₜ` ([`shine_sh::aaf::TANGENT_SCALE`]) is
+//!   filtered (nine channels), the neighbours' geometric normals tested against the threshold,
+//!   and `V · n` evaluated at each pixel's shading normal. With the paper's scalar mean, the
+//!   room's bevelled tiles (normal map, 31° slopes) fail the 10° shading-normal test against
+//!   their flat neighbours, so every bevel and every tile was filtered alone at eq. 21's 16
+//!   samples; testing geometric normals with the scalar mean instead blurs away the normal
+//!   map's real detail in the indirect light. The vector keeps both: the room's samples saved at
+//!   equal error rose from 2.6× to 5.7× (docs/quality.md). Surfaces without a normal map are
+//!   filtered as before (`V · n` is then the scalar filter's result).
 //! * **Path regularisation at the hits** ([`AafParams::hit_roughness_min`]): a hit's BRDF is
 //!   evaluated no sharper than roughness 0.5, so a point light's highlight on chrome does not
 //!   turn into caustic fireflies that no sample count averages out.
@@ -150,6 +160,13 @@ pub struct AafParams {
     /// paper's gaussian; 2 (default) fits a quadratic and keeps the peaks, valleys and edges of
     /// the light that the gaussian flattens and tilts.
     pub filter_degree: u32,
+    /// Filter the diffuse part as an irradiance vector (shine's; the paper filters the scalar
+    /// mean): each pixel's `V = M₀ n + (8/3) E[L ω_t]` ([`shine_sh::aaf::TANGENT_SCALE`]),
+    /// neighbours tested by their geometric normals, the result evaluated at each pixel's
+    /// shading normal. A normal map then no longer cuts the filter into tiles and bevels,
+    /// and its detail in the indirect light stays (docs/quality.md: the room's samples saved
+    /// at equal error rose from 2.6× to 5.7×).
+    pub irradiance_vector: bool,
     /// Least roughness of the BRDF at the samples' hits (path regularisation, Kaplanyan and
     /// Dachsbacher 2013): a point light's highlight on a mirror-like reflector, seen by a
     /// cosine-weighted ray, is a caustic that Monte Carlo gathering cannot sample (one
@@ -182,6 +199,7 @@ impl Default for AafParams {
             seed: 0,
             specular_limit: 0.0,
             filter_degree: shine_sh::aaf::FILTER_DEGREE,
+            irradiance_vector: true,
             hit_roughness_min: HIT_ROUGHNESS_MIN,
             slices: 1,
         }
@@ -318,8 +336,10 @@ pub struct FilterPush {
     pub degree: u32,
     /// [`ROUGHNESS_TOLERANCE`].
     pub roughness_tolerance: f32,
+    /// [`AafParams::irradiance_vector`].
+    pub irradiance_vector: u32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// The scene as the AAF rays see it.
@@ -394,8 +414,12 @@ pub struct AafRecords {
 
 /// vec4 per pixel of [`AafRecords::sums`] (`AAF_SUMS_STRIDE` of aaf.glsl): the diffuse sum
 /// (rgb) and the samples taken, then the specular sum (rgb) and 1 where the receiver's `kd`
-/// carries light ([`crate::reference::aaf::WEIGHT_MIN`]).
-pub const SUMS_STRIDE: u64 = 2;
+/// carries light ([`crate::reference::aaf::WEIGHT_MIN`]), then the sums of the diffuse samples
+/// times the x, y and z of their direction's part tangent to the shading normal (rgb each).
+pub const SUMS_STRIDE: u64 = 5;
+/// vec4 per pixel of the filter's rows (`AAF_ROWS_STRIDE`): the irradiance vector's x, y, z
+/// columns, then the specular mean and the diffuse part's flag.
+pub const ROWS_STRIDE: u64 = 4;
 /// Bytes per pixel of [`AafRecords::sums`].
 pub const SUMS_BYTES: u64 = 16 * SUMS_STRIDE;
 /// Bytes per pixel of [`AafRecords::widths`] (and of the depths).
@@ -581,11 +605,12 @@ pub fn aaf_filter(
         specular_limit: params.specular_limit,
         degree: params.filter_degree,
         roughness_tolerance: ROUGHNESS_TOLERANCE,
-        pad: [0; 2],
+        irradiance_vector: u32::from(params.irradiance_vector),
+        pad: 0,
     };
     let mut rows = rg.create_buffer(
         "aaf_rows",
-        BufferDesc::new(u64::from(w) * u64::from(h) * SUMS_BYTES),
+        BufferDesc::new(u64::from(w) * u64::from(h) * 16 * ROWS_STRIDE),
     );
     rg.compute("aaf_filter_x", &shaders::AAF_FILTER_COMP_X)
         .read("gb_position", &g.position)

@@ -5,7 +5,8 @@
 use glam::{Vec3, Vec4};
 use shine_sh::ShError;
 use shine_sh::aaf::{
-    LocalFit, PixelFootprint, filter_bandwidth, filter_width, receiver_bandlimit, samples_per_pixel,
+    LocalFit, PixelFootprint, TANGENT_SCALE, filter_bandwidth, filter_width, receiver_bandlimit,
+    samples_per_pixel,
 };
 
 use crate::passes::aaf::{AafParams, MAX_RADIUS, PLANE_TOLERANCE, ROUGHNESS_TOLERANCE};
@@ -72,9 +73,11 @@ pub fn weights(
 pub struct FilterTexel {
     /// xyz world position, w linear depth (0 on background).
     pub position: Vec4,
-    /// Shading normal (normalised here): the normal threshold.
+    /// Shading normal (normalised here): the normal threshold of the specular part (and of the
+    /// diffuse part without the irradiance vector), and where the result is evaluated.
     pub normal: Vec3,
-    /// Geometric normal (normalised here): the tangent-plane test.
+    /// Geometric normal (normalised here): the tangent-plane test, and the diffuse part's normal
+    /// threshold with the irradiance vector.
     pub geometric_normal: Vec3,
     /// Perceptual roughness: the specular means' test ([`ROUGHNESS_TOLERANCE`]).
     pub roughness: f32,
@@ -84,88 +87,145 @@ pub struct FilterTexel {
     pub means: Means,
 }
 
-/// A pixel's mean incident light, demodulated, in the diffuse and specular parts the filter
-/// smooths apart.
+/// A pixel's mean incident light as the sampling passes leave it, demodulated, in the diffuse
+/// and specular parts the filter smooths apart.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Means {
-    /// The diffuse mean (the samples' `π f_d L / kd`).
+    /// The diffuse mean `M₀` (the samples' `π f_d L / kd`).
     pub diffuse: Vec3,
+    /// The mean of the diffuse samples times the x, y and z of their direction's part tangent
+    /// to the shading normal (`M₁ₜ`, rgb per axis).
+    pub tangent: [Vec3; 3],
     /// The specular mean (the samples' `π f_s L / ks`).
     pub specular: Vec3,
     /// Whether the diffuse mean holds light (`kd` at least [`WEIGHT_MIN`] on some channel).
     pub lit: bool,
 }
 
+/// A pixel's light as the filter passes hand it on: the diffuse part as an irradiance vector.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Filtered {
+    /// The irradiance vector over π, as its x, y and z columns (rgb each): the diffuse mean at
+    /// normal `n` is `Σ_k vector[k] n_k`.
+    pub vector: [Vec3; 3],
+    /// The specular mean.
+    pub specular: Vec3,
+    /// Whether the diffuse part holds light.
+    pub lit: bool,
+}
+
+impl Filtered {
+    /// The diffuse mean at the unit normal `n`, clamped at 0.
+    pub fn diffuse_at(&self, n: Vec3) -> Vec3 {
+        (self.vector[0] * n.x + self.vector[1] * n.y + self.vector[2] * n.z).max(Vec3::ZERO)
+    }
+
+    /// The sampled means of a pixel of shading normal `n` as the first pass takes them: `V =
+    /// M₀ n + (8/3) M₁ₜ` ([`TANGENT_SCALE`]) with `irradiance_vector`, else `M₀ n`.
+    pub fn from_means(means: &Means, n: Vec3, irradiance_vector: bool) -> Self {
+        let tangent = if irradiance_vector {
+            TANGENT_SCALE
+        } else {
+            0.0
+        };
+        Self {
+            vector: std::array::from_fn(|k| means.diffuse * n[k] + means.tangent[k] * tangent),
+            specular: means.specular,
+            lit: means.lit,
+        }
+    }
+}
+
 /// The two passes of `aaf_filter.comp` (rows, then columns) over a `width`-wide image, before
-/// the receivers' weights: the filtered means per pixel.
+/// the receivers' weights: per pixel, the filtered irradiance vector (to evaluate at the
+/// pixel's shading normal) and specular mean.
 pub fn filter_cpu(
     texels: &[FilterTexel],
     width: usize,
     footprint: [f32; 2],
     params: &AafParams,
-) -> Vec<Means> {
-    let rows = filter_axis(texels, width, footprint, params, [1, 0]);
-    let columns: Vec<FilterTexel> = texels
+) -> Vec<Filtered> {
+    let sampled: Vec<Filtered> = texels
         .iter()
-        .zip(&rows)
-        .map(|(t, m)| FilterTexel { means: *m, ..*t })
+        .map(|t| Filtered::from_means(&t.means, t.normal.normalize(), params.irradiance_vector))
         .collect();
-    filter_axis(&columns, width, footprint, params, [0, 1])
+    let rows = filter_axis(texels, &sampled, width, footprint, params, [1, 0]);
+    filter_axis(texels, &rows, width, footprint, params, [0, 1])
 }
 
-/// One separable pass along `axis` ([1, 0]: rows, [0, 1]: columns).
+/// One separable pass along `axis` ([1, 0]: rows, [0, 1]: columns) of `values`.
 fn filter_axis(
     texels: &[FilterTexel],
+    values: &[Filtered],
     width: usize,
     footprint: [f32; 2],
     params: &AafParams,
     axis: [i64; 2],
-) -> Vec<Means> {
+) -> Vec<Filtered> {
     let height = texels.len() / width.max(1);
     let cos_threshold = params.normal_threshold_degrees.to_radians().cos();
+    // Neighbour q's irradiance vector as the centre of normal n takes it: without the
+    // irradiance vector, q's scalar mean along n.
+    let vector = |q: &Filtered, nq: Vec3, n: Vec3| -> [f32; 9] {
+        let v = if params.irradiance_vector {
+            q.vector
+        } else {
+            let mean = q.vector[0] * nq.x + q.vector[1] * nq.y + q.vector[2] * nq.z;
+            std::array::from_fn(|k| mean * n[k])
+        };
+        std::array::from_fn(|i| v[i / 3][i % 3])
+    };
     (0..texels.len())
         .map(|p| {
             let centre = &texels[p];
             let (x, y) = ((p % width) as i64, (p / width) as i64);
             if !params.filter || centre.position.w == 0.0 || centre.beta <= 0.0 {
-                return centre.means;
+                return values[p];
             }
             let n = centre.normal.normalize();
             let ng = centre.geometric_normal.normalize();
             let d = centre.position.w * footprint[0] + footprint[1];
             let radius = MAX_RADIUS.min((2.0 * centre.beta / d).ceil() as u32) as i64;
-            let (mut diffuse, mut specular) = (LocalFit::default(), LocalFit::default());
+            let (mut diffuse, mut specular) = (LocalFit::<9>::default(), LocalFit::<3>::default());
             for k in -radius..=radius {
                 let (qx, qy) = (x + axis[0] * k, y + axis[1] * k);
                 if qx < 0 || qy < 0 || qx >= width as i64 || qy >= height as i64 {
                     continue;
                 }
-                let q = &texels[qy as usize * width + qx as usize];
+                let qi = qy as usize * width + qx as usize;
+                let q = &texels[qi];
                 if q.position.w == 0.0 {
                     continue;
                 }
                 let offset = q.position.truncate() - centre.position.truncate();
-                if n.dot(q.normal.normalize()) < cos_threshold
-                    || ng.dot(offset).abs() > PLANE_TOLERANCE * d
-                {
+                if ng.dot(offset).abs() > PLANE_TOLERANCE * d {
                     continue;
                 }
+                let nq = q.normal.normalize();
+                let shading_close = n.dot(nq) >= cos_threshold;
+                let diffuse_close = if params.irradiance_vector {
+                    ng.dot(q.geometric_normal.normalize()) >= cos_threshold
+                } else {
+                    shading_close
+                };
+                let specular_close =
+                    shading_close && (q.roughness - centre.roughness).abs() <= ROUGHNESS_TOLERANCE;
                 let u = (k as f32).signum() * offset.length() / centre.beta;
-                if q.means.lit {
-                    diffuse.add(u, q.means.diffuse.to_array());
+                if diffuse_close && values[qi].lit {
+                    diffuse.add(u, vector(&values[qi], nq, n));
                 }
-                if (q.roughness - centre.roughness).abs() <= ROUGHNESS_TOLERANCE {
-                    specular.add(u, q.means.specular.to_array());
+                if specular_close {
+                    specular.add(u, values[qi].specular.to_array());
                 }
             }
-            let value = |fit: &LocalFit, own: Vec3| {
-                fit.value(params.filter_degree)
-                    .map_or(own, Vec3::from_array)
-            };
-            Means {
-                diffuse: value(&diffuse, centre.means.diffuse),
-                specular: value(&specular, centre.means.specular),
-                lit: centre.means.lit || diffuse.has_neighbours(),
+            let own = vector(&values[p], n, n);
+            let v = diffuse.value(params.filter_degree).unwrap_or(own);
+            Filtered {
+                vector: std::array::from_fn(|k| Vec3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2])),
+                specular: specular
+                    .value(params.filter_degree)
+                    .map_or(values[p].specular, Vec3::from_array),
+                lit: values[p].lit || diffuse.has_neighbours(),
             }
         })
         .collect()

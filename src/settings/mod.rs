@@ -157,6 +157,11 @@ pub struct AafSettings {
     /// gaussian flattens, but removes less noise where the filter has few neighbours, as on a
     /// normal-mapped floor; docs/quality.md). Range 0..=2, default 2.
     pub filter_degree: u32,
+    /// Filter the diffuse light as an irradiance vector, neighbours tested by their geometric
+    /// normals, evaluated at each pixel's shading normal, so that a normal map does not cut the
+    /// filter (shine's; false is the paper's scalar filter, shading normals tested). Default
+    /// true.
+    pub irradiance_vector: bool,
     /// Pixels per refresh (paper 001): 1 samples every pixel every frame; 4 samples one pixel
     /// per 2×2 cell per frame and reprojects the others' sums from the previous frames
     /// (`aaf_reproject`, src/passes/amortise.rs). Default 1.
@@ -177,6 +182,7 @@ impl Default for AafSettings {
             adaptive: p.adaptive,
             filter: p.filter,
             filter_degree: p.filter_degree,
+            irradiance_vector: p.irradiance_vector,
             slices: p.slices,
         }
     }

@@ -418,6 +418,7 @@ pub fn run(
         repeats: config.repeats,
         setup: Setup {
             filter_degree: config.params.filter_degree,
+            irradiance_vector: config.params.irradiance_vector,
             specular_limit: config.params.specular_limit,
             hit_roughness_min: config.params.hit_roughness_min,
         },

@@ -167,6 +167,8 @@ pub struct Maps {
 pub struct Setup {
     /// Degree of the filter's local polynomial fit (0: the paper's gaussian).
     pub filter_degree: u32,
+    /// Whether the diffuse part is filtered as an irradiance vector.
+    pub irradiance_vector: bool,
     /// Roughness limit of the traced specular pass whose lobes AAF leaves out (0: none).
     pub specular_limit: f32,
     /// Least roughness of the BRDF at the samples' hits.
@@ -226,11 +228,12 @@ impl AafStudyReport {
         let _ = writeln!(
             s,
             "AAF study: {} at {w}×{h} on {} ({} render(s) per point); filter degree {}, \
-             specular limit {}, hit roughness ≥ {}",
+             irradiance vector {}, specular limit {}, hit roughness ≥ {}",
             self.scene,
             self.device,
             self.repeats,
             self.setup.filter_degree,
+            self.setup.irradiance_vector,
             self.setup.specular_limit,
             self.setup.hit_roughness_min
         );

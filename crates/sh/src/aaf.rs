@@ -162,30 +162,49 @@ pub const FILTER_DEGREES: std::ops::RangeInclusive<u32> = 0..=2;
 /// neighbours to pin a slope or a curvature).
 pub const FIT_CONDITION_MIN: f32 = 1e-4;
 
+/// The tangent part of the irradiance vector from cosine-weighted samples (shine's, not the
+/// paper's; GLSL `AAF_TANGENT_SCALE`). For radiance linear in the direction, `L(ω) = l₀ + l₁·ω`,
+/// cosine-weighted samples about `n` have `E[L ω_t] = l₁ₜ / 4` (the tangent second moment of the
+/// cosine lobe is `1/4`), and the cosine-weighted mean at a normal tilted from `n` by `δ` changes
+/// by `(2/3) l₁·δ`: so `8/3` times the mean of `L ω_t` is the gradient of the mean with respect
+/// to the normal. With the mean `M₀` along `n`, `V = M₀ n + (8/3) E[L ω_t]` is the irradiance
+/// vector (over π): the mean at a nearby normal `m` is `V·m`, which the filter evaluates at each
+/// pixel's shading normal after smoothing `V` across a normal-mapped surface.
+pub const TANGENT_SCALE: f32 = 8.0 / 3.0;
+
 /// One separable pass of the filter at one pixel, as a weighted least-squares fit of a
 /// polynomial in `u` (the signed world distance from the centre along the pass's axis, in units
-/// of β) to the neighbours' values, with the paper's gaussian weights `exp(−u²/2)`: the filtered
-/// value is the fit at `u = 0`. Degree 0 is the paper's normalised gaussian. A gaussian flattens
-/// every peak and valley of the light by `O(β²)` (its bias) and, where the normal and plane tests
-/// or the image's border cut its support to one side, tilts it by `O(β)`; the quadratic fit is
-/// exact for light that varies quadratically along the axis, on either side. GLSL twin:
-/// `AafFit` in `shaders/include/aaf.glsl`.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct LocalFit {
+/// of β) to the neighbours' values (`N` channels), with the paper's gaussian weights
+/// `exp(−u²/2)`: the filtered value is the fit at `u = 0`. Degree 0 is the paper's normalised
+/// gaussian. A gaussian flattens every peak and valley of the light by `O(β²)` (its bias) and,
+/// where the normal and plane tests or the image's border cut its support to one side, tilts it
+/// by `O(β)`; the quadratic fit is exact for light that varies quadratically along the axis, on
+/// either side. GLSL twin: `AafFit` in `shaders/include/aaf.glsl` (nine channels, a mat3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LocalFit<const N: usize = 3> {
     /// `Σ w u^k`, k = 0..4.
     s: [f32; 5],
     /// `Σ w u^k y`, k = 0..2, per channel.
-    t: [[f32; 3]; 3],
+    t: [[f32; N]; 3],
 }
 
-impl LocalFit {
+impl<const N: usize> Default for LocalFit<N> {
+    fn default() -> Self {
+        Self {
+            s: [0.0; 5],
+            t: [[0.0; N]; 3],
+        }
+    }
+}
+
+impl<const N: usize> LocalFit<N> {
     /// Whether any neighbour was added.
     pub fn has_neighbours(&self) -> bool {
         self.s[0] > 0.0
     }
 
     /// Adds a neighbour at `u` (in units of β) with value `y` and the gaussian weight of `u`.
-    pub fn add(&mut self, u: f32, y: [f32; 3]) {
+    pub fn add(&mut self, u: f32, y: [f32; N]) {
         let w = (-0.5 * u * u).exp();
         let mut power = w;
         for k in 0..5 {
@@ -199,33 +218,36 @@ impl LocalFit {
         }
     }
 
-    /// The fitted value at `u = 0` of the highest degree up to `degree` whose fit is well
-    /// conditioned ([`FIT_CONDITION_MIN`]), clamped at 0 (light is never negative; a fit
-    /// extrapolated over noise can dip below); `None` without neighbours.
-    pub fn value(&self, degree: u32) -> Option<[f32; 3]> {
+    /// The coefficients `c` of the fitted value at `u = 0`, `Σ_k c_k Σ w u^k y`, of the highest
+    /// degree up to `degree` whose fit is well conditioned ([`FIT_CONDITION_MIN`]); `None`
+    /// without neighbours.
+    pub fn coefficients(&self, degree: u32) -> Option<[f32; 3]> {
         let [s0, s1, s2, s3, s4] = self.s;
-        let [t0, t1, t2] = self.t;
         if s0 <= 0.0 {
             return None;
         }
-        let solve = |a: [f32; 3], b: [f32; 3], c: [f32; 3], det: f32| {
-            std::array::from_fn(|i| ((a[i] + b[i] + c[i]) / det).max(0.0))
-        };
-        let scale = |t: [f32; 3], k: f32| t.map(|v| v * k);
         let det2 = s0 * (s2 * s4 - s3 * s3) - s1 * (s1 * s4 - s2 * s3) + s2 * (s1 * s3 - s2 * s2);
         if degree >= 2 && det2 > FIT_CONDITION_MIN * s0 * s2 * s4 {
-            return Some(solve(
-                scale(t0, s2 * s4 - s3 * s3),
-                scale(t1, -(s1 * s4 - s2 * s3)),
-                scale(t2, s1 * s3 - s2 * s2),
-                det2,
-            ));
+            return Some(
+                [s2 * s4 - s3 * s3, s2 * s3 - s1 * s4, s1 * s3 - s2 * s2].map(|c| c / det2),
+            );
         }
         let det1 = s0 * s2 - s1 * s1;
         if degree >= 1 && det1 > FIT_CONDITION_MIN * s0 * s2 {
-            return Some(solve(scale(t0, s2), scale(t1, -s1), [0.0; 3], det1));
+            return Some([s2 / det1, -s1 / det1, 0.0]);
         }
-        Some(solve(t0, [0.0; 3], [0.0; 3], s0))
+        Some([1.0 / s0, 0.0, 0.0])
+    }
+
+    /// The fitted value at `u = 0` ([`Self::coefficients`]); `None` without neighbours. Not
+    /// clamped: a channel may be a signed component (the irradiance vector's); the caller
+    /// clamps the light it evaluates at zero.
+    pub fn value(&self, degree: u32) -> Option<[f32; N]> {
+        let c = self.coefficients(degree)?;
+        let [t0, t1, t2] = &self.t;
+        Some(std::array::from_fn(|i| {
+            c[0] * t0[i] + c[1] * t1[i] + c[2] * t2[i]
+        }))
     }
 }
 
@@ -286,12 +308,12 @@ mod tests {
     fn the_quadratic_fit_is_exact_for_quadratic_light_even_one_sided() {
         let light = |u: f32| 2.0 + 0.5 * u - 0.3 * u * u;
         for side in [-3..=3, 0..=4] {
-            let mut fit = LocalFit::default();
+            let mut fit = LocalFit::<3>::default();
             for k in side {
                 let u = 0.7 * k as f32;
                 fit.add(u, [light(u), 2.0 * light(u), 0.0]);
             }
-            let v = fit.value(2).unwrap();
+            let v: [f32; 3] = fit.value(2).unwrap();
             assert!(
                 (v[0] - 2.0).abs() < 1e-4 && (v[1] - 4.0).abs() < 1e-4,
                 "{v:?}"
@@ -306,20 +328,91 @@ mod tests {
 
     #[test]
     fn an_ill_conditioned_fit_drops_a_degree() {
-        let mut none = LocalFit::default();
+        let mut none = LocalFit::<3>::default();
         assert_eq!(none.value(2), None);
         none.add(0.0, [1.0; 3]);
         assert_eq!(none.value(2), Some([1.0; 3]));
         // Two neighbours pin a line, not a parabola: the linear fit through them.
-        let mut two = LocalFit::default();
+        let mut two = LocalFit::<3>::default();
         two.add(0.5, [3.0; 3]);
         two.add(1.0, [4.0; 3]);
         let v = two.value(2).unwrap();
         assert!((v[0] - 2.0).abs() < 1e-4, "{v:?}");
-        // A fit extrapolated below zero is clamped.
-        let mut down = LocalFit::default();
+        // A fit extrapolated below zero is not clamped (a channel may be a signed component).
+        let mut down = LocalFit::<3>::default();
         down.add(0.5, [1.0; 3]);
         down.add(1.0, [3.0; 3]);
-        assert_eq!(down.value(1), Some([0.0; 3]));
+        let v = down.value(1).unwrap();
+        assert!((v[0] + 1.0).abs() < 1e-4, "{v:?}");
+    }
+
+    /// The cosine-weighted mean of `radiance` over the hemisphere about the unit normal `n`
+    /// (midpoint quadrature), and the mean of the radiance times the direction's part tangent
+    /// to `n`.
+    fn cosine_moments(radiance: impl Fn([f64; 3]) -> f64, n: [f64; 3]) -> (f64, [f64; 3]) {
+        let helper = if n[0].abs() < 0.9 {
+            [1.0, 0.0, 0.0]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
+        let cross = |a: [f64; 3], b: [f64; 3]| {
+            [
+                a[1] * b[2] - a[2] * b[1],
+                a[2] * b[0] - a[0] * b[2],
+                a[0] * b[1] - a[1] * b[0],
+            ]
+        };
+        let unit = |a: [f64; 3]| {
+            let l = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
+            a.map(|c| c / l)
+        };
+        let t = unit(cross(n, helper));
+        let b = cross(n, t);
+        let (steps_theta, steps_phi) = (400, 400);
+        let (mut m0, mut m1, mut weight) = (0.0, [0.0; 3], 0.0);
+        for i in 0..steps_theta {
+            let theta = (i as f64 + 0.5) / steps_theta as f64 * std::f64::consts::FRAC_PI_2;
+            for j in 0..steps_phi {
+                let phi = (j as f64 + 0.5) / steps_phi as f64 * std::f64::consts::TAU;
+                let (st, ct) = theta.sin_cos();
+                let (sp, cp) = phi.sin_cos();
+                let w: [f64; 3] =
+                    std::array::from_fn(|k| st * cp * t[k] + st * sp * b[k] + ct * n[k]);
+                let dw = ct * st; // cosine × the solid angle's sin θ
+                let l = radiance(w);
+                m0 += l * dw;
+                for k in 0..3 {
+                    m1[k] += l * (w[k] - ct * n[k]) * dw;
+                }
+                weight += dw;
+            }
+        }
+        (m0 / weight, m1.map(|c| c / weight))
+    }
+
+    #[test]
+    fn the_irradiance_vector_follows_a_tilted_normal() {
+        // Radiance linear in the direction, brighter from one side and from above.
+        let radiance = |w: [f64; 3]| 1.0 + 0.6 * w[0] + 0.3 * w[2];
+        let n = [0.0, 0.0, 1.0];
+        let (m0, m1t) = cosine_moments(radiance, n);
+        let v: [f64; 3] = std::array::from_fn(|k| m0 * n[k] + f64::from(TANGENT_SCALE) * m1t[k]);
+        for tilt in [0.02f64, 0.05, 0.1] {
+            let m = [tilt.sin(), 0.0, tilt.cos()];
+            let truth = cosine_moments(radiance, m).0;
+            let estimate: f64 = (0..3).map(|k| v[k] * m[k]).sum();
+            // The first-order change in the tilt is exact; what is left is O(tilt²): the
+            // constant part l₀ (1 − cos tilt), tilt² / 2 here. A scale of 2 instead of 8/3
+            // misses 0.1 × tilt and fails.
+            let first_order = cosine_moments(radiance, n).0 + 0.4 * tilt;
+            assert!(
+                (truth - first_order).abs() < tilt * tilt,
+                "tilt {tilt}: {truth} {first_order}"
+            );
+            assert!(
+                (estimate - truth).abs() < 0.7 * tilt * tilt,
+                "tilt {tilt}: V.m {estimate}, the mean at m {truth}"
+            );
+        }
     }
 }
