@@ -92,7 +92,7 @@ Means means_at(uint q, vec3 nq, vec3 n) {
     vec4 s = sums.s[k];
     vec4 specular = sums.s[k + 1u];
     float inverse = s.w > 0.0 ? 1.0 / s.w : 0.0;
-    vec3 mean = s.rgb * inverse;
+    vec3 mean = (s.rgb - specular.rgb) * inverse;
     mat3 diffuse = outerProduct(mean, n);
     if (push.irradiance_vector != 0u) {
         float tangent = AAF_TANGENT_SCALE * inverse;

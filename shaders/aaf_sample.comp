@@ -1,12 +1,13 @@
 // AAF sampling (paper 004 §5, src/passes/aaf.rs): Monte-Carlo estimate of the indirect light
 // leaving every G-buffer pixel towards the camera, with directions cosine-weighted about the
 // shading normal, diffuse and glossy parts apart (paper 004 §6): a sample carrying radiance L
-// from direction l adds pi f_d(l, v) L / kd to the diffuse sum and pi f_s(l, v) L / ks to the
-// specular one, f_d + f_s the receiver's metallic-roughness BRDF and kd, ks its demodulation
-// weights (brdf_indirect_weights, never below AAF_WEIGHT_MIN; for a Lambertian receiver the diffuse mean is the irradiance over pi, the
-// quantity paper 004 filters). The directions of a pixel's samples are the points of a
-// digitally shifted (0, 2)-sequence (sobol_02), stratified whatever their count (the paper
-// stratifies both passes). Each sample
+// from direction l adds pi L f_d(l, v) / kd to the diffuse sum (aaf_diffuse_share: one ratio
+// for the three channels) and pi f_s(l, v) L / ks to the specular one, f_d + f_s the
+// receiver's metallic-roughness BRDF and kd, ks its demodulation weights
+// (brdf_indirect_weights; for a Lambertian receiver the diffuse mean is the irradiance over
+// pi, the quantity paper 004 filters). The directions of a pixel's samples are the points of
+// a digitally shifted (0, 2)-sequence (sobol_02): the first 2^k of them, and every aligned
+// block of 2^k after, are stratified (the paper stratifies both passes). Each sample
 // traces a ray through the BVH; where it hits, the radiance leaving the hit towards the pixel is
 // next-event estimation to the punctual lights (path.glsl), continued for `bounces` - 1 further
 // BRDF-sampled vertices. Misses, emission and the environment add nothing (the raster GI
@@ -56,7 +57,8 @@ layout(set = 0, binding = 10, rgba16f) readonly uniform image2D gb_normal;
 layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_normal;
 layout(set = 0, binding = 15, rgba8) readonly uniform image2D gb_albedo;
 layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
-// AAF_SUMS_STRIDE vec4 per pixel: the diffuse sum (rgb) and the samples taken (a), then the
+// AAF_SUMS_STRIDE vec4 per pixel: the diffuse plus the specular sum (rgb: what the amortised
+// change test compares, RecordSignal::MeanRgb) and the samples taken (a), then the
 // specular sum (rgb) and 1 where kd carries light (a; AAF_WEIGHT_MIN), then the sums of the
 // diffuse samples times the x, y and z of their direction's part tangent to the shading normal
 // (rgb each; the irradiance vector's tangent part, aaf.glsl).
@@ -133,8 +135,8 @@ void main() {
     vec3 specular_sum = vec3(0.0);
     mat3 tangent_sum = mat3(0.0);
 #else
-    vec4 sum = first_sums.s[record];
     vec3 specular_sum = first_sums.s[record + 1u].rgb;
+    vec4 sum = first_sums.s[record] - vec4(specular_sum, 0.0);
     mat3 tangent_sum = mat3(first_sums.s[record + 2u].rgb, first_sums.s[record + 3u].rgb, first_sums.s[record + 4u].rgb);
     uint begin = uint(sum.w);
     uint end = max(begin, uint(filter_widths.f[p].y));
@@ -176,7 +178,7 @@ void main() {
         vec3 f_s;
         brdf_metallic_roughness_parts(n, l, v, albedo, roughness_metallic.y, roughness_metallic.x, f_d, f_s);
         vec3 radiance = incident(l, hit, push.config.x) * BRDF_PI;
-        vec3 diffuse = radiance * f_d / max(kd, vec3(AAF_WEIGHT_MIN));
+        vec3 diffuse = radiance * aaf_diffuse_share(f_d, kd);
         vec3 specular = radiance * f_s / max(ks, vec3(AAF_WEIGHT_MIN));
         if (!any(isnan(diffuse)) && !any(isinf(diffuse)) && !any(isnan(specular)) && !any(isinf(specular))) {
             sum.rgb += diffuse;
@@ -185,7 +187,7 @@ void main() {
             tangent_sum += mat3(diffuse * t.x, diffuse * t.y, diffuse * t.z);
         }
     }
-    sums.s[record] = sum;
+    sums.s[record] = vec4(sum.rgb + specular_sum, sum.w);
     sums.s[record + 1u] = vec4(specular_sum, aaf_carries_light(kd) ? 1.0 : 0.0);
     for (uint k = 0u; k < 3u; ++k) {
         sums.s[record + 2u + k] = vec4(tangent_sum[k], 0.0);

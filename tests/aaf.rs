@@ -56,7 +56,7 @@ fn means(s: &Synthetic, p: usize) -> Means {
     let record = &s.sums[aaf::SUMS_STRIDE as usize * p..][..aaf::SUMS_STRIDE as usize];
     let count = record[0].w;
     Means {
-        diffuse: record[0].truncate() / count,
+        diffuse: (record[0].truncate() - record[1].truncate()) / count,
         tangent: std::array::from_fn(|k| record[2 + k].truncate() / count),
         specular: record[1].truncate() / count,
         lit: record[1].w > 0.0,
@@ -126,19 +126,31 @@ fn synthetic() -> Synthetic {
                 5 => 0.5,
                 _ => 0.0,
             };
-            s.sums.push((radiance * noise * count).extend(count));
+            // A normal map: every third pixel's shading normal tilted by about 6°, every
+            // eleventh by about 22° (past the 10° threshold: the diffuse part, testing geometric
+            // normals, still takes it; the specular part does not); the tangent-plane test takes
+            // the geometric normal.
+            let tilt = match (p % 3, p % 11) {
+                (_, 4) => 0.4,
+                (1, _) => 0.1,
+                _ => 0.0,
+            };
+            let shading = (normal + Vec4::new(normal.y, normal.x, 0.0, 0.0) * tilt)
+                .truncate()
+                .normalize_or_zero();
+            let diffuse = radiance * noise;
+            let specular = radiance * (0.5 + hash(p + 3000));
+            // Word 0..2: the diffuse plus the specular sum.
+            s.sums.push(((diffuse + specular) * count).extend(count));
             // Metals carry no diffuse light: their diffuse sums are left out of the filter.
             let lit = if metallic < 1.0 { 1.0 } else { 0.0 };
-            s.sums
-                .push((radiance * (0.5 + hash(p + 3000)) * count).extend(lit));
-            // Tangent sums: signed, up to a third of the diffuse sum.
+            s.sums.push((specular * count).extend(lit));
+            // Tangent sums: the diffuse colour times a direction tangent to the shading normal,
+            // up to a third of the diffuse sum.
+            let t = Vec3::new(hash(p + 4000), hash(p + 5000), hash(p + 6000)) - 0.5;
+            let t = (t - shading * shading.dot(t)) * 0.6;
             for axis in 0..3 {
-                let t = Vec3::new(
-                    hash(p + 4000 + 3 * axis),
-                    hash(p + 5000 + 3 * axis),
-                    hash(p + 6000 + 3 * axis),
-                ) - 0.5;
-                s.sums.push((radiance * t * 0.6 * count).extend(0.0));
+                s.sums.push((diffuse * t[axis] * count).extend(0.0));
             }
             let hit = position.w > 0.0 && p % 17 != 5;
             let z_min = 0.05 + hash(p + 1000);
@@ -149,18 +161,13 @@ fn synthetic() -> Synthetic {
             });
             s.position.push(position);
             s.geometric_normal.push(q16(normal));
-            // A normal map: every third pixel's shading normal tilted by about 6°, within the
-            // normal threshold; the tangent-plane test takes the geometric normal.
-            let tilt = if p % 3 == 1 {
-                Vec4::new(normal.y, normal.x, 0.0, 0.0) * 0.1
-            } else {
-                Vec4::ZERO
-            };
-            s.normal.push(q16((normal + tilt).normalize_or_zero()));
+            s.normal.push(q16(shading.extend(0.0)));
             s.albedo
                 .push(q8(Vec4::new(0.2 + 0.6 * u, 0.5, 0.8 - 0.5 * v, 1.0)));
+            // Roughness steps along y and, by 0.15 (past the specular part's tolerance), along x.
+            let roughness = 0.2 + 0.6 * v + 0.15 * ((i / 2) % 2) as f32;
             s.material
-                .push(q8(Vec4::new(0.2 + 0.6 * v, metallic, 0.0, 0.0)));
+                .push(q8(Vec4::new(roughness.min(1.0), metallic, 0.0, 0.0)));
         }
     }
     s
@@ -279,18 +286,24 @@ fn run_gpu(device: &Device, s: &Synthetic, params: &AafParams) -> GpuResult {
 
 /// β and the sample count of every pixel equal shine-sh's eq. 15, 16 and 21 (through the CPU
 /// twin), and the filtered, albedo-modulated light equals the CPU twin of the filter: the
-/// default quadratic fit, and the paper's gaussian with a traced specular pass's limit.
+/// quadratic fit and the paper's gaussian, each with the irradiance vector and with the paper's
+/// scalar mean, two of them with a traced specular pass's limit.
 #[test]
 fn beta_spp_and_filter_match_the_cpu_twin() {
     let device = device();
     let s = synthetic();
-    let paper = AafParams {
-        filter_degree: 0,
-        irradiance_vector: false,
-        specular_limit: 0.5,
-        ..AafParams::default()
-    };
-    for params in [AafParams::default(), paper] {
+    for (filter_degree, irradiance_vector, specular_limit) in [
+        (2, true, 0.0),
+        (0, false, 0.5),
+        (0, true, 0.5),
+        (2, false, 0.0),
+    ] {
+        let params = AafParams {
+            filter_degree,
+            irradiance_vector,
+            specular_limit,
+            ..AafParams::default()
+        };
         matches_the_cpu_twin(&device, &s, &params);
     }
 }

@@ -48,12 +48,21 @@ const uint AAF_ROWS_STRIDE = 4u;
 const float AAF_TANGENT_SCALE = 2.6666667;
 
 // shine::reference::aaf::WEIGHT_MIN: the least demodulation weight divided by; a pixel whose kd
-// is below it on every channel (a metal) carries no diffuse light.
+// sums to less over its channels (a metal) carries no diffuse light.
 const float AAF_WEIGHT_MIN = 1e-3;
 
 // Whether the diffuse weight kd carries light (AAF_WEIGHT_MIN).
 bool aaf_carries_light(vec3 kd) {
-    return any(greaterThanEqual(kd, vec3(AAF_WEIGHT_MIN)));
+    return kd.r + kd.g + kd.b >= AAF_WEIGHT_MIN;
+}
+
+// The share of the incident light a diffuse sample carries, f_d / kd, one number for the three
+// channels (their sums' ratio): f_d and kd share the albedo and (1 - metallic), so their ratio
+// is the same on every channel for a grey F0 (dielectrics) and stays finite where one channel's
+// albedo is 0 (dividing channel by channel would leave that channel's diffuse mean dark and
+// darken its neighbours'). 0 where kd carries no light.
+float aaf_diffuse_share(vec3 f_d, vec3 kd) {
+    return aaf_carries_light(kd) ? (f_d.r + f_d.g + f_d.b) / (kd.r + kd.g + kd.b) : 0.0;
 }
 
 // shine_sh::aaf::FIT_CONDITION_MIN

@@ -20,8 +20,8 @@ float rand() {
 
 // Point i of the first two dimensions of the Sobol sequence, a (0, 2)-sequence in base 2: every
 // prefix of 2^k points puts one point in each of the 2^k elementary intervals of area 2^-k (for
-// 16 points: a 4 x 4 grid, 2 x 8, 8 x 2, ...), so a pixel's samples stay stratified whatever
-// their count. Dimension 1 is the base-2 radical inverse; dimension 2's generator matrix is
+// 16 points: a 4 x 4 grid, 2 x 8, 8 x 2, ...), so the first 2^k samples of a pixel, and every
+// aligned block of 2^k after them, are stratified. Dimension 1 is the base-2 radical inverse; dimension 2's generator matrix is
 // the Pascal matrix mod 2 (v_{k+1} = v_k ^ (v_k >> 1)). `shift`: a random digital shift (XOR),
 // which keeps the stratification. 24 bits per coordinate. Rust twin:
 // shine_sh::sequence::sobol_02 (tests/sequence_glsl.rs).

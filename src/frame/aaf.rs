@@ -10,17 +10,20 @@ use glam::Vec3;
 use shine_graph::{Handle, Image, RenderGraph};
 
 use super::error::RenderError;
-use crate::gpu::vk;
+use crate::gpu::{Device, vk};
 use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
 use crate::passes::aaf::{self, AafParams, AafRecords, AafScene, AafSlice};
 use crate::passes::amortise::{self, RecordHistory, RecordSignal, Schedule, Slice};
 use crate::passes::gbuffer::{GBuffer, View};
 
-/// The AAF technique: which frame last wrote its amortised samples' history.
-#[derive(Debug, Default)]
+/// The AAF technique: which frame last wrote its amortised samples' history, and how large a
+/// storage buffer its device allows.
+#[derive(Debug)]
 pub struct AafTechnique {
     schedule: Schedule,
+    /// The device's `maxStorageBufferRange` ([`AafParams::storage_limit`]).
+    storage_limit: u64,
 }
 
 /// An AAF frame ready to be declared: its checked parameters.
@@ -49,15 +52,26 @@ pub struct AafInputs<'a> {
 }
 
 impl AafTechnique {
-    /// Checks `params` (AAF uploads nothing of its own); for amortised frames of `extent`,
+    /// The technique on `device`.
+    pub fn new(device: &Device) -> Self {
+        Self {
+            schedule: Schedule::default(),
+            storage_limit: u64::from(device.info().max_storage_buffer_range),
+        }
+    }
+
+    /// Checks `params` and that `extent`'s sums fit the device (AAF uploads nothing of its own);
+    /// for amortised frames of `extent`,
     /// picks this frame's slice.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
-        params: AafParams,
+        mut params: AafParams,
         extent: [u32; 2],
     ) -> Result<PreparedAaf, RenderError> {
+        params.storage_limit = self.storage_limit;
         params.validate()?;
+        params.check_extent(extent)?;
         let amortised = self.schedule.next(rg.frame(), extent, params.slices, 0);
         Ok(PreparedAaf { params, amortised })
     }

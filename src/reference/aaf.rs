@@ -47,8 +47,8 @@ pub fn beta_cpu(
     ])
 }
 
-/// The least demodulation weight the samples are divided by (`AAF_WEIGHT_MIN` of
-/// `shaders/include/aaf.glsl`): a pixel whose `kd` is below it on every channel (a metal)
+/// The least diffuse weight the samples are divided by (`AAF_WEIGHT_MIN` of
+/// `shaders/include/aaf.glsl`): a pixel whose `kd` sums to less over its channels (a metal)
 /// carries no diffuse light, and the filter leaves its diffuse mean out.
 pub const WEIGHT_MIN: f32 = 1e-3;
 
@@ -98,7 +98,7 @@ pub struct Means {
     pub tangent: [Vec3; 3],
     /// The specular mean (the samples' `π f_s L / ks`).
     pub specular: Vec3,
-    /// Whether the diffuse mean holds light (`kd` at least [`WEIGHT_MIN`] on some channel).
+    /// Whether the diffuse mean holds light (`kd` summing to at least [`WEIGHT_MIN`]).
     pub lit: bool,
 }
 

@@ -154,8 +154,8 @@ pub struct AafSettings {
     pub filter: bool,
     /// Degree of the filter's local polynomial fit with the paper's gaussian weights: 0 is
     /// paper 004's gaussian, 1 linear, 2 quadratic (keeps the light's peaks and edges the
-    /// gaussian flattens, but removes less noise where the filter has few neighbours, as on a
-    /// normal-mapped floor; docs/quality.md). Range 0..=2, default 2.
+    /// gaussian flattens, but removes less noise where the filter has few neighbours;
+    /// docs/quality.md). Range 0..=2, default 2.
     pub filter_degree: u32,
     /// Filter the diffuse light as an irradiance vector, neighbours tested by their geometric
     /// normals, evaluated at each pixel's shading normal, so that a normal map does not cut the

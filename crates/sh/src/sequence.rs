@@ -1,8 +1,9 @@
 //! Low-discrepancy sample points of the Monte-Carlo passes: the first two dimensions of the
 //! Sobol sequence, a (0, 2)-sequence in base 2. Every prefix of `2^k` points puts one point in
 //! each elementary interval of area `2^-k` (for 16 points: a 4 × 4 grid, 2 × 8, 8 × 2, 1 × 16,
-//! 16 × 1), so the samples of a pixel stay stratified whatever their count, and a second pass
-//! that continues the sequence keeps the first pass's strata. A random digital shift (XOR of
+//! 16 × 1), so the first `2^k` samples of a pixel, and every aligned block of `2^k` after them,
+//! are stratified, and a second pass that continues the sequence keeps the first pass's strata
+//! (counts between powers of two are stratified at the next coarser level). A random digital shift (XOR of
 //! the bits) per pixel decorrelates pixels and keeps the property. GLSL twin: `sobol_02` in
 //! `shaders/include/random.glsl` (tied by tests/sequence_glsl.rs).
 

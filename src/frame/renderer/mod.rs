@@ -253,7 +253,7 @@ impl Renderer {
             shadows: None,
             hvl: HvlTechnique::new(device),
             igi: IgiTechnique::new(device),
-            aaf: AafTechnique::default(),
+            aaf: AafTechnique::new(device),
             motion: MotionState::new(device)?,
             accumulate: AccumulateTechnique::new("accumulate", "accumulated indirect"),
             taa: AccumulateTechnique::new("taa", "taa direct"),

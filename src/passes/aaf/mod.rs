@@ -64,7 +64,8 @@
 //!   specular part is weighted by `ks (1 − trace_weight)`, the share the frame's traced specular
 //!   pass leaves ([`AafParams::specular_limit`]). One mean demodulated by `kd + ks (1 −
 //!   trace_weight)`, as before, mixed the grout's and the tiles' different weightings of the
-//!   light: the room's filtered error floor was 0.124, now 0.086 (docs/quality.md).
+//!   light: with the stratified samples, the room's filtered error floor went from 0.143 to
+//!   0.086 (docs/quality.md).
 //! * **The diffuse part as an irradiance vector** ([`AafParams::irradiance_vector`], on by
 //!   default): each pixel's `V = M₀ n + (8/3) M₁ₜ` ([`shine_sh::aaf::TANGENT_SCALE`]) is
 //!   filtered (nine channels), the neighbours' geometric normals tested against the threshold,
@@ -73,15 +74,16 @@
 //!   their flat neighbours, so every bevel and every tile was filtered alone at eq. 21's 16
 //!   samples; testing geometric normals with the scalar mean instead blurs away the normal
 //!   map's real detail in the indirect light. The vector keeps both: the room's samples saved at
-//!   equal error rose from 2.6× to 5.7× (docs/quality.md). Surfaces without a normal map are
-//!   filtered as before (`V · n` is then the scalar filter's result).
+//!   equal error rose from 2.6× to 5.7× (docs/quality.md). Where a pixel's neighbours share its
+//!   shading normal (no normal map, flat faces), `V · n` is the scalar filter's result; on
+//!   smooth-shaded curved surfaces the geometric normals now decide which neighbours count. The
+//!   vector is first order in the tilt: at the room's 31° bevels it misses up to 14% of the
+//!   light's constant part (the energy reads 1.015 there).
 //! * **Path regularisation at the hits** ([`AafParams::hit_roughness_min`]): a hit's BRDF is
 //!   evaluated no sharper than roughness 0.5, so a point light's highlight on chrome does not
 //!   turn into caustic fireflies that no sample count averages out.
 //! * The emission of emissive surfaces and the environment light nothing (punctual lights only,
 //!   the convention of every raster GI technique).
-
-use std::ops::RangeInclusive;
 
 use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceBuffers;
@@ -90,181 +92,9 @@ use crate::passes::amortise;
 use crate::passes::gbuffer::{GBuffer, View};
 use crate::shaders;
 
-/// Ω_h of a Lambertian receiver (paper 004 eq. 18): the default bandlimit.
-pub const OMEGA_H: f32 = shine_sh::aaf::OMEGA_H_DIFFUSE;
-/// Bandlimits Ω_h the settings take.
-pub const OMEGA_H_RANGE: RangeInclusive<f32> = 0.1..=100.0;
-/// Filter scales μ the settings take (paper: 0.9; larger μ narrows the filter and samples more).
-pub const MU_RANGE: RangeInclusive<f32> = 0.01..=100.0;
-/// Samples of the first pass the settings take (paper: 16).
-pub const FIRST_SAMPLES: RangeInclusive<u32> = 1..=1024;
-/// The lower spp clamps the settings take: never below the paper's 16.
-pub const SPP_MIN: RangeInclusive<u32> = 16..=1024;
-/// The upper spp clamps (before the factor μ) the settings take (paper: 100).
-pub const SPP_MAX: RangeInclusive<u32> = 16..=10_000;
-/// Path vertices after the receiver (1: one-bounce indirect light).
-pub const BOUNCES: RangeInclusive<u32> = 1..=8;
-/// The lower clamps of z_min the settings take, as a fraction of the scene's [`scene_size`].
-pub const Z_MIN_FRACTION: RangeInclusive<f32> = 1e-4..=1.0;
-/// How far from the centre's tangent plane a neighbour may lie, in pixel footprints.
-pub const PLANE_TOLERANCE: f32 = 2.0;
-/// Largest filter radius in pixels (the gaussian is cut at 2β).
-pub const MAX_RADIUS: u32 = 32;
-/// Largest roughness difference between a pixel and a neighbour whose specular mean its filter
-/// takes: the mean of a glossy lobe depends on the lobe's width (the room's glazed tiles, 0.2 to
-/// 0.35, and their grout, 0.9, hold different specular means). The diffuse means need no such
-/// test.
-pub const ROUGHNESS_TOLERANCE: f32 = 0.1;
-/// Default [`AafParams::hit_roughness_min`] (not the paper's: its scenes have no mirror-like
-/// reflectors). At 0.5 the room's chrome (0.05) and gold (0.15) no longer make caustic
-/// fireflies: its 2048-spp study truth went from a relative noise of 3.2 to 0.08. A fixed
-/// constant, not tied to the specular pass's limit (that pass traces lobes seen from the camera,
-/// never at AAF's hits).
-pub const HIT_ROUGHNESS_MIN: f32 = 0.5;
-/// The hits' least roughnesses the parameters take (0: no regularisation).
-pub const HIT_ROUGHNESS_RANGE: RangeInclusive<f32> = 0.0..=1.0;
+mod params;
 
-/// Parameters of the AAF passes.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct AafParams {
-    /// Stratified samples of the first pass (paper: 16).
-    pub first_samples: u32,
-    /// Filter scale μ (eq. 15, 21; paper: 0.9).
-    pub mu: f32,
-    /// Bandlimit Ω_h of the receiver's transfer function (paper, diffuse: 2.8).
-    pub omega_h: f32,
-    /// α of `Ω_x^max = α/d` (paper: 0.3).
-    pub alpha: f32,
-    /// Importance-sampling factor γ of eq. 21 (paper, diffuse: 0.4).
-    pub gamma: f32,
-    /// Lower clamp of the per-pixel sample count.
-    pub spp_min: u32,
-    /// Upper clamp of the per-pixel sample count before the factor μ (paper: 100μ).
-    pub spp_max: u32,
-    /// Path vertices after the receiver (1: one bounce).
-    pub bounces: u32,
-    /// Lower clamp of z_min as a fraction of the scene's [`scene_size`] (paper: about 2%).
-    pub z_min_fraction: f32,
-    /// Normal threshold of the filter in degrees (paper: 10°).
-    pub normal_threshold_degrees: f32,
-    /// Take the adaptive second pass (off: uniform sampling at `first_samples`).
-    pub adaptive: bool,
-    /// Filter (off: the unfiltered Monte-Carlo mean).
-    pub filter: bool,
-    /// Seed of the samples' random numbers.
-    pub seed: u32,
-    /// Roughness limit of the frame's traced specular pass (0: none): the samples' specular
-    /// BRDF term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
-    pub specular_limit: f32,
-    /// Degree of the filter's local polynomial fit ([`shine_sh::aaf::LocalFit`]): 0 is the
-    /// paper's gaussian; 2 (default) fits a quadratic and keeps the peaks, valleys and edges of
-    /// the light that the gaussian flattens and tilts.
-    pub filter_degree: u32,
-    /// Filter the diffuse part as an irradiance vector (shine's; the paper filters the scalar
-    /// mean): each pixel's `V = M₀ n + (8/3) E[L ω_t]` ([`shine_sh::aaf::TANGENT_SCALE`]),
-    /// neighbours tested by their geometric normals, the result evaluated at each pixel's
-    /// shading normal. A normal map then no longer cuts the filter into tiles and bevels,
-    /// and its detail in the indirect light stays (docs/quality.md: the room's samples saved
-    /// at equal error rose from 2.6× to 5.7×).
-    pub irradiance_vector: bool,
-    /// Least roughness of the BRDF at the samples' hits (path regularisation, Kaplanyan and
-    /// Dachsbacher 2013): a point light's highlight on a mirror-like reflector, seen by a
-    /// cosine-weighted ray, is a caustic that Monte Carlo gathering cannot sample (one
-    /// sample in millions carries it); rougher, the same energy spreads into a lobe the rays find.
-    pub hit_roughness_min: f32,
-    /// Pixels per refresh (paper 001): 1, or [`amortise::SLICES`]: the sampling passes sample
-    /// one pixel per 2×2 cell per frame and the others keep their sums, reprojected
-    /// ([`AafSlice`]).
-    pub slices: u32,
-}
-
-impl Default for AafParams {
-    /// Paper 004's values (§4.3, §6), except two that are shine's: the filter's quadratic fit
-    /// ([`shine_sh::aaf::FILTER_DEGREE`]; 0 is the paper's) and the hits' least roughness
-    /// ([`HIT_ROUGHNESS_MIN`]).
-    fn default() -> Self {
-        Self {
-            first_samples: 16,
-            mu: shine_sh::aaf::DEFAULT_MU,
-            omega_h: OMEGA_H,
-            alpha: shine_sh::aaf::DEFAULT_ALPHA,
-            gamma: shine_sh::aaf::DEFAULT_GAMMA,
-            spp_min: 16,
-            spp_max: 100,
-            bounces: 1,
-            z_min_fraction: 0.02,
-            normal_threshold_degrees: 10.0,
-            adaptive: true,
-            filter: true,
-            seed: 0,
-            specular_limit: 0.0,
-            filter_degree: shine_sh::aaf::FILTER_DEGREE,
-            irradiance_vector: true,
-            hit_roughness_min: HIT_ROUGHNESS_MIN,
-            slices: 1,
-        }
-    }
-}
-
-/// What the AAF passes refuse.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum AafError {
-    /// A parameter out of its range.
-    #[error("AAF {0}")]
-    OutOfRange(#[from] super::OutOfRange),
-    /// An amortised dispatch's slice without its marks, or out of range.
-    #[error(transparent)]
-    Slice(#[from] amortise::AmortiseError),
-}
-
-impl AafParams {
-    /// Checks every parameter against its range.
-    pub fn validate(&self) -> Result<(), AafError> {
-        use super::check_range as check;
-        check("first_samples", self.first_samples, &FIRST_SAMPLES)?;
-        check("mu", self.mu, &MU_RANGE)?;
-        check("omega_h", self.omega_h, &OMEGA_H_RANGE)?;
-        check("alpha", self.alpha, &(1e-3..=1.0))?;
-        check("gamma", self.gamma, &(0.0..=10.0))?;
-        check("spp_min", self.spp_min, &SPP_MIN)?;
-        check("spp_max", self.spp_max, &SPP_MAX)?;
-        check("bounces", self.bounces, &BOUNCES)?;
-        check("z_min_fraction", self.z_min_fraction, &Z_MIN_FRACTION)?;
-        check(
-            "filter_degree",
-            self.filter_degree,
-            &shine_sh::aaf::FILTER_DEGREES,
-        )?;
-        check(
-            "hit_roughness_min",
-            self.hit_roughness_min,
-            &HIT_ROUGHNESS_RANGE,
-        )?;
-        check(
-            "specular_limit",
-            self.specular_limit,
-            &crate::passes::specular::LIMIT_RANGE,
-        )?;
-        check(
-            "normal_threshold_degrees",
-            self.normal_threshold_degrees,
-            &(0.0..=180.0),
-        )?;
-        if !amortise::SLICE_CHOICES.contains(&self.slices) {
-            return Err(AafError::OutOfRange(super::OutOfRange {
-                name: "slices",
-                value: f64::from(self.slices),
-                expected: format!("one of {:?}", amortise::SLICE_CHOICES),
-            }));
-        }
-        Ok(())
-    }
-
-    /// The upper clamp of the sample count, `spp_max · μ`, never below `spp_min`.
-    pub fn spp_upper(&self) -> f32 {
-        (self.spp_max as f32 * self.mu).max(self.spp_min as f32)
-    }
-}
+pub use params::*;
 
 /// The world-space size `d` of a pixel at linear view depth `z` is `z · scale + bias`:
 /// `2 tan(fov/2) / H` and 0 for a perspective camera, 0 and `width / H` for an orthographic one.
@@ -412,8 +242,9 @@ pub struct AafRecords {
     pub widths: Handle<Buffer>,
 }
 
-/// vec4 per pixel of [`AafRecords::sums`] (`AAF_SUMS_STRIDE` of aaf.glsl): the diffuse sum
-/// (rgb) and the samples taken, then the specular sum (rgb) and 1 where the receiver's `kd`
+/// vec4 per pixel of [`AafRecords::sums`] (`AAF_SUMS_STRIDE` of aaf.glsl): the diffuse plus the
+/// specular sum (rgb: the amortised change test's signal, [`amortise::RecordSignal::MeanRgb`])
+/// and the samples taken, then the specular sum (rgb) and 1 where the receiver's `kd`
 /// carries light ([`crate::reference::aaf::WEIGHT_MIN`]), then the sums of the diffuse samples
 /// times the x, y and z of their direction's part tangent to the shading normal (rgb each).
 pub const SUMS_STRIDE: u64 = 5;
@@ -448,6 +279,7 @@ pub fn aaf_sample(
     slice: AafSlice,
 ) -> Result<AafSamples, AafError> {
     params.validate()?;
+    params.check_extent(g.extent)?;
     amortise::check_slice(slice.slice, slice.marks.is_some())?;
     let regather = slice.slice == amortise::REGATHER_SLICE;
     let [w, h] = g.extent;
@@ -591,6 +423,7 @@ pub fn aaf_filter(
     params: &AafParams,
 ) -> Result<Handle<Image>, AafError> {
     params.validate()?;
+    params.check_extent(g.extent)?;
     let [w, h] = g.extent;
     let push = FilterPush {
         camera: camera
