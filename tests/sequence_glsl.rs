@@ -4,7 +4,6 @@
 
 mod common;
 
-use shine::gpu::{Buffer, BufferDesc, ComputePipeline, Descriptor, MemoryLocation, vk};
 use shine::shaders;
 use shine_sh::sequence::sobol_02;
 
@@ -20,44 +19,13 @@ fn sobol_glsl_matches_shine_sh() {
             [i, shift, shift.rotate_left(13) ^ 0x2c1b_3c6d]
         })
         .collect();
-    let pipeline = ComputePipeline::new(&device, &shaders::TESTS_SOBOL_COMP).expect("pipeline");
-    let input = Buffer::with_data(
+    let bytes = common::run_cases(
         &device,
-        &BufferDesc {
-            name: "cases",
-            size: 0,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::GpuOnly,
-        },
+        &shaders::TESTS_SOBOL_COMP,
         bytemuck::cast_slice(&cases),
-    )
-    .expect("cases");
-    let results = Buffer::new(
-        &device,
-        &BufferDesc {
-            name: "results",
-            size: (cases.len() * 8) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-            location: MemoryLocation::GpuOnly,
-        },
-    )
-    .expect("results");
-    let count = cases.len() as u32;
-    device
-        .run_once(|cmd| {
-            cmd.bind_compute(
-                &pipeline,
-                &[
-                    ("cases", Descriptor::from(&input)),
-                    ("results", Descriptor::from(&results)),
-                ],
-            )?;
-            cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
-            cmd.dispatch_threads(&pipeline, [count, 1, 1]);
-            Ok(())
-        })
-        .expect("dispatch");
-    let bytes = device.read_buffer(&results).expect("readback");
+        (cases.len() * 8) as u64,
+        cases.len() as u32,
+    );
     let gpu: &[[f32; 2]] = bytemuck::cast_slice(&bytes);
     for (case, got) in cases.iter().zip(gpu) {
         let want = sobol_02(case[0], [case[1], case[2]]);

@@ -13,7 +13,6 @@
 mod common;
 
 use glam::Vec3;
-use shine::gpu::{Buffer, BufferDesc, ComputePipeline, Descriptor, MemoryLocation, vk};
 use shine::shaders;
 use shine_sh::{
     basis, dot, exp_log::ShExp, hvl, kernels, kernels::Window, product::TripleProduct, zonal,
@@ -231,44 +230,13 @@ fn run_bands(
     let stride = expected[0].len();
     let input: Vec<f32> = cases.iter().flat_map(Case::floats).collect();
 
-    let pipeline = ComputePipeline::new(device, shader).expect("pipeline");
-    let cases_buf = Buffer::with_data(
+    let bytes = common::run_cases(
         device,
-        &BufferDesc {
-            name: "cases",
-            size: 0,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-            location: MemoryLocation::GpuOnly,
-        },
+        shader,
         bytemuck::cast_slice(&input),
-    )
-    .expect("cases");
-    let results = Buffer::new(
-        device,
-        &BufferDesc {
-            name: "results",
-            size: (cases.len() * stride * 4) as u64,
-            usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
-            location: MemoryLocation::GpuOnly,
-        },
-    )
-    .expect("results");
-    let count = cases.len() as u32;
-    device
-        .run_once(|cmd| {
-            cmd.bind_compute(
-                &pipeline,
-                &[
-                    ("cases", Descriptor::from(&cases_buf)),
-                    ("results", Descriptor::from(&results)),
-                ],
-            )?;
-            cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
-            cmd.dispatch_threads(&pipeline, [count, 1, 1]);
-            Ok(())
-        })
-        .expect("dispatch");
-    let bytes = device.read_buffer(&results).expect("readback");
+        (cases.len() * stride * 4) as u64,
+        cases.len() as u32,
+    );
     let gpu: &[f32] = bytemuck::cast_slice(&bytes);
 
     let mut worst = 0.0f32;

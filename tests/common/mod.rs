@@ -300,3 +300,38 @@ pub fn motion_image(device: &Device, extent: [u32; 2], motion: &[glam::Vec2]) ->
         &bytes,
     )
 }
+
+/// Runs a test shader of the "cases" shape once: binding `cases` (a storage buffer holding
+/// `cases`), binding `results` (`result_bytes`, read back and returned), a push constant of
+/// `count` and one invocation per case (the GLSL-against-Rust checks of `shaders/tests/`).
+pub fn run_cases(
+    device: &Device,
+    shader: &'static ShaderDesc,
+    cases: &[u8],
+    result_bytes: u64,
+    count: u32,
+) -> Vec<u8> {
+    let pipeline = ComputePipeline::new(device, shader).expect("pipeline");
+    let input = storage_with(device, "cases", cases);
+    let results = buffer(
+        device,
+        "results",
+        result_bytes,
+        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+    );
+    device
+        .run_once(|cmd| {
+            cmd.bind_compute(
+                &pipeline,
+                &[
+                    ("cases", Descriptor::from(&input)),
+                    ("results", Descriptor::from(&results)),
+                ],
+            )?;
+            cmd.push_constants(pipeline.layout(), bytemuck::bytes_of(&count))?;
+            cmd.dispatch_threads(&pipeline, [count, 1, 1]);
+            Ok(())
+        })
+        .expect("dispatch");
+    device.read_buffer(&results).expect("readback")
+}
