@@ -1,4 +1,4 @@
-// AAF filter width and sampling rate per pixel (paper 004 eq. 15, 16, 21; src/passes/aaf.rs):
+// AAF filter width and sampling rate per pixel (paper 004 eq. 15, 16, 21; src/passes/aaf/):
 // from the first pass's nearest and farthest reflector distances and the pixel's world-space
 // footprint d. z_min is clamped from below (a fraction of the scene's size) and z_max to at
 // least z_min; the sample count is clamped to [spp_min, spp_max]. A pixel whose first rays all

@@ -1,4 +1,4 @@
-// AAF screen-space filter (paper 004 §5, src/passes/aaf.rs): a separable filter of the per-pixel
+// AAF screen-space filter (paper 004 §5, src/passes/aaf/): a separable filter of the per-pixel
 // mean incident radiance, its diffuse and specular parts apart (aaf_sample.comp), the diffuse
 // part as an irradiance vector V (aaf.glsl) evaluated at each pixel's shading normal, with gaussian
 // weights of standard deviation beta (world units, the aaf_beta pass) of the CENTRE pixel, over

@@ -1,4 +1,4 @@
-// AAF sampling (paper 004 §5, src/passes/aaf.rs): Monte-Carlo estimate of the indirect light
+// AAF sampling (paper 004 §5, src/passes/aaf/): Monte-Carlo estimate of the indirect light
 // leaving every G-buffer pixel towards the camera, with directions cosine-weighted about the
 // shading normal, diffuse and glossy parts apart (paper 004 §6): a sample carrying radiance L
 // from direction l adds pi L f_d(l, v) / kd to the diffuse sum (aaf_diffuse_share: one ratio

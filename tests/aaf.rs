@@ -1,4 +1,4 @@
-//! AAF (paper 004, `src/passes/aaf.rs`) on the GPU against its CPU twin
+//! AAF (paper 004, `src/passes/aaf/`) on the GPU against its CPU twin
 //! (`shine::reference::aaf`) and the path-traced reference, with the validation layer reporting
 //! nothing. Never skips (docs/architecture.md, "Tests").
 

@@ -1,5 +1,5 @@
 //! The AAF technique (paper 004) as the frame uses it: path-traced indirect light at every
-//! G-buffer pixel through the BVH, sampled adaptively and filtered (`src/passes/aaf.rs`). With
+//! G-buffer pixel through the BVH, sampled adaptively and filtered (`src/passes/aaf/`). With
 //! `aaf.slices = 4` its samples are amortised (paper 001): one pixel per 2×2 cell per frame is
 //! sampled into a history of per-pixel sums and filter widths, `aaf_reproject` carries the
 //! others over where they show the same surface, the rest are sampled again

@@ -1,4 +1,4 @@
-//! CPU twin of the AAF filter-width and filter passes (paper 004, `src/passes/aaf.rs`):
+//! CPU twin of the AAF filter-width and filter passes (paper 004, `src/passes/aaf/`):
 //! [`beta_cpu`] is `aaf_beta.comp` through shine-sh's formulas, [`filter_cpu`] the two passes
 //! of `aaf_filter.comp` before the receivers' weights ([`weights`]). `tests/aaf.rs` ties them to the GPU.
 

@@ -129,7 +129,7 @@ impl Default for HistorySettings {
 }
 
 /// `[aaf]`: axis-aligned filtering of path-traced indirect light (paper 004,
-/// `src/passes/aaf.rs`). Defaults are the paper's, except the filter's fit (`filter_degree`).
+/// `src/passes/aaf/`). Defaults are the paper's, except the filter's fit (`filter_degree`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AafSettings {
