@@ -93,12 +93,10 @@ Means means_at(uint q, vec3 nq, vec3 n) {
     vec4 specular = sums.s[k + 1u];
     float inverse = s.w > 0.0 ? 1.0 / s.w : 0.0;
     vec3 mean = (s.rgb - specular.rgb) * inverse;
-    mat3 diffuse = outerProduct(mean, n);
-    if (push.irradiance_vector != 0u) {
-        float tangent = AAF_TANGENT_SCALE * inverse;
-        diffuse = outerProduct(mean, nq)
-            + tangent * mat3(sums.s[k + 2u].rgb, sums.s[k + 3u].rgb, sums.s[k + 4u].rgb);
-    }
+    mat3 diffuse = push.irradiance_vector != 0u
+        ? outerProduct(mean, nq)
+            + AAF_TANGENT_SCALE * inverse * mat3(sums.s[k + 2u].rgb, sums.s[k + 3u].rgb, sums.s[k + 4u].rgb)
+        : outerProduct(mean, n);
     return Means(diffuse, specular.rgb * inverse, specular.w > 0.0);
 #else
     uint k = AAF_ROWS_STRIDE * q;

@@ -191,9 +191,10 @@ pub struct AafScene<'a> {
 /// The AAF passes' outputs.
 #[derive(Debug, Clone, Copy)]
 pub struct AafOutputs {
-    /// Indirect light (RGBA16F, full resolution): `kd` × filtered irradiance / π.
+    /// Indirect light (RGBA16F, full resolution): `kd` × the filtered diffuse part at the
+    /// shading normal plus `ks (1 − trace_weight)` × the filtered specular mean.
     pub indirect: Handle<Image>,
-    /// Per pixel: rgb sum of the samples' radiance, a: samples taken (vec4).
+    /// Per pixel: the samples' sums ([`SUMS_STRIDE`] vec4).
     pub sums: Handle<Buffer>,
     /// Per pixel: z_min, z_max of the first pass (vec2).
     pub depths: Handle<Buffer>,
@@ -236,7 +237,7 @@ pub struct AafSlice {
 /// AAF's per-pixel records: what the filter reads.
 #[derive(Debug, Clone, Copy)]
 pub struct AafRecords {
-    /// vec4 per pixel: rgb sum of the samples, their count.
+    /// [`SUMS_STRIDE`] vec4 per pixel: the samples' sums and their count.
     pub sums: Handle<Buffer>,
     /// vec2 per pixel: β, samples per pixel ([`aaf_beta`]).
     pub widths: Handle<Buffer>,
