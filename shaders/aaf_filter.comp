@@ -4,7 +4,9 @@
 // weights of standard deviation beta (world units, the aaf_beta pass) of the CENTRE pixel, over
 // world-space distances between the pixels' positions: per pass and part, a weighted
 // least-squares polynomial fit of degree `degree` along the axis (AafFit in aaf.glsl; degree 0
-// is the paper's normalised gaussian). A neighbour counts only when its shading normal is
+// is the paper's normalised gaussian). The x pass weights every pixel's means alike; above
+// degree 0, the y pass weights each row by its x fit's precision (the inverse of its noise
+// variance: a row fitted from few neighbours counts less). A neighbour counts only when its shading normal is
 // within the normal threshold of the centre's (paper 004: 10 degrees) and it lies within
 // `plane_tolerance` pixel footprints of the centre's geometric tangent plane (a normal map's
 // tilt would push coplanar neighbours off a shading plane), so no light leaks across surfaces.
@@ -39,8 +41,9 @@ layout(set = 0, binding = 2, std430) readonly buffer Filter {
 layout(set = 0, binding = 3, std430) readonly buffer Sums {
     vec4 s[];
 } sums;
-// AAF_ROWS_STRIDE vec4 per pixel: the filtered irradiance vector's x, y, z columns (rgb), then
-// the filtered specular mean and 1 where the diffuse part holds light.
+// AAF_ROWS_STRIDE vec4 per pixel: the filtered irradiance vector's x, y, z columns (rgb; w of
+// the first two: the diffuse and the specular fit's precision), then the filtered specular mean
+// and 1 where the diffuse part holds light.
 layout(set = 0, binding = 4, std430) buffer Filtered {
     vec4 m[];
 } filtered;
@@ -84,6 +87,10 @@ struct Means {
     mat3 diffuse;
     vec3 specular;
     bool lit;
+    // The precisions of the diffuse and specular parts (LocalFit::precision): 1 for a pixel's
+    // sampled means, the first pass's fit for a row.
+    float diffuse_precision;
+    float specular_precision;
 };
 
 Means means_at(uint q, vec3 nq, vec3 n) {
@@ -97,7 +104,7 @@ Means means_at(uint q, vec3 nq, vec3 n) {
         ? outerProduct(mean, nq)
             + AAF_TANGENT_SCALE * inverse * mat3(sums.s[k + 2u].rgb, sums.s[k + 3u].rgb, sums.s[k + 4u].rgb)
         : outerProduct(mean, n);
-    return Means(diffuse, specular.rgb * inverse, specular.w > 0.0);
+    return Means(diffuse, specular.rgb * inverse, specular.w > 0.0, 1.0, 1.0);
 #else
     uint k = AAF_ROWS_STRIDE * q;
     mat3 diffuse = mat3(filtered.m[k].rgb, filtered.m[k + 1u].rgb, filtered.m[k + 2u].rgb);
@@ -105,7 +112,9 @@ Means means_at(uint q, vec3 nq, vec3 n) {
         diffuse = outerProduct(diffuse * nq, n);
     }
     vec4 specular = filtered.m[k + 3u];
-    return Means(diffuse, specular.rgb, specular.w > 0.0);
+    bool weighted = push.degree > 0u;
+    return Means(diffuse, specular.rgb, specular.w > 0.0, weighted ? filtered.m[k].w : 1.0,
+        weighted ? filtered.m[k + 1u].w : 1.0);
 #endif
 }
 
@@ -163,20 +172,22 @@ void main() {
             float u = sign(float(k)) * length(offset) / beta;
             Means m = means_at(uint(q.y) * push.extent.x + uint(q.x), nq, n);
             if (diffuse_close && m.lit) {
-                aaf_fit_add(diffuse, u, m.diffuse);
+                aaf_fit_add(diffuse, u, m.diffuse, m.diffuse_precision);
             }
             if (specular_close) {
-                aaf_fit_add(specular, u, mat3(m.specular, vec3(0.0), vec3(0.0)));
+                aaf_fit_add(specular, u, mat3(m.specular, vec3(0.0), vec3(0.0)), m.specular_precision);
             }
         }
+        result.diffuse_precision = aaf_fit_precision(diffuse, push.degree, result.diffuse_precision);
+        result.specular_precision = aaf_fit_precision(specular, push.degree, result.specular_precision);
         result.diffuse = aaf_fit_value(diffuse, push.degree, result.diffuse);
         result.specular = aaf_fit_value(specular, push.degree, mat3(result.specular, vec3(0.0), vec3(0.0)))[0];
         result.lit = result.lit || diffuse.s0 > 0.0;
     }
 #ifdef AAF_X
-    for (uint k = 0u; k < 3u; ++k) {
-        filtered.m[AAF_ROWS_STRIDE * p + k] = vec4(result.diffuse[k], 0.0);
-    }
+    filtered.m[AAF_ROWS_STRIDE * p] = vec4(result.diffuse[0], result.diffuse_precision);
+    filtered.m[AAF_ROWS_STRIDE * p + 1u] = vec4(result.diffuse[1], result.specular_precision);
+    filtered.m[AAF_ROWS_STRIDE * p + 2u] = vec4(result.diffuse[2], 0.0);
     filtered.m[AAF_ROWS_STRIDE * p + 3u] = vec4(result.specular, result.lit ? 1.0 : 0.0);
 #else
     vec3 out_radiance = vec3(0.0);

@@ -70,38 +70,45 @@ const float AAF_FIT_CONDITION_MIN = 1e-4;
 
 // shine_sh::aaf::LocalFit: one separable filter pass at one pixel as a weighted least-squares
 // polynomial fit in u (signed world distance along the axis, in units of beta) with the paper's
-// gaussian weights; degree 0 is paper 004's normalised gaussian (eq. 16). Nine channels: the
-// irradiance vector's x, y, z columns (rgb each), or an rgb value in column 0.
+// gaussian weights g times each value's precision p (inverse noise variance, in units of one
+// pixel's mean); degree 0 is paper 004's normalised gaussian (eq. 16). Nine channels: the
+// irradiance vector's x, y, z columns (rgb each), or an rgb value in column 0. v0..v4 are
+// sum g w u^k, the fitted value's noise variance (aaf_fit_precision).
 struct AafFit {
     float s0, s1, s2, s3, s4;
     mat3 t0, t1, t2;
+    float v0, v1, v2, v3, v4;
 };
 
 AafFit aaf_fit_new() {
-    return AafFit(0.0, 0.0, 0.0, 0.0, 0.0, mat3(0.0), mat3(0.0), mat3(0.0));
+    return AafFit(0.0, 0.0, 0.0, 0.0, 0.0, mat3(0.0), mat3(0.0), mat3(0.0), 0.0, 0.0, 0.0, 0.0, 0.0);
 }
 
-void aaf_fit_add(inout AafFit f, float u, mat3 y) {
-    float w = exp(-0.5 * u * u);
+void aaf_fit_add(inout AafFit f, float u, mat3 y, float p) {
+    float g = exp(-0.5 * u * u);
+    float w = g * p;
     float w1 = w * u;
     float w2 = w1 * u;
     float w3 = w2 * u;
+    float w4 = w3 * u;
     f.s0 += w;
     f.s1 += w1;
     f.s2 += w2;
     f.s3 += w3;
-    f.s4 += w3 * u;
+    f.s4 += w4;
     f.t0 += w * y;
     f.t1 += w1 * y;
     f.t2 += w2 * y;
+    f.v0 += g * w;
+    f.v1 += g * w1;
+    f.v2 += g * w2;
+    f.v3 += g * w3;
+    f.v4 += g * w4;
 }
 
-// The fit at u = 0 of the highest well-conditioned degree up to `degree`, not clamped (the
-// irradiance vector's components are signed); `fallback` without neighbours.
-mat3 aaf_fit_value(AafFit f, uint degree, mat3 fallback) {
-    if (f.s0 <= 0.0) {
-        return fallback;
-    }
+// The coefficients c of the fit at u = 0, c.x t0 + c.y t1 + c.z t2, of the highest
+// well-conditioned degree up to `degree`; the caller checks for neighbours (s0 > 0).
+vec3 aaf_fit_coefficients(AafFit f, uint degree) {
     vec3 c = vec3(1.0 / f.s0, 0.0, 0.0);
     float det2 = f.s0 * (f.s2 * f.s4 - f.s3 * f.s3) - f.s1 * (f.s1 * f.s4 - f.s2 * f.s3)
         + f.s2 * (f.s1 * f.s3 - f.s2 * f.s2);
@@ -111,7 +118,29 @@ mat3 aaf_fit_value(AafFit f, uint degree, mat3 fallback) {
     } else if (degree >= 1u && det1 > AAF_FIT_CONDITION_MIN * f.s0 * f.s2) {
         c = vec3(f.s2 / det1, -f.s1 / det1, 0.0);
     }
+    return c;
+}
+
+// The fit at u = 0, not clamped (the irradiance vector's components are signed); `fallback`
+// without neighbours.
+mat3 aaf_fit_value(AafFit f, uint degree, mat3 fallback) {
+    if (f.s0 <= 0.0) {
+        return fallback;
+    }
+    vec3 c = aaf_fit_coefficients(f, degree);
     return c.x * f.t0 + c.y * f.t1 + c.z * f.t2;
+}
+
+// The precision of the fit at u = 0 (shine_sh::aaf::LocalFit::precision); `fallback` without
+// neighbours.
+float aaf_fit_precision(AafFit f, uint degree, float fallback) {
+    if (f.s0 <= 0.0) {
+        return fallback;
+    }
+    vec3 c = aaf_fit_coefficients(f, degree);
+    float variance = c.x * c.x * f.v0 + 2.0 * c.x * c.y * f.v1 + (c.y * c.y + 2.0 * c.x * c.z) * f.v2
+        + 2.0 * c.y * c.z * f.v3 + c.z * c.z * f.v4;
+    return variance > 0.0 ? 1.0 / variance : fallback;
 }
 
 #endif

@@ -112,6 +112,10 @@ pub struct Filtered {
     pub specular: Vec3,
     /// Whether the diffuse part holds light.
     pub lit: bool,
+    /// The precisions of the diffuse and specular parts ([`LocalFit::precision`]): 1 for a
+    /// pixel's sampled means, the fit's after a pass. Above degree 0 the columns' pass weights
+    /// each row by them.
+    pub precision: [f32; 2],
 }
 
 impl Filtered {
@@ -132,13 +136,15 @@ impl Filtered {
             vector: std::array::from_fn(|k| means.diffuse * n[k] + means.tangent[k] * tangent),
             specular: means.specular,
             lit: means.lit,
+            precision: [1.0; 2],
         }
     }
 }
 
 /// The two passes of `aaf_filter.comp` (rows, then columns) over a `width`-wide image, before
 /// the receivers' weights: per pixel, the filtered irradiance vector (to evaluate at the
-/// pixel's shading normal) and specular mean.
+/// pixel's shading normal) and specular mean. Above degree 0, the columns' pass weights each
+/// row by the precision of its row fit ([`LocalFit`]'s precision).
 pub fn filter_cpu(
     texels: &[FilterTexel],
     width: usize,
@@ -164,6 +170,9 @@ fn filter_axis(
 ) -> Vec<Filtered> {
     let height = texels.len() / width.max(1);
     let cos_threshold = params.normal_threshold_degrees.to_radians().cos();
+    // The columns' pass above degree 0 weights each row by its precision; the rows' pass, and
+    // the paper's gaussian, weight every value alike.
+    let weighted = axis[1] == 1 && params.filter_degree > 0;
     // Neighbour q's irradiance vector as the centre of normal n takes it: without the
     // irradiance vector, q's scalar mean along n.
     let vector = |q: &Filtered, nq: Vec3, n: Vec3| -> [f32; 9] {
@@ -211,21 +220,31 @@ fn filter_axis(
                 let specular_close =
                     shading_close && (q.roughness - centre.roughness).abs() <= ROUGHNESS_TOLERANCE;
                 let u = (k as f32).signum() * offset.length() / centre.beta;
+                let [diffuse_precision, specular_precision] = if weighted {
+                    values[qi].precision
+                } else {
+                    [1.0; 2]
+                };
                 if diffuse_close && values[qi].lit {
-                    diffuse.add(u, vector(&values[qi], nq, n));
+                    diffuse.add(u, vector(&values[qi], nq, n), diffuse_precision);
                 }
                 if specular_close {
-                    specular.add(u, values[qi].specular.to_array());
+                    specular.add(u, values[qi].specular.to_array(), specular_precision);
                 }
             }
             let own = vector(&values[p], n, n);
-            let v = diffuse.value(params.filter_degree).unwrap_or(own);
+            let degree = params.filter_degree;
+            let v = diffuse.value(degree).unwrap_or(own);
             Filtered {
                 vector: std::array::from_fn(|k| Vec3::new(v[3 * k], v[3 * k + 1], v[3 * k + 2])),
                 specular: specular
-                    .value(params.filter_degree)
+                    .value(degree)
                     .map_or(values[p].specular, Vec3::from_array),
                 lit: values[p].lit || diffuse.has_neighbours(),
+                precision: [
+                    diffuse.precision(degree).unwrap_or(values[p].precision[0]),
+                    specular.precision(degree).unwrap_or(values[p].precision[1]),
+                ],
             }
         })
         .collect()

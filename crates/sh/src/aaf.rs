@@ -181,13 +181,23 @@ pub const TANGENT_SCALE: f32 = 8.0 / 3.0;
 /// gaussian. A gaussian flattens every peak and valley of the light by `O(β²)` (its bias) and,
 /// where the normal and plane tests or the image's border cut its support to one side, tilts it
 /// by `O(β)`; the quadratic fit is exact for light that varies quadratically along the axis, on
-/// either side. GLSL twin: `AafFit` in `shaders/include/aaf.glsl` (nine channels, a mat3).
+/// either side.
+///
+/// Each neighbour also carries a precision `p` (the inverse of its value's noise variance, in
+/// units of one pixel's mean): its weight is `p exp(−u²/2)`, the weighted least squares of
+/// values of unequal noise, and [`Self::precision`] is the fitted value's own. The first pass
+/// gives every pixel's mean precision 1; the second weights each row by the precision of the
+/// first pass's fit there, so a row fitted from few neighbours (at the image's border, beside
+/// an edge, or a quadratic extrapolated from one side) counts less than one fitted from many.
+/// GLSL twin: `AafFit` in `shaders/include/aaf.glsl` (nine channels, a mat3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LocalFit<const N: usize = 3> {
-    /// `Σ w u^k`, k = 0..4.
+    /// `Σ w u^k`, k = 0..4, with `w = p g` and `g` the gaussian.
     s: [f32; 5],
     /// `Σ w u^k y`, k = 0..2, per channel.
     t: [[f32; N]; 3],
+    /// `Σ g w u^k = Σ w² u^k / p`, k = 0..4: the fitted value's noise variance.
+    v: [f32; 5],
 }
 
 impl<const N: usize> Default for LocalFit<N> {
@@ -195,6 +205,7 @@ impl<const N: usize> Default for LocalFit<N> {
         Self {
             s: [0.0; 5],
             t: [[0.0; N]; 3],
+            v: [0.0; 5],
         }
     }
 }
@@ -205,15 +216,18 @@ impl<const N: usize> LocalFit<N> {
         self.s[0] > 0.0
     }
 
-    /// Adds a neighbour at `u` (in units of β) with value `y` and the gaussian weight of `u`.
-    pub fn add(&mut self, u: f32, y: [f32; N]) {
-        let w = (-0.5 * u * u).exp();
-        let mut power = w;
+    /// Adds a neighbour at `u` (in units of β) with value `y` of precision `precision`, weighted
+    /// by `precision` times the gaussian of `u`.
+    pub fn add(&mut self, u: f32, y: [f32; N], precision: f32) {
+        let g = (-0.5 * u * u).exp();
+        let w = g * precision;
+        let mut power = 1.0;
         for k in 0..5 {
-            self.s[k] += power;
+            self.s[k] += w * power;
+            self.v[k] += g * w * power;
             if k < 3 {
                 for (t, y) in self.t[k].iter_mut().zip(y) {
-                    *t += power * y;
+                    *t += w * power * y;
                 }
             }
             power *= u;
@@ -250,6 +264,21 @@ impl<const N: usize> LocalFit<N> {
         Some(std::array::from_fn(|i| {
             c[0] * t0[i] + c[1] * t1[i] + c[2] * t2[i]
         }))
+    }
+
+    /// The precision of the fitted value at `u = 0` ([`Self::coefficients`]): the inverse of
+    /// `Σ l² / p` over the neighbours, `l` the weight the fit gives each value; `None` without
+    /// neighbours. A gaussian average of `K` values of precision 1 at `u = 0` has precision
+    /// `K`; a fit extrapolated from one side may have less than one value's.
+    pub fn precision(&self, degree: u32) -> Option<f32> {
+        let c = self.coefficients(degree)?;
+        let v = &self.v;
+        let variance = c[0] * c[0] * v[0]
+            + 2.0 * c[0] * c[1] * v[1]
+            + (c[1] * c[1] + 2.0 * c[0] * c[2]) * v[2]
+            + 2.0 * c[1] * c[2] * v[3]
+            + c[2] * c[2] * v[4];
+        (variance > 0.0).then(|| 1.0 / variance)
     }
 }
 
@@ -314,7 +343,7 @@ mod tests {
             let mut fit = LocalFit::<3>::default();
             for k in side {
                 let u = 0.7 * k as f32;
-                fit.add(u, [light(u), 2.0 * light(u), 0.0]);
+                fit.add(u, [light(u), 2.0 * light(u), 0.0], 1.0);
             }
             let v: [f32; 3] = fit.value(2).unwrap();
             assert!(
@@ -333,20 +362,59 @@ mod tests {
     fn an_ill_conditioned_fit_drops_a_degree() {
         let mut none = LocalFit::<3>::default();
         assert_eq!(none.value(2), None);
-        none.add(0.0, [1.0; 3]);
+        none.add(0.0, [1.0; 3], 1.0);
         assert_eq!(none.value(2), Some([1.0; 3]));
         // Two neighbours pin a line, not a parabola: the linear fit through them.
         let mut two = LocalFit::<3>::default();
-        two.add(0.5, [3.0; 3]);
-        two.add(1.0, [4.0; 3]);
+        two.add(0.5, [3.0; 3], 1.0);
+        two.add(1.0, [4.0; 3], 1.0);
         let v = two.value(2).unwrap();
         assert!((v[0] - 2.0).abs() < 1e-4, "{v:?}");
         // A fit extrapolated below zero is not clamped (a channel may be a signed component).
         let mut down = LocalFit::<3>::default();
-        down.add(0.5, [1.0; 3]);
-        down.add(1.0, [3.0; 3]);
+        down.add(0.5, [1.0; 3], 1.0);
+        down.add(1.0, [3.0; 3], 1.0);
         let v = down.value(1).unwrap();
         assert!((v[0] + 1.0).abs() < 1e-4, "{v:?}");
+    }
+
+    #[test]
+    fn precision_is_the_inverse_of_the_fitted_values_noise_variance() {
+        // Values of unequal precision at one place: the inverse-variance mean, whose precision
+        // is the sum.
+        let mut same = LocalFit::<1>::default();
+        same.add(0.0, [1.0], 4.0);
+        same.add(0.0, [6.0], 1.0);
+        assert!((same.value(0).unwrap()[0] - 2.0).abs() < 1e-6);
+        assert!((same.precision(0).unwrap() - 5.0).abs() < 1e-5);
+        assert_eq!(LocalFit::<1>::default().precision(2), None);
+        // Any degree, any layout: Σ l² / p, with l the weight the fit gives each value (the
+        // fit of a value of 1 there and 0 elsewhere).
+        let neighbours = [(-1.3, 0.5), (-0.4, 2.0), (0.2, 1.0), (0.9, 3.0), (1.7, 0.8)];
+        let fit_of = |one: Option<usize>| {
+            let mut fit = LocalFit::<1>::default();
+            for (i, &(u, p)) in neighbours.iter().enumerate() {
+                fit.add(u, [f32::from(one == Some(i))], p);
+            }
+            fit
+        };
+        for degree in 0..=2 {
+            let variance: f32 = (0..neighbours.len())
+                .map(|i| fit_of(Some(i)).value(degree).unwrap()[0].powi(2) / neighbours[i].1)
+                .sum();
+            let precision = fit_of(None).precision(degree).unwrap();
+            assert!(
+                (precision * variance - 1.0).abs() < 1e-4,
+                "degree {degree}: {precision} against 1 / {variance}"
+            );
+        }
+        // A quadratic extrapolated from one side is noisier than one value.
+        let mut one_sided = LocalFit::<1>::default();
+        for k in 1..=4 {
+            one_sided.add(0.5 * k as f32, [0.0], 1.0);
+        }
+        assert!(one_sided.precision(2).unwrap() < 1.0);
+        assert!(one_sided.precision(0).unwrap() > 1.0);
     }
 
     /// The cosine-weighted mean of `radiance` over the hemisphere about the unit normal `n`
