@@ -6,10 +6,11 @@
 // least-squares polynomial fit of degree `degree` along the axis (AafFit in aaf.glsl; degree 0
 // is the paper's normalised gaussian). The x pass weights every pixel's means alike; above
 // degree 0, the y pass weights each row by its x fit's precision (the inverse of its noise
-// variance: a row fitted from few neighbours counts less). A neighbour counts only when its shading normal is
-// within the normal threshold of the centre's (paper 004: 10 degrees) and it lies within
-// `plane_tolerance` pixel footprints of the centre's geometric tangent plane (a normal map's
-// tilt would push coplanar neighbours off a shading plane), so no light leaks across surfaces.
+// variance: a row fitted from few neighbours counts less). A neighbour counts only when its
+// shading normal is within the normal threshold of the centre's (paper 004: 10 degrees) and it
+// lies within `plane_tolerance` pixel footprints of the centre's geometric tangent plane (a
+// normal map's tilt would push coplanar neighbours off a shading plane), so no light leaks
+// across surfaces.
 // The diffuse part takes every such neighbour whose kd carries light (the diffuse mean is the
 // irradiance over pi whatever the material), testing geometric normals (a normal map's detail
 // is in V . n, not in which neighbours count); the specular part only neighbours within the
