@@ -176,13 +176,16 @@ void main() {
                 aaf_fit_add(diffuse, u, m.diffuse, m.diffuse_precision);
             }
             if (specular_close) {
-                aaf_fit_add(specular, u, mat3(m.specular, vec3(0.0), vec3(0.0)), m.specular_precision);
+                mat3 y = mat3(m.specular, vec3(0.0), vec3(0.0));
+                aaf_fit_add(specular, u, y, m.specular_precision);
             }
         }
-        result.diffuse_precision = aaf_fit_precision(diffuse, push.degree, result.diffuse_precision);
-        result.specular_precision = aaf_fit_precision(specular, push.degree, result.specular_precision);
-        result.diffuse = aaf_fit_value(diffuse, push.degree, result.diffuse);
-        result.specular = aaf_fit_value(specular, push.degree, mat3(result.specular, vec3(0.0), vec3(0.0)))[0];
+        uint degree = push.degree;
+        result.diffuse_precision = aaf_fit_precision(diffuse, degree, result.diffuse_precision);
+        result.specular_precision = aaf_fit_precision(specular, degree, result.specular_precision);
+        result.diffuse = aaf_fit_value(diffuse, degree, result.diffuse);
+        mat3 specular_own = mat3(result.specular, vec3(0.0), vec3(0.0));
+        result.specular = aaf_fit_value(specular, degree, specular_own)[0];
         result.lit = result.lit || diffuse.s0 > 0.0;
     }
 #ifdef AAF_X

@@ -81,7 +81,8 @@ struct AafFit {
 };
 
 AafFit aaf_fit_new() {
-    return AafFit(0.0, 0.0, 0.0, 0.0, 0.0, mat3(0.0), mat3(0.0), mat3(0.0), 0.0, 0.0, 0.0, 0.0, 0.0);
+    return AafFit(0.0, 0.0, 0.0, 0.0, 0.0, mat3(0.0), mat3(0.0), mat3(0.0),
+        0.0, 0.0, 0.0, 0.0, 0.0);
 }
 
 void aaf_fit_add(inout AafFit f, float u, mat3 y, float p) {
@@ -132,15 +133,16 @@ mat3 aaf_fit_value(AafFit f, uint degree, mat3 fallback) {
 }
 
 // The precision of the fit at u = 0 (shine_sh::aaf::LocalFit::precision); `fallback` without
-// neighbours.
+// neighbours or where the inverse is not finite.
 float aaf_fit_precision(AafFit f, uint degree, float fallback) {
     if (f.s0 <= 0.0) {
         return fallback;
     }
     vec3 c = aaf_fit_coefficients(f, degree);
-    float variance = c.x * c.x * f.v0 + 2.0 * c.x * c.y * f.v1 + (c.y * c.y + 2.0 * c.x * c.z) * f.v2
-        + 2.0 * c.y * c.z * f.v3 + c.z * c.z * f.v4;
-    return variance > 0.0 ? 1.0 / variance : fallback;
+    float variance = c.x * c.x * f.v0 + 2.0 * c.x * c.y * f.v1
+        + (c.y * c.y + 2.0 * c.x * c.z) * f.v2 + 2.0 * c.y * c.z * f.v3 + c.z * c.z * f.v4;
+    float inverse = 1.0 / variance;
+    return variance > 0.0 && !isinf(inverse) ? inverse : fallback;
 }
 
 #endif

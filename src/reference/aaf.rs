@@ -113,8 +113,8 @@ pub struct Filtered {
     /// Whether the diffuse part holds light.
     pub lit: bool,
     /// The precisions of the diffuse and specular parts ([`LocalFit::precision`]): 1 for a
-    /// pixel's sampled means, the fit's after a pass. Above degree 0 the columns' pass weights
-    /// each row by them.
+    /// pixel's sampled means, the fit's after a pass (else unchanged). Above degree 0 the
+    /// columns' pass weights each row by them.
     pub precision: [f32; 2],
 }
 

@@ -186,8 +186,8 @@ pub const TANGENT_SCALE: f32 = 8.0 / 3.0;
 /// Each neighbour also carries a precision `p` (the inverse of its value's noise variance, in
 /// units of one pixel's mean): its weight is `p exp(−u²/2)`, the weighted least squares of
 /// values of unequal noise, and [`Self::precision`] is the fitted value's own. The first pass
-/// gives every pixel's mean precision 1; the second weights each row by the precision of the
-/// first pass's fit there, so a row fitted from few neighbours (at the image's border, beside
+/// gives every pixel's mean precision 1; above degree 0, the second weights each row by the
+/// precision of the first pass's fit there, so a row fitted from few neighbours (at the image's border, beside
 /// an edge, or a quadratic extrapolated from one side) counts less than one fitted from many.
 /// GLSL twin: `AafFit` in `shaders/include/aaf.glsl` (nine channels, a mat3).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -196,7 +196,8 @@ pub struct LocalFit<const N: usize = 3> {
     s: [f32; 5],
     /// `Σ w u^k y`, k = 0..2, per channel.
     t: [[f32; N]; 3],
-    /// `Σ g w u^k = Σ w² u^k / p`, k = 0..4: the fitted value's noise variance.
+    /// `Σ g w u^k = Σ w² u^k / p`, k = 0..4: the moments `V` of the fitted value's noise
+    /// variance `cᵀ V c` ([`Self::precision`]).
     v: [f32; 5],
 }
 
@@ -267,8 +268,8 @@ impl<const N: usize> LocalFit<N> {
     }
 
     /// The precision of the fitted value at `u = 0` ([`Self::coefficients`]): the inverse of
-    /// `Σ l² / p` over the neighbours, `l` the weight the fit gives each value; `None` without
-    /// neighbours. A gaussian average of `K` values of precision 1 at `u = 0` has precision
+    /// `Σ (l² / p)` over the neighbours, `l` the weight the fit gives each value; `None`
+    /// without neighbours (or if the inverse is not finite). A gaussian average of `K` values of precision 1 at `u = 0` has precision
     /// `K`; a fit extrapolated from one side may have less than one value's.
     pub fn precision(&self, degree: u32) -> Option<f32> {
         let c = self.coefficients(degree)?;
@@ -278,7 +279,8 @@ impl<const N: usize> LocalFit<N> {
             + (c[1] * c[1] + 2.0 * c[0] * c[2]) * v[2]
             + 2.0 * c[1] * c[2] * v[3]
             + c[2] * c[2] * v[4];
-        (variance > 0.0).then(|| 1.0 / variance)
+        let precision = 1.0 / variance;
+        (variance > 0.0 && precision.is_finite()).then_some(precision)
     }
 }
 

@@ -26,7 +26,8 @@
 //! 4. **Filter** (`aaf_filter.comp`, variants `x` then `y`): per pass, a weighted least-squares
 //!    fit of a polynomial of degree [`AafParams::filter_degree`] along the axis to the diffuse
 //!    and, apart, the specular means ([`shine_sh::aaf::LocalFit`]), with the paper's gaussian
-//!    weights of standard deviation `β` of the centre pixel over world-space distances,
+//!    weights of standard deviation `β` of the centre pixel over world-space distances (above
+//!    degree 0, the columns' pass also weights each row by its row fit's precision),
 //!    neighbours only within the normal threshold (paper: 10°) and near the centre's geometric
 //!    tangent plane, the specular means only of neighbours within [`ROUGHNESS_TOLERANCE`] of the
 //!    centre's roughness; then the receiver's weights `kd` and `ks (1 − trace_weight)` (the
