@@ -42,15 +42,6 @@ fn q8(v: Vec4) -> Vec4 {
     Vec4::from_array(v.to_array().map(|c| (c * 255.0).round() / 255.0))
 }
 
-/// A hash in [0, 1) for reproducible pseudo-random inputs.
-fn hash(i: u32) -> f32 {
-    let mut x = i.wrapping_mul(0x9e37_79b9) ^ 0x85eb_ca6b;
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x2c1b_3c6d);
-    x ^= x >> 12;
-    (x >> 8) as f32 / (1u32 << 24) as f32
-}
-
 /// Pixel `p`'s means as the filter reads them from the synthetic sums.
 fn means(s: &Synthetic, p: usize) -> Means {
     let record = &s.sums[aaf::SUMS_STRIDE as usize * p..][..aaf::SUMS_STRIDE as usize];
@@ -119,8 +110,12 @@ fn synthetic() -> Synthetic {
                     Vec3::splat(5.0),
                 )
             };
-            let count = 16.0 + (hash(p) * 40.0).floor();
-            let noise = Vec3::new(hash(3 * p + 1), hash(3 * p + 2), hash(3 * p + 3)) * 2.0;
+            let count = 16.0 + (common::hash01(p) * 40.0).floor();
+            let noise = Vec3::new(
+                common::hash01(3 * p + 1),
+                common::hash01(3 * p + 2),
+                common::hash01(3 * p + 3),
+            ) * 2.0;
             let metallic = match i % 7 {
                 2 => 1.0,
                 5 => 0.5,
@@ -139,7 +134,7 @@ fn synthetic() -> Synthetic {
                 .truncate()
                 .normalize_or_zero();
             let diffuse = radiance * noise;
-            let specular = radiance * (0.5 + hash(p + 3000));
+            let specular = radiance * (0.5 + common::hash01(p + 3000));
             // Word 0..2: the diffuse plus the specular sum.
             s.sums.push(((diffuse + specular) * count).extend(count));
             // Metals carry no diffuse light: their diffuse sums are left out of the filter.
@@ -147,15 +142,19 @@ fn synthetic() -> Synthetic {
             s.sums.push((specular * count).extend(lit));
             // Tangent sums: the diffuse colour times a direction tangent to the shading normal,
             // up to a third of the diffuse sum.
-            let t = Vec3::new(hash(p + 4000), hash(p + 5000), hash(p + 6000)) - 0.5;
+            let t = Vec3::new(
+                common::hash01(p + 4000),
+                common::hash01(p + 5000),
+                common::hash01(p + 6000),
+            ) - 0.5;
             let t = (t - shading * shading.dot(t)) * 0.6;
             for axis in 0..3 {
                 s.sums.push((diffuse * t[axis] * count).extend(0.0));
             }
             let hit = position.w > 0.0 && p % 17 != 5;
-            let z_min = 0.05 + hash(p + 1000);
+            let z_min = 0.05 + common::hash01(p + 1000);
             s.depths.push(if hit {
-                [z_min, z_min + 2.0 * hash(p + 2000)]
+                [z_min, z_min + 2.0 * common::hash01(p + 2000)]
             } else {
                 [0.0, 0.0]
             });

@@ -18,15 +18,6 @@ struct Case {
     neighbours: Vec<[f32; 3]>,
 }
 
-/// A number in [0, 1) from `i` (a fixed hash: the cases are the same every run).
-fn hash(i: u32) -> f32 {
-    let mut x = i.wrapping_mul(0x9e37_79b9) ^ 0x85eb_ca6b;
-    x ^= x >> 15;
-    x = x.wrapping_mul(0x2c1b_3c6d);
-    x ^= x >> 12;
-    (x >> 8) as f32 / (1u32 << 24) as f32
-}
-
 #[test]
 fn aaf_fit_glsl_matches_shine_sh() {
     let device = common::device();
@@ -37,7 +28,7 @@ fn aaf_fit_glsl_matches_shine_sh() {
         let one_sided = c % 5 == 0;
         let neighbours = (0..count as u32)
             .map(|k| {
-                let h = |s: u32| hash(c * 97 + k * 13 + s);
+                let h = |s: u32| common::hash01(c * 97 + k * 13 + s);
                 let u = if one_sided {
                     2.0 * h(0)
                 } else {

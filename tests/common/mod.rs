@@ -301,6 +301,15 @@ pub fn motion_image(device: &Device, extent: [u32; 2], motion: &[glam::Vec2]) ->
     )
 }
 
+/// A number in [0, 1) from `i`, the same every run: reproducible pseudo-random test inputs.
+pub fn hash01(i: u32) -> f32 {
+    let mut x = i.wrapping_mul(0x9e37_79b9) ^ 0x85eb_ca6b;
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x2c1b_3c6d);
+    x ^= x >> 12;
+    (x >> 8) as f32 / (1u32 << 24) as f32
+}
+
 /// Runs a test shader of the "cases" shape once: binding `cases` (a storage buffer holding
 /// `cases`), binding `results` (`result_bytes`, read back and returned), a push constant of
 /// `count` and one invocation per case (the GLSL-against-Rust checks of `shaders/tests/`).
