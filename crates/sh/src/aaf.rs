@@ -187,8 +187,9 @@ pub const TANGENT_SCALE: f32 = 8.0 / 3.0;
 /// units of one pixel's mean): its weight is `p exp(−u²/2)`, the weighted least squares of
 /// values of unequal noise, and [`Self::precision`] is the fitted value's own. The first pass
 /// gives every pixel's mean precision 1; above degree 0, the second weights each row by the
-/// precision of the first pass's fit there, so a row fitted from few neighbours (at the image's border, beside
-/// an edge, or a quadratic extrapolated from one side) counts less than one fitted from many.
+/// precision of the first pass's fit there, so a row fitted from few neighbours (at the image's
+/// border, beside an edge, or a quadratic extrapolated from one side) counts less than one
+/// fitted from many.
 /// GLSL twin: `AafFit` in `shaders/include/aaf.glsl` (nine channels, a mat3).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LocalFit<const N: usize = 3> {
@@ -269,8 +270,9 @@ impl<const N: usize> LocalFit<N> {
 
     /// The precision of the fitted value at `u = 0` ([`Self::coefficients`]): the inverse of
     /// `Σ (l² / p)` over the neighbours, `l` the weight the fit gives each value; `None`
-    /// without neighbours (or if the inverse is not finite). A gaussian average of `K` values of precision 1 at `u = 0` has precision
-    /// `K`; a fit extrapolated from one side may have less than one value's.
+    /// without neighbours (or if the inverse is not finite). A gaussian average of `K` values
+    /// of precision 1 at `u = 0` has precision `K`; a fit extrapolated from one side may have
+    /// less than one value's.
     pub fn precision(&self, degree: u32) -> Option<f32> {
         let c = self.coefficients(degree)?;
         let v = &self.v;
