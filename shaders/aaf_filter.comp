@@ -181,8 +181,11 @@ void main() {
             }
         }
         uint degree = push.degree;
+#ifdef AAF_X
+        // The columns' pass weights each row by these; its own are not needed.
         result.diffuse_precision = aaf_fit_precision(diffuse, degree, result.diffuse_precision);
         result.specular_precision = aaf_fit_precision(specular, degree, result.specular_precision);
+#endif
         result.diffuse = aaf_fit_value(diffuse, degree, result.diffuse);
         mat3 specular_own = mat3(result.specular, vec3(0.0), vec3(0.0));
         result.specular = aaf_fit_value(specular, degree, specular_own)[0];
