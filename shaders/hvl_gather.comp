@@ -93,10 +93,8 @@ layout(set = 0, binding = 1, rgba16f) readonly uniform image2D recv_normal;
 layout(set = 0, binding = 2, rgba8) readonly uniform image2D recv_albedo;
 layout(set = 0, binding = 3, rgba8) readonly uniform image2D recv_material;
 
-// The cache as hvl_gather_prep.comp prepared it.
-layout(set = 0, binding = 4, std430) readonly buffer Records {
-    GatherHvl h[];
-} hvl_records;
+// The cache as hvl_gather_prep.comp prepared it: GatherHvl records, four texels each.
+layout(set = 0, binding = 4, rgba32f) readonly uniform image2D hvl_records;
 
 #ifdef HVL_FULL
 // shine::passes::brdf_tables::GatherBrdf::gpu_data: F of Lambert (albedo 1) then F of GGX at each
@@ -289,8 +287,7 @@ void main() {
     rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y) + pcg(push.seed));
 #endif
     for (uint j = 0u; j < push.hvl_count; ++j) {
-        // Field by field: naga cannot read the OpCopyLogical of a whole-struct load.
-        vec4 position_radius = hvl_records.h[j].position_radius;
+        vec4 position_radius = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_POSITION_RADIUS));
         float r = position_radius.w;
         if (!(r > 0.0)) {
             continue;
@@ -304,7 +301,7 @@ void main() {
         float dist = dist2 * inv_dist;
         vec3 wj = v * inv_dist;
         // Eq. 21 in parts: the sender's cosine, then H (eq. 22).
-        vec4 normal_area = hvl_records.h[j].normal_area;
+        vec4 normal_area = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_NORMAL_AREA));
         vec3 hvl_normal = normal_area.xyz;
         float facing = -dot(hvl_normal, wj);
         if (!(facing > 0.0)) {
@@ -325,8 +322,8 @@ void main() {
 #endif
         // The near field's share of the diffuse light is hvl_near.comp's.
         float far = hvl_far_weight(dist, push.near_range);
-        vec4 flux_e0 = hvl_records.h[j].flux_e0;
-        vec4 e14 = hvl_records.h[j].emission;
+        vec4 flux_e0 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_FLUX_E0));
+        vec4 e14 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_EMISSION));
         float e_poly[HVL_EMISSION_MAX_BANDS] = float[](flux_e0.w, e14.x, e14.y, e14.z, e14.w);
         float e = max(0.0, hvl_poly_eval(e_poly, min(facing, 1.0)));
         if (push.disc_falloff != 0u) {
@@ -401,7 +398,9 @@ void main() {
     if (weight_total > 0.0) {
         for (int k = 0; k < rays; ++k) {
             uint j = pick[k];
-            vec3 target = hvl_shadow_target(hvl_records.h[j].position_radius, hvl_records.h[j].normal_area.xyz);
+            vec4 position_radius = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_POSITION_RADIUS));
+            vec3 hvl_normal = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_NORMAL_AREA)).xyz;
+            vec3 target = hvl_shadow_target(position_radius, hvl_normal);
             visible += trace_occluded_by(origin, target) ? 0.0 : 1.0;
         }
     }

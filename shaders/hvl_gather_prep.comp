@@ -17,9 +17,8 @@ layout(set = 0, binding = 0, std430) readonly buffer Hvls {
     Hvl h[];
 } hvls;
 
-layout(set = 0, binding = 1, std430) buffer Records {
-    GatherHvl h[];
-} hvl_records;
+// GatherHvl records, four texels each (hvl_record_texel).
+layout(set = 0, binding = 1, rgba32f) writeonly uniform image2D hvl_records;
 
 // shine::passes::hvl::PrepPush
 layout(push_constant) uniform Push {
@@ -44,9 +43,9 @@ void main() {
     float a[HVL_EMISSION_MAX_BANDS];
     hvl_zh_poly(emission, int(push.emission_bands), a);
     bool valid = r > 0.0;
-    hvl_records.h[j].position_radius = valid ? position_radius : vec4(0.0);
     vec3 n = hvls.h[j].normal_distance.xyz;
-    hvl_records.h[j].normal_area = valid ? vec4(normalize(n), hvl_geometric_factor_of(1.0, 1.0, r)) : vec4(0.0);
-    hvl_records.h[j].flux_e0 = vec4(hvls.h[j].flux.rgb, a[0]);
-    hvl_records.h[j].emission = vec4(a[1], a[2], a[3], a[4]);
+    imageStore(hvl_records, hvl_record_texel(j, HVL_RECORD_POSITION_RADIUS), valid ? position_radius : vec4(0.0));
+    imageStore(hvl_records, hvl_record_texel(j, HVL_RECORD_NORMAL_AREA), valid ? vec4(normalize(n), hvl_geometric_factor_of(1.0, 1.0, r)) : vec4(0.0));
+    imageStore(hvl_records, hvl_record_texel(j, HVL_RECORD_FLUX_E0), vec4(hvls.h[j].flux.rgb, a[0]));
+    imageStore(hvl_records, hvl_record_texel(j, HVL_RECORD_EMISSION), vec4(a[1], a[2], a[3], a[4]));
 }

@@ -18,7 +18,7 @@ use shine::passes::hvl::shadows::{self, FilterTexel, ShadowSampling};
 use shine::passes::hvl::{
     CONV_BANDS, CachePush, Distribution, Falloff, GatherHvl, GatherPath, GatherPush, Hvl, HvlError,
     HvlParams, MAX_HVLS, PrepPush, RadiusHeuristic, Window, gather_variants, hvl_cache, hvl_gather,
-    hvl_gather_prep,
+    hvl_gather_prep, records_extent,
 };
 use shine::passes::receivers::Receivers;
 use shine::passes::rsm::{Rsm, RsmProjection};
@@ -413,14 +413,6 @@ fn records_and_push_constants_match_the_shaders() {
     assert_eq!(struct_size(prep, "Hvl"), std::mem::size_of::<Hvl>());
     assert_eq!(std::mem::size_of::<Hvl>(), 80);
     assert_eq!(
-        struct_size(prep, "GatherHvl"),
-        std::mem::size_of::<GatherHvl>()
-    );
-    assert_eq!(
-        struct_size(&shaders::HVL_GATHER_COMP_FULL_C3, "GatherHvl"),
-        std::mem::size_of::<GatherHvl>()
-    );
-    assert_eq!(
         prep.push_constant_size as usize,
         std::mem::size_of::<PrepPush>()
     );
@@ -767,19 +759,21 @@ fn gather_records_match_the_cpu_twin() {
             std::mem::size_of_val(hvls.as_slice()) as u64,
             Some(bytemuck::cast_slice(&hvls)),
         );
-        let bytes = u64::from(p.count) * std::mem::size_of::<GatherHvl>() as u64;
+        // Record j is texels 4j .. 4j + 3 of the image read row by row (rows of whole records).
+        let [w, h] = records_extent(p.count);
+        let bytes = u64::from(w * h) * 16;
         let readback = transfer_storage(&device, "records_readback", bytes, None);
         let mut executor = Executor::new(&device, 1).unwrap();
         let mut rg = executor.begin_frame();
         let handle = rg.import_gpu_buffer(&buffer, uploaded_state(), UNUSED_AFTER);
         let records = hvl_gather_prep(&mut rg, &handle, &p).unwrap();
         let mut out = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
-        rg.copy_buffer("read_records", &records, &mut out);
+        rg.copy_image_to_buffer("read_records", &records, &mut out);
         common::run_graph(&device, &mut executor, rg);
         let gpu: Vec<GatherHvl> =
             bytemuck::cast_slice(&device.read_buffer(&readback).unwrap()).to_vec();
         let cpu = reference::gather_records(&hvls, p.count as usize, emission as usize);
-        assert_eq!(gpu.len(), cpu.len());
+        assert!(gpu.len() >= cpu.len());
         for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
             let (g, c): (&[f32; 16], &[f32; 16]) = (bytemuck::cast_ref(g), bytemuck::cast_ref(c));
             for k in 0..16 {

@@ -2,7 +2,7 @@
 //! and checks the value there against the Rust constant, so changing one side alone fails.
 
 use shine::capture::tonemap::Tonemap;
-use shine::passes::hvl::EMISSION_MAX_BANDS;
+use shine::passes::hvl::{EMISSION_MAX_BANDS, GatherHvl, RECORD_TEXELS, RECORDS_PER_ROW};
 use shine::passes::path_trace::{
     FLAG_EMISSIVE_LIGHTING, FLAG_JITTER, FLAG_LAMBERT_ONLY, FLAG_LIGHT_SAMPLING,
 };
@@ -259,4 +259,41 @@ fn rec709_luma_matches_the_shader() {
         "REC709_LUMA differs from {:?}",
         [r, g, b]
     );
+}
+
+#[test]
+fn hvl_records_layout_matches_the_shader() {
+    assert_eq!(
+        glsl_uint("include/hvl.glsl", "HVL_RECORDS_PER_ROW"),
+        RECORDS_PER_ROW
+    );
+    assert_eq!(
+        std::mem::size_of::<GatherHvl>(),
+        16 * RECORD_TEXELS as usize
+    );
+    // One texel per field, in GatherHvl's order.
+    for (name, offset) in [
+        (
+            "HVL_RECORD_POSITION_RADIUS",
+            std::mem::offset_of!(GatherHvl, position_radius),
+        ),
+        (
+            "HVL_RECORD_NORMAL_AREA",
+            std::mem::offset_of!(GatherHvl, normal_area),
+        ),
+        (
+            "HVL_RECORD_FLUX_E0",
+            std::mem::offset_of!(GatherHvl, flux_e0),
+        ),
+        (
+            "HVL_RECORD_EMISSION",
+            std::mem::offset_of!(GatherHvl, emission),
+        ),
+    ] {
+        assert_eq!(
+            glsl_uint("include/hvl.glsl", name) as usize * 16,
+            offset,
+            "{name}"
+        );
+    }
 }

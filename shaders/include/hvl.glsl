@@ -23,18 +23,26 @@ struct Hvl {
     float emission[8];
 };
 
-// One HVL as the gather reads it, std430, 64 bytes: shine::passes::hvl::GatherHvl, written
-// from the cache by hvl_gather_prep.comp with the per-HVL terms of the gather precomputed.
-struct GatherHvl {
-    // xyz: centre y_j; w: radius r_j, 0 for an empty cell (skipped)
-    vec4 position_radius;
-    // xyz: unit normal n_j; w: 1 / (pi r_j^2), eq. 21's denominator (hvl_geometric_factor_of)
-    vec4 normal_area;
-    // rgb: flux Phi_j; a: a_0 of the emission polynomial (hvl_zh_poly)
-    vec4 flux_e0;
-    // a_1..a_4 of the emission polynomial
-    vec4 emission;
-};
+// One HVL as the gather reads it: shine::passes::hvl::GatherHvl, written from the cache by
+// hvl_gather_prep.comp with the per-HVL terms of the gather precomputed. The records live in an
+// RGBA32F image, not a storage buffer: llvmpipe loads an image texel about 4x faster than a
+// storage buffer's vec4 (docs/performance.md). Record j is the four texels
+// x = 4 (j mod HVL_RECORDS_PER_ROW) + field, y = j / HVL_RECORDS_PER_ROW
+// (shine::passes::hvl::RECORDS_PER_ROW), one per field:
+const uint HVL_RECORDS_PER_ROW = 1024u;
+// xyz: centre y_j; w: radius r_j, 0 for an empty cell (skipped)
+const uint HVL_RECORD_POSITION_RADIUS = 0u;
+// xyz: unit normal n_j; w: 1 / (pi r_j^2), eq. 21's denominator (hvl_geometric_factor_of)
+const uint HVL_RECORD_NORMAL_AREA = 1u;
+// rgb: flux Phi_j; a: a_0 of the emission polynomial (hvl_zh_poly)
+const uint HVL_RECORD_FLUX_E0 = 2u;
+// a_1..a_4 of the emission polynomial
+const uint HVL_RECORD_EMISSION = 3u;
+
+// The texel of field `field` (HVL_RECORD_*) of record j.
+ivec2 hvl_record_texel(uint j, uint field) {
+    return ivec2(int((j % HVL_RECORDS_PER_ROW) * 4u + field), int(j / HVL_RECORDS_PER_ROW));
+}
 
 // shine::reference::hvl::sender_emission_zh: ZH coefficient l of the Lambert sender's F'
 // (paper 003 eq. 20; albedo in the flux, cosine in G): 1/pi in every direction, band 0 only.

@@ -7,8 +7,9 @@ use super::{
     Falloff, GatherHvl, GatherPath, GatherPush, HvlError, HvlParams, PrepPush, Window, cache_bytes,
     check_extent, shadows,
 };
+use crate::gpu::vk;
 use crate::gpu_scene::bvh::TraceBuffers;
-use crate::graph::{Buffer, BufferDesc, Handle, Image, PassCost, RenderGraph};
+use crate::graph::{Buffer, Handle, Image, ImageDesc, PassCost, RenderGraph};
 use crate::passes::amortise;
 use crate::passes::brdf_tables::{
     GLOSSY_ROUGHNESS_MIN, GLOSSY_TABLES, GatherBrdf, glossy_roughness_step,
@@ -28,7 +29,7 @@ use shadows::Shadowing;
 pub fn hvl_gather(
     rg: &mut RenderGraph,
     receivers: &Receivers,
-    records: &Handle<Buffer>,
+    records: &Handle<Image>,
     brdf: &Handle<Buffer>,
     bvh: Option<&TraceBuffers>,
     camera: Vec3,
@@ -59,7 +60,7 @@ pub fn hvl_gather(
 pub fn hvl_regather(
     rg: &mut RenderGraph,
     receivers: &Receivers,
-    records: &Handle<Buffer>,
+    records: &Handle<Image>,
     brdf: &Handle<Buffer>,
     bvh: Option<&TraceBuffers>,
     camera: Vec3,
@@ -81,7 +82,7 @@ pub fn hvl_regather(
 /// What a gather pass reads.
 struct GatherInputs<'a> {
     receivers: &'a Receivers,
-    records: &'a Handle<Buffer>,
+    records: &'a Handle<Image>,
     brdf: &'a Handle<Buffer>,
     bvh: Option<&'a TraceBuffers>,
     camera: Vec3,
@@ -92,7 +93,7 @@ impl<'a> GatherInputs<'a> {
     /// buffer sizes, a BVH when `params.visibility` is set.
     fn checked(
         receivers: &'a Receivers,
-        records: &'a Handle<Buffer>,
+        records: &'a Handle<Image>,
         brdf: &'a Handle<Buffer>,
         bvh: Option<&'a TraceBuffers>,
         camera: Vec3,
@@ -112,12 +113,16 @@ impl<'a> GatherInputs<'a> {
         ] {
             check_extent(name, image, receivers.extent)?;
         }
-        let need = records_bytes(params);
-        if records.desc().size < need {
+        let [need_w, need_h] = records_extent(params.count);
+        let extent = records.desc().extent;
+        if extent.width < need_w || extent.height < need_h {
             return Err(HvlError::Size {
                 name: "hvl_records",
-                actual: format!("{} bytes", records.desc().size),
-                expected: format!("at least {need} bytes for {} HVLs", params.count),
+                actual: format!("{}×{} texels", extent.width, extent.height),
+                expected: format!(
+                    "at least {need_w}×{need_h} texels for {} HVLs",
+                    params.count
+                ),
             });
         }
         let table = GatherBrdf::gpu_bytes(params.conv_bands);
@@ -206,13 +211,13 @@ fn record_gather(
 }
 
 /// Adds `hvl_gather_prep`: the first `params.count` HVLs of `hvls` as [`GatherHvl`] records in
-/// a new buffer, returned (per-HVL terms of the gather computed once a frame, read by
+/// a new RGBA32F image ([`RECORDS_PER_ROW`]), returned (per-HVL terms of the gather computed once a frame, read by
 /// [`hvl_gather`] and [`hvl_regather`]; CPU twin [`crate::reference::hvl::gather_records`]).
 pub fn hvl_gather_prep(
     rg: &mut RenderGraph,
     hvls: &Handle<Buffer>,
     params: &HvlParams,
-) -> Result<Handle<Buffer>, HvlError> {
+) -> Result<Handle<Image>, HvlError> {
     params.validate_gather()?;
     let need = cache_bytes(params.count);
     if hvls.desc().size < need {
@@ -223,7 +228,11 @@ pub fn hvl_gather_prep(
         });
     }
     let bytes = records_bytes(params);
-    let mut records = rg.create_buffer("hvl_records", BufferDesc::new(bytes));
+    let [w, h] = records_extent(params.count);
+    let mut records = rg.create_image(
+        "hvl_records",
+        ImageDesc::new_2d(vk::Format::R32G32B32A32_SFLOAT, w, h),
+    );
     let push = PrepPush {
         count: params.count,
         emission_bands: params.emission_bands,
@@ -289,7 +298,45 @@ pub fn gather_cost(params: &HvlParams, receivers: u64) -> PassCost {
     }
 }
 
+/// Texels of a [`GatherHvl`] record in the records image, one per field.
+pub const RECORD_TEXELS: u32 = 4;
+
+/// Records per row of the records image (`HVL_RECORDS_PER_ROW` of `shaders/include/hvl.glsl`):
+/// record `j` is texels `RECORD_TEXELS · (j mod RECORDS_PER_ROW) + field` of row
+/// `j / RECORDS_PER_ROW`. An image, not a storage buffer: llvmpipe loads an image texel about
+/// 4× faster than a storage buffer's vec4, and the gather loads four per receiver–HVL pair
+/// (docs/performance.md).
+pub const RECORDS_PER_ROW: u32 = 1024;
+
+/// Width and height in texels of the records image of `count` HVLs.
+pub fn records_extent(count: u32) -> [u32; 2] {
+    let count = count.max(1);
+    [
+        RECORD_TEXELS * count.min(RECORDS_PER_ROW),
+        count.div_ceil(RECORDS_PER_ROW),
+    ]
+}
+
 /// Bytes of the [`GatherHvl`] records of `params.count` HVLs.
 fn records_bytes(params: &HvlParams) -> u64 {
     u64::from(params.count.max(1)) * std::mem::size_of::<GatherHvl>() as u64
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::passes::hvl::MAX_HVLS;
+
+    /// Rows hold whole records, so texel `RECORD_TEXELS · j + field` read row by row is
+    /// field `field` of record `j`; the largest cache fits the smallest allowed image.
+    #[test]
+    fn records_extent_rows_of_whole_records() {
+        assert_eq!(records_extent(1), [4, 1]);
+        assert_eq!(records_extent(400), [1600, 1]);
+        assert_eq!(records_extent(RECORDS_PER_ROW), [4096, 1]);
+        assert_eq!(records_extent(RECORDS_PER_ROW + 1), [4096, 2]);
+        let [w, h] = records_extent(MAX_HVLS);
+        assert!(w <= 4096 && h <= 4096, "{w}×{h}");
+        assert!(u64::from(w) * u64::from(h) >= u64::from(RECORD_TEXELS * MAX_HVLS));
+    }
 }

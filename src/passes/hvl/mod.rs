@@ -87,7 +87,9 @@ mod grid;
 pub mod near;
 pub mod shadows;
 mod variants;
-pub use gather::{hvl_gather, hvl_gather_prep, hvl_regather};
+pub use gather::{
+    RECORD_TEXELS, RECORDS_PER_ROW, hvl_gather, hvl_gather_prep, hvl_regather, records_extent,
+};
 pub use grid::HvlGrid;
 pub use variants::{gather_shader, gather_variants};
 
@@ -118,9 +120,10 @@ impl Hvl {
     }
 }
 
-/// One HVL as the gather reads it (std430, 64 bytes; `struct GatherHvl` of
-/// `shaders/include/hvl.glsl`): what depends on the HVL alone, computed once per frame by
-/// `hvl_gather_prep` instead of once per receiver ([`crate::reference::hvl::gather_records`]).
+/// One HVL as the gather reads it (64 bytes, one RGBA32F texel per field of the records image:
+/// `HVL_RECORD_*` of `shaders/include/hvl.glsl`, [`RECORDS_PER_ROW`]): what depends on the HVL
+/// alone, computed once per frame by `hvl_gather_prep` instead of once per receiver
+/// ([`crate::reference::hvl::gather_records`]).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GatherHvl {
