@@ -388,7 +388,8 @@ fn gpu_traversal_hits_equal_cpu_bvh_hits() {
     let device = common::device();
     let scene = Scene::builtin("cornell-box").expect("scene");
     let mut gpu = GpuScene::upload(&device, &scene, 0.0).expect("upload");
-    check_traversal(&device, &mut gpu);
+    let hits = check_traversal(&device, &mut gpu);
+    assert!(hits > 1.0 / 3.0, "only {hits} of the rays hit");
     let nodes = gpu
         .instances
         .iter()
@@ -411,12 +412,50 @@ fn gpu_traversal_hits_equal_cpu_bvh_hits() {
         ..FrameUpdate::at(0.0)
     })
     .expect("update");
-    check_traversal(&device, &mut gpu);
+    let hits = check_traversal(&device, &mut gpu);
+    assert!(hits > 1.0 / 3.0, "only {hits} of the rays hit");
     common::assert_clean(&device);
 }
 
-/// Traces 4096 pseudo-random rays through `gpu`'s BVH on the GPU and on the CPU.
-fn check_traversal(device: &shine::gpu::Device, gpu: &mut GpuScene) {
+/// The same on a mesh whose bottom level fills several rows of the BVH images (a wavy grid of
+/// 2 × 72² triangles: more than `TRACE_ROW_TEXELS` texels of nodes and of triangles), so
+/// texels past the first row are addressed.
+#[test]
+fn gpu_traversal_reads_bvh_images_of_several_rows() {
+    let device = common::device();
+    let n = 72;
+    let point = |i: usize, j: usize| {
+        let (x, z) = (i as f32 / n as f32 - 0.5, j as f32 / n as f32 - 0.5);
+        Vec3::new(x, 0.05 * (17.0 * x).sin() * (11.0 * z).cos(), z)
+    };
+    let mut grid = Vec::new();
+    for i in 0..n {
+        for j in 0..n {
+            let (a, b, c, d) = (
+                point(i, j),
+                point(i + 1, j),
+                point(i + 1, j + 1),
+                point(i, j + 1),
+            );
+            grid.push([a, b, c]);
+            grid.push([a, c, d]);
+        }
+    }
+    let camera = Mat4::look_at_rh(Vec3::new(0.0, 1.0, 1.5), Vec3::ZERO, Vec3::Y);
+    let scene = one_mesh_scene(&grid, lambert(0.5, 0.0), camera, vec![], None);
+    let mut gpu = GpuScene::upload(&device, &scene, 0.0).expect("upload");
+    let row = shine::gpu_scene::bvh::TRACE_ROW_TEXELS;
+    assert!(gpu.bvh.nodes.extent()[1] > 1 && gpu.bvh.triangles.extent()[1] > 1);
+    assert_eq!(gpu.bvh.nodes.extent()[0], row);
+    let hits = check_traversal(&device, &mut gpu);
+    // A sheet: a fifth of the rays from all around meet it.
+    assert!(hits > 0.2, "only {hits} of the rays hit");
+    common::assert_clean(&device);
+}
+
+/// Traces 4096 pseudo-random rays through `gpu`'s BVH on the GPU and on the CPU; returns the
+/// share of them that hit.
+fn check_traversal(device: &shine::gpu::Device, gpu: &mut GpuScene) -> f32 {
     let (cpu_bvh, flat_index) = world_bvh(gpu.rig(), &gpu.state.pose.world).expect("cpu bvh");
     let (lo, hi) = gpu.state.bounds;
     // Deterministic pseudo-random rays: origins in the box grown by 20 %, directions anywhere.
@@ -501,8 +540,8 @@ fn check_traversal(device: &shine::gpu::Device, gpu: &mut GpuScene) {
             }
         }
     }
-    assert!(hit_count > count / 3, "only {hit_count} hits");
     assert!(ties <= count / 100, "{ties} hits on a different triangle");
+    hit_count as f32 / count as f32
 }
 
 /// The Monte-Carlo error falls as 1/√spp: two independent estimates (different seeds) of the

@@ -297,3 +297,11 @@ fn hvl_records_layout_matches_the_shader() {
         );
     }
 }
+
+#[test]
+fn bvh_image_rows_match_the_shader() {
+    assert_eq!(
+        glsl_uint("include/trace.glsl", "TRACE_ROW_TEXELS"),
+        shine::gpu_scene::bvh::TRACE_ROW_TEXELS
+    );
+}

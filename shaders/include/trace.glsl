@@ -1,6 +1,6 @@
 // Ray traversal of the scene's two-level BVH (src/gpu_scene/bvh.rs): closest hit and occlusion
 // (any hit) with fixed-size stacks. Any compute pass can include it; before the #include define
-// the binding numbers of the four buffers it declares (set 0, names fixed so the graph binds
+// the binding numbers of the four images it declares (set 0, names fixed so the graph binds
 // them by name):
 //
 //     #define TRACE_NODES_BINDING 7       // `bvh_nodes`: bottom-level nodes
@@ -9,8 +9,11 @@
 //     #define TRACE_INSTANCES_BINDING 10  // `bvh_instances`: top-level instance records
 //     #include "trace.glsl"
 //
-// Layout: a node is two vec4, (min, bits of left_or_first) and (max, bits of count) —
-// shine_scene::bvh::BvhNode; a leaf has count > 0 and holds items left_or_first ..
+// Storage: each array is an RGBA32F image read row by row, its vec4 k at texel
+// (k mod TRACE_ROW_TEXELS, k / TRACE_ROW_TEXELS) (shine::gpu_scene::bvh::TRACE_ROW_TEXELS), not
+// a storage buffer: llvmpipe loads an image texel about 4x faster than a storage buffer's vec4
+// (docs/performance.md). Layout: a node is two vec4, (min, bits of left_or_first) and (max, bits
+// of count) — shine_scene::bvh::BvhNode; a leaf has count > 0 and holds items left_or_first ..
 // left_or_first + count (triangles in a bottom level, instances in the top level); an interior
 // node's left child is the next node, its right child left_or_first. A triangle is three vec4,
 // (v0, bits of its index within its mesh), (v1, 0), (v2, 0) — GpuBvhTriangle, mesh space. An
@@ -25,18 +28,18 @@
 #error "define TRACE_NODES_BINDING, TRACE_TRIANGLES_BINDING, TRACE_TOP_BINDING and TRACE_INSTANCES_BINDING before including trace.glsl"
 #endif
 
-layout(set = 0, binding = TRACE_NODES_BINDING, std430) readonly buffer BvhNodes {
-    vec4 n[];
-} bvh_nodes;
-layout(set = 0, binding = TRACE_TRIANGLES_BINDING, std430) readonly buffer BvhTriangles {
-    vec4 t[];
-} bvh_triangles;
-layout(set = 0, binding = TRACE_TOP_BINDING, std430) readonly buffer BvhTop {
-    vec4 n[];
-} bvh_top;
-layout(set = 0, binding = TRACE_INSTANCES_BINDING, std430) readonly buffer BvhInstances {
-    vec4 i[];
-} bvh_instances;
+layout(set = 0, binding = TRACE_NODES_BINDING, rgba32f) readonly uniform image2D bvh_nodes;
+layout(set = 0, binding = TRACE_TRIANGLES_BINDING, rgba32f) readonly uniform image2D bvh_triangles;
+layout(set = 0, binding = TRACE_TOP_BINDING, rgba32f) readonly uniform image2D bvh_top;
+layout(set = 0, binding = TRACE_INSTANCES_BINDING, rgba32f) readonly uniform image2D bvh_instances;
+
+// Texels per row of the BVH images: shine::gpu_scene::bvh::TRACE_ROW_TEXELS.
+const uint TRACE_ROW_TEXELS = 4096u;
+
+// The texel of vec4 k of a BVH image.
+ivec2 trace_texel(uint k) {
+    return ivec2(int(k % TRACE_ROW_TEXELS), int(k / TRACE_ROW_TEXELS));
+}
 
 // Deeper than any binned-SAH tree over a storage buffer's worth of triangles needs (the far
 // child is pushed, so the stack holds at most one entry per level).
@@ -69,20 +72,24 @@ float trace_slab(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float t_min, float
 
 // Slab test of a bottom-level node.
 float trace_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
-    return trace_slab(bvh_nodes.n[2u * node].xyz, bvh_nodes.n[2u * node + 1u].xyz, origin, inv_dir, t_min, t_max);
+    vec3 lo = imageLoad(bvh_nodes, trace_texel(2u * node)).xyz;
+    vec3 hi = imageLoad(bvh_nodes, trace_texel(2u * node + 1u)).xyz;
+    return trace_slab(lo, hi, origin, inv_dir, t_min, t_max);
 }
 
 // Slab test of a top-level node.
 float trace_top_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
-    return trace_slab(bvh_top.n[2u * node].xyz, bvh_top.n[2u * node + 1u].xyz, origin, inv_dir, t_min, t_max);
+    vec3 lo = imageLoad(bvh_top, trace_texel(2u * node)).xyz;
+    vec3 hi = imageLoad(bvh_top, trace_texel(2u * node + 1u)).xyz;
+    return trace_slab(lo, hi, origin, inv_dir, t_min, t_max);
 }
 
 // Möller–Trumbore (both faces), as shine_scene::bvh::intersect_triangle: (t, u, v) when the
 // hit lies in [t_min, t_max].
 bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, out vec3 tuv) {
-    vec3 a = bvh_triangles.t[3u * tri].xyz;
-    vec3 e1 = bvh_triangles.t[3u * tri + 1u].xyz - a;
-    vec3 e2 = bvh_triangles.t[3u * tri + 2u].xyz - a;
+    vec3 a = imageLoad(bvh_triangles, trace_texel(3u * tri)).xyz;
+    vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * tri + 1u)).xyz - a;
+    vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * tri + 2u)).xyz - a;
     vec3 p = cross(dir, e2);
     float det = dot(e1, p);
     tuv = vec3(0.0);
@@ -125,8 +132,8 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
     uint node = root;
     bool found = false;
     while (true) {
-        vec4 lo = bvh_nodes.n[2u * node];
-        vec4 hi = bvh_nodes.n[2u * node + 1u];
+        vec4 lo = imageLoad(bvh_nodes, trace_texel(2u * node));
+        vec4 hi = imageLoad(bvh_nodes, trace_texel(2u * node + 1u));
         uint count = floatBitsToUint(hi.w);
         uint first = floatBitsToUint(lo.w);
         if (count > 0u) {
@@ -177,10 +184,10 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
 
 // Tests a ray against top-level instance `k` (its bottom level in mesh space).
 bool trace_instance(uint k, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit) {
-    vec4 r0 = bvh_instances.i[4u * k];
-    vec4 r1 = bvh_instances.i[4u * k + 1u];
-    vec4 r2 = bvh_instances.i[4u * k + 2u];
-    vec4 info = bvh_instances.i[4u * k + 3u];
+    vec4 r0 = imageLoad(bvh_instances, trace_texel(4u * k));
+    vec4 r1 = imageLoad(bvh_instances, trace_texel(4u * k + 1u));
+    vec4 r2 = imageLoad(bvh_instances, trace_texel(4u * k + 2u));
+    vec4 info = imageLoad(bvh_instances, trace_texel(4u * k + 3u));
     vec4 o = vec4(origin, 1.0);
     vec3 mesh_origin = vec3(dot(r0, o), dot(r1, o), dot(r2, o));
     vec3 mesh_dir = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
@@ -188,13 +195,14 @@ bool trace_instance(uint k, vec3 origin, vec3 dir, float t_min, bool any_hit, in
     if (!trace_bottom(floatBitsToUint(info.x), mesh_origin, mesh_dir, t_min, any_hit, hit, leaf)) {
         return false;
     }
-    vec3 a = bvh_triangles.t[3u * leaf].xyz;
-    vec3 b = bvh_triangles.t[3u * leaf + 1u].xyz;
-    vec3 c = bvh_triangles.t[3u * leaf + 2u].xyz;
+    vec3 a = imageLoad(bvh_triangles, trace_texel(3u * leaf)).xyz;
+    vec3 b = imageLoad(bvh_triangles, trace_texel(3u * leaf + 1u)).xyz;
+    vec3 c = imageLoad(bvh_triangles, trace_texel(3u * leaf + 2u)).xyz;
     // Normals move with the inverse transpose: the transpose of world-to-mesh.
     vec3 n = cross(b - a, c - a);
     hit.normal = r0.xyz * n.x + r1.xyz * n.y + r2.xyz * n.z;
-    hit.triangle = floatBitsToUint(info.y) + floatBitsToUint(bvh_triangles.t[3u * leaf].w);
+    uint index = floatBitsToUint(imageLoad(bvh_triangles, trace_texel(3u * leaf)).w);
+    hit.triangle = floatBitsToUint(info.y) + index;
     return true;
 }
 
@@ -215,8 +223,8 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
     uint node = 0u;
     bool found = false;
     while (true) {
-        vec4 lo = bvh_top.n[2u * node];
-        vec4 hi = bvh_top.n[2u * node + 1u];
+        vec4 lo = imageLoad(bvh_top, trace_texel(2u * node));
+        vec4 hi = imageLoad(bvh_top, trace_texel(2u * node + 1u));
         uint count = floatBitsToUint(hi.w);
         uint first = floatBitsToUint(lo.w);
         if (count > 0u) {

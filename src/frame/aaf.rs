@@ -12,7 +12,7 @@ use shine_graph::{Handle, Image, RenderGraph};
 use super::error::RenderError;
 use crate::gpu::{Device, vk};
 use crate::gpu_scene::SceneHandles;
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::passes::aaf::{self, AafParams, AafRecords, AafScene, AafSlice};
 use crate::passes::amortise::{self, RecordHistory, RecordSignal, Schedule, Slice};
 use crate::passes::gbuffer::{GBuffer, View};
@@ -40,7 +40,7 @@ pub struct AafInputs<'a> {
     /// The scene's buffers and textures (the rays' hits are shaded from them).
     pub scene: &'a SceneHandles,
     /// The scene's BVH.
-    pub bvh: &'a TraceBuffers,
+    pub bvh: &'a TraceImages,
     /// Lights in the scene's light buffer.
     pub light_count: u32,
     /// The scene's bounds ([`aaf::scene_size`]).

@@ -10,7 +10,7 @@ use shine_gpu::Device;
 use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::passes::amortise::{self, ResolveHistory, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::hvl::{self, HvlParams};
@@ -42,7 +42,7 @@ pub struct HvlInputs<'a> {
     /// one only).
     pub rsm: &'a [Rsm],
     /// The scene's BVH this frame (read only with `hvl.visibility`).
-    pub bvh: &'a TraceBuffers,
+    pub bvh: &'a TraceImages,
     /// The camera position (the gather's view direction).
     pub camera: Vec3,
     /// The G-buffer's motion vectors (amortised frames reproject with them).

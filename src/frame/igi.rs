@@ -13,7 +13,7 @@ use shine_gpu::Device;
 use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use super::error::RenderError;
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::passes::amortise::{self, RecordHistory, RecordSignal, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
 use crate::passes::gbuffer::GBuffer;
@@ -46,7 +46,7 @@ pub struct IgiInputs<'a> {
     /// one only).
     pub rsm: &'a [Rsm],
     /// The scene's BVH for the VPL shadow rays.
-    pub bvh: &'a TraceBuffers,
+    pub bvh: &'a TraceImages,
     /// The camera position.
     pub camera: Vec3,
 }

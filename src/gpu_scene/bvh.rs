@@ -18,28 +18,67 @@
 //!   passes.
 
 use glam::{Mat4, Vec3};
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_gpu::{Device, Image, ImageDesc, vk};
 use shine_scene::bvh::{Bvh, BvhNode, BvhTriangle, build_over_boxes};
 use shine_scene::{Aabb, Mesh, Scene};
 
 use crate::gpu_scene::SceneUploadError;
 use crate::graph::{ExternalState, Handle, RenderGraph};
 
-/// The BVH buffers imported into a frame graph, bound by the names `trace.glsl` declares.
-#[derive(Debug, Clone, Copy)]
-pub struct TraceBuffers {
-    /// `bvh_nodes`: the bottom levels' nodes.
-    pub nodes: Handle<crate::graph::Buffer>,
-    /// `bvh_triangles`: the bottom levels' triangles.
-    pub triangles: Handle<crate::graph::Buffer>,
-    /// `bvh_top`: the top level's nodes.
-    pub top: Handle<crate::graph::Buffer>,
-    /// `bvh_instances`: the top level's instance records.
-    pub instances: Handle<crate::graph::Buffer>,
+/// Texels per row of the BVH images (`TRACE_ROW_TEXELS` of `trace.glsl`): vec4 `k` of an
+/// array is texel `(k mod TRACE_ROW_TEXELS, k / TRACE_ROW_TEXELS)`. The arrays are RGBA32F
+/// images, not storage buffers, because llvmpipe loads an image texel about 4× faster than a
+/// storage buffer's vec4 (docs/performance.md); 4096 is the smallest `maxImageDimension2D`
+/// Vulkan allows, so a row fits every device.
+pub const TRACE_ROW_TEXELS: u32 = 4096;
+
+/// Format of the BVH images: one vec4 per texel.
+pub const TRACE_FORMAT: vk::Format = vk::Format::R32G32B32A32_SFLOAT;
+
+/// Bytes of one texel of the BVH images.
+const TEXEL_BYTES: usize = 16;
+
+/// Width and height of a BVH image holding `texels` vec4s (at least one).
+pub fn trace_extent(texels: usize) -> [u32; 2] {
+    let (texels, row) = (texels.max(1), TRACE_ROW_TEXELS as usize);
+    [texels.min(row) as u32, texels.div_ceil(row) as u32]
 }
 
-impl TraceBuffers {
-    /// Binds the four buffers to `pass` by the names `trace.glsl` declares.
+/// The first `data.len()` bytes of `full` (an image's whole contents) replaced by `data` and
+/// cut after the last row `data` touches: what an upload that rewrites the start of an image
+/// of width `width` stages (the copy fills whole rows; see
+/// [`RenderGraph::copy_buffer_to_image`]).
+pub fn leading_rows(data: &[u8], full: &[u8], width: u32) -> Vec<u8> {
+    let row = width as usize * TEXEL_BYTES;
+    let end = data.len().div_ceil(row).max(1) * row;
+    let mut out = full[..end.min(full.len())].to_vec();
+    out.resize(end, 0);
+    out[..data.len()].copy_from_slice(data);
+    out
+}
+
+/// `data` padded with zeros to fill an image of `extent`.
+fn padded(data: &[u8], extent: [u32; 2]) -> Vec<u8> {
+    let mut out = data.to_vec();
+    out.resize(extent[0] as usize * extent[1] as usize * TEXEL_BYTES, 0);
+    out
+}
+
+/// The BVH images imported into a frame graph, bound by the names `trace.glsl` declares.
+#[derive(Debug, Clone, Copy)]
+pub struct TraceImages {
+    /// `bvh_nodes`: the bottom levels' nodes.
+    pub nodes: Handle<crate::graph::Image>,
+    /// `bvh_triangles`: the bottom levels' triangles.
+    pub triangles: Handle<crate::graph::Image>,
+    /// `bvh_top`: the top level's nodes.
+    pub top: Handle<crate::graph::Image>,
+    /// `bvh_instances`: the top level's instance records.
+    pub instances: Handle<crate::graph::Image>,
+}
+
+impl TraceImages {
+    /// Binds the four images to `pass` by the names `trace.glsl` declares.
     pub fn bind(&self, pass: &mut crate::graph::ComputePass<'_>) {
         pass.read("bvh_nodes", &self.nodes)
             .read("bvh_triangles", &self.triangles)
@@ -251,23 +290,25 @@ impl TopLevel {
     }
 }
 
-/// The two levels on the GPU: the bottom levels, uploaded once, and the top level's buffers,
-/// sized for every instance and rewritten every frame.
+/// The two levels on the GPU, as RGBA32F images ([`TRACE_ROW_TEXELS`]) in `GENERAL` layout:
+/// the bottom levels, uploaded once, and the top level's images, sized for every instance and
+/// rewritten every frame.
 pub struct GpuBvh {
-    /// Bottom-level nodes ([`BvhNode`], 32 bytes each).
-    pub nodes: Buffer,
-    /// Bottom-level triangles ([`GpuBvhTriangle`]).
-    pub triangles: Buffer,
+    /// Bottom-level nodes ([`BvhNode`], two texels each).
+    pub nodes: Image,
+    /// Bottom-level triangles ([`GpuBvhTriangle`], three texels each).
+    pub triangles: Image,
     /// Top-level nodes (room for `2n - 1` nodes of `n` instances).
-    pub top: Buffer,
-    /// Top-level instance records ([`TraceInstance`]).
-    pub instances: Buffer,
+    pub top: Image,
+    /// Top-level instance records ([`TraceInstance`], four texels each).
+    pub instances: Image,
     /// The bottom levels on the CPU (their roots and bounds place instances in the top level).
     pub bottom: BottomLevels,
 }
 
 impl GpuBvh {
-    /// Uploads `bottom` and allocates top-level buffers for up to `instance_count` instances.
+    /// Uploads `bottom` and allocates top-level images for up to `instance_count` instances
+    /// (zeroed). A level with more texels than the device's images hold rows for is refused.
     pub fn new(
         device: &Device,
         bottom: BottomLevels,
@@ -276,36 +317,22 @@ impl GpuBvh {
         if bottom.triangles.is_empty() {
             return Err(SceneUploadError::Empty);
         }
-        let storage = |name, data: &[u8]| {
-            Buffer::with_data(
-                device,
-                &BufferDesc {
-                    name,
-                    size: data.len().max(16) as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER,
-                    location: MemoryLocation::GpuOnly,
-                },
-                data,
-            )
-        };
-        let dynamic = |name, size: usize| {
-            Buffer::new(
-                device,
-                &BufferDesc {
-                    name,
-                    size: size.max(16) as u64,
-                    usage: vk::BufferUsageFlags::STORAGE_BUFFER
-                        | vk::BufferUsageFlags::TRANSFER_DST,
-                    location: MemoryLocation::GpuOnly,
-                },
-            )
-        };
         let n = instance_count.max(1);
+        let texels = |bytes: usize| bytes.div_ceil(TEXEL_BYTES);
+        let node = std::mem::size_of::<BvhNode>();
         Ok(Self {
-            nodes: storage("bvh nodes", bytemuck::cast_slice(&bottom.nodes))?,
-            triangles: storage("bvh triangles", bytemuck::cast_slice(&bottom.triangles))?,
-            top: dynamic("bvh top", (2 * n - 1) * std::mem::size_of::<BvhNode>())?,
-            instances: dynamic("bvh instances", n * std::mem::size_of::<TraceInstance>())?,
+            nodes: trace_image(device, "bvh nodes", bytemuck::cast_slice(&bottom.nodes))?,
+            triangles: trace_image(
+                device,
+                "bvh triangles",
+                bytemuck::cast_slice(&bottom.triangles),
+            )?,
+            top: trace_image(device, "bvh top", &vec![0; texels((2 * n - 1) * node) * 16])?,
+            instances: trace_image(
+                device,
+                "bvh instances",
+                &vec![0; n * std::mem::size_of::<TraceInstance>()],
+            )?,
             bottom,
         })
     }
@@ -323,21 +350,56 @@ impl GpuBvh {
             triangle_base: 0,
         }]);
         let gpu = Self::new(device, bottom, 1)?;
-        device.upload_buffer(&gpu.top, 0, bytemuck::cast_slice(&top.nodes))?;
-        device.upload_buffer(&gpu.instances, 0, bytemuck::cast_slice(&top.instances))?;
+        for (image, data) in [
+            (&gpu.top, bytemuck::cast_slice(&top.nodes)),
+            (&gpu.instances, bytemuck::cast_slice(&top.instances)),
+        ] {
+            let data = padded(data, image.extent());
+            device.upload_image(image, &data, vk::ImageLayout::GENERAL)?;
+        }
         Ok(gpu)
     }
 
-    /// Imports all four buffers into `rg`, read-only, in `state` before and after the frame
+    /// Imports all four images into `rg`, read-only, in `state` before and after the frame
     /// (for a BVH whose top level is already on the device, e.g. [`GpuBvh::from_world`]).
-    pub fn import(&self, rg: &mut RenderGraph, state: ExternalState) -> TraceBuffers {
-        TraceBuffers {
-            nodes: rg.import_gpu_buffer(&self.nodes, state, state),
-            triangles: rg.import_gpu_buffer(&self.triangles, state, state),
-            top: rg.import_gpu_buffer(&self.top, state, state),
-            instances: rg.import_gpu_buffer(&self.instances, state, state),
+    pub fn import(&self, rg: &mut RenderGraph, state: ExternalState) -> TraceImages {
+        TraceImages {
+            nodes: rg.import_gpu_image(&self.nodes, state, state),
+            triangles: rg.import_gpu_image(&self.triangles, state, state),
+            top: rg.import_gpu_image(&self.top, state, state),
+            instances: rg.import_gpu_image(&self.instances, state, state),
         }
     }
+
+    /// Bytes of device memory the four images hold.
+    pub fn allocated_bytes(&self) -> u64 {
+        [&self.nodes, &self.triangles, &self.top, &self.instances]
+            .iter()
+            .map(|i| i.allocated_bytes())
+            .sum()
+    }
+}
+
+/// A BVH image named `name` holding `data` (whole vec4s, zero-padded to whole rows), in
+/// `GENERAL` layout.
+fn trace_image(device: &Device, name: &str, data: &[u8]) -> Result<Image, SceneUploadError> {
+    let texels = data.len().div_ceil(TEXEL_BYTES);
+    let extent = trace_extent(texels);
+    let rows = device.limits().max_image_dimension2_d;
+    if extent[1] > rows {
+        return Err(SceneUploadError::TooLarge(format!(
+            "{name}: {texels} texels need {} rows of {TRACE_ROW_TEXELS}, the device's images \
+             hold {rows}",
+            extent[1]
+        )));
+    }
+    let usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST;
+    let image = Image::new(
+        device,
+        &ImageDesc::new_2d(name, extent, TRACE_FORMAT, usage),
+    )?;
+    device.upload_image(&image, &padded(data, extent), vk::ImageLayout::GENERAL)?;
+    Ok(image)
 }
 
 /// A one-level world-space BVH of `scene` placed with `world`, and for every triangle of it
@@ -382,3 +444,36 @@ pub fn world_bvh(scene: &Scene, world: &[Mat4]) -> Result<(Bvh, Vec<u32>), Scene
 const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuBvhTriangle>() == 48);
 const _: () = assert!(std::mem::size_of::<TraceInstance>() == 64);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn trace_extent_fills_rows_of_trace_row_texels() {
+        assert_eq!(trace_extent(0), [1, 1]);
+        assert_eq!(trace_extent(5), [5, 1]);
+        let row = TRACE_ROW_TEXELS as usize;
+        assert_eq!(trace_extent(row), [TRACE_ROW_TEXELS, 1]);
+        assert_eq!(trace_extent(row + 1), [TRACE_ROW_TEXELS, 2]);
+        assert_eq!(trace_extent(3 * row), [TRACE_ROW_TEXELS, 3]);
+    }
+
+    /// The staged rows hold the new prefix, then the rest of its last row from the whole
+    /// image's contents (zeros past its end), and nothing past that row.
+    #[test]
+    fn leading_rows_keep_the_rest_of_the_last_row() {
+        let texel = |v: u8| [v; TEXEL_BYTES];
+        let full: Vec<u8> = (0..10u8).flat_map(texel).collect();
+        let prefix: Vec<u8> = [100u8, 101, 102].into_iter().flat_map(texel).collect();
+        let out = leading_rows(&prefix, &full, 4);
+        let expected: Vec<u8> = [100u8, 101, 102, 3].into_iter().flat_map(texel).collect();
+        assert_eq!(out, expected);
+        let out = leading_rows(&full[..5 * TEXEL_BYTES], &full, 4);
+        assert_eq!(out.len(), 8 * TEXEL_BYTES);
+        assert_eq!(&out[..], &full[..8 * TEXEL_BYTES]);
+        let out = leading_rows(&prefix, &[], 4);
+        assert_eq!(&out[..3 * TEXEL_BYTES], &prefix[..]);
+        assert_eq!(&out[3 * TEXEL_BYTES..], &[0; TEXEL_BYTES]);
+    }
+}

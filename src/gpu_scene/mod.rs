@@ -24,7 +24,7 @@ use shine_graph::{ExternalState, Handle, RenderGraph};
 use shine_scene::{Light, LightKind, Material, Scene};
 
 use crate::passes::update_vertices::{DeformInputs, update_vertices};
-use bvh::{BottomLevels, GpuBvh, TopInstance, TopLevel, TraceBuffers};
+use bvh::{BottomLevels, GpuBvh, TopInstance, TopLevel, TraceImages};
 use deformers::Deformers;
 pub use frame_update::{CameraPose, FrameState, FrameUpdate};
 use geometry::{DeformFrame, DeformInstance, Geometry, InstanceRange};
@@ -43,6 +43,14 @@ pub const BUFFER_READ: ExternalState = ExternalState::new(
     vk::PipelineStageFlags2::ALL_COMMANDS,
     vk::AccessFlags2::MEMORY_READ,
     vk::ImageLayout::UNDEFINED,
+);
+
+/// Persistent storage images the frame reads (the BVH's): `GENERAL` layout, read by any stage,
+/// before and after the frame.
+pub const STORAGE_READ: ExternalState = ExternalState::new(
+    vk::PipelineStageFlags2::ALL_COMMANDS,
+    vk::AccessFlags2::MEMORY_READ,
+    vk::ImageLayout::GENERAL,
 );
 
 /// Persistent sampled images (texture arrays, environment): read-only, before and after.
@@ -113,7 +121,7 @@ pub struct SceneHandles {
     /// Linear texture array.
     pub linear_textures: Handle<shine_graph::Image>,
     /// The two-level BVH of this frame.
-    pub trace: TraceBuffers,
+    pub trace: TraceImages,
     /// Index count of the single draw.
     pub index_count: u32,
 }
@@ -321,10 +329,6 @@ impl GpuScene {
             &self.indices,
             &self.materials,
             &self.lights,
-            &self.bvh.nodes,
-            &self.bvh.triangles,
-            &self.bvh.top,
-            &self.bvh.instances,
             &self.deform_instances,
             &self.skin_vertices,
             &self.morph_deltas,
@@ -332,6 +336,7 @@ impl GpuScene {
             &self.morph_weights,
         ];
         let scene = buffers.iter().map(|b| b.allocated_bytes()).sum::<u64>()
+            + self.bvh.allocated_bytes()
             + self.srgb_textures.allocated_bytes()
             + self.linear_textures.allocated_bytes();
         (scene, self.ring.allocated_bytes())
@@ -431,17 +436,25 @@ impl GpuScene {
             &self.lights,
             bytemuck::cast_slice(&self.state.lights),
         )?;
-        let top_nodes = ring.upload(
+        let top_nodes = ring.upload_image_rows(
             rg,
             "bvh top",
             &self.bvh.top,
-            bytemuck::cast_slice(&top.nodes),
+            &bvh::leading_rows(
+                bytemuck::cast_slice(&top.nodes),
+                &[],
+                self.bvh.top.extent()[0],
+            ),
         )?;
-        let top_instances = ring.upload(
+        let top_instances = ring.upload_image_rows(
             rg,
             "bvh instances",
             &self.bvh.instances,
-            bytemuck::cast_slice(&top.instances),
+            &bvh::leading_rows(
+                bytemuck::cast_slice(&top.instances),
+                &[],
+                self.bvh.instances.extent()[0],
+            ),
         )?;
         let inputs = DeformInputs {
             source: rg.import_gpu_buffer(&self.source_vertices, BUFFER_READ, BUFFER_READ),
@@ -472,7 +485,7 @@ impl GpuScene {
             lights,
             srgb_textures: rg.import_gpu_image(&self.srgb_textures, SAMPLED_READ, SAMPLED_READ),
             linear_textures: rg.import_gpu_image(&self.linear_textures, SAMPLED_READ, SAMPLED_READ),
-            trace: TraceBuffers {
+            trace: TraceImages {
                 nodes,
                 triangles,
                 top: top_nodes,
@@ -482,7 +495,7 @@ impl GpuScene {
         })
     }
 
-    /// The bottom-level buffers of this frame: the deformers refitted and their prefix
+    /// The bottom-level images of this frame: the deformers refitted and their prefix
     /// uploaded (when there are any), and per instance its deformer's root and bounds.
     #[allow(clippy::type_complexity)]
     fn declare_bottom_levels(
@@ -490,33 +503,44 @@ impl GpuScene {
         rg: &mut RenderGraph,
     ) -> Result<
         (
-            Handle<shine_graph::Buffer>,
-            Handle<shine_graph::Buffer>,
+            Handle<shine_graph::Image>,
+            Handle<shine_graph::Image>,
             Vec<Option<(u32, shine_scene::Aabb)>>,
         ),
         SceneUploadError,
     > {
         if self.deformers.is_empty() {
             return Ok((
-                rg.import_gpu_buffer(&self.bvh.nodes, BUFFER_READ, BUFFER_READ),
-                rg.import_gpu_buffer(&self.bvh.triangles, BUFFER_READ, BUFFER_READ),
+                rg.import_gpu_image(&self.bvh.nodes, STORAGE_READ, STORAGE_READ),
+                rg.import_gpu_image(&self.bvh.triangles, STORAGE_READ, STORAGE_READ),
                 vec![None; self.instances.len()],
             ));
         }
         let (prefix, roots) = self
             .deformers
             .refit(&self.rig, &self.instances, &self.state.pose);
-        let nodes = self.ring.upload_prefix(
+        // The deformers' levels come first; the copies rewrite the rows they touch, the rest
+        // of the last one from the static levels.
+        let bottom = &self.bvh.bottom;
+        let nodes = self.ring.upload_image_rows(
             rg,
             "bvh deformer nodes",
             &self.bvh.nodes,
-            bytemuck::cast_slice(&prefix.nodes),
+            &bvh::leading_rows(
+                bytemuck::cast_slice(&prefix.nodes),
+                bytemuck::cast_slice(&bottom.nodes),
+                self.bvh.nodes.extent()[0],
+            ),
         )?;
-        let triangles = self.ring.upload_prefix(
+        let triangles = self.ring.upload_image_rows(
             rg,
             "bvh deformer triangles",
             &self.bvh.triangles,
-            bytemuck::cast_slice(&prefix.triangles),
+            &bvh::leading_rows(
+                bytemuck::cast_slice(&prefix.triangles),
+                bytemuck::cast_slice(&bottom.triangles),
+                self.bvh.triangles.extent()[0],
+            ),
         )?;
         Ok((nodes, triangles, roots))
     }

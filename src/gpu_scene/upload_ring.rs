@@ -1,6 +1,6 @@
 //! Per-frame uploads without waiting: a ring of host-visible staging buffers, one set per
-//! frame in flight, copied into device buffers by `update …` transfer passes recorded into
-//! the frame's own command buffer.
+//! frame in flight, copied into device buffers (and the BVH's images) by `update …` transfer
+//! passes recorded into the frame's own command buffer.
 //!
 //! Frame `f` writes the staging buffers of its graph's slot (`RenderGraph::slot`, `f mod n`
 //! for an executor with `n` frames in flight). The executor lets at most `n` frames run ahead
@@ -9,10 +9,10 @@
 //! destination (or of the prefix rewritten) and then reused, so a steady stream of frames
 //! allocates nothing.
 
-use shine_gpu::{Buffer, BufferDesc, Device, MemoryLocation, vk};
+use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, format_texel_size, vk};
 use shine_graph::{ExternalState, Handle, RenderGraph};
 
-use super::BUFFER_READ;
+use super::{BUFFER_READ, STORAGE_READ};
 
 /// A ring of staging buffers for the device buffers a frame rewrites.
 pub struct UploadRing {
@@ -127,6 +127,39 @@ impl UploadRing {
         self.stage(rg, name, dst, data, (data.len() as u64).max(4))
     }
 
+    /// Writes `data` (whole rows of tightly packed texels) into this frame's staging buffer
+    /// `name` and adds a transfer pass `update <name>` copying it into the leading rows of
+    /// `dst` (a persistent 2D image with `TRANSFER_DST` in `GENERAL` layout, read by any stage
+    /// before and after the frame; the other rows keep what they hold). `data` must keep its
+    /// length from frame to frame, or the staging buffer is replaced. Returns `dst`'s handle
+    /// after the copy.
+    pub fn upload_image_rows(
+        &mut self,
+        rg: &mut RenderGraph,
+        name: &str,
+        dst: &Image,
+        data: &[u8],
+    ) -> Result<Handle<crate::graph::Image>, shine_gpu::Error> {
+        let [w, h] = dst.extent();
+        let texel = format_texel_size(dst.format()).unwrap_or(0) as usize;
+        let row = w as usize * texel;
+        if row == 0
+            || data.is_empty()
+            || !data.len().is_multiple_of(row)
+            || data.len() > row * h as usize
+        {
+            return Err(shine_gpu::Error::InvalidUsage(format!(
+                "upload `{name}`: {} bytes are not whole rows of its {w}×{h} image ({row} bytes \
+                 a row)",
+                data.len()
+            )));
+        }
+        let src = self.staged(rg, name, data, data.len() as u64)?;
+        let mut handle = rg.import_gpu_image(dst, STORAGE_READ, STORAGE_READ);
+        rg.copy_buffer_to_image(&format!("update {name}"), &src, &mut handle);
+        Ok(handle)
+    }
+
     /// Stages `data` in a buffer of `size` bytes and copies that whole buffer into `dst`.
     fn stage(
         &mut self,
@@ -143,6 +176,21 @@ impl UploadRing {
                 dst.size()
             )));
         }
+        let src = self.staged(rg, name, data, size)?;
+        let mut handle = rg.import_gpu_buffer(dst, BUFFER_READ, BUFFER_READ);
+        rg.copy_buffer(&format!("update {name}"), &src, &mut handle);
+        Ok(handle)
+    }
+
+    /// This frame's staging buffer `name` of `size` bytes (made or replaced when its size
+    /// changes) holding `data` at its start, imported into `rg`.
+    fn staged(
+        &mut self,
+        rg: &mut RenderGraph,
+        name: &str,
+        data: &[u8],
+        size: u64,
+    ) -> Result<Handle<crate::graph::Buffer>, shine_gpu::Error> {
         // A graph with another number of frames in flight (a new executor) starts over: the
         // old staging buffers are dropped, their destruction deferred past their last frame.
         if self.slots.len() != rg.frames_in_flight() {
@@ -175,9 +223,6 @@ impl UploadRing {
             shine_gpu::Error::InvalidUsage(format!("staging buffer `{name}` is not host-visible"))
         })?;
         mapped[..data.len()].copy_from_slice(data);
-        let src = rg.import_gpu_buffer(staging, ExternalState::UNDEFINED, ExternalState::UNDEFINED);
-        let mut handle = rg.import_gpu_buffer(dst, BUFFER_READ, BUFFER_READ);
-        rg.copy_buffer(&format!("update {name}"), &src, &mut handle);
-        Ok(handle)
+        Ok(rg.import_gpu_buffer(staging, ExternalState::UNDEFINED, ExternalState::UNDEFINED))
     }
 }

@@ -67,7 +67,7 @@ use std::ops::RangeInclusive;
 
 use glam::Vec3;
 
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::amortise;
 use crate::passes::brdf_tables;
@@ -391,7 +391,7 @@ pub fn vpl_sh(
     rg: &mut RenderGraph,
     g: &GBuffer,
     vpls: &Handle<Buffer>,
-    bvh: &TraceBuffers,
+    bvh: &TraceImages,
     camera: Vec3,
     params: &IgiParams,
     slice: IgiSlice,

@@ -28,7 +28,7 @@
 
 use std::ops::RangeInclusive;
 
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, Handle, Image, RenderGraph};
 use crate::passes::receivers::Receivers;
 use crate::passes::upsample::UpsampleParams;
@@ -145,7 +145,7 @@ pub fn sky(
     rg: &mut RenderGraph,
     receivers: &Receivers,
     environment: &Handle<Buffer>,
-    bvh: &TraceBuffers,
+    bvh: &TraceImages,
     camera: glam::Vec3,
     params: &SkyParams,
     upsample: &UpsampleParams,
@@ -225,7 +225,7 @@ fn trace_pass(
     output: &str,
     shader: &'static crate::gpu::ShaderDesc,
     receivers: &Receivers,
-    bvh: &TraceBuffers,
+    bvh: &TraceImages,
     params: &SkyParams,
     seed: u32,
     extra: impl FnOnce(&mut crate::graph::ComputePass<'_>),
@@ -264,7 +264,7 @@ pub fn cavity(
     rg: &mut RenderGraph,
     receivers: &Receivers,
     light: &Handle<Image>,
-    bvh: &TraceBuffers,
+    bvh: &TraceImages,
     params: &SkyParams,
     seed: u32,
 ) -> Result<Handle<Image>, SkyError> {

@@ -5,7 +5,7 @@
 //! (`passes::cubes`) and HVL's near field (`passes::hvl::near`).
 
 use crate::gpu_scene::SceneHandles;
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{ComputePass, Handle, Image, vk};
 
 /// The scene as rays see it.
@@ -14,7 +14,7 @@ pub struct TracedScene<'a> {
     /// The scene's buffers and textures.
     pub handles: &'a SceneHandles,
     /// Its BVH.
-    pub bvh: &'a TraceBuffers,
+    pub bvh: &'a TraceImages,
     /// Lights in the light buffer.
     pub light_count: u32,
     /// The sampler of the scene's textures (level 0 at ray hits).
@@ -50,7 +50,7 @@ pub fn bind_surfaces(
     pass: &mut ComputePass<'_>,
     handles: &SceneHandles,
     texture_sampler: vk::Sampler,
-    bvh: &TraceBuffers,
+    bvh: &TraceImages,
 ) {
     pass.read("materials", &handles.materials)
         .read("srgb_textures", &handles.srgb_textures)

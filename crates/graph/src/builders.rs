@@ -98,7 +98,9 @@ impl RenderGraph {
         pass
     }
 
-    /// Copies a tightly packed buffer into mip 0, layer 0 of an image.
+    /// Copies a tightly packed buffer into mip 0, layer 0 of an image. A buffer shorter than a
+    /// 2D image fills only the whole rows it holds, from the top (uploads that rewrite the
+    /// start of an image; the other rows keep what they hold).
     pub fn copy_buffer_to_image(
         &mut self,
         name: &str,

@@ -25,6 +25,23 @@ fn image_extent(plan: &Plan, id: ResourceId) -> vk::Extent3D {
     }
 }
 
+/// Rows of 2D image `id` that a tightly packed buffer of `bytes` fills: all of them when it
+/// holds the whole image (or the image is not a single-layer 2D image of a known texel size),
+/// else its whole leading rows.
+fn leading_rows(plan: &Plan, bytes: u64, id: ResourceId) -> u32 {
+    let Some(AnyDesc::Image(d)) = plan.resource(id).map(|r| r.desc) else {
+        return 0;
+    };
+    let height = d.extent.height;
+    match shine_gpu::format_texel_size(d.format) {
+        Some(texel) if d.extent.depth == 1 && d.layers == 1 => {
+            let row = u64::from(d.extent.width) * u64::from(texel);
+            (bytes / row.max(1)).min(u64::from(height)) as u32
+        }
+        _ => height,
+    }
+}
+
 /// Every mip and layer of image `id` (an empty range when it is not an image of `plan`).
 fn image_range(plan: &Plan, id: ResourceId) -> vk::ImageSubresourceRange {
     match plan.resource(id).map(|r| r.desc) {
@@ -408,13 +425,20 @@ impl<'a> Recorder<'a> {
                     self.buffer(dst),
                     &[copy(src)],
                 ),
-                TransferOp::CopyBufferToImage { src, dst } => raw.cmd_copy_buffer_to_image(
-                    cb,
-                    self.buffer(src),
-                    self.image(dst).0,
-                    vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                    &[copy(dst)],
-                ),
+                TransferOp::CopyBufferToImage { src, dst } => {
+                    let mut region = copy(dst);
+                    region.image_extent.height =
+                        leading_rows(self.plan, buffer_size(self.plan, src), dst);
+                    if region.image_extent.height > 0 {
+                        raw.cmd_copy_buffer_to_image(
+                            cb,
+                            self.buffer(src),
+                            self.image(dst).0,
+                            vk::ImageLayout::TRANSFER_DST_OPTIMAL,
+                            &[region],
+                        );
+                    }
+                }
                 TransferOp::ClearImage { dst, color } => raw.cmd_clear_color_image(
                     cb,
                     self.image(dst).0,

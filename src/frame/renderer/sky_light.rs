@@ -8,7 +8,7 @@ use shine_graph::{Handle, Image, RenderGraph};
 use crate::frame::error::RenderError;
 use crate::frame::params::FrameParams;
 use crate::frame::proxy::ProxyTechnique;
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::passes::aaf::scene_size;
 use crate::passes::receivers::Receivers;
 use crate::passes::sky::{self, SkyParams};
@@ -29,7 +29,7 @@ pub(super) fn cavity_shaded(
     rg: &mut RenderGraph,
     p: &FrameParams,
     bounds: (Vec3, Vec3),
-    bvh: &TraceBuffers,
+    bvh: &TraceImages,
     receivers: Option<&Receivers>,
     light: Option<Handle<Image>>,
 ) -> Result<Option<Handle<Image>>, RenderError> {
@@ -53,7 +53,7 @@ pub(super) fn sky_light(
     p: &FrameParams,
     params: &SkyParams,
     proxy: &mut ProxyTechnique,
-    bvh: &TraceBuffers,
+    bvh: &TraceImages,
     receivers: &Receivers,
     camera: Vec3,
 ) -> Result<Handle<Image>, RenderError> {

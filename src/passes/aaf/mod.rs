@@ -97,7 +97,7 @@
 //!   the convention of every raster GI technique).
 
 use crate::gpu_scene::SceneHandles;
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::amortise;
 use crate::passes::gbuffer::{GBuffer, View};
@@ -189,7 +189,7 @@ pub struct AafScene<'a> {
     /// The scene's buffers and textures.
     pub handles: &'a SceneHandles,
     /// Its BVH.
-    pub bvh: &'a TraceBuffers,
+    pub bvh: &'a TraceImages,
     /// Lights in the light buffer.
     pub light_count: u32,
     /// [`scene_size`] of the scene's bounds (the z_min clamp, and the reflector distance of a

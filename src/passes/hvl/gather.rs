@@ -8,7 +8,7 @@ use super::{
     check_extent, shadows,
 };
 use crate::gpu::vk;
-use crate::gpu_scene::bvh::TraceBuffers;
+use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, Handle, Image, ImageDesc, PassCost, RenderGraph};
 use crate::passes::amortise;
 use crate::passes::brdf_tables::{
@@ -31,7 +31,7 @@ pub fn hvl_gather(
     receivers: &Receivers,
     records: &Handle<Image>,
     brdf: &Handle<Buffer>,
-    bvh: Option<&TraceBuffers>,
+    bvh: Option<&TraceImages>,
     camera: Vec3,
     params: &HvlParams,
     slice: u32,
@@ -62,7 +62,7 @@ pub fn hvl_regather(
     receivers: &Receivers,
     records: &Handle<Image>,
     brdf: &Handle<Buffer>,
-    bvh: Option<&TraceBuffers>,
+    bvh: Option<&TraceImages>,
     camera: Vec3,
     params: &HvlParams,
     target: &mut Handle<Image>,
@@ -84,7 +84,7 @@ struct GatherInputs<'a> {
     receivers: &'a Receivers,
     records: &'a Handle<Image>,
     brdf: &'a Handle<Buffer>,
-    bvh: Option<&'a TraceBuffers>,
+    bvh: Option<&'a TraceImages>,
     camera: Vec3,
 }
 
@@ -95,7 +95,7 @@ impl<'a> GatherInputs<'a> {
         receivers: &'a Receivers,
         records: &'a Handle<Image>,
         brdf: &'a Handle<Buffer>,
-        bvh: Option<&'a TraceBuffers>,
+        bvh: Option<&'a TraceImages>,
         camera: Vec3,
         params: &HvlParams,
     ) -> Result<(&'static crate::gpu::ShaderDesc, Self), HvlError> {
