@@ -70,20 +70,6 @@ float trace_slab(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float t_min, float
     return near <= far ? near : -1.0;
 }
 
-// Slab test of a bottom-level node.
-float trace_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
-    vec3 lo = imageLoad(bvh_nodes, trace_texel(2u * node)).xyz;
-    vec3 hi = imageLoad(bvh_nodes, trace_texel(2u * node + 1u)).xyz;
-    return trace_slab(lo, hi, origin, inv_dir, t_min, t_max);
-}
-
-// Slab test of a top-level node.
-float trace_top_box(uint node, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
-    vec3 lo = imageLoad(bvh_top, trace_texel(2u * node)).xyz;
-    vec3 hi = imageLoad(bvh_top, trace_texel(2u * node + 1u)).xyz;
-    return trace_slab(lo, hi, origin, inv_dir, t_min, t_max);
-}
-
 // Möller–Trumbore (both faces), as shine_scene::bvh::intersect_triangle: (t, u, v) when the
 // hit lies in [t_min, t_max].
 bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, out vec3 tuv) {
@@ -124,18 +110,20 @@ vec3 trace_inverse(vec3 dir) {
 bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit, out uint leaf) {
     leaf = 0xffffffffu;
     vec3 inv_dir = trace_inverse(dir);
-    if (trace_box(root, origin, inv_dir, t_min, hit.t) < 0.0) {
+    // A node's two texels hold its box and (first, count): a child's box test loads what its
+    // visit needs, so only the root and the nodes popped off the stack are loaded again.
+    vec4 lo = imageLoad(bvh_nodes, trace_texel(2u * root));
+    vec4 hi = imageLoad(bvh_nodes, trace_texel(2u * root + 1u));
+    if (trace_slab(lo.xyz, hi.xyz, origin, inv_dir, t_min, hit.t) < 0.0) {
         return false;
     }
     uint stack[TRACE_STACK_SIZE];
     uint sp = 0u;
     uint node = root;
+    uint first = floatBitsToUint(lo.w);
+    uint count = floatBitsToUint(hi.w);
     bool found = false;
     while (true) {
-        vec4 lo = imageLoad(bvh_nodes, trace_texel(2u * node));
-        vec4 hi = imageLoad(bvh_nodes, trace_texel(2u * node + 1u));
-        uint count = floatBitsToUint(hi.w);
-        uint first = floatBitsToUint(lo.w);
         if (count > 0u) {
             for (uint i = first; i < first + count; ++i) {
                 vec3 tuv;
@@ -153,23 +141,22 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
         } else {
             uint left = node + 1u;
             uint right = first;
-            float tl = trace_box(left, origin, inv_dir, t_min, hit.t);
-            float tr = trace_box(right, origin, inv_dir, t_min, hit.t);
-            if (tl >= 0.0 && tr >= 0.0) {
-                bool left_first = tl <= tr;
-                if (sp < TRACE_STACK_SIZE) {
-                    stack[sp] = left_first ? right : left;
+            vec4 left_lo = imageLoad(bvh_nodes, trace_texel(2u * left));
+            vec4 left_hi = imageLoad(bvh_nodes, trace_texel(2u * left + 1u));
+            vec4 right_lo = imageLoad(bvh_nodes, trace_texel(2u * right));
+            vec4 right_hi = imageLoad(bvh_nodes, trace_texel(2u * right + 1u));
+            float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, hit.t);
+            float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, hit.t);
+            if (tl >= 0.0 || tr >= 0.0) {
+                // Into the nearer child hit; the other, if hit, waits on the stack.
+                bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
+                if (tl >= 0.0 && tr >= 0.0 && sp < TRACE_STACK_SIZE) {
+                    stack[sp] = go_left ? right : left;
                     sp += 1u;
                 }
-                node = left_first ? left : right;
-                continue;
-            }
-            if (tl >= 0.0) {
-                node = left;
-                continue;
-            }
-            if (tr >= 0.0) {
-                node = right;
+                node = go_left ? left : right;
+                first = floatBitsToUint(go_left ? left_lo.w : right_lo.w);
+                count = floatBitsToUint(go_left ? left_hi.w : right_hi.w);
                 continue;
             }
         }
@@ -178,6 +165,8 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
         }
         sp -= 1u;
         node = stack[sp];
+        first = floatBitsToUint(imageLoad(bvh_nodes, trace_texel(2u * node)).w);
+        count = floatBitsToUint(imageLoad(bvh_nodes, trace_texel(2u * node + 1u)).w);
     }
     return found;
 }
@@ -215,18 +204,19 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
     hit.triangle = 0xffffffffu;
     hit.normal = vec3(0.0);
     vec3 inv_dir = trace_inverse(dir);
-    if (trace_top_box(0u, origin, inv_dir, t_min, t_max) < 0.0) {
+    // As trace_bottom: the box tests load what the visits need.
+    vec4 lo = imageLoad(bvh_top, trace_texel(0u));
+    vec4 hi = imageLoad(bvh_top, trace_texel(1u));
+    if (trace_slab(lo.xyz, hi.xyz, origin, inv_dir, t_min, t_max) < 0.0) {
         return false;
     }
     uint stack[TRACE_TOP_STACK_SIZE];
     uint sp = 0u;
     uint node = 0u;
+    uint first = floatBitsToUint(lo.w);
+    uint count = floatBitsToUint(hi.w);
     bool found = false;
     while (true) {
-        vec4 lo = imageLoad(bvh_top, trace_texel(2u * node));
-        vec4 hi = imageLoad(bvh_top, trace_texel(2u * node + 1u));
-        uint count = floatBitsToUint(hi.w);
-        uint first = floatBitsToUint(lo.w);
         if (count > 0u) {
             for (uint k = first; k < first + count; ++k) {
                 if (trace_instance(k, origin, dir, t_min, any_hit, hit)) {
@@ -239,23 +229,21 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
         } else {
             uint left = node + 1u;
             uint right = first;
-            float tl = trace_top_box(left, origin, inv_dir, t_min, hit.t);
-            float tr = trace_top_box(right, origin, inv_dir, t_min, hit.t);
-            if (tl >= 0.0 && tr >= 0.0) {
-                bool left_first = tl <= tr;
-                if (sp < TRACE_TOP_STACK_SIZE) {
-                    stack[sp] = left_first ? right : left;
+            vec4 left_lo = imageLoad(bvh_top, trace_texel(2u * left));
+            vec4 left_hi = imageLoad(bvh_top, trace_texel(2u * left + 1u));
+            vec4 right_lo = imageLoad(bvh_top, trace_texel(2u * right));
+            vec4 right_hi = imageLoad(bvh_top, trace_texel(2u * right + 1u));
+            float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, hit.t);
+            float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, hit.t);
+            if (tl >= 0.0 || tr >= 0.0) {
+                bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
+                if (tl >= 0.0 && tr >= 0.0 && sp < TRACE_TOP_STACK_SIZE) {
+                    stack[sp] = go_left ? right : left;
                     sp += 1u;
                 }
-                node = left_first ? left : right;
-                continue;
-            }
-            if (tl >= 0.0) {
-                node = left;
-                continue;
-            }
-            if (tr >= 0.0) {
-                node = right;
+                node = go_left ? left : right;
+                first = floatBitsToUint(go_left ? left_lo.w : right_lo.w);
+                count = floatBitsToUint(go_left ? left_hi.w : right_hi.w);
                 continue;
             }
         }
@@ -264,6 +252,8 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
         }
         sp -= 1u;
         node = stack[sp];
+        first = floatBitsToUint(imageLoad(bvh_top, trace_texel(2u * node)).w);
+        count = floatBitsToUint(imageLoad(bvh_top, trace_texel(2u * node + 1u)).w);
     }
     return found;
 }
