@@ -318,7 +318,6 @@ impl GpuBvh {
             return Err(SceneUploadError::Empty);
         }
         let n = instance_count.max(1);
-        let texels = |bytes: usize| bytes.div_ceil(TEXEL_BYTES);
         let node = std::mem::size_of::<BvhNode>();
         Ok(Self {
             nodes: trace_image(device, "bvh nodes", bytemuck::cast_slice(&bottom.nodes))?,
@@ -327,7 +326,7 @@ impl GpuBvh {
                 "bvh triangles",
                 bytemuck::cast_slice(&bottom.triangles),
             )?,
-            top: trace_image(device, "bvh top", &vec![0; texels((2 * n - 1) * node) * 16])?,
+            top: trace_image(device, "bvh top", &vec![0; (2 * n - 1) * node])?,
             instances: trace_image(
                 device,
                 "bvh instances",
