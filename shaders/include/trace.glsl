@@ -104,6 +104,24 @@ vec3 trace_inverse(vec3 dir) {
     return 1.0 / safe;
 }
 
+// An interior node's step, shared by both levels, its children's texels loaded (the left child
+// is node `left`, the right `right`): when the ray meets either child's box, `node`, `first`
+// and `count` become the nearer one's, and `deferred` the other's if the ray meets it too
+// (0xffffffffu otherwise); false when it meets neither.
+bool trace_children(uint left, vec4 left_lo, vec4 left_hi, uint right, vec4 right_lo, vec4 right_hi, vec3 origin, vec3 inv_dir, float t_min, float t_max, inout uint node, inout uint first, inout uint count, out uint deferred) {
+    float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, t_max);
+    float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, t_max);
+    bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
+    deferred = tl >= 0.0 && tr >= 0.0 ? (go_left ? right : left) : 0xffffffffu;
+    if (tl < 0.0 && tr < 0.0) {
+        return false;
+    }
+    node = go_left ? left : right;
+    first = floatBitsToUint(go_left ? left_lo.w : right_lo.w);
+    count = floatBitsToUint(go_left ? left_hi.w : right_hi.w);
+    return true;
+}
+
 // Traverses one bottom level from `root` with a mesh-space ray; on a hit closer than hit.t
 // updates hit.t/u/v, sets `leaf` to the triangle's index in bvh_triangles and returns true.
 // With `any_hit` returns at the first hit found.
@@ -145,18 +163,13 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
             vec4 left_hi = imageLoad(bvh_nodes, trace_texel(2u * left + 1u));
             vec4 right_lo = imageLoad(bvh_nodes, trace_texel(2u * right));
             vec4 right_hi = imageLoad(bvh_nodes, trace_texel(2u * right + 1u));
-            float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, hit.t);
-            float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, hit.t);
-            if (tl >= 0.0 || tr >= 0.0) {
+            uint deferred;
+            if (trace_children(left, left_lo, left_hi, right, right_lo, right_hi, origin, inv_dir, t_min, hit.t, node, first, count, deferred)) {
                 // Into the nearer child hit; the other, if hit, waits on the stack.
-                bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
-                if (tl >= 0.0 && tr >= 0.0 && sp < TRACE_STACK_SIZE) {
-                    stack[sp] = go_left ? right : left;
+                if (deferred != 0xffffffffu && sp < TRACE_STACK_SIZE) {
+                    stack[sp] = deferred;
                     sp += 1u;
                 }
-                node = go_left ? left : right;
-                first = floatBitsToUint(go_left ? left_lo.w : right_lo.w);
-                count = floatBitsToUint(go_left ? left_hi.w : right_hi.w);
                 continue;
             }
         }
@@ -233,17 +246,13 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
             vec4 left_hi = imageLoad(bvh_top, trace_texel(2u * left + 1u));
             vec4 right_lo = imageLoad(bvh_top, trace_texel(2u * right));
             vec4 right_hi = imageLoad(bvh_top, trace_texel(2u * right + 1u));
-            float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, hit.t);
-            float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, hit.t);
-            if (tl >= 0.0 || tr >= 0.0) {
-                bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
-                if (tl >= 0.0 && tr >= 0.0 && sp < TRACE_TOP_STACK_SIZE) {
-                    stack[sp] = go_left ? right : left;
+            uint deferred;
+            if (trace_children(left, left_lo, left_hi, right, right_lo, right_hi, origin, inv_dir, t_min, hit.t, node, first, count, deferred)) {
+                // Into the nearer child hit; the other, if hit, waits on the stack.
+                if (deferred != 0xffffffffu && sp < TRACE_TOP_STACK_SIZE) {
+                    stack[sp] = deferred;
                     sp += 1u;
                 }
-                node = go_left ? left : right;
-                first = floatBitsToUint(go_left ? left_lo.w : right_lo.w);
-                count = floatBitsToUint(go_left ? left_hi.w : right_hi.w);
                 continue;
             }
         }
