@@ -7,12 +7,15 @@
 // through the BVH, aiming each shadow ray at the HVL's centre lifted off its surface by 1% of
 // its radius; a receiver inside an HVL's sphere is never shadowed from it.
 //   `_vis`: one ray per receiver and HVL, `indirect` the shadowed sum.
-//   `_shadows`: push.shadow_rays = K rays per receiver, to HVLs drawn in proportion to their
-//     weight w_j = (c_j.r + c_j.g + c_j.b) / 3 (c_j the HVL's light; K weighted reservoirs over the
-//     loop). With W the weight outside the spheres and W_in inside, the shadowed weight
-//       S = W_in + W * (visible rays / K)
-//     is unbiased; `unshadowed` holds (U, W_in + W) (U the unshadowed sum), `indirect`
-//     (U * min(1, S / (W_in + W)), S). hvl_shadow_filter.comp then returns
+//   `_shadows`: push.shadow_rays = K rays per receiver, one per stratum of the HVLs: stratum k
+//     holds HVLs k, k + K, k + 2K, ... (interleaved, so each is a thinned copy of the whole
+//     cache) and draws one of them in proportion to its weight w_j = (c_j.r + c_j.g + c_j.b) / 3
+//     (c_j the HVL's light; a one-item weighted reservoir over the stratum). With W_k the
+//     stratum's weight outside the spheres, V_k its drawn HVL's visibility and W_in the weight
+//     inside them, the shadowed weight
+//       S = W_in + sum_k W_k V_k
+//     is unbiased; `unshadowed` holds (U, W_in + W) (U the unshadowed sum, W = sum_k W_k),
+//     `indirect` (U * min(1, S / (W_in + W)), S). hvl_shadow_filter.comp then returns
 //     U * min(1, sum w S / sum w (W_in + W)) over the receivers around (the ratio estimator of
 //     Heitz et al. 2018): exactly U where nothing is in the way. Regathered receivers
 //     (amortised frames) are scattered and keep their own ratio.
@@ -198,6 +201,112 @@ void store_nothing(ivec2 px) {
 #endif
 }
 
+// What every pair of a receiver shares, set up once per receiver in main.
+struct Receiver {
+    vec3 x;
+    vec3 n;
+    vec3 kd;
+    vec3 ks;
+#ifdef HVL_FULL
+    // The receiver frame of the tables: z = n, omega_o in the xz half-plane (phi_o = 0, eq. 17).
+    vec3 t;
+    vec3 b;
+    // dot(window * cap, F) of a cap ZH rotated to d (sh_rotate_zh) is
+    //   sum_l cap_l win_l sqrt(4 pi / (2l + 1)) sum_m Y_lm(d) F_lm,
+    // so the rows take the per-band factors once per receiver. In the receiver frame Lambert's F
+    // is zonal and the glossy F even in phi (shine_sh::brdf_table tests): only m = 0, and
+    // m >= 0, are kept.
+    float lambert_zh[SH_BANDS];
+    float glossy_even[SH_EVEN_COEFFS];
+#else
+    float cc[SH_BANDS];
+    // The window's factor per band (1 without a window), applied to each HVL's cap.
+    float win[SH_BANDS];
+#endif
+#ifdef HVL_VISIBILITY
+    // Where the receiver's shadow rays start.
+    vec3 origin;
+#endif
+};
+
+// HVL j's light at the receiver towards the camera (eq. 1, 3, 19-22), 0 when it sends none
+// there (an empty cell, a receiver at its centre, a sender facing away, a cap below the
+// horizon; in `_vis`, a shadow ray blocked). `inside`: the receiver lies in its sphere.
+vec3 pair_light(Receiver rc, uint j, out bool inside) {
+    inside = false;
+    vec4 position_radius = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_POSITION_RADIUS));
+    float r = position_radius.w;
+    if (!(r > 0.0)) {
+        return vec3(0.0);
+    }
+    vec3 v = position_radius.xyz - rc.x;
+    float dist2 = dot(v, v);
+    if (dist2 < HVL_MIN_DISTANCE * HVL_MIN_DISTANCE) {
+        return vec3(0.0);
+    }
+    float inv_dist = inversesqrt(dist2);
+    float dist = dist2 * inv_dist;
+    inside = dist <= r;
+    vec3 wj = v * inv_dist;
+    // Eq. 21 in parts: the sender's cosine, then H (eq. 22).
+    vec4 normal_area = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_NORMAL_AREA));
+    vec3 hvl_normal = normal_area.xyz;
+    float facing = -dot(hvl_normal, wj);
+    if (!(facing > 0.0)) {
+        return vec3(0.0);
+    }
+    float cos_r = dot(rc.n, wj);
+    float cos_a;
+    float h = hvl_cap_terms(dist, r, cos_r, cos_a);
+    if (!(h > 0.0)) {
+        return vec3(0.0);
+    }
+    // hvl_geometric_factor_of(facing, h, r), its 1 / (pi r^2) from the record.
+    float g = facing * h * normal_area.w;
+#if defined(HVL_VISIBILITY) && !defined(HVL_SHADOW_SAMPLES)
+    if (!inside && trace_occluded_by(rc.origin, hvl_shadow_target(position_radius, hvl_normal))) {
+        return vec3(0.0);
+    }
+#endif
+    // The near field's share of the diffuse light is hvl_near.comp's.
+    float far = hvl_far_weight(dist, push.near_range);
+    vec4 flux_e0 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_FLUX_E0));
+    vec4 e14 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_EMISSION));
+    float e_poly[HVL_EMISSION_MAX_BANDS] = float[](flux_e0.w, e14.x, e14.y, e14.z, e14.w);
+    float e = max(0.0, hvl_poly_eval(e_poly, min(facing, 1.0)));
+    if (push.disc_falloff != 0u) {
+        e *= hvl_disc_falloff(dist, r);
+    }
+    vec3 lj = flux_e0.rgb * (e * g);
+    float cap[SH_BANDS];
+    sh_cap_zh(cos_a, cap);
+#ifdef HVL_FULL
+    // wj in the receiver frame is unit already (t, b, n orthonormal).
+    float y[SH_EVEN_COEFFS];
+    sh_basis_even(vec3(dot(wj, rc.t), dot(wj, rc.b), cos_r), y);
+    float diffuse = 0.0;
+    float glossy = 0.0;
+    SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+        float band = 0.0;
+        SH_UNROLL for (int m = 0; m < SH_BANDS; ++m) {
+            if (m > l) {
+                continue;
+            }
+            band += rc.glossy_even[l * (l + 1) / 2 + m] * y[l * (l + 1) / 2 + m];
+        }
+        diffuse += cap[l] * rc.lambert_zh[l] * y[l * (l + 1) / 2];
+        glossy += cap[l] * band;
+    }
+    // The near field's traced light is diffuse: the glossy lobe keeps all of the HVL.
+    return max(vec3(0.0), lj * (rc.kd * (far * diffuse) + rc.ks * glossy));
+#else
+    SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
+        cap[l] *= rc.win[l];
+    }
+    return max(vec3(0.0), lj * rc.kd * (far * hvl_zh_dot(cap, rc.cc, cos_r) / SH_PI));
+#endif
+}
+
 void main() {
     ivec2 px = amortise_pixel(gl_GlobalInvocationID.xy, push.slice);
     if (px.x >= int(push.extent.x) || px.y >= int(push.extent.y)) {
@@ -212,205 +321,104 @@ void main() {
         store_nothing(px);
         return;
     }
-    vec3 x = position.xyz;
-    vec3 n = normalize(imageLoad(recv_normal, px).xyz);
+    Receiver rc;
+    rc.x = position.xyz;
+    rc.n = normalize(imageLoad(recv_normal, px).xyz);
     vec3 albedo = imageLoad(recv_albedo, px).rgb;
     vec2 roughness_metallic = imageLoad(recv_material, px).rg;
     float metallic = roughness_metallic.y;
-    vec3 wo = normalize(push.camera.xyz - x);
-    float cos_o = dot(n, wo);
-    vec3 kd;
-    vec3 ks;
-    brdf_indirect_weights(albedo, metallic, cos_o, kd, ks);
-#ifdef HVL_FULL
-    ks = brdf_table_fresnel_weight(ks, cos_o) * (1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w));
-    if (cos_o <= 0.0) {
-        store_nothing(px);
-        return;
-    }
-    // Receiver frame of the tables: z = n, omega_o in the xz half-plane (phi_o = 0, eq. 17).
-    vec3 t = wo - n * cos_o;
-    if (dot(t, t) < 1e-12) {
-        t = abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
-        t -= n * dot(n, t);
-    }
-    t = normalize(t);
-    vec3 b = cross(n, t);
-    float theta_o = acos(min(cos_o, 1.0));
-    float f_lambert[SH_COEFFS];
-    float f_glossy[SH_COEFFS];
-    brdf_row(0, theta_o, f_lambert);
-    glossy_row(roughness_metallic.x, theta_o, f_glossy);
-#else
-    float cc[SH_BANDS];
-    sh_clamped_cosine_zh(cc);
-#endif
-    // The window's factor per band (1 without a window), applied to each HVL's cap.
+    vec3 wo = normalize(push.camera.xyz - rc.x);
+    float cos_o = dot(rc.n, wo);
+    brdf_indirect_weights(albedo, metallic, cos_o, rc.kd, rc.ks);
     float win[SH_BANDS];
     SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
         win[l] = push.window_width > 0.0 ? sh_window_sinc(l, push.window_width) : 1.0;
     }
 #ifdef HVL_FULL
-    // dot(window * cap, F) of a cap ZH rotated to d (sh_rotate_zh) is
-    //   sum_l cap_l win_l sqrt(4 pi / (2l + 1)) sum_m Y_lm(d) F_lm,
-    // so the rows take the per-band factors once per receiver. In the receiver frame (omega_o in
-    // the xz half-plane) Lambert's F is zonal and the glossy F even in phi (shine_sh::brdf_table
-    // tests): only m = 0, and m >= 0, are kept.
-    float lambert_zh[SH_BANDS];
-    float glossy_even[SH_EVEN_COEFFS];
+    rc.ks = brdf_table_fresnel_weight(rc.ks, cos_o) * (1.0 - specular_trace_weight(roughness_metallic.x, push.camera.w));
+    if (cos_o <= 0.0) {
+        store_nothing(px);
+        return;
+    }
+    vec3 t = wo - rc.n * cos_o;
+    if (dot(t, t) < 1e-12) {
+        t = abs(rc.n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0);
+        t -= rc.n * dot(rc.n, t);
+    }
+    rc.t = normalize(t);
+    rc.b = cross(rc.n, rc.t);
+    float theta_o = acos(min(cos_o, 1.0));
+    float f_lambert[SH_COEFFS];
+    float f_glossy[SH_COEFFS];
+    brdf_row(0, theta_o, f_lambert);
+    glossy_row(roughness_metallic.x, theta_o, f_glossy);
     SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
         float k = win[l] * sh_zh_factor(l);
-        lambert_zh[l] = k * f_lambert[l * l + l];
+        rc.lambert_zh[l] = k * f_lambert[l * l + l];
         SH_UNROLL for (int m = 0; m < SH_BANDS; ++m) {
             if (m > l) {
                 continue;
             }
-            glossy_even[l * (l + 1) / 2 + m] = k * f_glossy[l * l + l + m];
+            rc.glossy_even[l * (l + 1) / 2 + m] = k * f_glossy[l * l + l + m];
         }
     }
+#else
+    sh_clamped_cosine_zh(rc.cc);
+    rc.win = win;
 #endif
-    vec3 sum = vec3(0.0);
 #ifdef HVL_VISIBILITY
-    vec3 origin = trace_offset(x, n);
+    rc.origin = trace_offset(rc.x, rc.n);
 #endif
 #ifdef HVL_SHADOW_SAMPLES
     // The unshadowed sum and its weights (w_j = mean of c_j's channels), inside HVLs' spheres and
-    // outside, and the reservoirs: each keeps one HVL, all drawn over the same running weight.
+    // outside, and the weight the strata's rays found unblocked. The loops over HVLs carry no
+    // per-stratum arrays and each stratum's ray is traced after its loop: lavapipe runs every
+    // branch's and loop's code for every HVL whatever its condition (docs/pitfalls.md), so a
+    // reservoir update that runs rarely still costs every pair.
     vec3 unshadowed_sum = vec3(0.0);
     float weight_inside = 0.0;
     float weight_total = 0.0;
-    uint pick[HVL_SHADOW_RAYS_MAX];
-    SH_UNROLL for (int k = 0; k < HVL_SHADOW_RAYS_MAX; ++k) {
-        pick[k] = 0u;
-    }
-    int rays = int(clamp(push.shadow_rays, 1u, uint(HVL_SHADOW_RAYS_MAX)));
+    float weight_visible = 0.0;
+    uint strata = clamp(push.shadow_rays, 1u, uint(HVL_SHADOW_RAYS_MAX));
     rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y) + pcg(push.seed));
-#endif
-    for (uint j = 0u; j < push.hvl_count; ++j) {
-        vec4 position_radius = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_POSITION_RADIUS));
-        float r = position_radius.w;
-        if (!(r > 0.0)) {
-            continue;
+    for (uint stratum = 0u; stratum < strata; ++stratum) {
+        float weight = 0.0;
+        uint pick = 0u;
+        for (uint j = stratum; j < push.hvl_count; j += strata) {
+            bool inside;
+            vec3 c = pair_light(rc, j, inside);
+            unshadowed_sum += c;
+            float w = (c.r + c.g + c.b) * (1.0 / 3.0);
+            weight_inside += inside ? w : 0.0;
+            float w_out = inside ? 0.0 : w;
+            weight += w_out;
+            // The stratum's reservoir takes HVL j with probability w_j / (its weight so far).
+            pick = rand() * weight < w_out ? j : pick;
         }
-        vec3 v = position_radius.xyz - x;
-        float dist2 = dot(v, v);
-        if (dist2 < HVL_MIN_DISTANCE * HVL_MIN_DISTANCE) {
-            continue;
-        }
-        float inv_dist = inversesqrt(dist2);
-        float dist = dist2 * inv_dist;
-        vec3 wj = v * inv_dist;
-        // Eq. 21 in parts: the sender's cosine, then H (eq. 22).
-        vec4 normal_area = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_NORMAL_AREA));
-        vec3 hvl_normal = normal_area.xyz;
-        float facing = -dot(hvl_normal, wj);
-        if (!(facing > 0.0)) {
-            continue;
-        }
-        float cos_r = dot(n, wj);
-        float cos_a;
-        float h = hvl_cap_terms(dist, r, cos_r, cos_a);
-        if (!(h > 0.0)) {
-            continue;
-        }
-        // hvl_geometric_factor_of(facing, h, r), its 1 / (pi r^2) from the record.
-        float g = facing * h * normal_area.w;
-#if defined(HVL_VISIBILITY) && !defined(HVL_SHADOW_SAMPLES)
-        if (dist > r && trace_occluded_by(origin, hvl_shadow_target(position_radius, hvl_normal))) {
-            continue;
-        }
-#endif
-        // The near field's share of the diffuse light is hvl_near.comp's.
-        float far = hvl_far_weight(dist, push.near_range);
-        vec4 flux_e0 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_FLUX_E0));
-        vec4 e14 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_EMISSION));
-        float e_poly[HVL_EMISSION_MAX_BANDS] = float[](flux_e0.w, e14.x, e14.y, e14.z, e14.w);
-        float e = max(0.0, hvl_poly_eval(e_poly, min(facing, 1.0)));
-        if (push.disc_falloff != 0u) {
-            e *= hvl_disc_falloff(dist, r);
-        }
-        vec3 lj = flux_e0.rgb * (e * g);
-        float cap[SH_BANDS];
-        sh_cap_zh(cos_a, cap);
-#ifdef HVL_FULL
-        // wj in the receiver frame is unit already (t, b, n orthonormal).
-        float y[SH_EVEN_COEFFS];
-        sh_basis_even(vec3(dot(wj, t), dot(wj, b), cos_r), y);
-        float diffuse = 0.0;
-        float glossy = 0.0;
-        SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
-            float band = 0.0;
-            SH_UNROLL for (int m = 0; m < SH_BANDS; ++m) {
-                if (m > l) {
-                    continue;
-                }
-                band += glossy_even[l * (l + 1) / 2 + m] * y[l * (l + 1) / 2 + m];
-            }
-            diffuse += cap[l] * lambert_zh[l] * y[l * (l + 1) / 2];
-            glossy += cap[l] * band;
-        }
-        // The near field's traced light is diffuse: the glossy lobe keeps all of the HVL.
-        vec3 c = max(vec3(0.0), lj * (kd * (far * diffuse) + ks * glossy));
-#else
-        SH_UNROLL for (int l = 0; l < SH_BANDS; ++l) {
-            cap[l] *= win[l];
-        }
-        vec3 c = max(vec3(0.0), lj * kd * (far * hvl_zh_dot(cap, cc, cos_r) / SH_PI));
-#endif
-#ifdef HVL_SHADOW_SAMPLES
-        unshadowed_sum += c;
-        float w = (c.r + c.g + c.b) * (1.0 / 3.0);
-        if (dist <= r) {
-            weight_inside += w;
-            continue;
-        }
-        if (!(w > 0.0)) {
-            continue;
-        }
-        weight_total += w;
-        // One random number u per HVL, rotated by k / K for reservoir k (each uniform on its
-        // own): reservoir k takes HVL j when fract(u + k / K) < p = w / W. The rotated values
-        // are s + m / K (s = fract(u K) / K, m = 0..K-1, reservoir k = (m - floor(u K)) mod K),
-        // so the first ceil((p - s) K) of them take it: no loop over reservoirs that do not.
-        float p = w / weight_total;
-        float uk = rand() * float(rays);
-        float s = fract(uk) / float(rays);
-        int takers = p > s ? min(rays, int(ceil((p - s) * float(rays)))) : 0;
-        int base = int(uk);
-        // Usually none or one (p falls below 1/K after the first few HVLs), so the loop adds
-        // little to lavapipe's loop limiter (tests/hvl.rs runs it over 10 000 lit HVLs). One
-        // loop, not a first store before it: lavapipe runs a branch's stores whatever its
-        // condition (docs/pitfalls.md). (m - base) mod K without an integer division
-        // (0 <= base < K, 0 <= m < K).
-        for (int m = 0; m < takers; ++m) {
-            int k = m - base;
-            pick[k < 0 ? k + rays : k] = j;
-        }
-#else
-        sum += c;
-#endif
-    }
-#ifdef HVL_SHADOW_SAMPLES
-    // The shadowed weight: the HVLs the receiver is inside of, plus the drawn ones' visibility.
-    float visible = 0.0;
-    if (weight_total > 0.0) {
-        for (int k = 0; k < rays; ++k) {
-            uint j = pick[k];
-            vec4 position_radius = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_POSITION_RADIUS));
-            vec3 hvl_normal = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_NORMAL_AREA)).xyz;
+        if (weight > 0.0) {
+            vec4 position_radius = imageLoad(hvl_records, hvl_record_texel(pick, HVL_RECORD_POSITION_RADIUS));
+            vec3 hvl_normal = imageLoad(hvl_records, hvl_record_texel(pick, HVL_RECORD_NORMAL_AREA)).xyz;
             vec3 target = hvl_shadow_target(position_radius, hvl_normal);
-            visible += trace_occluded_by(origin, target) ? 0.0 : 1.0;
+            weight_visible += trace_occluded_by(rc.origin, target) ? 0.0 : weight;
         }
+        weight_total += weight;
     }
-    float shadowed_weight = weight_inside + weight_total * (visible / float(rays));
+    // The shadowed weight: the HVLs the receiver is inside of, plus the strata's visible weight.
+    float shadowed_weight = weight_inside + weight_visible;
     float unshadowed_weight = weight_inside + weight_total;
     // The receiver's own ratio; scattered regathered receivers (amortised frames) have no
     // refreshed neighbours to filter with and keep it, the history smooths it.
-    sum = unshadowed_weight > 0.0 ? unshadowed_sum * min(1.0, shadowed_weight / unshadowed_weight) : vec3(0.0);
+    vec3 sum = unshadowed_weight > 0.0 ? unshadowed_sum * min(1.0, shadowed_weight / unshadowed_weight) : vec3(0.0);
     imageStore(unshadowed, px, vec4(unshadowed_sum, unshadowed_weight));
     if (push.slice != AMORTISE_REGATHER_SLICE) {
         imageStore(indirect, px, vec4(sum, shadowed_weight));
         return;
+    }
+#else
+    vec3 sum = vec3(0.0);
+    for (uint j = 0u; j < push.hvl_count; ++j) {
+        bool inside;
+        sum += pair_light(rc, j, inside);
     }
 #endif
     imageStore(indirect, px, vec4(sum, 0.0));

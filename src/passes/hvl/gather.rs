@@ -264,7 +264,8 @@ pub fn hvl_gather_prep(
 ///   (`b (b + 1) + 5 b`);
 /// - zonal path: the Legendre recurrence at the receiver's cosine and the ZH product,
 ///   `5 (b - 1) + 3 b`;
-/// - sampled shadows add the reservoir, 15 per pair.
+/// - sampled shadows add the unshadowed sum and weights and the stratum's reservoir (the mean
+///   weight, its sums, the random number's scale and the take test), 10 per pair.
 ///
 /// Every pair is counted as lit: a SIMD group runs the whole path whenever one of its lanes
 /// does. The shadow rays' traversal is not counted (it depends on the scene's BVH).
@@ -277,7 +278,7 @@ pub fn gather_pair_flops(path: GatherPath, b: u32, sampled_shadows: bool) -> u64
         }
         GatherPath::Zonal => 5 * (b - 1) + 3 * b,
     };
-    75 + cap + specific + if sampled_shadows { 15 } else { 0 }
+    75 + cap + specific + if sampled_shadows { 10 } else { 0 }
 }
 
 /// The gather's [`PassCost`] over `receivers` receivers: `receivers × count ×`

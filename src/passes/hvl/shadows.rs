@@ -5,10 +5,12 @@
 //! too bright, because the boxes hide the floor's HVLs from half the room. One shadow ray per
 //! receiver and HVL ([`ShadowSampling::rays`] = 0, the `_vis` variants) fixes the energy but
 //! multiplies the gather's cost by about 10 on lavapipe (400 rays per receiver). With
-//! `rays = K`, the gather (`shaders/hvl_gather.comp`, `_shadows` variants) draws K HVLs per
-//! receiver in proportion to their weight `w_j` (the mean of their light's channels; weighted
-//! reservoirs over its loop) and traces only those, giving an unbiased, noisy shadowed weight
-//! `S` beside the exact unshadowed light `U` and its weight `W_u`. The filter
+//! `rays = K`, the gather (`shaders/hvl_gather.comp`, `_shadows` variants) splits the HVLs into
+//! K interleaved strata (HVLs k, k + K, k + 2K, …), draws one HVL of each in proportion to its
+//! weight `w_j` (the mean of its light's channels; a one-item weighted reservoir over the
+//! stratum's loop) and traces only those: `S = W_in + Σ_k W_k V_k` (`W_k` a stratum's weight,
+//! `V_k` its drawn HVL's visibility, `W_in` the weight of HVLs the receiver is inside of) is an
+//! unbiased, noisy shadowed weight beside the exact unshadowed light `U` and its weight `W_u`. The filter
 //! (`shaders/hvl_shadow_filter.comp`) then returns `U · min(1, Σ w S / Σ w W_u)` over the
 //! receivers around each one: exactly `U` where nothing is in the way (a scalar ratio: the
 //! shadows take the light's colour, not the hidden HVLs' own). This is the ratio estimator of
