@@ -227,6 +227,10 @@ struct Receiver {
     // Where the receiver's shadow rays start.
     vec3 origin;
 #endif
+    // push.near_range and push.disc_falloff, read once per receiver: llvmpipe loads a push
+    // constant read inside a loop lane by lane at every iteration (docs/pitfalls.md).
+    float near_range;
+    bool disc_falloff;
 };
 
 // HVL j's light at the receiver towards the camera (eq. 1, 3, 19-22), 0 when it sends none
@@ -269,12 +273,12 @@ vec3 pair_light(Receiver rc, uint j, out bool inside) {
     }
 #endif
     // The near field's share of the diffuse light is hvl_near.comp's.
-    float far = hvl_far_weight(dist, push.near_range);
+    float far = hvl_far_weight(dist, rc.near_range);
     vec4 flux_e0 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_FLUX_E0));
     vec4 e14 = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_EMISSION));
     float e_poly[HVL_EMISSION_MAX_BANDS] = float[](flux_e0.w, e14.x, e14.y, e14.z, e14.w);
     float e = max(0.0, hvl_poly_eval(e_poly, min(facing, 1.0)));
-    if (push.disc_falloff != 0u) {
+    if (rc.disc_falloff) {
         e *= hvl_disc_falloff(dist, r);
     }
     vec3 lj = flux_e0.rgb * (e * g);
@@ -322,6 +326,8 @@ void main() {
         return;
     }
     Receiver rc;
+    rc.near_range = push.near_range;
+    rc.disc_falloff = push.disc_falloff != 0u;
     rc.x = position.xyz;
     rc.n = normalize(imageLoad(recv_normal, px).xyz);
     vec3 albedo = imageLoad(recv_albedo, px).rgb;
@@ -379,12 +385,13 @@ void main() {
     float weight_inside = 0.0;
     float weight_total = 0.0;
     float weight_visible = 0.0;
+    uint hvl_count = push.hvl_count;
     uint strata = clamp(push.shadow_rays, 1u, uint(HVL_SHADOW_RAYS_MAX));
     rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y) + pcg(push.seed));
     for (uint stratum = 0u; stratum < strata; ++stratum) {
         float weight = 0.0;
         uint pick = 0u;
-        for (uint j = stratum; j < push.hvl_count; j += strata) {
+        for (uint j = stratum; j < hvl_count; j += strata) {
             bool inside;
             vec3 c = pair_light(rc, j, inside);
             unshadowed_sum += c;
@@ -416,7 +423,8 @@ void main() {
     }
 #else
     vec3 sum = vec3(0.0);
-    for (uint j = 0u; j < push.hvl_count; ++j) {
+    uint hvl_count = push.hvl_count;
+    for (uint j = 0u; j < hvl_count; ++j) {
         bool inside;
         sum += pair_light(rc, j, inside);
     }
