@@ -44,14 +44,19 @@ layout(push_constant) uniform Push {
     vec4 pad;
 } push;
 
-#define PATH_LIGHT_COUNT push.config.y
-#define PATH_FLAGS push.config.z
+// The push constants the loops read, read once per invocation in main: llvmpipe loads a push
+// constant read inside a loop lane by lane at every iteration (docs/pitfalls.md).
+uint path_light_count;
+uint path_flags;
+#define PATH_LIGHT_COUNT path_light_count
+#define PATH_FLAGS path_flags
 #include "path.glsl"
 #define LIGHT_TABLES_BINDING 14
 #include "light_sampling.glsl"
 
-vec3 unproject(vec2 ndc, float z) {
-    vec4 p = push.inv_view_proj * vec4(ndc, z, 1.0);
+// The point at clip-space (ndc, z) in the world; `inv_view_proj` is push.inv_view_proj.
+vec3 unproject(mat4 inv_view_proj, vec2 ndc, float z) {
+    vec4 p = inv_view_proj * vec4(ndc, z, 1.0);
     return p.xyz / p.w;
 }
 
@@ -71,25 +76,31 @@ vec3 light_contribution(Vertex x, vec3 v, vec3 from, vec3 l, float t_max, vec3 r
 
 void main() {
     uvec2 pixel = gl_GlobalInvocationID.xy;
-    uvec2 extent = push.frame.xy;
+    uvec4 frame = push.frame;
+    uvec4 config = push.config;
+    mat4 inv_view_proj = push.inv_view_proj;
+    uvec2 extent = frame.xy;
     if (any(greaterThanEqual(pixel, extent))) {
         return;
     }
-    uint bounces = push.config.x;
-    uint flags = push.config.z;
+    path_light_count = config.y;
+    path_flags = config.z;
+    uint bounces = config.x;
+    uint flags = config.z;
     bool sample_lights = (flags & PT_LIGHT_SAMPLING) != 0u;
     bool sample_emitters = sample_lights && (flags & PT_EMISSIVE_LIGHTING) != 0u && light_emitter_count() > 0u;
     bool sample_environment = sample_lights && light_environment_on();
     vec3 sum_direct = vec3(0.0);
     vec3 sum_indirect = vec3(0.0);
-    for (uint s = 0u; s < push.frame.w; ++s) {
-        uint sample_index = push.frame.z + s;
-        rng_state = pcg(pcg(pcg(pixel.x ^ pcg(push.config.w)) + pixel.y) + sample_index);
+    uint seed = pcg(config.w);
+    for (uint s = 0u; s < frame.w; ++s) {
+        uint sample_index = frame.z + s;
+        rng_state = pcg(pcg(pcg(pixel.x ^ seed) + pixel.y) + sample_index);
         vec2 jitter = (flags & PT_JITTER) != 0u ? vec2(rand(), rand()) : vec2(0.5);
         vec2 ndc = (vec2(pixel) + jitter) / vec2(extent) * 2.0 - 1.0;
-        vec3 near = unproject(ndc, 0.0);
+        vec3 near = unproject(inv_view_proj, ndc, 0.0);
         vec3 origin = near;
-        vec3 dir = normalize(unproject(ndc, 0.5) - near);
+        vec3 dir = normalize(unproject(inv_view_proj, ndc, 0.5) - near);
         vec3 throughput = vec3(1.0);
         vec3 direct = vec3(0.0);
         vec3 indirect = vec3(0.0);
@@ -174,7 +185,7 @@ void main() {
     }
     uint plane = extent.x * extent.y;
     uint p = pixel.y * extent.x + pixel.x;
-    float count = float(push.frame.w);
+    float count = float(frame.w);
     accumulation.a[p] += vec4(sum_direct, count);
     accumulation.a[plane + p] += vec4(sum_indirect, count);
     accumulation.a[2u * plane + p] += vec4(sum_direct + sum_indirect, count);
