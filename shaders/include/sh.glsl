@@ -427,25 +427,46 @@ float hvl_cap_half_angle(float distance, float radius) {
     return SH_PI - 0.5 * SH_PI * distance / radius;
 }
 
+// asin(x) by Abramowitz and Stegun 4.4.46, pi/2 - sqrt(1 - |x|) (a0 + a1 |x| + ... + a7 |x|^7)
+// with the sign of x: error below 2e-8 before float rounding, and no division (Mesa lowers
+// GLSL's asin to two polynomials, a division and a select, all of which lavapipe runs).
+float hvl_asin(float x) {
+    float a = abs(x);
+    float p = -0.0012624911;
+    p = p * a + 0.0066700901;
+    p = p * a - 0.0170881256;
+    p = p * a + 0.0308918810;
+    p = p * a - 0.0501743046;
+    p = p * a + 0.0889789874;
+    p = p * a - 0.2145988016;
+    p = p * a + 1.5707963050;
+    float r = 0.5 * SH_PI - sqrt(max(0.0, 1.0 - a)) * p;
+    return x < 0.0 ? -r : r;
+}
+
+// cos(pi t / 2) for t in [0, 1]: its Taylor series in y = pi t / 2 to y^10 (error below 5e-7).
+float hvl_cos_half_pi(float t) {
+    float y = 0.5 * SH_PI * t;
+    float y2 = y * y;
+    return 1.0 + y2 * (-1.0 / 2.0 + y2 * (1.0 / 24.0 + y2 * (-1.0 / 720.0 + y2 * (1.0 / 40320.0 - y2 / 3628800.0))));
+}
+
 // shine_sh::hvl::cap_terms: returns H (eq. 22) and sets cos_a to the cosine of
-// hvl_cap_half_angle, without trigonometry outside the sphere for caps wholly above
-// (cos_angle >= r/d = sin a) or below (cos_angle <= -sin a) the receiver's horizon.
+// hvl_cap_half_angle, the same formulas in one branch-free form: lavapipe runs every branch
+// whatever its condition (docs/pitfalls.md), so the twin's early-outs would save nothing
+// there, and GLSL's asin, acos and cos cost it more than the polynomials here. With
+// theta = acos(c), pi/2 - theta = asin(c), so eq. 22's argument is (a + asin(c)) / 2a, clamped
+// to [0, 1]: caps wholly above the horizon (c >= sin a) give 1 and wholly below (c <= -sin a) 0.
+// Outside the sphere a = asin(r/d) and cos a = sqrt(1 - (r/d)^2); inside, a >= pi/2 is clamped
+// to pi/2 = asin(1) in H, and cos a = cos(pi - (pi/2) d/r) = -cos((pi/2) d/r).
 float hvl_cap_terms(float distance, float radius, float cos_angle, out float cos_a) {
-    if (distance >= radius) {
-        float s = radius / distance;
-        cos_a = sqrt(max(0.0, 1.0 - s * s));
-        if (cos_angle >= s) {
-            return 1.0;
-        }
-        if (cos_angle <= -s) {
-            return 0.0;
-        }
-    }
-    float a = hvl_cap_half_angle(distance, radius);
-    if (distance < radius) {
-        cos_a = cos(a);
-    }
-    return hvl_hemisphere_cap_fraction(cos_angle, a);
+    bool outside = distance >= radius;
+    // r/d outside, d/r inside.
+    float q = min(distance, radius) / max(distance, radius);
+    float s = outside ? q : 1.0;
+    cos_a = outside ? sqrt(max(0.0, 1.0 - s * s)) : -hvl_cos_half_pi(q);
+    float a = max(hvl_asin(s), 1e-9);
+    return smoothstep(0.0, 1.0, 0.5 + hvl_asin(clamp(cos_angle, -1.0, 1.0)) / (2.0 * a));
 }
 
 // shine_sh::hvl::geometric_factor_of: eq. 21 from its parts, facing * H / (pi r^2)
