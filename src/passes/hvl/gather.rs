@@ -254,9 +254,12 @@ pub fn hvl_gather_prep(
 /// Floating-point operations of one receiver–HVL pair, counted from `hvl_gather.comp` (a fused
 /// multiply-add is two, a square root, reciprocal or division one) for `b` convolution bands:
 ///
-/// - common to both paths, 75: the vector to the HVL and its length (14), the two cosines (11),
-///   the cap terms outside the sphere (4), G (2), the near field's weight (7), the emission
-///   polynomial (9), the light L_j (4), the clamped contribution and its sum (24);
+/// - common to both paths, 130: the vector to the HVL and its length (14), the two cosines
+///   (11), the cap terms (59: `hvl_cap_terms` runs all of its branch-free form for every pair —
+///   two 7-term `asin` polynomials with their square roots (36), the inside cosine's
+///   polynomial (12), r/d, cos a, eq. 22's argument and smoothstep (11)), G (2), the near
+///   field's weight (7), the emission polynomial (9), the light L_j (4), the clamped
+///   contribution and its sum (24);
 /// - the cap's ZH, `7 (b - 1) + 2`: the Legendre recurrence (5 per band) and the ZH (2 per band);
 /// - full path: the direction in the receiver frame (10), the basis at m ≥ 0
 ///   (`7 (b - 1) + 3.5 b (b - 1) / 2 + b (b - 1)`: the (x + iy)^m recurrence, the normalised
@@ -278,7 +281,7 @@ pub fn gather_pair_flops(path: GatherPath, b: u32, sampled_shadows: bool) -> u64
         }
         GatherPath::Zonal => 5 * (b - 1) + 3 * b,
     };
-    75 + cap + specific + if sampled_shadows { 10 } else { 0 }
+    130 + cap + specific + if sampled_shadows { 10 } else { 0 }
 }
 
 /// The gather's [`PassCost`] over `receivers` receivers: `receivers × count ×`
