@@ -12,7 +12,10 @@
 // weighted by the power heuristic. A contribution that scattered once is direct, more than
 // once is indirect; what the camera sees unscattered (emission, background) is direct. `bounces` B
 // vertices after the first scatter further (B = 1: one-bounce indirect, what the GI techniques
-// compute). No Russian roulette, no clamping; a non-finite sample is dropped.
+// compute). No Russian roulette, no clamping; a non-finite sample is dropped. Variants:
+// `environment` samples the environment when its tables say so, `no_environment` never does.
+//! variant no_environment PT_ENVIRONMENT_SAMPLING=0
+//! variant environment PT_ENVIRONMENT_SAMPLING=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
@@ -89,7 +92,14 @@ void main() {
     uint flags = config.z;
     bool sample_lights = (flags & PT_LIGHT_SAMPLING) != 0u;
     bool sample_emitters = sample_lights && (flags & PT_EMISSIVE_LIGHTING) != 0u && light_emitter_count() > 0u;
+#if PT_ENVIRONMENT_SAMPLING
     bool sample_environment = sample_lights && light_environment_on();
+#else
+    // The `no_environment` variant, for light tables that do not sample the environment
+    // (src/passes/path_trace.rs): none of that code in the loop, where lavapipe would run it
+    // for every vertex whatever its condition (23% of the sample loop's instructions).
+    const bool sample_environment = false;
+#endif
     vec3 sum_direct = vec3(0.0);
     vec3 sum_indirect = vec3(0.0);
     uint seed = pcg(config.w);

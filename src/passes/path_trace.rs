@@ -61,6 +61,11 @@ pub struct PathTraceParams {
     pub first_sample: u32,
     /// Samples per pixel added by this dispatch.
     pub samples: u32,
+    /// Whether the light tables sample the environment
+    /// ([`crate::reference::light_tables::LightTables::environment`]): picks the shader variant
+    /// that holds that code (lavapipe runs a branch's code whatever its condition, so the
+    /// variant without it is about 7% faster on scenes that do not need it).
+    pub environment_sampling: bool,
 }
 
 /// Adds one progressive `path_trace` dispatch accumulating into `accumulation` (at least
@@ -90,7 +95,12 @@ pub fn path_trace(
         ],
         pad: [0.0; 4],
     };
-    let mut pass = rg.compute("path_trace", &shaders::PATH_TRACE_COMP);
+    let shader = if params.environment_sampling {
+        &shaders::PATH_TRACE_COMP_ENVIRONMENT
+    } else {
+        &shaders::PATH_TRACE_COMP_NO_ENVIRONMENT
+    };
+    let mut pass = rg.compute("path_trace", shader);
     scene.trace.bind(&mut pass);
     pass.read("materials", &scene.materials)
         .read("srgb_textures", &scene.srgb_textures)

@@ -136,6 +136,8 @@ pub struct PathTracer {
     scene: GpuScene,
     environment: Image,
     light_tables: Buffer,
+    /// [`LightTables::environment`] of `light_tables`.
+    environment_sampling: bool,
     texture_sampler: Sampler,
     environment_sampler: Sampler,
     accumulation: Buffer,
@@ -156,10 +158,11 @@ impl PathTracer {
         let gpu_scene = GpuScene::upload(device, scene, t)?;
         let texels = crate::gpu_scene::environment::bake(scene.environment.as_ref());
         let environment = crate::gpu_scene::environment::upload_baked(device, &texels)?;
+        let tables = light_tables_of(scene, &gpu_scene, &texels)?;
         let light_tables = Buffer::storage_with_data(
             device,
             "light tables",
-            bytemuck::cast_slice(light_tables_of(scene, &gpu_scene, &texels)?.words()),
+            bytemuck::cast_slice(tables.words()),
         )?;
         let sampler = |u, v| {
             Sampler::new(
@@ -193,6 +196,7 @@ impl PathTracer {
             scene: gpu_scene,
             environment,
             light_tables,
+            environment_sampling: tables.environment,
             texture_sampler: sampler(
                 vk::SamplerAddressMode::REPEAT,
                 vk::SamplerAddressMode::REPEAT,
@@ -275,6 +279,7 @@ impl PathTracer {
             seed: self.params.seed,
             first_sample: self.samples,
             samples,
+            environment_sampling: self.environment_sampling,
         };
         path_trace::path_trace(
             &mut rg,
