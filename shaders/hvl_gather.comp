@@ -1,11 +1,11 @@
 // HVL gather (paper 003 §5.1, eq. 1, 3, 19-22): outgoing radiance towards the camera at each
 // receiver from every HVL of the cache (brute force, as the paper's prototype), read as the
-// records hvl_gather_prep.comp wrote (per-HVL terms computed once). Per pair, no trigonometry
-// unless the HVL's cap straddles the receiver's horizon (hvl_cap_terms), and the cap meets the
-// BRDF rows in their m >= 0 half only (see the receiver set-up in main). As published,
-// HVLs are unshadowed (§6). The `_vis` and `_shadows` variants (shine's extension) shadow them
-// through the BVH, aiming each shadow ray at the HVL's centre lifted off its surface by 1% of
-// its radius; a receiver inside an HVL's sphere is never shadowed from it.
+// records hvl_gather_prep.comp wrote (per-HVL terms computed once). Per pair, no GLSL
+// trigonometry (hvl_cap_terms evaluates eq. 22 with polynomials, branch-free: lavapipe runs
+// every branch), and the cap meets the BRDF rows in their m >= 0 half only (see Receiver).
+// As published, HVLs are unshadowed (§6). The `_vis` and `_shadows` variants (shine's
+// extension) shadow them through the BVH, aiming each shadow ray at the HVL's centre lifted off
+// its surface by 1% of its radius; a receiver inside an HVL's sphere is never shadowed from it.
 //   `_vis`: one ray per receiver and HVL, `indirect` the shadowed sum.
 //   `_shadows`: push.shadow_rays = K rays per receiver, one per stratum of the HVLs: stratum k
 //     holds HVLs k, k + K, k + 2K, ... (interleaved, so each is a thinned copy of the whole
