@@ -375,6 +375,8 @@ void main() {
 #ifdef HVL_VISIBILITY
     rc.origin = trace_offset(rc.x, rc.n);
 #endif
+    // The loops' bound, read once (a push constant: see Receiver.near_range).
+    uint hvl_count = push.hvl_count;
 #ifdef HVL_SHADOW_SAMPLES
     // The unshadowed sum and its weights (w_j = mean of c_j's channels), inside HVLs' spheres and
     // outside, and the weight the strata's rays found unblocked. The loops over HVLs carry no
@@ -385,7 +387,6 @@ void main() {
     float weight_inside = 0.0;
     float weight_total = 0.0;
     float weight_visible = 0.0;
-    uint hvl_count = push.hvl_count;
     uint strata = clamp(push.shadow_rays, 1u, uint(HVL_SHADOW_RAYS_MAX));
     rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y) + pcg(push.seed));
     for (uint stratum = 0u; stratum < strata; ++stratum) {
@@ -423,7 +424,6 @@ void main() {
     }
 #else
     vec3 sum = vec3(0.0);
-    uint hvl_count = push.hvl_count;
     for (uint j = 0u; j < hvl_count; ++j) {
         bool inside;
         sum += pair_light(rc, j, inside);

@@ -89,9 +89,8 @@ void main() {
     path_light_count = config.y;
     path_flags = config.z;
     uint bounces = config.x;
-    uint flags = config.z;
-    bool sample_lights = (flags & PT_LIGHT_SAMPLING) != 0u;
-    bool sample_emitters = sample_lights && (flags & PT_EMISSIVE_LIGHTING) != 0u && light_emitter_count() > 0u;
+    bool sample_lights = (path_flags & PT_LIGHT_SAMPLING) != 0u;
+    bool sample_emitters = sample_lights && (path_flags & PT_EMISSIVE_LIGHTING) != 0u && light_emitter_count() > 0u;
 #if PT_ENVIRONMENT_SAMPLING
     bool sample_environment = sample_lights && light_environment_on();
 #else
@@ -106,7 +105,7 @@ void main() {
     for (uint s = 0u; s < frame.w; ++s) {
         uint sample_index = frame.z + s;
         rng_state = pcg(pcg(pcg(pixel.x ^ seed) + pixel.y) + sample_index);
-        vec2 jitter = (flags & PT_JITTER) != 0u ? vec2(rand(), rand()) : vec2(0.5);
+        vec2 jitter = (path_flags & PT_JITTER) != 0u ? vec2(rand(), rand()) : vec2(0.5);
         vec2 ndc = (vec2(pixel) + jitter) / vec2(extent) * 2.0 - 1.0;
         vec3 near = unproject(inv_view_proj, ndc, 0.0);
         vec3 origin = near;
@@ -133,7 +132,7 @@ void main() {
             vec3 v = -dir;
             if (scatters == 0u) {
                 direct += x.s.emissive;
-            } else if ((flags & PT_EMISSIVE_LIGHTING) != 0u && any(greaterThan(x.s.emissive, vec3(0.0)))) {
+            } else if ((path_flags & PT_EMISSIVE_LIGHTING) != 0u && any(greaterThan(x.s.emissive, vec3(0.0)))) {
                 float w = sample_emitters ? light_mis(last_pdf, light_triangle_pdf(hit.triangle, origin, x.position)) : 1.0;
                 if (scatters == 1u) {
                     direct += w * throughput * x.s.emissive;
@@ -170,7 +169,7 @@ void main() {
             vec3 n = x.s.normal;
             vec3 l;
             vec3 weight;
-            if ((flags & PT_LAMBERT_ONLY) != 0u) {
+            if ((path_flags & PT_LAMBERT_ONLY) != 0u) {
                 l = sample_cosine(n, xi.xy);
                 weight = x.s.base_color;
                 last_pdf = max(dot(n, l), 0.0) / BRDF_PI;
