@@ -3,13 +3,14 @@
 // lights and BRDF of the raster passes. Each dispatch adds `frame.w` samples per pixel to the
 // sums in `accumulation` (planes direct | indirect | full, w = samples so far).
 //
-// Path: the camera ray hits vertex 0; at every vertex the punctual lights are sampled
-// (next-event estimation, shadow rays through trace.glsl) and the BRDF is importance-sampled
-// (Lambert + GGX mixture, brdf.glsl) for the next ray, which gathers emission and the
-// environment where it lands. With PT_LIGHT_SAMPLING the emissive triangles (when they light
-// the scene: PT_EMISSIVE_LIGHTING) and the environment (when its tables say it has peaks) are
-// also sampled at every vertex (light_sampling.glsl), and both estimates of their light are
-// weighted by the power heuristic. A contribution that scattered once is direct, more than
+// Path: the camera ray hits vertex 0; at every vertex one light is sampled (next-event
+// estimation with one shadow ray through trace.glsl), chosen uniformly among the punctual
+// lights and, with PT_LIGHT_SAMPLING, the emissive triangles as one choice (when they light
+// the scene: PT_EMISSIVE_LIGHTING) and the environment (when its tables say it has peaks;
+// light_sampling.glsl); then the BRDF is importance-sampled (Lambert + GGX mixture, brdf.glsl)
+// for the next ray, which gathers emission and the environment where it lands. Both estimates
+// of an area light's light are weighted by the power heuristic, the light's density including
+// the probability of its choice. A contribution that scattered once is direct, more than
 // once is indirect; what the camera sees unscattered (emission, background) is direct. `bounces` B
 // vertices after the first scatter further (B = 1: one-bounce indirect, what the GI techniques
 // compute). No Russian roulette, no clamping; a non-finite sample is dropped. Variants:
@@ -64,9 +65,11 @@ vec3 unproject(mat4 inv_view_proj, vec2 ndc, float z) {
 }
 
 // One light sample's contribution at x (times the path's throughput): the BRDF, the cosine
-// and the radiance over the light's density, weighted against BRDF sampling; 0 when l is
-// below either normal or the shadow ray from `from` meets something before `t_max`.
-vec3 light_contribution(Vertex x, vec3 v, vec3 from, vec3 l, float t_max, vec3 radiance, float pdf) {
+// and the radiance over the density of its choice, weighted against BRDF sampling when the
+// light has an area (`area`; a punctual light's `radiance` is its irradiance and `pdf` the
+// probability of choosing it); 0 when l is below either normal or the shadow ray from `from`
+// meets something before `t_max`.
+vec3 light_contribution(Vertex x, vec3 v, vec3 from, vec3 l, float t_max, vec3 radiance, float pdf, bool area) {
     float nl = dot(x.s.normal, l);
     if (!(pdf > 0.0) || nl <= 0.0 || dot(x.geometric_normal, l) <= 0.0 || all(equal(radiance, vec3(0.0)))) {
         return vec3(0.0);
@@ -74,7 +77,8 @@ vec3 light_contribution(Vertex x, vec3 v, vec3 from, vec3 l, float t_max, vec3 r
     if (trace_occluded(from, l, 0.0, t_max)) {
         return vec3(0.0);
     }
-    return brdf(x, l, v) * radiance * nl / pdf * light_mis(pdf, brdf_sample_pdf(x, l, v));
+    float w = area ? light_mis(pdf, brdf_sample_pdf(x, l, v)) : 1.0;
+    return brdf(x, l, v) * radiance * nl / pdf * w;
 }
 
 void main() {
@@ -99,6 +103,11 @@ void main() {
     // for every vertex whatever its condition (23% of the sample loop's instructions).
     const bool sample_environment = false;
 #endif
+    // Next-event estimation picks one light per vertex, uniformly among the punctual lights,
+    // the emissive triangles (one choice; light_sampling.glsl then picks a triangle by power)
+    // and the environment: one shadow ray per vertex, as Mitsuba's path tracer casts.
+    uint light_choices = path_light_count + (sample_emitters ? 1u : 0u) + (sample_environment ? 1u : 0u);
+    float choice_probability = light_choices > 0u ? 1.0 / float(light_choices) : 0.0;
     vec3 sum_direct = vec3(0.0);
     vec3 sum_indirect = vec3(0.0);
     uint seed = pcg(config.w);
@@ -119,7 +128,7 @@ void main() {
         for (uint scatters = 0u; ; ++scatters) {
             TraceHit hit;
             if (!trace_closest(origin, dir, 0.0, PT_FAR, hit)) {
-                float w = scatters > 0u && sample_environment ? light_mis(last_pdf, light_environment_pdf(dir)) : 1.0;
+                float w = scatters > 0u && sample_environment ? light_mis(last_pdf, choice_probability * light_environment_pdf(dir)) : 1.0;
                 vec3 env = w * throughput * environment_radiance(dir);
                 if (scatters <= 1u) {
                     direct += env;
@@ -133,7 +142,7 @@ void main() {
             if (scatters == 0u) {
                 direct += x.s.emissive;
             } else if ((path_flags & PT_EMISSIVE_LIGHTING) != 0u && any(greaterThan(x.s.emissive, vec3(0.0)))) {
-                float w = sample_emitters ? light_mis(last_pdf, light_triangle_pdf(hit.triangle, origin, x.position)) : 1.0;
+                float w = sample_emitters ? light_mis(last_pdf, choice_probability * light_triangle_pdf(hit.triangle, origin, x.position)) : 1.0;
                 if (scatters == 1u) {
                     direct += w * throughput * x.s.emissive;
                 } else {
@@ -143,21 +152,35 @@ void main() {
             if (scatters > bounces) {
                 break;
             }
-            vec3 nee = throughput * punctual_lights(x, v);
             vec3 from = trace_offset(x.position, x.geometric_normal);
-            if (sample_emitters) {
-                vec3 l;
-                float d;
-                vec3 radiance;
-                float pdf = light_sample_triangle(from, vec3(rand(), rand(), rand()), l, d, radiance);
-                nee += throughput * light_contribution(x, v, from, l, d * (1.0 - 1e-4), radiance, pdf);
-            }
-            if (sample_environment) {
-                vec3 l;
-                float pdf = light_sample_environment(vec3(rand(), rand(), rand()), l);
-                if (pdf > 0.0) {
-                    nee += throughput * light_contribution(x, v, from, l, PT_FAR, environment_radiance(l), pdf);
+            vec3 nee = vec3(0.0);
+            if (light_choices > 0u) {
+                uint choice = min(uint(rand() * float(light_choices)), light_choices - 1u);
+                vec3 xi = vec3(rand(), rand(), rand());
+                vec3 l = x.s.normal;
+                float t_max = 0.0;
+                vec3 radiance = vec3(0.0);
+                float pdf = 0.0;
+                bool area = true;
+                if (choice < path_light_count) {
+                    float d;
+                    punctual_light(x, choice, l, d, radiance);
+                    t_max = punctual_shadow_end(d);
+                    pdf = choice_probability;
+                    area = false;
+                } else if (sample_emitters && choice == path_light_count) {
+                    float d;
+                    pdf = choice_probability * light_sample_triangle(from, xi, l, d, radiance);
+                    t_max = d * (1.0 - 1e-4);
                 }
+#if PT_ENVIRONMENT_SAMPLING
+                else {
+                    pdf = choice_probability * light_sample_environment(xi, l);
+                    radiance = environment_radiance(l);
+                    t_max = PT_FAR;
+                }
+#endif
+                nee = throughput * light_contribution(x, v, from, l, t_max, radiance, pdf, area);
             }
             if (scatters == 0u) {
                 direct += nee;

@@ -73,31 +73,42 @@ float brdf_sample_pdf(Vertex x, vec3 l, vec3 v) {
     return brdf_pdf(x.s.normal, l, v, p_specular, x.s.roughness);
 }
 
+// Punctual light i seen from x: the unit direction l towards it, its distance d (PT_FAR for
+// a directional light) and the irradiance it brings to a surface facing it.
+void punctual_light(Vertex x, uint i, out vec3 l, out float d, out vec3 irradiance) {
+    Light light = load_light(i);
+    if (light.kind == LIGHT_DIRECTIONAL) {
+        l = -light.direction;
+        irradiance = light.color * light.intensity;
+        d = PT_FAR;
+    } else {
+        vec3 to_light = light.position - x.position;
+        d = length(to_light);
+        l = to_light / max(d, 1e-6);
+        irradiance = light_intensity(light, -l) * light_range_window(light, d) / max(d * d, 1e-8);
+    }
+}
+
+// The shadow ray's end short of a punctual light at distance d (the offset origin is a little
+// closer).
+float punctual_shadow_end(float d) {
+    return d * (1.0 - 1e-5);
+}
+
 // Next-event estimation: every punctual light, shadowed by a ray through the BVH.
 vec3 punctual_lights(Vertex x, vec3 v) {
     vec3 sum = vec3(0.0);
     vec3 origin = trace_offset(x.position, x.geometric_normal);
     for (uint i = 0u; i < PATH_LIGHT_COUNT; ++i) {
-        Light light = load_light(i);
         vec3 l;
-        vec3 irradiance;
         float d;
-        if (light.kind == LIGHT_DIRECTIONAL) {
-            l = -light.direction;
-            irradiance = light.color * light.intensity;
-            d = PT_FAR;
-        } else {
-            vec3 to_light = light.position - x.position;
-            d = length(to_light);
-            l = to_light / max(d, 1e-6);
-            irradiance = light_intensity(light, -l) * light_range_window(light, d) / max(d * d, 1e-8);
-        }
+        vec3 irradiance;
+        punctual_light(x, i, l, d, irradiance);
         float nl = dot(x.s.normal, l);
         if (nl <= 0.0 || all(equal(irradiance, vec3(0.0)))) {
             continue;
         }
-        // The shadow ray stops just short of the light (the offset origin is a little closer).
-        if (trace_occluded(origin, l, 0.0, d * (1.0 - 1e-5))) {
+        if (trace_occluded(origin, l, 0.0, punctual_shadow_end(d))) {
             continue;
         }
         sum += brdf(x, l, v) * irradiance * nl;
