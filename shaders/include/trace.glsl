@@ -12,13 +12,15 @@
 // Storage: each array is an RGBA32F image read row by row, its vec4 k at texel
 // (k mod TRACE_ROW_TEXELS, k / TRACE_ROW_TEXELS) (shine::gpu_scene::bvh::TRACE_ROW_TEXELS), not
 // a storage buffer: llvmpipe loads an image texel about 4x faster than a storage buffer's vec4
-// (docs/performance.md). Layout: a node is two vec4, (min, bits of left_or_first) and (max, bits
-// of count) — shine_scene::bvh::BvhNode; a leaf has count > 0 and holds items left_or_first ..
-// left_or_first + count (triangles in a bottom level, instances in the top level); an interior
-// node's left child is the next node, its right child left_or_first. A triangle is three vec4,
+// (docs/performance.md). Layout: a bottom-level node is two texels holding its two children's
+// boxes in half floats and their references (leaf or node: TRACE_LEAF below) —
+// shine::gpu_scene::bvh::TraceNode. A top-level node is two vec4, (min, bits of
+// left_or_first) and (max, bits of count) — shine_scene::bvh::BvhNode; a leaf has count > 0
+// and holds instances left_or_first .. left_or_first + count; an interior node's left child
+// is the next node, its right child left_or_first. A triangle is three vec4,
 // (v0, bits of its index within its mesh), (v1, 0), (v2, 0) — GpuBvhTriangle, mesh space. An
 // instance is four vec4: rows 0–2 of its world-to-mesh matrix, then (bits of its bottom-level
-// root, bits of its first flattened triangle, 0, 0) — TraceInstance. Rays enter a bottom level
+// root's reference, bits of its first flattened triangle, 0, 0) — TraceInstance. Rays enter a bottom level
 // transformed but not renormalised, so hit distances are world distances. Both faces of every
 // triangle are hit.
 #ifndef TRACE_GLSL
@@ -104,7 +106,7 @@ vec3 trace_inverse(vec3 dir) {
     return 1.0 / safe;
 }
 
-// An interior node's step, shared by both levels, its children's texels loaded (the left child
+// A top-level interior node's step, its children's texels loaded (the left child
 // is node `left`, the right `right`): when the ray meets either child's box, `node`, `first`
 // and `count` become the nearer one's, and `deferred` the other's if the ray meets it too
 // (0xffffffffu otherwise); false when it meets neither.
@@ -122,28 +124,45 @@ bool trace_children(uint left, vec4 left_lo, vec4 left_hi, uint right, vec4 righ
     return true;
 }
 
-// Traverses one bottom level from `root` with a mesh-space ray; on a hit closer than hit.t
-// updates hit.t/u/v, sets `leaf` to the triangle's index in bvh_triangles and returns true.
-// With `any_hit` returns at the first hit found.
+// A child reference with this bit is a leaf (shine::gpu_scene::bvh::TRACE_LEAF): bits 27-30
+// hold its triangle count minus one, bits 0-26 its first triangle; without it, an interior
+// node's index in bvh_nodes.
+const uint TRACE_LEAF = 0x80000000u;
+
+// Bottom-level node `node`'s children's boxes (half floats rounded outwards, as
+// shine::gpu_scene::bvh::TraceNode) and references.
+void trace_node(uint node, out vec3 left_lo, out vec3 left_hi, out vec3 right_lo, out vec3 right_hi, out uint left, out uint right) {
+    uvec4 a = floatBitsToUint(imageLoad(bvh_nodes, trace_texel(2u * node)));
+    uvec4 b = floatBitsToUint(imageLoad(bvh_nodes, trace_texel(2u * node + 1u)));
+    vec2 h0 = unpackHalf2x16(a.x);
+    vec2 h1 = unpackHalf2x16(a.y);
+    vec2 h2 = unpackHalf2x16(a.z);
+    vec2 h3 = unpackHalf2x16(a.w);
+    vec2 h4 = unpackHalf2x16(b.x);
+    vec2 h5 = unpackHalf2x16(b.y);
+    left_lo = vec3(h0, h1.x);
+    left_hi = vec3(h1.y, h2);
+    right_lo = vec3(h3, h4.x);
+    right_hi = vec3(h4.y, h5);
+    left = b.z;
+    right = b.w;
+}
+
+// Traverses one bottom level from the reference `root` with a mesh-space ray; on a hit closer
+// than hit.t updates hit.t/u/v, sets `leaf` to the triangle's index in bvh_triangles and
+// returns true. With `any_hit` returns at the first hit found.
 bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit, out uint leaf) {
     leaf = 0xffffffffu;
     vec3 inv_dir = trace_inverse(dir);
-    // A node's two texels hold its box and (first, count): a child's box test loads what its
-    // visit needs, so only the root and the nodes popped off the stack are loaded again.
-    vec4 lo = imageLoad(bvh_nodes, trace_texel(2u * root));
-    vec4 hi = imageLoad(bvh_nodes, trace_texel(2u * root + 1u));
-    if (trace_slab(lo.xyz, hi.xyz, origin, inv_dir, t_min, hit.t) < 0.0) {
-        return false;
-    }
     uint stack[TRACE_STACK_SIZE];
     uint sp = 0u;
-    uint node = root;
-    uint first = floatBitsToUint(lo.w);
-    uint count = floatBitsToUint(hi.w);
+    uint ref = root;
     bool found = false;
     while (true) {
-        if (count > 0u) {
-            for (uint i = first; i < first + count; ++i) {
+        if ((ref & TRACE_LEAF) != 0u) {
+            uint first = ref & 0x07ffffffu;
+            uint end = first + ((ref >> 27u) & 15u) + 1u;
+            for (uint i = first; i < end; ++i) {
                 vec3 tuv;
                 if (trace_triangle(i, origin, dir, t_min, hit.t, tuv)) {
                     hit.t = tuv.x;
@@ -157,19 +176,19 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
                 }
             }
         } else {
-            uint left = node + 1u;
-            uint right = first;
-            vec4 left_lo = imageLoad(bvh_nodes, trace_texel(2u * left));
-            vec4 left_hi = imageLoad(bvh_nodes, trace_texel(2u * left + 1u));
-            vec4 right_lo = imageLoad(bvh_nodes, trace_texel(2u * right));
-            vec4 right_hi = imageLoad(bvh_nodes, trace_texel(2u * right + 1u));
-            uint deferred;
-            if (trace_children(left, left_lo, left_hi, right, right_lo, right_hi, origin, inv_dir, t_min, hit.t, node, first, count, deferred)) {
+            vec3 left_lo, left_hi, right_lo, right_hi;
+            uint left, right;
+            trace_node(ref, left_lo, left_hi, right_lo, right_hi, left, right);
+            float tl = trace_slab(left_lo, left_hi, origin, inv_dir, t_min, hit.t);
+            float tr = trace_slab(right_lo, right_hi, origin, inv_dir, t_min, hit.t);
+            if (tl >= 0.0 || tr >= 0.0) {
                 // Into the nearer child hit; the other, if hit, waits on the stack.
-                if (deferred != 0xffffffffu && sp < TRACE_STACK_SIZE) {
-                    stack[sp] = deferred;
+                bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
+                if (tl >= 0.0 && tr >= 0.0 && sp < TRACE_STACK_SIZE) {
+                    stack[sp] = go_left ? right : left;
                     sp += 1u;
                 }
+                ref = go_left ? left : right;
                 continue;
             }
         }
@@ -177,9 +196,7 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
             break;
         }
         sp -= 1u;
-        node = stack[sp];
-        first = floatBitsToUint(imageLoad(bvh_nodes, trace_texel(2u * node)).w);
-        count = floatBitsToUint(imageLoad(bvh_nodes, trace_texel(2u * node + 1u)).w);
+        ref = stack[sp];
     }
     return found;
 }
