@@ -14,9 +14,12 @@
 // once is indirect; what the camera sees unscattered (emission, background) is direct. `bounces` B
 // vertices after the first scatter further (B = 1: one-bounce indirect, what the GI techniques
 // compute). No Russian roulette, no clamping; a non-finite sample is dropped. Variants:
-// `environment` samples the environment when its tables say so, `no_environment` never does.
-//! variant no_environment PT_ENVIRONMENT_SAMPLING=0
-//! variant environment PT_ENVIRONMENT_SAMPLING=1
+// `environment` samples the environment when its tables say so, `no_environment` never does;
+// the `_untextured` ones, for scenes whose materials have no textures, make no lookups.
+//! variant no_environment PT_ENVIRONMENT_SAMPLING=0 SURFACE_TEXTURES=1
+//! variant environment PT_ENVIRONMENT_SAMPLING=1 SURFACE_TEXTURES=1
+//! variant no_environment_untextured PT_ENVIRONMENT_SAMPLING=0 SURFACE_TEXTURES=0
+//! variant environment_untextured PT_ENVIRONMENT_SAMPLING=1 SURFACE_TEXTURES=0
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)

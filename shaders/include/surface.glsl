@@ -17,6 +17,13 @@ layout(set = 0, binding = 3) uniform sampler texture_sampler;
 #define SURFACE_SAMPLE(tex, uvw) texture(sampler2DArray(tex, texture_sampler), uvw)
 #endif
 
+// SURFACE_TEXTURES 0 leaves every texture lookup out, for scenes whose materials have none (a
+// shader variant): lavapipe runs a lookup whatever its condition, four or five per surface
+// (docs/pitfalls.md, "lavapipe runs every branch").
+#ifndef SURFACE_TEXTURES
+#define SURFACE_TEXTURES 1
+#endif
+
 struct Surface {
     vec3 base_color;
     vec3 normal;
@@ -30,9 +37,11 @@ struct Surface {
 vec3 surface_emission(uint i, vec2 uv) {
     vec3 e = materials.m[i].emissive;
     uint emissive_tex = materials.m[i].emissive_texture;
+#if SURFACE_TEXTURES
     if (emissive_tex != NO_TEXTURE) {
         e *= SURFACE_SAMPLE(srgb_textures, vec3(uv, float(emissive_tex))).rgb;
     }
+#endif
     return e;
 }
 
@@ -43,17 +52,21 @@ Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 u
     Surface s;
     s.base_color = materials.m[i].base_color.rgb;
     uint base_tex = materials.m[i].base_color_texture;
+#if SURFACE_TEXTURES
     if (base_tex != NO_TEXTURE) {
         s.base_color *= SURFACE_SAMPLE(srgb_textures, vec3(uv, float(base_tex))).rgb;
     }
+#endif
     s.roughness = materials.m[i].roughness;
     s.metallic = materials.m[i].metallic;
     uint mr_tex = materials.m[i].metallic_roughness_texture;
+#if SURFACE_TEXTURES
     if (mr_tex != NO_TEXTURE) {
         vec4 mr = SURFACE_SAMPLE(linear_textures, vec3(uv, float(mr_tex)));
         s.roughness *= mr.g;
         s.metallic *= mr.b;
     }
+#endif
     s.emissive = surface_emission(i, uv);
     uint normal_tex = materials.m[i].normal_texture;
     float normal_scale = materials.m[i].normal_scale;
@@ -61,6 +74,7 @@ Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 u
     if (!front) {
         n = -n;
     }
+#if SURFACE_TEXTURES
     if (normal_tex != NO_TEXTURE) {
         vec3 t = normalize(tangent.xyz - n * dot(n, tangent.xyz));
         vec3 b = cross(n, t) * tangent.w;
@@ -68,6 +82,7 @@ Surface surface(uint material_index, vec3 geometric_normal, vec4 tangent, vec2 u
         tn.xy *= normal_scale;
         n = normalize(tn.x * t + tn.y * b + tn.z * n);
     }
+#endif
     s.normal = n;
     return s;
 }

@@ -32,7 +32,7 @@ use crate::passes::path_trace::{self, PathTraceParams};
 use light_tables::LightTables;
 use shine_gpu::{Buffer, BufferDesc, Device, Image, MemoryLocation, Sampler, vk};
 use shine_graph::{Executor, ExternalState};
-use shine_scene::Scene;
+use shine_scene::{Material, Scene};
 
 /// Largest image side of a reference (the accumulation buffer stays far below 128 MiB).
 pub const MAX_EXTENT: u32 = 2048;
@@ -138,6 +138,8 @@ pub struct PathTracer {
     light_tables: Buffer,
     /// [`LightTables::environment`] of `light_tables`.
     environment_sampling: bool,
+    /// Whether any material of the scene has a texture ([`PathTraceParams::textures`]).
+    textures: bool,
     texture_sampler: Sampler,
     environment_sampler: Sampler,
     accumulation: Buffer,
@@ -197,6 +199,7 @@ impl PathTracer {
             environment,
             light_tables,
             environment_sampling: tables.environment,
+            textures: scene.materials.iter().any(Material::has_textures),
             texture_sampler: sampler(
                 vk::SamplerAddressMode::REPEAT,
                 vk::SamplerAddressMode::REPEAT,
@@ -280,6 +283,7 @@ impl PathTracer {
             first_sample: self.samples,
             samples,
             environment_sampling: self.environment_sampling,
+            textures: self.textures,
         };
         path_trace::path_trace(
             &mut rg,

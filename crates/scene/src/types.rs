@@ -273,6 +273,20 @@ pub struct Material {
     pub _pad: [u32; 3],
 }
 
+impl Material {
+    /// Whether any of its texture fields names a texture.
+    pub fn has_textures(&self) -> bool {
+        [
+            self.base_color_texture,
+            self.metallic_roughness_texture,
+            self.normal_texture,
+            self.emissive_texture,
+        ]
+        .iter()
+        .any(|&t| t != NO_TEXTURE)
+    }
+}
+
 impl Default for Material {
     /// The glTF default material (glTF 2.0 §3.9.6): white, metallic 1, roughness 1, opaque.
     fn default() -> Self {
@@ -460,3 +474,23 @@ pub struct Instance {
 
 /// No skin, in [`Instance::skin`].
 pub const NO_SKIN: u32 = u32::MAX;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The default material has no texture; any one texture field makes one.
+    #[test]
+    fn has_textures_sees_every_texture_field() {
+        assert!(!Material::default().has_textures());
+        let with = |set: fn(&mut Material)| {
+            let mut m = Material::default();
+            set(&mut m);
+            m.has_textures()
+        };
+        assert!(with(|m| m.base_color_texture = 0));
+        assert!(with(|m| m.metallic_roughness_texture = 3));
+        assert!(with(|m| m.normal_texture = 1));
+        assert!(with(|m| m.emissive_texture = 2));
+    }
+}
