@@ -73,31 +73,24 @@ float trace_slab(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float t_min, float
 }
 
 // Möller–Trumbore (both faces), as shine_scene::bvh::intersect_triangle: (t, u, v) when the
-// hit lies in [t_min, t_max].
+// hit lies in [t_min, t_max]. The decision compares u, v and t scaled by the determinant's
+// magnitude, so the one division (for tuv) is off its path: lavapipe runs the test for every
+// lane and the division's latency stalled the chain behind it.
 bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, out vec3 tuv) {
     vec3 a = imageLoad(bvh_triangles, trace_texel(3u * tri)).xyz;
     vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * tri + 1u)).xyz - a;
     vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * tri + 2u)).xyz - a;
     vec3 p = cross(dir, e2);
     float det = dot(e1, p);
-    tuv = vec3(0.0);
-    if (abs(det) < 1e-12) {
-        return false;
-    }
-    float inv = 1.0 / det;
     vec3 s = origin - a;
-    float u = dot(s, p) * inv;
-    if (u < 0.0 || u > 1.0) {
-        return false;
-    }
     vec3 q = cross(s, e1);
-    float v = dot(dir, q) * inv;
-    if (v < 0.0 || u + v > 1.0) {
-        return false;
-    }
-    float t = dot(e2, q) * inv;
-    tuv = vec3(t, u, v);
-    return t >= t_min && t <= t_max;
+    float sign_det = det < 0.0 ? -1.0 : 1.0;
+    float size = abs(det);
+    float u = dot(s, p) * sign_det;
+    float v = dot(dir, q) * sign_det;
+    float t = dot(e2, q) * sign_det;
+    tuv = vec3(t, u, v) / size;
+    return size >= 1e-12 && u >= 0.0 && v >= 0.0 && u + v <= size && t >= t_min * size && t <= t_max * size;
 }
 
 // 1 / dir with zero components replaced by a huge value of the right sign (no NaN in slabs).
