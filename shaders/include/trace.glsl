@@ -17,12 +17,12 @@
 // shine::gpu_scene::bvh::TraceNode. A top-level node is two vec4, (min, bits of
 // left_or_first) and (max, bits of count) — shine_scene::bvh::BvhNode; a leaf has count > 0
 // and holds instances left_or_first .. left_or_first + count; an interior node's left child
-// is the next node, its right child left_or_first. A triangle is three vec4,
-// (v0, bits of its index within its mesh), (v1, 0), (v2, 0) — GpuBvhTriangle, mesh space. An
+// is the next node, its right child left_or_first. A triangle is three vec4, (v0, bits of its
+// index within its mesh), (v1 − v0, 0), (v2 − v0, 0) — GpuBvhTriangle, mesh space. An
 // instance is four vec4: rows 0–2 of its world-to-mesh matrix, then (bits of its bottom-level
-// root's reference, bits of its first flattened triangle, 0, 0) — TraceInstance. Rays enter a bottom level
-// transformed but not renormalised, so hit distances are world distances. Both faces of every
-// triangle are hit.
+// root's reference, bits of its first flattened triangle, 0, 0) — TraceInstance. Rays enter a
+// bottom level transformed but not renormalised, so hit distances are world distances. Both
+// faces of every triangle are hit.
 #ifndef TRACE_GLSL
 #define TRACE_GLSL
 
@@ -78,8 +78,8 @@ float trace_slab(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float t_min, float
 // lane and the division's latency stalled the chain behind it.
 bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, out vec3 tuv) {
     vec3 a = imageLoad(bvh_triangles, trace_texel(3u * tri)).xyz;
-    vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * tri + 1u)).xyz - a;
-    vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * tri + 2u)).xyz - a;
+    vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * tri + 1u)).xyz;
+    vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * tri + 2u)).xyz;
     vec3 p = cross(dir, e2);
     float det = dot(e1, p);
     vec3 s = origin - a;
@@ -207,11 +207,10 @@ bool trace_instance(uint k, vec3 origin, vec3 dir, float t_min, bool any_hit, in
     if (!trace_bottom(floatBitsToUint(info.x), mesh_origin, mesh_dir, t_min, any_hit, hit, leaf)) {
         return false;
     }
-    vec3 a = imageLoad(bvh_triangles, trace_texel(3u * leaf)).xyz;
-    vec3 b = imageLoad(bvh_triangles, trace_texel(3u * leaf + 1u)).xyz;
-    vec3 c = imageLoad(bvh_triangles, trace_texel(3u * leaf + 2u)).xyz;
+    vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * leaf + 1u)).xyz;
+    vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * leaf + 2u)).xyz;
     // Normals move with the inverse transpose: the transpose of world-to-mesh.
-    vec3 n = cross(b - a, c - a);
+    vec3 n = cross(e1, e2);
     hit.normal = r0.xyz * n.x + r1.xyz * n.y + r2.xyz * n.z;
     uint index = floatBitsToUint(imageLoad(bvh_triangles, trace_texel(3u * leaf)).w);
     hit.triangle = floatBitsToUint(info.y) + index;

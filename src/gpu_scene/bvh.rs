@@ -89,8 +89,9 @@ impl TraceImages {
     }
 }
 
-/// A bottom-level triangle as `trace.glsl` reads it (48 bytes): mesh-space vertices and the
-/// triangle's index within its mesh.
+/// A bottom-level triangle as `trace.glsl` reads it (48 bytes): its first vertex and two edges
+/// in mesh space (the ray test's operands, subtracted once here rather than at every test) and
+/// the triangle's index within its mesh.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct GpuBvhTriangle {
@@ -98,12 +99,12 @@ pub struct GpuBvhTriangle {
     pub v0: [f32; 3],
     /// Triangle index within the mesh; the instance's `triangle_base` is added at a hit.
     pub index: u32,
-    /// Second vertex.
-    pub v1: [f32; 3],
+    /// Second vertex minus the first.
+    pub e1: [f32; 3],
     /// Padding.
     pub _pad0: u32,
-    /// Third vertex.
-    pub v2: [f32; 3],
+    /// Third vertex minus the first.
+    pub e2: [f32; 3],
     /// Padding.
     pub _pad1: u32,
 }
@@ -285,8 +286,8 @@ impl BottomLevels {
             .extend(bvh.triangles.iter().map(|t| GpuBvhTriangle {
                 v0: t.v0,
                 index: index(t),
-                v1: t.v1,
-                v2: t.v2,
+                e1: (Vec3::from(t.v1) - Vec3::from(t.v0)).to_array(),
+                e2: (Vec3::from(t.v2) - Vec3::from(t.v0)).to_array(),
                 ..GpuBvhTriangle::default()
             }));
         let bounds = Aabb {
