@@ -22,14 +22,18 @@
 //! variant environment_untextured PT_ENVIRONMENT_SAMPLING=1 SURFACE_TEXTURES=0
 #version 460
 #extension GL_GOOGLE_include_directive : require
-#define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
-#include "surface.glsl"
-#include "brdf.glsl"
 #define TRACE_NODES_BINDING 7
 #define TRACE_TRIANGLES_BINDING 8
 #define TRACE_TOP_BINDING 12
 #define TRACE_INSTANCES_BINDING 13
 #include "trace.glsl"
+// The scene's materials, vertices, indices, lights and light tables from images that copy
+// their buffers (src/reference/mod.rs): llvmpipe loads a storage buffer lane by lane.
+#define SURFACE_MATERIAL_TEXELS
+#define PATH_SCENE_TEXELS
+#define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
+#include "surface.glsl"
+#include "brdf.glsl"
 #define ENVIRONMENT_BINDING 9
 #define ENVIRONMENT_SAMPLER_BINDING 10
 #include "environment.glsl"

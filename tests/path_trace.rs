@@ -578,3 +578,44 @@ fn error_falls_as_inverse_square_root_of_samples() {
     );
     common::assert_clean(&device);
 }
+
+/// A buffer copied into an image fills its whole rows, then the start of the next row, and
+/// leaves the rest as it was: how the path tracer's scene texels mirror buffers whose sizes
+/// are not whole rows (src/reference/scene_texels.rs).
+#[test]
+fn a_buffer_copy_fills_whole_rows_then_the_start_of_the_next() {
+    let device = common::device();
+    let (width, height) = (16u32, 4u32);
+    let words: Vec<u32> = (0..2 * width + 5).map(|k| 1000 + k).collect();
+    let buffer = common::buffer_with(
+        &device,
+        "words",
+        vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+        bytemuck::cast_slice(&words),
+    );
+    let before: Vec<u32> = vec![7; (width * height) as usize];
+    let image = common::storage_image_with(
+        &device,
+        "texels",
+        vk::Format::R32_UINT,
+        [width, height],
+        bytemuck::cast_slice(&before),
+    );
+    let mut executor = Executor::new(&device, 1).expect("executor");
+    let mut rg = executor.begin_frame();
+    let src = rg.import_gpu_buffer(&buffer, common::uploaded_state(), common::read_by_copy());
+    let mut dst = rg.import_gpu_image(&image, common::uploaded_state(), common::uploaded_state());
+    rg.copy_buffer_to_image("mirror", &src, &mut dst);
+    common::run_graph(&device, &mut executor, rg);
+    let after: Vec<u32> = bytemuck::cast_slice(
+        &device
+            .read_image(&image, vk::ImageLayout::GENERAL)
+            .expect("readback"),
+    )
+    .to_vec();
+    for (k, &texel) in after.iter().enumerate() {
+        let expected = words.get(k).copied().unwrap_or(7);
+        assert_eq!(texel, expected, "texel {k}");
+    }
+    common::assert_clean(&device);
+}

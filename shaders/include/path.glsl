@@ -10,7 +10,44 @@
 
 // Bindings 0-3 (materials, srgb_textures, linear_textures, texture_sampler): surface.glsl.
 // GpuScene::vertices: four vec4 per vertex, (position, material bits), (normal, 0), tangent,
-// (uv, 0, 0).
+// (uv, 0, 0). With PATH_SCENE_TEXELS defined the vertices, indices and lights are read from
+// images holding copies of those buffers (`vertex_texels` RGBA32F, `index_texels` R32UI,
+// `light_texels` RGBA32F; rows of TRACE_ROW_TEXELS, as trace.glsl's): llvmpipe loads a
+// storage buffer lane by lane, an image texel in one gather (docs/pitfalls.md).
+#ifdef PATH_SCENE_TEXELS
+layout(set = 0, binding = 4, rgba32f) readonly uniform image2D vertex_texels;
+layout(set = 0, binding = 5, r32ui) readonly uniform uimage2D index_texels;
+layout(set = 0, binding = 6, rgba32f) readonly uniform image2D light_texels;
+
+// vec4 k of the vertices.
+vec4 path_vertex(uint k) {
+    return imageLoad(vertex_texels, trace_texel(k));
+}
+
+// Index k of the flattened index buffer.
+uint path_index(uint k) {
+    return imageLoad(index_texels, trace_texel(k)).x;
+}
+
+Light load_light(uint i) {
+    vec4 a = imageLoad(light_texels, trace_texel(4u * i));
+    vec4 b = imageLoad(light_texels, trace_texel(4u * i + 1u));
+    vec4 c = imageLoad(light_texels, trace_texel(4u * i + 2u));
+    vec4 d = imageLoad(light_texels, trace_texel(4u * i + 3u));
+    Light light;
+    light.position = a.xyz;
+    light.kind = floatBitsToUint(a.w);
+    light.direction = b.xyz;
+    light.range = b.w;
+    light.color = c.xyz;
+    light.intensity = c.w;
+    light.inner_cone_angle = d.x;
+    light.outer_cone_angle = d.y;
+    light.node = floatBitsToUint(d.z);
+    light.pad = 0u;
+    return light;
+}
+#else
 layout(set = 0, binding = 4, std430) readonly buffer Vertices {
     vec4 v[];
 } vertices;
@@ -21,6 +58,17 @@ layout(set = 0, binding = 6, std430) readonly buffer Lights {
     Light l[];
 } lights;
 DEFINE_LOAD_LIGHT(lights)
+
+// vec4 k of the vertices.
+vec4 path_vertex(uint k) {
+    return vertices.v[k];
+}
+
+// Index k of the flattened index buffer.
+uint path_index(uint k) {
+    return indices.i[k];
+}
+#endif
 
 const uint PT_JITTER = 1u;
 const uint PT_EMISSIVE_LIGHTING = 2u;
@@ -38,16 +86,16 @@ struct Vertex {
 
 // The surface at a hit, its geometric normal turned towards the ray's origin.
 Vertex shade(TraceHit hit, vec3 dir) {
-    uint i0 = indices.i[3u * hit.triangle];
-    uint i1 = indices.i[3u * hit.triangle + 1u];
-    uint i2 = indices.i[3u * hit.triangle + 2u];
+    uint i0 = path_index(3u * hit.triangle);
+    uint i1 = path_index(3u * hit.triangle + 1u);
+    uint i2 = path_index(3u * hit.triangle + 2u);
     vec3 b = vec3(1.0 - hit.u - hit.v, hit.u, hit.v);
     Vertex x;
-    x.position = b.x * vertices.v[4u * i0].xyz + b.y * vertices.v[4u * i1].xyz + b.z * vertices.v[4u * i2].xyz;
-    vec3 n = b.x * vertices.v[4u * i0 + 1u].xyz + b.y * vertices.v[4u * i1 + 1u].xyz + b.z * vertices.v[4u * i2 + 1u].xyz;
-    vec4 t = b.x * vertices.v[4u * i0 + 2u] + b.y * vertices.v[4u * i1 + 2u] + b.z * vertices.v[4u * i2 + 2u];
-    vec2 uv = b.x * vertices.v[4u * i0 + 3u].xy + b.y * vertices.v[4u * i1 + 3u].xy + b.z * vertices.v[4u * i2 + 3u].xy;
-    uint material = floatBitsToUint(vertices.v[4u * i0].w);
+    x.position = b.x * path_vertex(4u * i0).xyz + b.y * path_vertex(4u * i1).xyz + b.z * path_vertex(4u * i2).xyz;
+    vec3 n = b.x * path_vertex(4u * i0 + 1u).xyz + b.y * path_vertex(4u * i1 + 1u).xyz + b.z * path_vertex(4u * i2 + 1u).xyz;
+    vec4 t = b.x * path_vertex(4u * i0 + 2u) + b.y * path_vertex(4u * i1 + 2u) + b.z * path_vertex(4u * i2 + 2u);
+    vec2 uv = b.x * path_vertex(4u * i0 + 3u).xy + b.y * path_vertex(4u * i1 + 3u).xy + b.z * path_vertex(4u * i2 + 3u).xy;
+    uint material = floatBitsToUint(path_vertex(4u * i0).w);
     vec3 ng = normalize(hit.normal);
     bool front = dot(ng, dir) < 0.0;
     x.geometric_normal = front ? ng : -ng;

@@ -242,14 +242,18 @@ impl GpuScene {
             indices: storage(
                 "scene indices",
                 bytemuck::cast_slice(&geometry.indices),
-                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::STORAGE_BUFFER,
+                // TRANSFER_SRC: the path tracer copies indices, materials and lights into
+                // images (src/reference/scene_texels.rs).
+                vk::BufferUsageFlags::INDEX_BUFFER
+                    | vk::BufferUsageFlags::STORAGE_BUFFER
+                    | vk::BufferUsageFlags::TRANSFER_SRC,
             )?,
             index_count: geometry.indices.len() as u32,
             vertex_count: geometry.source.len() as u32,
             materials: storage(
                 "scene materials",
                 bytemuck::cast_slice(&materials),
-                vk::BufferUsageFlags::STORAGE_BUFFER,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
             )?,
             srgb_textures: textures::texture_array(
                 device,
@@ -266,7 +270,7 @@ impl GpuScene {
             lights: dynamic(
                 "scene lights",
                 scene.lights.len().max(1) * std::mem::size_of::<Light>(),
-                vk::BufferUsageFlags::STORAGE_BUFFER,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
             )?,
             bvh: GpuBvh::new(device, bottom, instance_count)?,
             deform_instances: dynamic(

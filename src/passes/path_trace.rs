@@ -72,16 +72,33 @@ pub struct PathTraceParams {
     pub textures: bool,
 }
 
+/// The scene's buffers `path_trace.comp` reads, as images holding their copies
+/// ([`crate::reference::scene_texels`]).
+#[derive(Debug, Clone, Copy)]
+pub struct SceneTexels {
+    /// `material_texels`: the materials, five texels each.
+    pub materials: Handle<Image>,
+    /// `vertex_texels`: the vertices, four texels each.
+    pub vertices: Handle<Image>,
+    /// `index_texels`: the flattened indices, one R32UI texel each.
+    pub indices: Handle<Image>,
+    /// `light_texels`: the punctual lights, four texels each.
+    pub lights: Handle<Image>,
+    /// `light_table_texels`: the light tables' words, one R32UI texel each.
+    pub light_tables: Handle<Image>,
+}
+
 /// Adds one progressive `path_trace` dispatch accumulating into `accumulation` (at least
 /// `ACCUMULATION_PLANES × width × height × 16` bytes), tracing the scene's BVH and lit by
-/// `environment` (RGBA32F equirectangular, src/gpu_scene/environment.rs) on escape;
-/// `light_tables` holds [`crate::reference::light_tables::LightTables::words`].
+/// `environment` (RGBA32F equirectangular, src/gpu_scene/environment.rs) on escape, reading
+/// the scene's materials, vertices, indices, lights and light tables
+/// ([`crate::reference::light_tables::LightTables::words`]) from `texels`.
 #[allow(clippy::too_many_arguments)]
 pub fn path_trace(
     rg: &mut RenderGraph,
     scene: &SceneHandles,
+    texels: &SceneTexels,
     environment: &Handle<Image>,
-    light_tables: &Handle<Buffer>,
     accumulation: &mut Handle<Buffer>,
     params: &PathTraceParams,
     texture_sampler: vk::Sampler,
@@ -107,16 +124,16 @@ pub fn path_trace(
     };
     let mut pass = rg.compute("path_trace", shader);
     scene.trace.bind(&mut pass);
-    pass.read("materials", &scene.materials)
+    pass.read("material_texels", &texels.materials)
         .read("srgb_textures", &scene.srgb_textures)
         .read("linear_textures", &scene.linear_textures)
         .sampler("texture_sampler", texture_sampler)
-        .read("vertices", &scene.vertices)
-        .read("indices", &scene.indices)
-        .read("lights", &scene.lights)
+        .read("vertex_texels", &texels.vertices)
+        .read("index_texels", &texels.indices)
+        .read("light_texels", &texels.lights)
         .read("environment", environment)
         .sampler("environment_sampler", environment_sampler)
-        .read("light_tables", light_tables)
+        .read("light_table_texels", &texels.light_tables)
         .write("accumulation", accumulation)
         .push(&constants)
         .dispatch([w, h, 1]);

@@ -21,6 +21,7 @@ pub mod igi;
 pub mod light_tables;
 pub mod proxy;
 pub mod resolve;
+pub mod scene_texels;
 
 use crate::capture::image_io::HdrImage;
 use crate::frame::RenderError;
@@ -136,6 +137,8 @@ pub struct PathTracer {
     scene: GpuScene,
     environment: Image,
     light_tables: Buffer,
+    /// Copies of the scene's buffers as images, for the shader's reads.
+    texels: scene_texels::SceneTexelImages,
     /// [`LightTables::environment`] of `light_tables`.
     environment_sampling: bool,
     /// Whether any material of the scene has a texture ([`PathTraceParams::textures`]).
@@ -161,11 +164,18 @@ impl PathTracer {
         let texels = crate::gpu_scene::environment::bake(scene.environment.as_ref());
         let environment = crate::gpu_scene::environment::upload_baked(device, &texels)?;
         let tables = light_tables_of(scene, &gpu_scene, &texels)?;
-        let light_tables = Buffer::storage_with_data(
+        // TRANSFER_SRC: copied into an image before every dispatch (scene_texels).
+        let light_tables = Buffer::with_data(
             device,
-            "light tables",
+            &BufferDesc {
+                name: "light tables",
+                size: 0,
+                usage: vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
+                location: MemoryLocation::GpuOnly,
+            },
             bytemuck::cast_slice(tables.words()),
         )?;
+        let scene_texels = scene_texels::SceneTexelImages::new(device, &gpu_scene, &light_tables)?;
         let sampler = |u, v| {
             Sampler::new(
                 device,
@@ -198,6 +208,7 @@ impl PathTracer {
             scene: gpu_scene,
             environment,
             light_tables,
+            texels: scene_texels,
             environment_sampling: tables.environment,
             textures: scene.materials.iter().any(Material::has_textures),
             texture_sampler: sampler(
@@ -285,11 +296,12 @@ impl PathTracer {
             environment_sampling: self.environment_sampling,
             textures: self.textures,
         };
+        let texels = self.texels.copy(&mut rg, &handles, &light_tables);
         path_trace::path_trace(
             &mut rg,
             &handles,
+            &texels,
             &environment,
-            &light_tables,
             &mut accumulation,
             &params,
             self.texture_sampler.raw(),

@@ -99,8 +99,9 @@ impl RenderGraph {
     }
 
     /// Copies a tightly packed buffer into mip 0, layer 0 of an image. A buffer shorter than a
-    /// 2D image fills only the whole rows it holds, from the top (uploads that rewrite the
-    /// start of an image; the other rows keep what they hold).
+    /// 2D image fills the whole rows it holds from the top, then the start of the next row
+    /// (uploads that rewrite the start of an image, buffers mirrored into images; the other
+    /// texels keep what they hold).
     pub fn copy_buffer_to_image(
         &mut self,
         name: &str,

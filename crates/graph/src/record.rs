@@ -25,20 +25,35 @@ fn image_extent(plan: &Plan, id: ResourceId) -> vk::Extent3D {
     }
 }
 
-/// Rows of 2D image `id` that a tightly packed buffer of `bytes` fills: all of them when it
-/// holds the whole image (or the image is not a single-layer 2D image of a known texel size),
-/// else its whole leading rows.
-fn leading_rows(plan: &Plan, bytes: u64, id: ResourceId) -> u32 {
+/// The whole rows of 2D image `id` that a tightly packed buffer of `bytes` fills (all of them
+/// when it holds the whole image, or the image is not a single-layer 2D image of a known
+/// texel size), and the texels of the next, partly filled row (0 when there is none or the
+/// image has no room for it): a buffer→image copy's two regions.
+fn buffer_rows(plan: &Plan, bytes: u64, id: ResourceId) -> (u32, u32) {
     let Some(AnyDesc::Image(d)) = plan.resource(id).map(|r| r.desc) else {
-        return 0;
+        return (0, 0);
     };
     let height = d.extent.height;
     match shine_gpu::format_texel_size(d.format) {
         Some(texel) if d.extent.depth == 1 && d.layers == 1 => {
             let row = u64::from(d.extent.width) * u64::from(texel);
-            (bytes / row.max(1)).min(u64::from(height)) as u32
+            let rows = (bytes / row.max(1)).min(u64::from(height)) as u32;
+            let rest = if rows < height {
+                ((bytes - u64::from(rows) * row) / u64::from(texel)) as u32
+            } else {
+                0
+            };
+            (rows, rest)
         }
-        _ => height,
+        _ => (height, 0),
+    }
+}
+
+/// Bytes of a texel of image `id` (0 when unknown).
+fn buffer_texel(plan: &Plan, id: ResourceId) -> u32 {
+    match plan.resource(id).map(|r| r.desc) {
+        Some(AnyDesc::Image(d)) => shine_gpu::format_texel_size(d.format).unwrap_or(0),
+        _ => 0,
     }
 }
 
@@ -426,16 +441,37 @@ impl<'a> Recorder<'a> {
                     &[copy(src)],
                 ),
                 TransferOp::CopyBufferToImage { src, dst } => {
-                    let mut region = copy(dst);
-                    region.image_extent.height =
-                        leading_rows(self.plan, buffer_size(self.plan, src), dst);
-                    if region.image_extent.height > 0 {
+                    // The whole rows the buffer fills, then the start of the next one.
+                    let (rows, rest) = buffer_rows(self.plan, buffer_size(self.plan, src), dst);
+                    let mut full = copy(dst);
+                    full.image_extent.height = rows;
+                    let row_bytes = u64::from(full.image_extent.width)
+                        * u64::from(buffer_texel(self.plan, dst));
+                    let partial = vk::BufferImageCopy {
+                        buffer_offset: u64::from(rows) * row_bytes,
+                        image_offset: vk::Offset3D {
+                            x: 0,
+                            y: rows as i32,
+                            z: 0,
+                        },
+                        image_extent: vk::Extent3D {
+                            width: rest,
+                            height: 1,
+                            depth: 1,
+                        },
+                        ..copy(dst)
+                    };
+                    let regions: Vec<vk::BufferImageCopy> = [(rows > 0, full), (rest > 0, partial)]
+                        .into_iter()
+                        .filter_map(|(some, r)| some.then_some(r))
+                        .collect();
+                    if !regions.is_empty() {
                         raw.cmd_copy_buffer_to_image(
                             cb,
                             self.buffer(src),
                             self.image(dst).0,
                             vk::ImageLayout::TRANSFER_DST_OPTIMAL,
-                            &[region],
+                            &regions,
                         );
                     }
                 }
