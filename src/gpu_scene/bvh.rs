@@ -478,6 +478,24 @@ impl GpuBvh {
 /// `GENERAL` layout.
 fn trace_image(device: &Device, name: &str, data: &[u8]) -> Result<Image, SceneUploadError> {
     let texels = data.len().div_ceil(TEXEL_BYTES);
+    let image = rows_image(device, name, texels, TRACE_FORMAT)?;
+    device.upload_image(
+        &image,
+        &padded(data, image.extent()),
+        vk::ImageLayout::GENERAL,
+    )?;
+    Ok(image)
+}
+
+/// A storage image named `name` of `format` with room for `texels` texels in rows of
+/// [`TRACE_ROW_TEXELS`] (texel `k` at `(k mod TRACE_ROW_TEXELS, k / TRACE_ROW_TEXELS)`), that
+/// transfers can fill; refused when the device's images hold too few rows.
+pub fn rows_image(
+    device: &Device,
+    name: &str,
+    texels: usize,
+    format: vk::Format,
+) -> Result<Image, SceneUploadError> {
     let extent = trace_extent(texels);
     let rows = device.limits().max_image_dimension2_d;
     if extent[1] > rows {
@@ -488,12 +506,10 @@ fn trace_image(device: &Device, name: &str, data: &[u8]) -> Result<Image, SceneU
         )));
     }
     let usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST;
-    let image = Image::new(
+    Ok(Image::new(
         device,
-        &ImageDesc::new_2d(name, extent, TRACE_FORMAT, usage),
-    )?;
-    device.upload_image(&image, &padded(data, extent), vk::ImageLayout::GENERAL)?;
-    Ok(image)
+        &ImageDesc::new_2d(name, extent, format, usage),
+    )?)
 }
 
 /// A one-level world-space BVH of `scene` placed with `world`, and for every triangle of it

@@ -139,6 +139,9 @@ pub struct PathTracer {
     light_tables: Buffer,
     /// Copies of the scene's buffers as images, for the shader's reads.
     texels: scene_texels::SceneTexelImages,
+    /// Whether `texels` hold the scene as the next dispatch sees it (false after an upload
+    /// or an update, until a dispatch copies it).
+    texels_current: bool,
     /// [`LightTables::environment`] of `light_tables`.
     environment_sampling: bool,
     /// Whether any material of the scene has a texture ([`PathTraceParams::textures`]).
@@ -164,7 +167,7 @@ impl PathTracer {
         let texels = crate::gpu_scene::environment::bake(scene.environment.as_ref());
         let environment = crate::gpu_scene::environment::upload_baked(device, &texels)?;
         let tables = light_tables_of(scene, &gpu_scene, &texels)?;
-        // TRANSFER_SRC: copied into an image before every dispatch (scene_texels).
+        // TRANSFER_SRC: copied into an image (scene_texels).
         let light_tables = Buffer::with_data(
             device,
             &BufferDesc {
@@ -209,6 +212,7 @@ impl PathTracer {
             environment,
             light_tables,
             texels: scene_texels,
+            texels_current: false,
             environment_sampling: tables.environment,
             textures: scene.materials.iter().any(Material::has_textures),
             texture_sampler: sampler(
@@ -230,6 +234,7 @@ impl PathTracer {
     /// the accumulation.
     pub fn update(&mut self, update: &FrameUpdate) -> Result<(), RenderError> {
         self.scene.update(update)?;
+        self.texels_current = false;
         self.samples = 0;
         Ok(())
     }
@@ -296,7 +301,9 @@ impl PathTracer {
             environment_sampling: self.environment_sampling,
             textures: self.textures,
         };
-        let texels = self.texels.copy(&mut rg, &handles, &light_tables);
+        let texels = self
+            .texels
+            .declare(&mut rg, &handles, &light_tables, !self.texels_current);
         path_trace::path_trace(
             &mut rg,
             &handles,
@@ -310,6 +317,7 @@ impl PathTracer {
         let mut commands = self.device.begin_commands()?;
         self.executor.execute(commands.raw(), rg)?;
         self.device.submit(commands)?.wait()?;
+        self.texels_current = true;
         self.samples = self.samples.saturating_add(samples);
         Ok(())
     }

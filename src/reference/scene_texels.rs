@@ -2,15 +2,16 @@
 //! materials, vertices, indices, lights and light tables (`path_trace.comp` defines
 //! `SURFACE_MATERIAL_TEXELS` and `PATH_SCENE_TEXELS`). llvmpipe loads a storage buffer lane by
 //! lane, one small loop per load, and those loops held 28% of the path tracer's time; an image
-//! texel is one gather (docs/pitfalls.md). The copies are made on the device before every
-//! dispatch, so deforming meshes and moving lights stay right; each image's texels follow its
-//! buffer's bytes in rows of [`TRACE_ROW_TEXELS`].
+//! texel is one gather (docs/pitfalls.md). The copies are made on the device by the first
+//! dispatch after the scene is uploaded or moved, so deforming meshes and moving lights stay
+//! right; each image's texels follow its buffer's bytes in rows of
+//! [`crate::gpu_scene::bvh::TRACE_ROW_TEXELS`].
 
-use shine_gpu::{Buffer, Device, Image, ImageDesc, vk};
+use shine_gpu::{Buffer, Device, Image, vk};
 use shine_graph::{ExternalState, Handle, RenderGraph};
 
 use crate::frame::RenderError;
-use crate::gpu_scene::bvh::{TRACE_ROW_TEXELS, trace_extent};
+use crate::gpu_scene::bvh::rows_image;
 use crate::gpu_scene::{GpuScene, STORAGE_READ, SceneHandles};
 use crate::passes::path_trace::SceneTexels;
 
@@ -33,20 +34,7 @@ fn mirror(
 ) -> Result<Image, RenderError> {
     let texels = usize::try_from(buffer.size().div_ceil(texel))
         .map_err(|_| RenderError::Invalid(format!("{name}: too large")))?;
-    let extent = trace_extent(texels);
-    let rows = device.limits().max_image_dimension2_d;
-    if extent[1] > rows {
-        return Err(RenderError::Invalid(format!(
-            "{name}: {texels} texels need {} rows of {TRACE_ROW_TEXELS}, the device's images \
-             hold {rows}",
-            extent[1]
-        )));
-    }
-    let usage = vk::ImageUsageFlags::STORAGE | vk::ImageUsageFlags::TRANSFER_DST;
-    Ok(Image::new(
-        device,
-        &ImageDesc::new_2d(name, extent, format, usage),
-    )?)
+    Ok(rows_image(device, name, texels, format)?)
 }
 
 impl SceneTexelImages {
@@ -67,25 +55,30 @@ impl SceneTexelImages {
         })
     }
 
-    /// Records the five copies into `rg` (after the frame's scene updates, which `scene`'s
-    /// handles carry) and returns the images for the path tracer to read.
-    pub fn copy(
+    /// The images for the path tracer to read, imported into `rg`. With `copy` (the scene was
+    /// uploaded or moved since the last copy) the five copies are recorded first, after the
+    /// frame's scene updates, which `scene`'s handles carry.
+    pub fn declare(
         &self,
         rg: &mut RenderGraph,
         scene: &SceneHandles,
         light_tables: &Handle<shine_graph::Buffer>,
+        copy: bool,
     ) -> SceneTexels {
-        let mut copy = |name: &str, image: &Image, src: &Handle<shine_graph::Buffer>| {
+        let mut image = |name: &str, image: &Image, src: &Handle<shine_graph::Buffer>| {
+            if !copy {
+                return rg.import_gpu_image(image, STORAGE_READ, STORAGE_READ);
+            }
             let mut handle = rg.import_gpu_image(image, ExternalState::UNDEFINED, STORAGE_READ);
             rg.copy_buffer_to_image(name, src, &mut handle);
             handle
         };
         SceneTexels {
-            materials: copy("copy material texels", &self.materials, &scene.materials),
-            vertices: copy("copy vertex texels", &self.vertices, &scene.vertices),
-            indices: copy("copy index texels", &self.indices, &scene.indices),
-            lights: copy("copy light texels", &self.lights, &scene.lights),
-            light_tables: copy("copy light table texels", &self.light_tables, light_tables),
+            materials: image("copy material texels", &self.materials, &scene.materials),
+            vertices: image("copy vertex texels", &self.vertices, &scene.vertices),
+            indices: image("copy index texels", &self.indices, &scene.indices),
+            lights: image("copy light texels", &self.lights, &scene.lights),
+            light_tables: image("copy light table texels", &self.light_tables, light_tables),
         }
     }
 }

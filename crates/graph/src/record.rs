@@ -25,13 +25,13 @@ fn image_extent(plan: &Plan, id: ResourceId) -> vk::Extent3D {
     }
 }
 
-/// The whole rows of 2D image `id` that a tightly packed buffer of `bytes` fills (all of them
-/// when it holds the whole image, or the image is not a single-layer 2D image of a known
-/// texel size), and the texels of the next, partly filled row (0 when there is none or the
-/// image has no room for it): a buffer→image copy's two regions.
-fn buffer_rows(plan: &Plan, bytes: u64, id: ResourceId) -> (u32, u32) {
+/// How a tightly packed buffer of `bytes` fills 2D image `id`: its whole rows (all of them when
+/// it holds the whole image, or the image is not a single-layer 2D image of a known texel
+/// size), the texels of the next, partly filled row (0 when there is none or the image has no
+/// room for it) and the bytes of a row: a buffer→image copy's two regions.
+fn buffer_rows(plan: &Plan, bytes: u64, id: ResourceId) -> (u32, u32, u64) {
     let Some(AnyDesc::Image(d)) = plan.resource(id).map(|r| r.desc) else {
-        return (0, 0);
+        return (0, 0, 0);
     };
     let height = d.extent.height;
     match shine_gpu::format_texel_size(d.format) {
@@ -43,17 +43,9 @@ fn buffer_rows(plan: &Plan, bytes: u64, id: ResourceId) -> (u32, u32) {
             } else {
                 0
             };
-            (rows, rest)
+            (rows, rest, row)
         }
-        _ => (height, 0),
-    }
-}
-
-/// Bytes of a texel of image `id` (0 when unknown).
-fn buffer_texel(plan: &Plan, id: ResourceId) -> u32 {
-    match plan.resource(id).map(|r| r.desc) {
-        Some(AnyDesc::Image(d)) => shine_gpu::format_texel_size(d.format).unwrap_or(0),
-        _ => 0,
+        _ => (height, 0, 0),
     }
 }
 
@@ -442,11 +434,10 @@ impl<'a> Recorder<'a> {
                 ),
                 TransferOp::CopyBufferToImage { src, dst } => {
                     // The whole rows the buffer fills, then the start of the next one.
-                    let (rows, rest) = buffer_rows(self.plan, buffer_size(self.plan, src), dst);
+                    let (rows, rest, row_bytes) =
+                        buffer_rows(self.plan, buffer_size(self.plan, src), dst);
                     let mut full = copy(dst);
                     full.image_extent.height = rows;
-                    let row_bytes = u64::from(full.image_extent.width)
-                        * u64::from(buffer_texel(self.plan, dst));
                     let partial = vk::BufferImageCopy {
                         buffer_offset: u64::from(rows) * row_bytes,
                         image_offset: vk::Offset3D {
