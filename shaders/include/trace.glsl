@@ -89,7 +89,7 @@ bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, o
     float u = dot(s, p) * sign_det;
     float v = dot(dir, q) * sign_det;
     float t = dot(e2, q) * sign_det;
-    tuv = vec3(t, u, v) / size;
+    tuv = vec3(t, u, v) * (1.0 / size);
     return size >= 1e-12 && u >= 0.0 && v >= 0.0 && u + v <= size && t >= t_min * size && t <= t_max * size;
 }
 
@@ -97,24 +97,6 @@ bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, o
 vec3 trace_inverse(vec3 dir) {
     vec3 safe = mix(dir, vec3(1e-30), lessThan(abs(dir), vec3(1e-30)));
     return 1.0 / safe;
-}
-
-// A top-level interior node's step, its children's texels loaded (the left child
-// is node `left`, the right `right`): when the ray meets either child's box, `node`, `first`
-// and `count` become the nearer one's, and `deferred` the other's if the ray meets it too
-// (0xffffffffu otherwise); false when it meets neither.
-bool trace_children(uint left, vec4 left_lo, vec4 left_hi, uint right, vec4 right_lo, vec4 right_hi, vec3 origin, vec3 inv_dir, float t_min, float t_max, inout uint node, inout uint first, inout uint count, out uint deferred) {
-    float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, t_max);
-    float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, t_max);
-    bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
-    deferred = tl >= 0.0 && tr >= 0.0 ? (go_left ? right : left) : 0xffffffffu;
-    if (tl < 0.0 && tr < 0.0) {
-        return false;
-    }
-    node = go_left ? left : right;
-    first = floatBitsToUint(go_left ? left_lo.w : right_lo.w);
-    count = floatBitsToUint(go_left ? left_hi.w : right_hi.w);
-    return true;
 }
 
 // A child reference with this bit is a leaf (shine::gpu_scene::bvh::TRACE_LEAF): bits 27-30
@@ -144,6 +126,12 @@ void trace_node(uint node, out vec3 left_lo, out vec3 left_hi, out vec3 right_lo
 // Traverses one bottom level from the reference `root` with a mesh-space ray; on a hit closer
 // than hit.t updates hit.t/u/v, sets `leaf` to the triangle's index in bvh_triangles and
 // returns true. With `any_hit` returns at the first hit found.
+//
+// The stack's push and pop sit outside every branch: llvmpipe stores to a private array lane
+// by lane, each lane behind a branch on its execution mask, and under a mask as random as
+// "this lane is at an interior node" those branches mispredicted (a tenth of the path
+// tracer's time). Out here the mask is the loop's, nearly always full; a lane with nothing to
+// push writes above its top of stack, which nothing reads.
 bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit, out uint leaf) {
     leaf = 0xffffffffu;
     vec3 inv_dir = trace_inverse(dir);
@@ -152,7 +140,8 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
     uint ref = root;
     bool found = false;
     while (true) {
-        if ((ref & TRACE_LEAF) != 0u) {
+        bool at_leaf = (ref & TRACE_LEAF) != 0u;
+        if (at_leaf) {
             uint first = ref & 0x07ffffffu;
             uint end = first + ((ref >> 27u) & 15u) + 1u;
             for (uint i = first; i < end; ++i) {
@@ -168,28 +157,25 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
                     }
                 }
             }
-        } else {
-            vec3 left_lo, left_hi, right_lo, right_hi;
-            uint left, right;
-            trace_node(ref, left_lo, left_hi, right_lo, right_hi, left, right);
-            float tl = trace_slab(left_lo, left_hi, origin, inv_dir, t_min, hit.t);
-            float tr = trace_slab(right_lo, right_hi, origin, inv_dir, t_min, hit.t);
-            if (tl >= 0.0 || tr >= 0.0) {
-                // Into the nearer child hit; the other, if hit, waits on the stack.
-                bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
-                if (tl >= 0.0 && tr >= 0.0 && sp < TRACE_STACK_SIZE) {
-                    stack[sp] = go_left ? right : left;
-                    sp += 1u;
-                }
-                ref = go_left ? left : right;
-                continue;
-            }
         }
-        if (sp == 0u) {
+        // A leaf's lanes step node 0 and ignore the result.
+        vec3 left_lo, left_hi, right_lo, right_hi;
+        uint left, right;
+        trace_node(at_leaf ? 0u : ref, left_lo, left_hi, right_lo, right_hi, left, right);
+        float tl = trace_slab(left_lo, left_hi, origin, inv_dir, t_min, hit.t);
+        float tr = trace_slab(right_lo, right_hi, origin, inv_dir, t_min, hit.t);
+        // Into the nearer child hit; the other, if hit, waits on the stack.
+        bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
+        bool descend = !at_leaf && (tl >= 0.0 || tr >= 0.0);
+        bool push = descend && tl >= 0.0 && tr >= 0.0 && sp < TRACE_STACK_SIZE;
+        stack[min(sp, TRACE_STACK_SIZE - 1u)] = go_left ? right : left;
+        sp += push ? 1u : 0u;
+        if (!descend && sp == 0u) {
             break;
         }
-        sp -= 1u;
-        ref = stack[sp];
+        sp -= descend ? 0u : 1u;
+        uint popped = stack[min(sp, TRACE_STACK_SIZE - 1u)];
+        ref = descend ? (go_left ? left : right) : popped;
     }
     return found;
 }
@@ -239,7 +225,8 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
     uint count = floatBitsToUint(hi.w);
     bool found = false;
     while (true) {
-        if (count > 0u) {
+        bool at_leaf = count > 0u;
+        if (at_leaf) {
             for (uint k = first; k < first + count; ++k) {
                 if (trace_instance(k, origin, dir, t_min, any_hit, hit)) {
                     found = true;
@@ -248,30 +235,31 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
                     }
                 }
             }
-        } else {
-            uint left = node + 1u;
-            uint right = first;
-            vec4 left_lo = imageLoad(bvh_top, trace_texel(2u * left));
-            vec4 left_hi = imageLoad(bvh_top, trace_texel(2u * left + 1u));
-            vec4 right_lo = imageLoad(bvh_top, trace_texel(2u * right));
-            vec4 right_hi = imageLoad(bvh_top, trace_texel(2u * right + 1u));
-            uint deferred;
-            if (trace_children(left, left_lo, left_hi, right, right_lo, right_hi, origin, inv_dir, t_min, hit.t, node, first, count, deferred)) {
-                // Into the nearer child hit; the other, if hit, waits on the stack.
-                if (deferred != 0xffffffffu && sp < TRACE_TOP_STACK_SIZE) {
-                    stack[sp] = deferred;
-                    sp += 1u;
-                }
-                continue;
-            }
         }
-        if (sp == 0u) {
+        // As trace_bottom: the stack outside every branch; a leaf's lanes test the root's box
+        // twice and ignore the result. An interior node's left child is the next node, its
+        // right child `first`.
+        uint left = at_leaf ? 0u : node + 1u;
+        uint right = at_leaf ? 0u : first;
+        vec4 left_lo = imageLoad(bvh_top, trace_texel(2u * left));
+        vec4 left_hi = imageLoad(bvh_top, trace_texel(2u * left + 1u));
+        vec4 right_lo = imageLoad(bvh_top, trace_texel(2u * right));
+        vec4 right_hi = imageLoad(bvh_top, trace_texel(2u * right + 1u));
+        float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, hit.t);
+        float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, hit.t);
+        bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
+        bool descend = !at_leaf && (tl >= 0.0 || tr >= 0.0);
+        bool push = descend && tl >= 0.0 && tr >= 0.0 && sp < TRACE_TOP_STACK_SIZE;
+        stack[min(sp, TRACE_TOP_STACK_SIZE - 1u)] = go_left ? right : left;
+        sp += push ? 1u : 0u;
+        if (!descend && sp == 0u) {
             break;
         }
-        sp -= 1u;
-        node = stack[sp];
-        first = floatBitsToUint(imageLoad(bvh_top, trace_texel(2u * node)).w);
-        count = floatBitsToUint(imageLoad(bvh_top, trace_texel(2u * node + 1u)).w);
+        sp -= descend ? 0u : 1u;
+        uint popped = stack[min(sp, TRACE_TOP_STACK_SIZE - 1u)];
+        node = descend ? (go_left ? left : right) : popped;
+        first = floatBitsToUint(descend ? (go_left ? left_lo.w : right_lo.w) : imageLoad(bvh_top, trace_texel(2u * node)).w);
+        count = floatBitsToUint(descend ? (go_left ? left_hi.w : right_hi.w) : imageLoad(bvh_top, trace_texel(2u * node + 1u)).w);
     }
     return found;
 }
