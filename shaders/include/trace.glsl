@@ -61,14 +61,31 @@ struct TraceHit {
     vec3 normal;
 };
 
-// Slab test of the box (lo, hi); returns the entry distance or -1 on a miss.
-float trace_slab(vec3 lo, vec3 hi, vec3 origin, vec3 inv_dir, float t_min, float t_max) {
-    vec3 t0 = (lo - origin) * inv_dir;
-    vec3 t1 = (hi - origin) * inv_dir;
-    vec3 a = min(t0, t1);
-    vec3 b = max(t0, t1);
-    float near = max(max(max(a.x, a.y), a.z), t_min);
-    float far = min(min(min(b.x, b.y), b.z), t_max);
+// A ray as the slab tests use it: 1 / dir, origin / dir and, per axis, whether the ray runs
+// towards smaller coordinates (the box's far plane is then its minimum).
+struct TraceSlabRay {
+    vec3 inv_dir;
+    vec3 origin_inv;
+    bvec3 negative;
+};
+
+// The larger and smaller of two floats as a compare and a select: GLSL's max and min also
+// handle NaN, which llvmpipe pays for with two more instructions each, and no NaN reaches a
+// slab test (trace_inverse keeps 1 / dir finite).
+float trace_larger(float a, float b) {
+    return a > b ? a : b;
+}
+float trace_smaller(float a, float b) {
+    return a < b ? a : b;
+}
+
+// Slab test of the box (lo, hi); returns the entry distance or -1 on a miss. Each axis's near
+// plane is chosen by the ray's direction, so no per-axis min/max sorts the two distances.
+float trace_slab(vec3 lo, vec3 hi, TraceSlabRay ray, float t_min, float t_max) {
+    vec3 t_near = fma(mix(lo, hi, ray.negative), ray.inv_dir, -ray.origin_inv);
+    vec3 t_far = fma(mix(hi, lo, ray.negative), ray.inv_dir, -ray.origin_inv);
+    float near = trace_larger(trace_larger(t_near.x, t_near.y), trace_larger(t_near.z, t_min));
+    float far = trace_smaller(trace_smaller(t_far.x, t_far.y), trace_smaller(t_far.z, t_max));
     return near <= far ? near : -1.0;
 }
 
@@ -97,6 +114,12 @@ bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, o
 vec3 trace_inverse(vec3 dir) {
     vec3 safe = mix(dir, vec3(1e-30), lessThan(abs(dir), vec3(1e-30)));
     return 1.0 / safe;
+}
+
+// The slab tests' view of the ray origin + t·dir.
+TraceSlabRay trace_slab_ray(vec3 origin, vec3 dir) {
+    vec3 inv_dir = trace_inverse(dir);
+    return TraceSlabRay(inv_dir, origin * inv_dir, lessThan(inv_dir, vec3(0.0)));
 }
 
 // A child reference with this bit is a leaf (shine::gpu_scene::bvh::TRACE_LEAF): bits 27-30
@@ -134,7 +157,7 @@ void trace_node(uint node, out vec3 left_lo, out vec3 left_hi, out vec3 right_lo
 // push writes above its top of stack, which nothing reads.
 bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit, out uint leaf) {
     leaf = 0xffffffffu;
-    vec3 inv_dir = trace_inverse(dir);
+    TraceSlabRay slab_ray = trace_slab_ray(origin, dir);
     uint stack[TRACE_STACK_SIZE];
     uint sp = 0u;
     uint ref = root;
@@ -162,8 +185,8 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
         vec3 left_lo, left_hi, right_lo, right_hi;
         uint left, right;
         trace_node(at_leaf ? 0u : ref, left_lo, left_hi, right_lo, right_hi, left, right);
-        float tl = trace_slab(left_lo, left_hi, origin, inv_dir, t_min, hit.t);
-        float tr = trace_slab(right_lo, right_hi, origin, inv_dir, t_min, hit.t);
+        float tl = trace_slab(left_lo, left_hi, slab_ray, t_min, hit.t);
+        float tr = trace_slab(right_lo, right_hi, slab_ray, t_min, hit.t);
         // Into the nearer child hit; the other, if hit, waits on the stack.
         bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
         bool descend = !at_leaf && (tl >= 0.0 || tr >= 0.0);
@@ -180,27 +203,36 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
     return found;
 }
 
-// Tests a ray against top-level instance `k` (its bottom level in mesh space).
-bool trace_instance(uint k, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit) {
+// Tests a ray against top-level instance `k` (its bottom level in mesh space); on a closer hit
+// sets `leaf` as trace_bottom. The hit's normal and triangle are found once, after the whole
+// traversal (trace_hit_triangle): lavapipe would load them here for every instance.
+bool trace_instance(uint k, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit, inout uint leaf) {
     vec4 r0 = imageLoad(bvh_instances, trace_texel(4u * k));
     vec4 r1 = imageLoad(bvh_instances, trace_texel(4u * k + 1u));
     vec4 r2 = imageLoad(bvh_instances, trace_texel(4u * k + 2u));
-    vec4 info = imageLoad(bvh_instances, trace_texel(4u * k + 3u));
+    uint root = floatBitsToUint(imageLoad(bvh_instances, trace_texel(4u * k + 3u)).x);
     vec4 o = vec4(origin, 1.0);
     vec3 mesh_origin = vec3(dot(r0, o), dot(r1, o), dot(r2, o));
     vec3 mesh_dir = vec3(dot(r0.xyz, dir), dot(r1.xyz, dir), dot(r2.xyz, dir));
-    uint leaf;
-    if (!trace_bottom(floatBitsToUint(info.x), mesh_origin, mesh_dir, t_min, any_hit, hit, leaf)) {
-        return false;
-    }
+    uint found;
+    bool hit_here = trace_bottom(root, mesh_origin, mesh_dir, t_min, any_hit, hit, found);
+    leaf = hit_here ? found : leaf;
+    return hit_here;
+}
+
+// Fills hit.normal and hit.triangle for a hit on bvh_triangles' triangle `leaf` of instance `k`.
+void trace_hit_triangle(uint k, uint leaf, inout TraceHit hit) {
+    vec4 r0 = imageLoad(bvh_instances, trace_texel(4u * k));
+    vec4 r1 = imageLoad(bvh_instances, trace_texel(4u * k + 1u));
+    vec4 r2 = imageLoad(bvh_instances, trace_texel(4u * k + 2u));
+    uint triangle_base = floatBitsToUint(imageLoad(bvh_instances, trace_texel(4u * k + 3u)).y);
     vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * leaf + 1u)).xyz;
     vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * leaf + 2u)).xyz;
     // Normals move with the inverse transpose: the transpose of world-to-mesh.
     vec3 n = cross(e1, e2);
     hit.normal = r0.xyz * n.x + r1.xyz * n.y + r2.xyz * n.z;
     uint index = floatBitsToUint(imageLoad(bvh_triangles, trace_texel(3u * leaf)).w);
-    hit.triangle = floatBitsToUint(info.y) + index;
-    return true;
+    hit.triangle = triangle_base + index;
 }
 
 // Traverses the top level, each instance's bottom level in turn; with `any_hit` returns at
@@ -211,11 +243,11 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
     hit.v = 0.0;
     hit.triangle = 0xffffffffu;
     hit.normal = vec3(0.0);
-    vec3 inv_dir = trace_inverse(dir);
+    TraceSlabRay slab_ray = trace_slab_ray(origin, dir);
     // As trace_bottom: the box tests load what the visits need.
     vec4 lo = imageLoad(bvh_top, trace_texel(0u));
     vec4 hi = imageLoad(bvh_top, trace_texel(1u));
-    if (trace_slab(lo.xyz, hi.xyz, origin, inv_dir, t_min, t_max) < 0.0) {
+    if (trace_slab(lo.xyz, hi.xyz, slab_ray, t_min, t_max) < 0.0) {
         return false;
     }
     uint stack[TRACE_TOP_STACK_SIZE];
@@ -224,11 +256,14 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
     uint first = floatBitsToUint(lo.w);
     uint count = floatBitsToUint(hi.w);
     bool found = false;
+    uint instance = 0u;
+    uint leaf = 0u;
     while (true) {
         bool at_leaf = count > 0u;
         if (at_leaf) {
             for (uint k = first; k < first + count; ++k) {
-                if (trace_instance(k, origin, dir, t_min, any_hit, hit)) {
+                if (trace_instance(k, origin, dir, t_min, any_hit, hit, leaf)) {
+                    instance = k;
                     found = true;
                     if (any_hit) {
                         return true;
@@ -245,8 +280,8 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
         vec4 left_hi = imageLoad(bvh_top, trace_texel(2u * left + 1u));
         vec4 right_lo = imageLoad(bvh_top, trace_texel(2u * right));
         vec4 right_hi = imageLoad(bvh_top, trace_texel(2u * right + 1u));
-        float tl = trace_slab(left_lo.xyz, left_hi.xyz, origin, inv_dir, t_min, hit.t);
-        float tr = trace_slab(right_lo.xyz, right_hi.xyz, origin, inv_dir, t_min, hit.t);
+        float tl = trace_slab(left_lo.xyz, left_hi.xyz, slab_ray, t_min, hit.t);
+        float tr = trace_slab(right_lo.xyz, right_hi.xyz, slab_ray, t_min, hit.t);
         bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
         bool descend = !at_leaf && (tl >= 0.0 || tr >= 0.0);
         bool push = descend && tl >= 0.0 && tr >= 0.0 && sp < TRACE_TOP_STACK_SIZE;
@@ -260,6 +295,9 @@ bool trace_traverse(vec3 origin, vec3 dir, float t_min, float t_max, bool any_hi
         node = descend ? (go_left ? left : right) : popped;
         first = floatBitsToUint(descend ? (go_left ? left_lo.w : right_lo.w) : imageLoad(bvh_top, trace_texel(2u * node)).w);
         count = floatBitsToUint(descend ? (go_left ? left_hi.w : right_hi.w) : imageLoad(bvh_top, trace_texel(2u * node + 1u)).w);
+    }
+    if (found && !any_hit) {
+        trace_hit_triangle(instance, leaf, hit);
     }
     return found;
 }
