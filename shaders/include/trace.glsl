@@ -146,15 +146,25 @@ void trace_node(uint node, out vec3 left_lo, out vec3 left_hi, out vec3 right_lo
     right = b.w;
 }
 
+// The triangles of leaf reference `ref`: first and one past the last.
+uvec2 trace_leaf_range(uint ref) {
+    uint first = ref & 0x07ffffffu;
+    return uvec2(first, first + ((ref >> 27u) & 15u) + 1u);
+}
+
 // Traverses one bottom level from the reference `root` with a mesh-space ray; on a hit closer
 // than hit.t updates hit.t/u/v, sets `leaf` to the triangle's index in bvh_triangles and
 // returns true. With `any_hit` returns at the first hit found.
 //
-// The stack's push and pop sit outside every branch: llvmpipe stores to a private array lane
-// by lane, each lane behind a branch on its execution mask, and under a mask as random as
-// "this lane is at an interior node" those branches mispredicted (a tenth of the path
-// tracer's time). Out here the mask is the loop's, nearly always full; a lane with nothing to
-// push writes above its top of stack, which nothing reads.
+// lavapipe runs every part of the loop's body at every step, the leaf's triangle loop at least
+// once, so a step is shaped to use both: it tests the boxes of a node's two children, then the
+// triangles of the children that are leaves the ray meets (two sibling leaves hold adjacent
+// triangles: one range), and walks on into the interior ones, nearer first. The stack's push
+// and pop sit outside every branch: llvmpipe stores to a private array lane by lane, each lane
+// behind a branch on its execution mask, and under a mask as random as "this lane is at an
+// interior node" those branches mispredicted (a tenth of the path tracer's time). Out here
+// the mask is the loop's, nearly always full; a lane with nothing to push writes above its
+// top of stack, which nothing reads.
 bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, inout TraceHit hit, out uint leaf) {
     leaf = 0xffffffffu;
     TraceSlabRay slab_ray = trace_slab_ray(origin, dir);
@@ -163,34 +173,39 @@ bool trace_bottom(uint root, vec3 origin, vec3 dir, float t_min, bool any_hit, i
     uint ref = root;
     bool found = false;
     while (true) {
+        // A leaf root's lanes step node 0 and ignore the result.
         bool at_leaf = (ref & TRACE_LEAF) != 0u;
-        if (at_leaf) {
-            uint first = ref & 0x07ffffffu;
-            uint end = first + ((ref >> 27u) & 15u) + 1u;
-            for (uint i = first; i < end; ++i) {
-                vec3 tuv;
-                if (trace_triangle(i, origin, dir, t_min, hit.t, tuv)) {
-                    hit.t = tuv.x;
-                    hit.u = tuv.y;
-                    hit.v = tuv.z;
-                    leaf = i;
-                    found = true;
-                    if (any_hit) {
-                        return true;
-                    }
-                }
-            }
-        }
-        // A leaf's lanes step node 0 and ignore the result.
         vec3 left_lo, left_hi, right_lo, right_hi;
         uint left, right;
         trace_node(at_leaf ? 0u : ref, left_lo, left_hi, right_lo, right_hi, left, right);
         float tl = trace_slab(left_lo, left_hi, slab_ray, t_min, hit.t);
         float tr = trace_slab(right_lo, right_hi, slab_ray, t_min, hit.t);
-        // Into the nearer child hit; the other, if hit, waits on the stack.
-        bool go_left = tl >= 0.0 && (tr < 0.0 || tl <= tr);
-        bool descend = !at_leaf && (tl >= 0.0 || tr >= 0.0);
-        bool push = descend && tl >= 0.0 && tr >= 0.0 && sp < TRACE_STACK_SIZE;
+        bool met_left = !at_leaf && tl >= 0.0;
+        bool met_right = !at_leaf && tr >= 0.0;
+        bool leaf_left = (left & TRACE_LEAF) != 0u;
+        bool leaf_right = (right & TRACE_LEAF) != 0u;
+        uvec2 range_left = met_left && leaf_left ? trace_leaf_range(left) : uvec2(0xffffffffu, 0u);
+        uvec2 range_right = met_right && leaf_right ? trace_leaf_range(right) : uvec2(0xffffffffu, 0u);
+        uvec2 range = at_leaf ? trace_leaf_range(ref) : uvec2(min(range_left.x, range_right.x), max(range_left.y, range_right.y));
+        for (uint i = range.x; i < range.y; ++i) {
+            vec3 tuv;
+            if (trace_triangle(i, origin, dir, t_min, hit.t, tuv)) {
+                hit.t = tuv.x;
+                hit.u = tuv.y;
+                hit.v = tuv.z;
+                leaf = i;
+                found = true;
+                if (any_hit) {
+                    return true;
+                }
+            }
+        }
+        // Into the interior children met, nearer first; the other waits on the stack.
+        bool into_left = met_left && !leaf_left;
+        bool into_right = met_right && !leaf_right;
+        bool go_left = into_left && (!into_right || tl <= tr);
+        bool descend = into_left || into_right;
+        bool push = into_left && into_right && sp < TRACE_STACK_SIZE;
         stack[min(sp, TRACE_STACK_SIZE - 1u)] = go_left ? right : left;
         sp += push ? 1u : 0u;
         if (!descend && sp == 0u) {
