@@ -17,8 +17,9 @@
 // shine::gpu_scene::bvh::TraceNode. A top-level node is two vec4, (min, bits of
 // left_or_first) and (max, bits of count) — shine_scene::bvh::BvhNode; a leaf has count > 0
 // and holds instances left_or_first .. left_or_first + count; an interior node's left child
-// is the next node, its right child left_or_first. A triangle is three vec4, (v0, bits of its
-// index within its mesh), (v1 − v0, 0), (v2 − v0, 0) — GpuBvhTriangle, mesh space. An
+// is the next node, its right child left_or_first. A triangle is four vec4 in one row, (v0, bits
+// of its index within its mesh), (v1 − v0, 0), (v2 − v0, 0), padding — GpuBvhTriangle, mesh
+// space. An
 // instance is four vec4: rows 0–2 of its world-to-mesh matrix, then (bits of its bottom-level
 // root's reference, bits of its first flattened triangle, 0, 0) — TraceInstance. Rays enter a
 // bottom level transformed but not renormalised, so hit distances are world distances. Both
@@ -94,9 +95,11 @@ float trace_slab(vec3 lo, vec3 hi, TraceSlabRay ray, float t_min, float t_max) {
 // magnitude, so the one division (for tuv) is off its path: lavapipe runs the test for every
 // lane and the division's latency stalled the chain behind it.
 bool trace_triangle(uint tri, vec3 origin, vec3 dir, float t_min, float t_max, out vec3 tuv) {
-    vec3 a = imageLoad(bvh_triangles, trace_texel(3u * tri)).xyz;
-    vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * tri + 1u)).xyz;
-    vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * tri + 2u)).xyz;
+    // A triangle's texels share a row: the three loads share its offset and bounds check.
+    ivec2 texel = trace_texel(4u * tri);
+    vec3 a = imageLoad(bvh_triangles, texel).xyz;
+    vec3 e1 = imageLoad(bvh_triangles, texel + ivec2(1, 0)).xyz;
+    vec3 e2 = imageLoad(bvh_triangles, texel + ivec2(2, 0)).xyz;
     vec3 p = cross(dir, e2);
     float det = dot(e1, p);
     vec3 s = origin - a;
@@ -241,12 +244,12 @@ void trace_hit_triangle(uint k, uint leaf, inout TraceHit hit) {
     vec4 r1 = imageLoad(bvh_instances, trace_texel(4u * k + 1u));
     vec4 r2 = imageLoad(bvh_instances, trace_texel(4u * k + 2u));
     uint triangle_base = floatBitsToUint(imageLoad(bvh_instances, trace_texel(4u * k + 3u)).y);
-    vec3 e1 = imageLoad(bvh_triangles, trace_texel(3u * leaf + 1u)).xyz;
-    vec3 e2 = imageLoad(bvh_triangles, trace_texel(3u * leaf + 2u)).xyz;
+    vec3 e1 = imageLoad(bvh_triangles, trace_texel(4u * leaf + 1u)).xyz;
+    vec3 e2 = imageLoad(bvh_triangles, trace_texel(4u * leaf + 2u)).xyz;
     // Normals move with the inverse transpose: the transpose of world-to-mesh.
     vec3 n = cross(e1, e2);
     hit.normal = r0.xyz * n.x + r1.xyz * n.y + r2.xyz * n.z;
-    uint index = floatBitsToUint(imageLoad(bvh_triangles, trace_texel(3u * leaf)).w);
+    uint index = floatBitsToUint(imageLoad(bvh_triangles, trace_texel(4u * leaf)).w);
     hit.triangle = triangle_base + index;
 }
 
