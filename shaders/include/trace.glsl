@@ -19,11 +19,10 @@
 // and holds instances left_or_first .. left_or_first + count; an interior node's left child
 // is the next node, its right child left_or_first. A triangle is four vec4 in one row, (v0, bits
 // of its index within its mesh), (v1 − v0, 0), (v2 − v0, 0), padding — GpuBvhTriangle, mesh
-// space. An
-// instance is four vec4: rows 0–2 of its world-to-mesh matrix, then (bits of its bottom-level
-// root's reference, bits of its first flattened triangle, 0, 0) — TraceInstance. Rays enter a
-// bottom level transformed but not renormalised, so hit distances are world distances. Both
-// faces of every triangle are hit.
+// space; two sibling leaves hold adjacent triangles. An instance is four vec4: rows 0–2 of its
+// world-to-mesh matrix, then (bits of its bottom-level root's reference, bits of its first
+// flattened triangle, 0, 0) — TraceInstance. Rays enter a bottom level transformed but not
+// renormalised, so hit distances are world distances. Both faces of every triangle are hit.
 #ifndef TRACE_GLSL
 #define TRACE_GLSL
 

@@ -631,6 +631,48 @@ mod tests {
         }
     }
 
+    /// A subtree's triangles are contiguous, the left child's before the right's, so two
+    /// sibling leaves hold adjacent ranges: `trace.glsl` tests both as one range
+    /// (`trace_bottom`), which would test others' triangles between them otherwise.
+    #[test]
+    fn sibling_leaves_hold_adjacent_triangles() {
+        let mut rng = 0x2545_f491_u32;
+        let mut f = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            (rng >> 8) as f32 / (1 << 24) as f32
+        };
+        let soup: Vec<BvhTriangle> = (0..500)
+            .map(|_| {
+                let c = [f() * 10.0, f() * 10.0, f() * 10.0];
+                BvhTriangle {
+                    v0: c,
+                    v1: [c[0] + f(), c[1], c[2] + f()],
+                    v2: [c[0], c[1] + f(), c[2]],
+                    ..bytemuck::Zeroable::zeroed()
+                }
+            })
+            .collect();
+        let bvh = Bvh::build(soup);
+        // The triangle range under every node, children before parents.
+        let mut span = vec![(0u32, 0u32); bvh.nodes.len()];
+        for (i, n) in bvh.nodes.iter().enumerate().rev() {
+            span[i] = if n.count > 0 {
+                (n.left_or_first, n.left_or_first + n.count)
+            } else {
+                let (l, r) = (span[i + 1], span[n.left_or_first as usize]);
+                assert_eq!(
+                    l.1, r.0,
+                    "node {i}: its children's triangles are not adjacent"
+                );
+                (l.0, r.1)
+            };
+        }
+        assert_eq!(span[0], (0, bvh.triangles.len() as u32));
+        assert!(bvh.nodes.iter().filter(|n| n.count == 0).count() > 50);
+    }
+
     #[test]
     fn trace_extent_fills_rows_of_trace_row_texels() {
         assert_eq!(trace_extent(0), [1, 1]);
