@@ -559,6 +559,10 @@ pub fn world_bvh(scene: &Scene, world: &[Mat4]) -> Result<(Bvh, Vec<u32>), Scene
 const _: () = assert!(std::mem::size_of::<BvhNode>() == 32);
 const _: () = assert!(std::mem::size_of::<TraceNode>() == 32);
 const _: () = assert!(std::mem::size_of::<GpuBvhTriangle>() == 64);
+/// A triangle's four texels lie in one row (`trace_triangle` offsets the first texel's x).
+const _: () = assert!(
+    (TRACE_ROW_TEXELS as usize).is_multiple_of(std::mem::size_of::<GpuBvhTriangle>() / TEXEL_BYTES)
+);
 const _: () = assert!(std::mem::size_of::<TraceInstance>() == 64);
 
 #[cfg(test)]
