@@ -42,6 +42,12 @@ macro_rules! named_choice {
             }
         }
 
+        impl $crate::declare::SettingValue for $name {
+            fn domain(&self) -> $crate::declare::Domain {
+                $crate::declare::Domain::Choice(Self::ALL.iter().map(|c| c.name()).collect())
+            }
+        }
+
         impl std::str::FromStr for $name {
             type Err = $crate::choice::UnknownChoice;
 

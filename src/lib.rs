@@ -10,6 +10,7 @@ pub use shine_graph as graph;
 
 pub mod capture;
 pub mod choice;
+pub mod declare;
 pub mod embed;
 pub mod frame;
 pub mod gpu_scene;

@@ -83,7 +83,7 @@ fn small_hvl() -> Settings {
     };
     s.rsm.size = 64;
     s.hvl.count = 64;
-    s.hvl.convolution_bands = 3;
+    s.hvl.conv_bands = 3;
     s.hvl.emission_bands = 3;
     s
 }

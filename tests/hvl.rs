@@ -167,14 +167,11 @@ fn params(path: GatherPath, conv_bands: u32, emission_bands: u32) -> HvlParams {
         emission_bands,
         path,
         visibility: false,
-        shadows: ShadowSampling {
-            rays: 0,
-            ..ShadowSampling::default()
-        },
-        near_range: 0.0,
+        shadow_rays: 0,
         slices: 1,
         // the glossy share of the traced specular pass: ties the GLSL fade to the Rust one
         specular_limit: shine::passes::specular::LIMIT,
+        ..HvlParams::default()
     }
 }
 
@@ -494,11 +491,8 @@ fn bad_parameters_are_errors() {
     };
     for (rays, filter_radius) in [(shadows::RAYS_MAX + 1, 3), (4, 9)] {
         let p = HvlParams {
-            shadows: ShadowSampling {
-                rays,
-                filter_radius,
-                ..ShadowSampling::default()
-            },
+            shadow_rays: rays,
+            shadow_filter_radius: filter_radius,
             ..vis
         };
         assert!(
@@ -829,7 +823,7 @@ fn gather_matches_the_cpu_reference() {
         let p = HvlParams {
             window,
             falloff,
-            near_range: near.iter().find(|n| n.0 == k).map_or(0.0, |n| n.1),
+            near_radius: near.iter().find(|n| n.0 == k).map_or(0.0, |n| n.1),
             ..params(path, conv, emission)
         };
         let brdf = tables(conv, [12, 24]);
@@ -861,8 +855,8 @@ fn gather_matches_the_cpu_reference() {
                 falloff: Falloff::Sphere,
                 ..p
             }),
-            (p.near_range > 0.0).then_some(HvlParams {
-                near_range: 0.0,
+            (p.near_radius > 0.0).then_some(HvlParams {
+                near_radius: 0.0,
                 ..p
             }),
         ];
@@ -1195,11 +1189,8 @@ fn gather_reaches_the_last_of_max_hvls() {
     };
     let sampled = HvlParams {
         visibility: true,
-        shadows: ShadowSampling {
-            rays: shadows::RAYS_MAX,
-            filter_radius: 0,
-            ..ShadowSampling::default()
-        },
+        shadow_rays: shadows::RAYS_MAX,
+        shadow_filter_radius: 0,
         ..plain
     };
     let clear = GpuBvh::from_world(&device, &world_bvh(&far_occluder())).unwrap();
@@ -1261,12 +1252,9 @@ fn sampled_shadows_approach_one_ray_per_hvl() {
     let with = |rays: u32, filter_radius: u32, seed: u32, bvh: &GpuBvh| {
         let p = HvlParams {
             visibility: true,
-            shadows: ShadowSampling {
-                rays,
-                filter_radius,
-                seed,
-                ..ShadowSampling::default()
-            },
+            shadow_rays: rays,
+            shadow_filter_radius: filter_radius,
+            shadow_seed: seed,
             ..base
         };
         gpu_gather(&device, &receivers, &hvls, &brdf, CAMERA, &p, Some(bvh))

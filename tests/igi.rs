@@ -403,7 +403,8 @@ fn worst(a: &[Vec3], b: &[Vec3]) -> f32 {
 
 fn params(pattern: [u32; 2], order: u32, radius: u32, mode: FilterMode) -> IgiParams {
     IgiParams {
-        pattern,
+        n: pattern[0],
+        m: pattern[1],
         vpl_count: 64,
         sh_order: order,
         filter_radius: radius,
@@ -614,7 +615,8 @@ fn bad_parameters_are_errors() {
     let sh = rg.create_buffer("sh", shine::graph::BufferDesc::new(8 * 8 * 9 * 8));
     for bad in [
         IgiParams {
-            pattern: [9, 1],
+            n: 9,
+            m: 1,
             ..IgiParams::default()
         },
         IgiParams {
@@ -761,7 +763,7 @@ fn sh_filtering_beats_irradiance_filtering_on_the_room() {
     let reference = room_reference();
     let sh = compare(&room_igi(|_| {}), &reference.indirect).expect("compare");
     let irradiance = compare(
-        &room_igi(|s| s.igi.filter = FilterMode::Irradiance),
+        &room_igi(|s| s.igi.mode = FilterMode::Irradiance),
         &reference.indirect,
     )
     .expect("compare");

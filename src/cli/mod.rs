@@ -8,6 +8,7 @@ mod progress;
 mod reference;
 mod render;
 mod scene;
+mod settings;
 mod study;
 
 use clap::{Parser, Subcommand};
@@ -38,6 +39,8 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Built-in scenes: list them or export one as .glb.
     Scene(scene::SceneArgs),
+    /// Every setting: key, default, values, what it changes (docs/settings.md).
+    Settings(settings::SettingsArgs),
     /// Quality studies: error against samples per pixel (`study aaf`: paper 004's Fig. 10).
     Study(study::StudyArgs),
 }
@@ -51,6 +54,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Reference(args) => reference::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Scene(args) => scene::run(&args),
+        Command::Settings(args) => settings::run(&args),
         Command::Study(args) => study::run(&args),
     }
 }

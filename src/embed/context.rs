@@ -180,7 +180,7 @@ impl GiContext {
         let display = self.display;
         let constants = dispatch.host_frame(display);
         let camera = dispatch.camera.view_for(display);
-        let proxy_bands = self.params.proxy.map(|p| p.pass.bands);
+        let proxy_bands = self.params.proxy.map(|p| p.sh_order);
         let (frame_constants, ring, sampler) =
             (&self.frame_constants, &mut self.ring, self.nearest.raw());
         self.renderer.record_indirect(

@@ -50,7 +50,7 @@ pub struct HvlInputs<'a> {
     /// Seed of the sampled shadow rays (the frame index when a history averages frames).
     pub seed: u32,
     /// R of the near field the frame traces beside the gather (world units; 0: none).
-    pub near_range: f32,
+    pub near_radius: f32,
 }
 
 impl HvlTechnique {
@@ -110,8 +110,8 @@ impl PreparedHvl {
         inputs: &HvlInputs<'_>,
     ) -> Result<Handle<Image>, RenderError> {
         let mut params = self.params;
-        params.shadows.seed = inputs.seed;
-        params.near_range = inputs.near_range;
+        params.shadow_seed = inputs.seed;
+        params.near_radius = inputs.near_radius;
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
         let records = hvl::hvl_gather_prep(rg, &hvls, &params)?;
         let bvh = params.visibility.then_some(inputs.bvh);

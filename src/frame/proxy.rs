@@ -15,12 +15,12 @@ use shine_scene::proxies::{self, ProxySphere};
 use shine_scene::{Mesh, Scene};
 
 use super::error::RenderError;
-use super::params::ProxySetup;
 use crate::gpu_scene::BUFFER_READ;
 use crate::gpu_scene::environment_sh::EnvironmentSh;
 use crate::gpu_scene::upload_ring::UploadRing;
 use crate::passes::amortise::{self, ResolveHistory, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
+use crate::passes::proxy::ProxySettings;
 use crate::passes::proxy::{
     self, GpuProxy, MAX_PROXIES, ProxyError, ProxyInputs, ProxyParams, ProxySlice, ProxyTables,
 };
@@ -188,12 +188,12 @@ impl ProxyTechnique {
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
-        setup: &ProxySetup,
+        setup: &ProxySettings,
         world: &[Mat4],
         environment: Option<Handle<shine_graph::Buffer>>,
         receiver_extent: [u32; 2],
     ) -> Result<PreparedProxy<'_>, RenderError> {
-        let bands = setup.pass.bands;
+        let bands = setup.sh_order;
         let amortised = self
             .schedule
             .next(rg.frame(), receiver_extent, setup.slices, 0);
@@ -203,7 +203,7 @@ impl ProxyTechnique {
         };
         let key = (
             bands,
-            setup.shadow_expansion.to_bits(),
+            setup.shadow_expansion().to_bits(),
             setup.indirect_expansion.to_bits(),
         );
         let (table_index, uploaded_tables) = match self
@@ -214,7 +214,7 @@ impl ProxyTechnique {
             Some(i) => (i, None),
             None => {
                 let tables =
-                    ProxyTables::build(bands, setup.shadow_expansion, setup.indirect_expansion)?;
+                    ProxyTables::build(bands, setup.shadow_expansion(), setup.indirect_expansion)?;
                 let data = tables.gpu_data();
                 let buffer = Buffer::storage_for_uploads(
                     &self.device,
@@ -261,7 +261,7 @@ impl ProxyTechnique {
             brdf,
         };
         Ok(PreparedProxy {
-            params: setup.pass,
+            params: setup.pass(),
             inputs,
             tables,
             amortised,

@@ -16,8 +16,10 @@
 
 use std::ops::RangeInclusive;
 
-use super::OutOfRange;
+use serde::{Deserialize, Serialize};
+
 use super::gbuffer::GBuffer;
+use crate::declare::{OutOfRange, Section, Settings};
 use crate::graph::{Handle, History, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
 
@@ -61,12 +63,21 @@ pub const TAA_CLIP: f32 = 1.0;
 /// Frames of TAA's jitter sequence before it repeats.
 pub const TAA_JITTER_CYCLE: u64 = 8;
 
-/// How an image is accumulated over frames.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// `[history]`: how an image is accumulated over frames (the indirect light's history:
+/// reprojected with the motion vectors, rejected on disocclusion, clipped to the current
+/// neighbourhood; TAA's with [`AccumulateParams::taa`]). A single still frame is unchanged (it
+/// has no history).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
 pub struct AccumulateParams {
-    /// Longest history n: the blend weight of the current frame never falls below 1/n.
+    /// Longest history n in frames: each frame blends in at least 1/n of its own light (1: no
+    /// accumulation).
+    #[serde(rename = "frames")]
+    #[setting(default = DEFAULT_MAX_FRAMES, range = MAX_FRAMES_RANGE, affects = quality)]
     pub max_frames: u32,
-    /// Half-width of the clip box in standard deviations (0: no clipping).
+    /// Half-width of the clip box in standard deviations of the current 3×3 neighbourhood
+    /// (0: history not clipped).
+    #[setting(default = DEFAULT_CLIP, range = CLIP_RANGE, affects = quality)]
     pub clip: f32,
     /// The indirect light's history: linear radiance, the background passes through. Without
     /// it, TAA: the background accumulates too, a still pixel ([`TAA_STILL_PIXELS`]) keeps
@@ -75,18 +86,9 @@ pub struct AccumulateParams {
     /// object over it, as it does in linear HDR; luma:
     /// [`crate::capture::tonemap::luminance`]). Both restart where the history shows another
     /// surface.
+    #[serde(skip)]
+    #[setting(default = true)]
     pub geometry: bool,
-}
-
-impl Default for AccumulateParams {
-    /// The indirect light's history.
-    fn default() -> Self {
-        Self {
-            max_frames: DEFAULT_MAX_FRAMES,
-            clip: DEFAULT_CLIP,
-            geometry: true,
-        }
-    }
 }
 
 impl AccumulateParams {
@@ -121,8 +123,7 @@ fn halton(mut index: u32, base: u32) -> f32 {
 impl AccumulateParams {
     /// Checks both parameters against their ranges.
     pub fn validate(&self) -> Result<(), OutOfRange> {
-        super::check_range("history.frames", self.max_frames, &MAX_FRAMES_RANGE)?;
-        super::check_range("history.clip", self.clip, &CLIP_RANGE)
+        self.check_in("history.")
     }
 }
 

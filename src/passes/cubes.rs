@@ -35,6 +35,9 @@
 //! * **Diffuse only**: the receivers get `kd · L̄`; the traced specular pass still adds the
 //!   sharp part of their glossy lobes, the rough part is left out.
 
+use serde::{Deserialize, Serialize};
+
+use crate::declare::Settings;
 use crate::graph::{Buffer, Handle, Image, RenderGraph};
 use crate::passes::receivers::Receivers;
 use crate::passes::traced_scene::TracedScene;
@@ -67,30 +70,32 @@ crate::choice::named_choice! {
     }
 }
 
-/// Parameters of the cube passes.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// `[cubes]`: one 6×6×6 cube of incoming light per dynamic object (a node with proxies),
+/// filled by rays and smoothed as paper 001 does; the object's receivers take their indirect
+/// light from it instead of from the frame's technique (issue 18). The cube passes'
+/// parameters, each declared once.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
 pub struct CubeParams {
-    /// How receivers read the cube.
+    /// Light the dynamic objects from their cubes (the frame declares the passes only then).
+    #[setting(default = false, affects = both)]
+    pub enabled: bool,
+    /// How a receiver reads its cube: `normal` (the smoothing sum at the normal) or `texel`
+    /// (the smoothed texel holding the normal, the paper's).
+    #[setting(default = CubeLookup::Normal, affects = quality)]
     pub lookup: CubeLookup,
-    /// Weight the smoothing sum by each texel's solid angle (false: the paper's plain sum).
+    /// Weight the smoothing by each texel's solid angle (false: the paper's plain sum).
+    #[setting(default = true, affects = quality)]
     pub solid_angle: bool,
-    /// Write 1 at the receivers the cubes light and 0 elsewhere, instead of light (a debugging
-    /// view, and the mask of the cube study's per-object error).
+    /// Write 1 at the receivers the cubes light and 0 elsewhere, instead of light (see with
+    /// `output.component = indirect`; the mask of the cube study's per-object error).
+    #[setting(default = false, affects = output)]
     pub mask: bool,
-    /// Refresh every `slices`-th cube per frame in turn (1: all), plus the cubes of objects and
-    /// lights that move (`crate::frame::cubes`).
+    /// Refresh one cube in `slices` per frame, in turn, plus at once those of objects that
+    /// move (and their neighbours) and all of them when a light changes (paper 001: "update
+    /// one object at the time"; `crate::frame::cubes`).
+    #[setting(default = SLICES, range = SLICES_RANGE, affects = both)]
     pub slices: u32,
-}
-
-impl Default for CubeParams {
-    fn default() -> Self {
-        Self {
-            lookup: CubeLookup::Normal,
-            solid_angle: true,
-            mask: false,
-            slices: SLICES,
-        }
-    }
 }
 
 /// One cube as the fill reads it (32 bytes).

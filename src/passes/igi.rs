@@ -66,7 +66,9 @@
 use std::ops::RangeInclusive;
 
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
 
+use crate::declare::{Section, Settings};
 use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::amortise;
@@ -121,39 +123,68 @@ crate::choice::named_choice! {
     }
 }
 
-/// Parameters of the IGI passes.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// `[igi]`: instant global illumination with interleaved sampling and SH-filtered incident
+/// radiance (paper 000): the parameters of the IGI passes, each declared once (the settings'
+/// keys, ranges and defaults are these fields').
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
 pub struct IgiParams {
-    /// Interleaving pattern n×m (each 1..=8).
-    pub pattern: [u32; 2],
-    /// VPL count M (64..=10 000, at most the RSM's texel count).
+    /// Interleaving pattern width n (VPL sets per row of a tile).
+    #[setting(default = 4, range = PATTERN, affects = both)]
+    pub n: u32,
+    /// Interleaving pattern height m.
+    #[setting(default = 4, range = PATTERN, affects = both)]
+    pub m: u32,
+    /// Number M of VPLs taken from the RSM (cut into exactly this many cells), shared out over
+    /// the n·m sets; at most `rsm.size²`.
+    #[setting(default = 256, range = VPL_COUNT, lab = 64..=1024, affects = both)]
     pub vpl_count: u32,
-    /// Where the VPLs are placed on the RSM (the HVL cache's distributions).
+    /// Where the VPLs are placed on the RSM: `grid` (cells uniform in the RSM's image) or
+    /// `flux` (texels drawn in proportion to their reflected flux), as `hvl.distribution`.
+    #[setting(default = hvl::Distribution::Flux, affects = quality)]
     pub distribution: hvl::Distribution,
-    /// SH order (bands) 2..=4 of the SH mode.
+    /// SH order (bands) of the per-pixel incident radiance (order² coefficients; paper 000
+    /// §3.1: 3).
+    #[setting(default = 3, range = SH_ORDERS, affects = both)]
     pub sh_order: u32,
-    /// Filter window size k in pattern tiles: k n × k m pixels around the pixel (0..=4; 0: no
-    /// filter; 1: exactly one tile, paper 000 §2.3).
+    /// Size k of the discontinuity filter's window in interleaving tiles: k·n × k·m pixels
+    /// around the pixel, every set counted k² times (0: no filter; 1: exactly one tile, as
+    /// paper 000 §2.3).
+    #[setting(default = 1, range = FILTER_RADIUS, affects = both)]
     pub filter_radius: u32,
-    /// SH (paper 000) or irradiance (classic IGI).
+    /// What is filtered: `sh` (paper 000) or `irradiance` (classic IGI).
+    #[serde(rename = "filter")]
+    #[setting(default = FilterMode::Sh, affects = both)]
     pub mode: FilterMode,
-    /// Glossy lobe of the SH mode.
+    /// Glossy lobe of the SH mode: `ggx` (BRDF SH tables) or `phong` (paper 000 §3.3.2).
+    #[setting(default = Glossy::Ggx, affects = quality)]
     pub glossy: Glossy,
-    /// d_min of the 1/d² clamp in metres (0..=10).
+    /// Minimum VPL distance d_min in metres: 1/d² is evaluated as 1/max(d², d_min²) (the VPL
+    /// singularity clamp).
+    #[setting(default = 0.1, range = CLAMP_DISTANCE, lab = 0.0..=0.5, affects = quality)]
     pub clamp_distance: f32,
-    /// Relative depth tolerance of the filter, in [`DEPTH_TOLERANCE`].
+    /// Relative depth tolerance of the filter: a neighbour q is used when
+    /// |z_q − z_p| ≤ depth_tolerance · z_p.
+    #[setting(default = 0.05, range = DEPTH_TOLERANCE, lab = 0.01..=0.2, affects = quality)]
     pub depth_tolerance: f32,
-    /// Cosine threshold of the geometric-normal test (−1..=1).
+    /// Cosine threshold of the filter's geometric-normal test (n_p · n_q ≥ this).
+    #[setting(default = 0.9, range = NORMAL_THRESHOLD, lab = 0.5..=0.99, affects = quality)]
     pub normal_threshold: f32,
-    /// Roughness limit of the frame's traced specular pass (0: none): the filter's glossy
-    /// term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    /// Roughness limit of the frame's traced specular pass (0: none; set by the frame): the
+    /// filter's glossy term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    #[serde(skip)]
+    #[setting(default = 0.0)]
     pub specular_limit: f32,
-    /// Pixels per refresh (paper 001): 1, or [`amortise::SLICES`]: `vpl_sh` gathers the VPL
-    /// sets of one pixel per 2×2 cell per frame and the others keep theirs, reprojected
-    /// ([`IgiSlice`], `igi_reproject`: [`amortise::reproject_records`]).
+    /// Pixels per refresh (paper 001): 1 gathers every pixel's VPL set every frame; 4 gathers
+    /// the sets of one pixel per 2×2 cell per frame and reprojects the others' SH from the
+    /// previous frames ([`IgiSlice`], `igi_reproject`: [`amortise::reproject_records`]).
+    #[setting(default = 1, one_of = amortise::SLICE_CHOICES, affects = both)]
     pub slices: u32,
     /// Bytes one storage buffer may hold on the device (`maxStorageBufferRange`; lavapipe's
-    /// is [`MAX_STORAGE_BUFFER`], NVIDIA's 4 GiB): bounds the per-pixel SH buffer.
+    /// is [`MAX_STORAGE_BUFFER`], NVIDIA's 4 GiB; set by the frame): bounds the per-pixel SH
+    /// buffer.
+    #[serde(skip)]
+    #[setting(default = MAX_STORAGE_BUFFER)]
     pub storage_limit: u64,
 }
 
@@ -170,26 +201,6 @@ pub struct IgiSlice {
     pub marks: Option<Handle<Image>>,
     /// The buffer to gather into (the amortised frame's SH history; `None`: a new one).
     pub into: Option<Handle<Buffer>>,
-}
-
-impl Default for IgiParams {
-    fn default() -> Self {
-        Self {
-            pattern: [4, 4],
-            vpl_count: 256,
-            distribution: hvl::Distribution::Flux,
-            sh_order: 3,
-            filter_radius: 1,
-            mode: FilterMode::Sh,
-            glossy: Glossy::Ggx,
-            clamp_distance: 0.1,
-            depth_tolerance: 0.05,
-            normal_threshold: 0.9,
-            specular_limit: 0.0,
-            slices: 1,
-            storage_limit: MAX_STORAGE_BUFFER,
-        }
-    }
 }
 
 /// Push constants of `shaders/vpl_sh.comp` (48 bytes).
@@ -241,7 +252,10 @@ pub struct FilterPush {
 pub enum IgiError {
     /// A parameter out of its range.
     #[error("IGI {0}")]
-    OutOfRange(#[from] super::OutOfRange),
+    OutOfRange(#[from] crate::passes::OutOfRange),
+    /// A setting outside its declared domain.
+    #[error("IGI: {0}")]
+    Setting(#[from] crate::declare::OutOfRange),
     /// The per-pixel SH buffer would exceed one storage buffer.
     #[error(
         "IGI per-pixel radiance of {width}×{height} pixels × {coefficients} coefficients needs {bytes} bytes, more than the {limit} bytes of one storage buffer on this device: lower igi.sh_order or the resolution"
@@ -267,26 +281,14 @@ pub enum IgiError {
 }
 
 impl IgiParams {
-    /// Checks every parameter (ranges as documented on the fields).
+    /// Checks every parameter against its declared range.
     pub fn validate(&self) -> Result<(), IgiError> {
-        use super::check_range as check;
-        let [n, m] = self.pattern;
-        check("n", n, &PATTERN)?;
-        check("m", m, &PATTERN)?;
-        check("vpl_count", self.vpl_count, &VPL_COUNT)?;
-        check("sh_order", self.sh_order, &SH_ORDERS)?;
-        check("filter_radius", self.filter_radius, &FILTER_RADIUS)?;
-        check("clamp_distance", self.clamp_distance, &CLAMP_DISTANCE)?;
-        check("depth_tolerance", self.depth_tolerance, &DEPTH_TOLERANCE)?;
-        check("normal_threshold", self.normal_threshold, &NORMAL_THRESHOLD)?;
-        if !amortise::SLICE_CHOICES.contains(&self.slices) {
-            return Err(IgiError::OutOfRange(super::OutOfRange {
-                name: "slices",
-                value: f64::from(self.slices),
-                expected: format!("one of {:?}", amortise::SLICE_CHOICES),
-            }));
-        }
-        Ok(())
+        Ok(self.check_in("igi.")?)
+    }
+
+    /// The interleaving pattern `[n, m]`.
+    pub fn pattern(&self) -> [u32; 2] {
+        [self.n, self.m]
     }
 
     /// Coefficients stored per pixel: order² (SH) or 2 (irradiance and glossy radiance).
@@ -375,10 +377,9 @@ pub fn vpls(
         window: hvl::Window::None,
         falloff: hvl::Falloff::Sphere,
         visibility: false,
-        shadows: hvl::shadows::ShadowSampling::default(),
-        near_range: 0.0,
+        shadow_rays: 0,
         slices: 1,
-        specular_limit: 0.0,
+        ..HvlParams::default()
     };
     Ok(hvl::hvl_cache(rg, rsm, &cache)?)
 }
@@ -423,7 +424,7 @@ pub fn vpl_sh(
     let push = VplShPush {
         camera_clamp: camera.extend(params.clamp_distance).to_array(),
         extent: g.extent,
-        pattern: params.pattern,
+        pattern: params.pattern(),
         vpl_count: params.vpl_count,
         stride: permutation_stride(params.vpl_count),
         slice: slice.slice,
@@ -491,7 +492,7 @@ pub fn sh_filter(
     let push = FilterPush {
         camera: camera.extend(params.specular_limit).to_array(),
         extent: g.extent,
-        pattern: params.pattern,
+        pattern: params.pattern(),
         radius: params.filter_radius,
         depth_tolerance: params.depth_tolerance,
         normal_threshold: params.normal_threshold,
@@ -570,7 +571,7 @@ mod tests {
         };
         assert_eq!(large.sh_bytes([1920, 1080]), Ok(1920 * 1080 * 16 * 8));
         let bad = IgiParams {
-            pattern: [0, 4],
+            n: 0,
             ..IgiParams::default()
         };
         assert!(bad.validate().is_err());

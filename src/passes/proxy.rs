@@ -39,10 +39,12 @@
 //!   clamped at 0. The proxies' own indirect light reaches the diffuse part only.
 
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
 use shine_sh::ShError;
 use shine_sh::exp_log::ShExp;
 use shine_sh::sphere_blocker::AlphaTable;
 
+use crate::declare::Settings;
 use crate::gpu_scene::environment_sh::ORDERS;
 use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::shaders;
@@ -133,6 +135,75 @@ impl Accumulation {
             Accumulation::Splat => "splat",
             Accumulation::Brute => "brute",
             Accumulation::Product => "product",
+        }
+    }
+}
+
+/// `[proxy]`: sphere proxies under the environment light (paper 002), each setting declared
+/// once: the proxy passes' parameters ([`ProxySettings::pass`]) and how the technique's GPU
+/// data is built (α tables, refitted spheres).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
+pub struct ProxySettings {
+    /// SH order n of the occlusion and the environment (n² coefficients; the paper's shadow
+    /// order is 4).
+    #[setting(default = DEFAULT_ORDER, range = ORDERS, affects = both)]
+    pub sh_order: u32,
+    /// Radius expansion factor η of the shadow sphere of influence (§4.1); 0 picks the paper's
+    /// value for the order ([`paper_expansion`]: 10 for order 3, 15 for order 4 and above).
+    #[setting(default = 0.0, zero_or = EXPANSION, affects = both)]
+    pub expansion: f32,
+    /// Expansion factor of the indirect sphere of influence (order-3 indirect: 10 in the
+    /// paper).
+    #[setting(default = paper_expansion(INDIRECT_BANDS as u32), range = EXPANSION, lab = 5.0..=30.0, affects = both)]
+    pub indirect_expansion: f32,
+    /// SH exponential: `ol`, `ps` or `hyb`.
+    #[setting(default = ExpMethod::Hyb, affects = both)]
+    pub exp: ExpMethod,
+    /// Proxy indirect light (eq. 12–15) on top of the shadowed environment.
+    #[setting(default = true, affects = both)]
+    pub indirect: bool,
+    /// Brute force: every proxy at every receiver, unclamped tables and the exact chain of SH
+    /// products instead of log/exp (a reference; slow).
+    #[setting(default = false, affects = both)]
+    pub brute_force: bool,
+    /// 0: the scene's proxies; k: refit k spheres to the mesh of every node that has proxies
+    /// (for profiling with many proxies).
+    #[setting(default = 0, range = FIT_COUNT, lab = 0..=16, affects = both)]
+    pub fit_count: u32,
+    /// Receivers per refresh (paper 001): 1 shades every receiver every frame; 4 shades one
+    /// receiver per 2×2 cell per frame and reprojects the others from the previous frames
+    /// (`proxy_resolve`, src/passes/amortise.rs).
+    #[setting(default = 1, one_of = amortise::SLICE_CHOICES, affects = both)]
+    pub slices: u32,
+    /// Roughness limit of the frame's traced specular pass (0: none; set by the frame).
+    #[serde(skip)]
+    #[setting(default = 0.0)]
+    pub specular_limit: f32,
+}
+
+impl ProxySettings {
+    /// The parameters of the proxy passes.
+    pub fn pass(&self) -> ProxyParams {
+        ProxyParams {
+            bands: self.sh_order,
+            accumulation: if self.brute_force {
+                Accumulation::Product
+            } else {
+                Accumulation::Splat
+            },
+            exp: self.exp,
+            indirect: self.indirect,
+            specular_limit: self.specular_limit,
+        }
+    }
+
+    /// Shadow expansion factor η of the α tables: `expansion`, or the paper's for the order.
+    pub fn shadow_expansion(&self) -> f32 {
+        if self.expansion > 0.0 {
+            self.expansion
+        } else {
+            paper_expansion(self.sh_order)
         }
     }
 }

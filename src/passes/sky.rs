@@ -28,6 +28,10 @@
 
 use std::ops::RangeInclusive;
 
+use serde::{Deserialize, Serialize};
+
+use crate::declare::{Section, Settings};
+
 use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, Handle, Image, RenderGraph};
 use crate::passes::receivers::Receivers;
@@ -47,31 +51,63 @@ pub const FILTER_RADIUS: u32 = 3;
 /// Filter radii the settings take (0: no filter).
 pub const FILTER_RADIUS_RANGE: RangeInclusive<u32> = 0..=8;
 
-/// Parameters of the sky pass.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// `[sky]`: the environment's diffuse light times each receiver's sky visibility and bent
+/// normal (issue 16), in every frame without the proxies (which shadow the environment
+/// themselves; `gi = none` included), when the scene has an environment: the sky pass's
+/// parameters, each declared once.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
 pub struct SkyParams {
+    /// Light the receivers by the sky (the frame declares the pass only then).
+    #[setting(default = true, affects = both)]
+    pub enabled: bool,
     /// Rays per receiver.
+    #[setting(default = RAYS, range = RAYS_RANGE, affects = both)]
     pub rays: u32,
-    /// How far a ray looks for an occluder (0: unbounded, the sky's visibility; a short range
-    /// gives cavity occlusion).
+    /// How far a ray looks for an occluder, in world units (0: unbounded, the sky's
+    /// visibility; a short range gives cavity occlusion).
+    #[setting(default = 0.0, range = RANGE_RANGE, affects = quality)]
     pub range: f32,
-    /// Look the irradiance up at the bent normal; false: at the shading normal.
+    /// Look the irradiance up at the bent normal (the mean open direction); false: at the
+    /// shading normal.
+    #[setting(default = true, affects = quality)]
     pub bent_normal: bool,
-    /// Seed of the rays.
+    /// Seed of the rays (set by the frame).
+    #[serde(skip)]
+    #[setting(default = 0)]
     pub seed: u32,
-    /// Radius in receivers of the sky filter's joint bilateral mean (0: none; unused by the
-    /// cavity pass).
+    /// Radius in receivers of the joint bilateral filter of the sky's light (0: none; unused
+    /// by the cavity pass).
+    #[setting(default = FILTER_RADIUS, range = FILTER_RADIUS_RANGE, affects = both)]
     pub filter_radius: u32,
 }
 
-impl Default for SkyParams {
-    fn default() -> Self {
-        Self {
-            rays: RAYS,
-            range: 0.0,
-            bent_normal: true,
-            seed: 0,
-            filter_radius: FILTER_RADIUS,
+/// `[cavity]`: paper 001's cavity shading of HVL's unshadowed indirect light (issue 18): the
+/// light times the share of short cosine-weighted rays that meet nothing.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
+pub struct CavitySettings {
+    /// Darken HVL's light by its receivers' cavity occlusion. Meant for HVLs without shadows
+    /// (`hvl.visibility = false`): shadowed HVLs already lose that light.
+    #[setting(default = false, affects = both)]
+    pub enabled: bool,
+    /// Rays per receiver.
+    #[setting(default = CAVITY_RAYS, range = RAYS_RANGE, affects = both)]
+    pub rays: u32,
+    /// Reach of the rays as a fraction of the scene's largest side.
+    #[setting(default = CAVITY_RANGE, range = CAVITY_RANGE_RANGE, affects = quality)]
+    pub range: f32,
+}
+
+impl CavitySettings {
+    /// The cavity pass's parameters: its rays, and their reach as a fraction of the scene's
+    /// largest side.
+    pub fn params(&self) -> SkyParams {
+        SkyParams {
+            rays: self.rays,
+            range: self.range,
+            bent_normal: false,
+            ..SkyParams::default()
         }
     }
 }
@@ -80,17 +116,15 @@ impl Default for SkyParams {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SkyError {
     /// A parameter out of its range.
-    #[error("sky {0}")]
-    OutOfRange(#[from] super::OutOfRange),
+    #[error("sky: {0}")]
+    OutOfRange(#[from] crate::declare::OutOfRange),
 }
 
 impl SkyParams {
     /// Checks every parameter against its range.
     pub fn validate(&self) -> Result<(), SkyError> {
-        super::check_range("rays", self.rays, &RAYS_RANGE)?;
-        super::check_range("range", self.range, &RANGE_RANGE)?;
-        super::check_range("filter_radius", self.filter_radius, &FILTER_RADIUS_RANGE)?;
-        Ok(())
+        // No prefix: the cavity pass runs on these parameters too (`[cavity]`).
+        Ok(self.check_in("")?)
     }
 }
 

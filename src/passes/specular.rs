@@ -27,6 +27,10 @@
 
 use std::ops::RangeInclusive;
 
+use serde::{Deserialize, Serialize};
+
+use crate::declare::{Section, Settings};
+
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::traced_scene::TracedScene;
@@ -44,23 +48,37 @@ pub const SAMPLES: u32 = 2;
 /// Reflection rays per pixel the settings take.
 pub const SAMPLES_RANGE: RangeInclusive<u32> = 1..=256;
 
-/// Parameters of the specular pass.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// `[specular]`: reflection rays for the sharp part of every glossy lobe (issue 21), in every
+/// frame with a GI technique; the techniques keep the lobes rougher than `limit`. The
+/// specular pass's parameters, each declared once.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
 pub struct SpecularParams {
+    /// Trace the reflections (off: the techniques' SH glossy term takes every lobe, and the
+    /// proxies none).
+    #[setting(default = true, affects = both)]
+    pub enabled: bool,
     /// Reflection rays per pixel and frame.
+    #[setting(default = SAMPLES, range = SAMPLES_RANGE, affects = both)]
     pub samples: u32,
-    /// Roughness above which the SH techniques keep the whole lobe ([`trace_weight`]).
+    /// Roughness above which a lobe is left to the SH techniques ([`trace_weight`]: faded
+    /// over the [`FADE`] below it).
+    #[setting(default = LIMIT, range = LIMIT_RANGE, affects = both)]
     pub limit: f32,
-    /// Seed of the random numbers.
+    /// Seed of the random numbers (set by the frame).
+    #[serde(skip)]
+    #[setting(default = 0)]
     pub seed: u32,
 }
 
-impl Default for SpecularParams {
-    fn default() -> Self {
-        Self {
-            samples: SAMPLES,
-            limit: LIMIT,
-            seed: 0,
+impl SpecularParams {
+    /// The roughness limit of the traced pass in a frame with indirect light: `limit` when the
+    /// pass is enabled, 0 (no pass) otherwise. The GI techniques leave the lobes below it out.
+    pub fn traced_limit(&self) -> f32 {
+        if self.enabled {
+            self.limit.max(0.0)
+        } else {
+            0.0
         }
     }
 }
@@ -69,16 +87,14 @@ impl Default for SpecularParams {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SpecularError {
     /// A parameter out of its range.
-    #[error("specular {0}")]
-    OutOfRange(#[from] super::OutOfRange),
+    #[error("specular: {0}")]
+    OutOfRange(#[from] crate::declare::OutOfRange),
 }
 
 impl SpecularParams {
     /// Checks every parameter against its range.
     pub fn validate(&self) -> Result<(), SpecularError> {
-        super::check_range("samples", self.samples, &SAMPLES_RANGE)?;
-        super::check_range("limit", self.limit, &LIMIT_RANGE)?;
-        Ok(())
+        Ok(self.check_in("specular.")?)
     }
 }
 

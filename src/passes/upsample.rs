@@ -23,6 +23,9 @@
 //! background pixel next to a silhouette can have only foreground receivers in its 2×2.
 //! Background pixels (`w == 0`) get 0. With s = 1 the output is an exact copy of the radiance.
 
+use serde::{Deserialize, Serialize};
+
+use crate::declare::Settings;
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::receivers::{ReceiverError, Receivers, receiver_extent};
@@ -49,26 +52,35 @@ pub const DEPTH_SIGMA_RANGE: std::ops::RangeInclusive<f32> = 1e-6..=10.0;
 /// depth weights).
 pub const NORMAL_POWER_RANGE: std::ops::RangeInclusive<f32> = 1.0..=256.0;
 
-/// Tuning of the bilateral weights, passed to the shader as push constants.
+/// `[upsample]`: the joint bilateral weights of the upsample (paper 002 eq. 11), passed to
+/// the shader as push constants.
 #[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+#[derive(
+    Debug,
+    Clone,
+    Copy,
+    PartialEq,
+    bytemuck::Pod,
+    bytemuck::Zeroable,
+    Serialize,
+    Deserialize,
+    Settings,
+)]
+#[serde(default, deny_unknown_fields)]
 pub struct UpsampleParams {
-    /// σ_z (> 0), see [`DEPTH_SIGMA`].
+    /// σ_z of the depth weight 1 / (1 + |z_p − z_i| / (σ_z z_p)): paper 002 eq. 11's ε made
+    /// relative to the pixel's linear depth z_p, so it does not depend on the scene's scale
+    /// ([`DEPTH_SIGMA`]).
+    #[serde(rename = "depth_epsilon")]
+    #[setting(default = DEPTH_SIGMA, range = DEPTH_SIGMA_RANGE, affects = quality)]
     pub depth_sigma: f32,
-    /// n (≥ 0), see [`NORMAL_POWER_N`].
+    /// Exponent p of the normal weight (N_p · N_i)^p (paper 002: 32; [`NORMAL_POWER_N`]).
+    #[setting(default = NORMAL_POWER_N, range = NORMAL_POWER_RANGE, affects = quality)]
     pub normal_power: f32,
     /// μ (≥ 0), see [`MIN_MATCH_MU`].
+    #[serde(skip)]
+    #[setting(default = MIN_MATCH_MU)]
     pub min_match: f32,
-}
-
-impl Default for UpsampleParams {
-    fn default() -> Self {
-        Self {
-            depth_sigma: DEPTH_SIGMA,
-            normal_power: NORMAL_POWER_N,
-            min_match: MIN_MATCH_MU,
-        }
-    }
 }
 
 impl UpsampleParams {

@@ -410,7 +410,7 @@ pub fn shade(
     // The diffuse share the traced near field leaves to the HVL.
     let far = |hvl: &Hvl| {
         let centre = Vec4::from(hvl.position_radius).truncate();
-        shine_sh::hvl::far_weight(centre.distance(x), params.near_range)
+        shine_sh::hvl::far_weight(centre.distance(x), params.near_radius)
     };
     let (kd, ks) = receiver.weights(camera);
     // the glossy share the frame's specular pass leaves to the gather

@@ -141,7 +141,7 @@ pub fn vpl_sh(
 ) -> Result<Vec<Vec<Vec3>>, ShError> {
     let count = params.vpl_count;
     let stride = permutation_stride(count);
-    let sets = params.pattern[0] * params.pattern[1];
+    let sets = params.n * params.m;
     let bands = params.sh_order as usize;
     let coefficients = params.coefficients() as usize;
     let [w, _] = g.extent;
@@ -157,7 +157,7 @@ pub fn vpl_sh(
             let r = (-wo).reflect(n);
             let exponent = phong_exponent(g.material[p].x);
             let lobe_norm = (exponent + 1.0) / std::f32::consts::TAU;
-            let s = pixel_set(p as u32 % w, p as u32 / w, params.pattern);
+            let s = pixel_set(p as u32 % w, p as u32 / w, params.pattern());
             if s < count {
                 let members = (count - s).div_ceil(sets);
                 let scale = count as f32 / members as f32;
@@ -206,7 +206,7 @@ pub fn sh_filter(
     let size = if params.filter_radius == 0 {
         [1, 1]
     } else {
-        params.pattern.map(|k| k * params.filter_radius)
+        params.pattern().map(|k| k * params.filter_radius)
     };
     let lo = size.map(|s| -((s / 2) as i64));
     let mut out = Vec::with_capacity(g.position.len());

@@ -3,20 +3,14 @@
 use std::path::PathBuf;
 
 use crate::choice::UnknownChoice;
+use crate::declare::OutOfRange;
 
 /// Why settings were rejected: each variant names the setting and what to do.
 #[derive(Debug, thiserror::Error)]
 pub enum SettingsError {
-    /// A numeric setting lies outside its documented range (or is not a finite number).
-    #[error("setting `{field}` = {value} is out of range: allowed {allowed}")]
-    OutOfRange {
-        /// Dotted name of the setting, as written in the TOML file (`hvl.count`).
-        field: &'static str,
-        /// The rejected value, as given.
-        value: String,
-        /// The allowed values (`64..=10000`, `1, 2 or 4`).
-        allowed: String,
-    },
+    /// A numeric setting lies outside its declared range (or is not a finite number).
+    #[error(transparent)]
+    OutOfRange(#[from] OutOfRange),
     /// A named choice (tonemap operator, GI technique, …) that shine does not know.
     #[error(transparent)]
     UnknownName(#[from] UnknownChoice),

@@ -129,3 +129,9 @@ impl<'de> Deserialize<'de> for GiTechniques {
         text.parse().map_err(serde::de::Error::custom)
     }
 }
+
+impl crate::declare::SettingValue for GiTechniques {
+    fn domain(&self) -> crate::declare::Domain {
+        crate::declare::Domain::Text
+    }
+}

@@ -94,7 +94,7 @@ impl Default for AafStudyConfig {
 /// the frame (the pass traces the lobes sharper than the limit: the room's chrome and gold).
 pub fn frame_defaults() -> AafParams {
     AafParams {
-        specular_limit: crate::settings::SpecularSettings::default().traced_limit(),
+        specular_limit: crate::passes::specular::SpecularParams::default().traced_limit(),
         ..AafParams::default()
     }
 }

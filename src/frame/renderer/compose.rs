@@ -265,7 +265,7 @@ impl Renderer {
         }
         // Sampled shadows draw new rays each frame a history averages: the indirect light's,
         // or the amortised gather's own.
-        let near_range = hvl_near.map_or(0.0, |n| n.range_fraction * scene_size(frame.bounds));
+        let near_radius = hvl_near.map_or(0.0, |n| n.range_fraction * scene_size(frame.bounds));
         let hvl_seed = match p.hvl {
             Some(h) if h.slices > 1 => rg.frame() as u32,
             _ => sky_light::history_seed(rg, p),
@@ -280,7 +280,7 @@ impl Renderer {
                     camera: camera.eye,
                     motion: &g.motion,
                     seed: hvl_seed,
-                    near_range,
+                    near_radius,
                 },
             )?),
             _ => None,
@@ -302,7 +302,7 @@ impl Renderer {
                 receivers,
                 traced,
                 &near,
-                near_range,
+                near_radius,
                 sky_light::history_seed(rg, p),
                 camera.eye,
                 &p.upsample,

@@ -3,6 +3,10 @@
 
 use std::ops::RangeInclusive;
 
+use serde::{Deserialize, Serialize};
+
+use crate::declare::{Section, Settings};
+
 use crate::passes::amortise;
 use crate::passes::igi::MAX_STORAGE_BUFFER;
 
@@ -40,91 +44,98 @@ pub const HIT_ROUGHNESS_MIN: f32 = 0.5;
 /// The hits' least roughnesses the parameters take (0: no regularisation).
 pub const HIT_ROUGHNESS_RANGE: RangeInclusive<f32> = 0.0..=1.0;
 
-/// Parameters of the AAF passes.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// α of `Ω_x^max = α/d` the settings take (paper: 0.3).
+pub const ALPHA_RANGE: RangeInclusive<f32> = 1e-3..=1.0;
+/// Importance-sampling factors γ of eq. 21 the settings take (paper, diffuse: 0.4).
+pub const GAMMA_RANGE: RangeInclusive<f32> = 0.0..=10.0;
+/// Normal thresholds of the filter the settings take, in degrees (paper: 10°).
+pub const NORMAL_THRESHOLD_RANGE: RangeInclusive<f32> = 0.0..=180.0;
+
+/// `[aaf]`: the parameters of the AAF passes (paper 004, `src/passes/aaf/`), each declared
+/// once: the settings' keys, ranges and defaults are these fields'. Defaults are paper 004's
+/// (§4.3, §6), except two that are shine's: the filter's quadratic fit
+/// ([`shine_sh::aaf::FILTER_DEGREE`]; 0 is the paper's) and the hits' least roughness
+/// ([`HIT_ROUGHNESS_MIN`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
 pub struct AafParams {
-    /// Stratified samples of the first pass (paper: 16).
+    /// Stratified samples per pixel of the first pass (paper: 16).
+    #[serde(rename = "samples")]
+    #[setting(default = 16, range = FIRST_SAMPLES, lab = 4..=64, affects = both)]
     pub first_samples: u32,
-    /// Filter scale μ (eq. 15, 21; paper: 0.9).
+    /// Filter scale μ (eq. 15, 21): larger narrows the filter and samples more.
+    #[setting(default = shine_sh::aaf::DEFAULT_MU, range = MU_RANGE, lab = 0.3..=3.0, affects = both)]
     pub mu: f32,
-    /// Bandlimit Ω_h of the receiver's transfer function (paper, diffuse: 2.8).
+    /// Bandlimit Ω_h of the receiver's transfer function (eq. 18; Lambert: 2.8).
+    #[setting(default = OMEGA_H, range = OMEGA_H_RANGE, lab = 1.0..=8.0, affects = both)]
     pub omega_h: f32,
-    /// α of `Ω_x^max = α/d` (paper: 0.3).
+    /// α of `Ω_x^max = α/d` (paper 004 §4.1: 0.3).
+    #[setting(default = shine_sh::aaf::DEFAULT_ALPHA, range = ALPHA_RANGE, lab = 0.1..=1.0, affects = both)]
     pub alpha: f32,
-    /// Importance-sampling factor γ of eq. 21 (paper, diffuse: 0.4).
+    /// Importance-sampling factor γ of eq. 21.
+    #[setting(default = shine_sh::aaf::DEFAULT_GAMMA, range = GAMMA_RANGE, lab = 0.0..=2.0, affects = both)]
     pub gamma: f32,
-    /// Lower clamp of the per-pixel sample count.
+    /// Lower clamp of the samples per pixel.
+    #[setting(default = 16, range = SPP_MIN, lab = 16..=64, affects = both)]
     pub spp_min: u32,
-    /// Upper clamp of the per-pixel sample count before the factor μ (paper: 100μ).
+    /// Upper clamp of the samples per pixel before the factor μ (the paper's 100μ).
+    #[setting(default = 100, range = SPP_MAX, lab = 16..=400, affects = both)]
     pub spp_max: u32,
-    /// Path vertices after the receiver (1: one bounce).
+    /// Path vertices after the receiver (1: one-bounce indirect).
+    #[setting(default = 1, range = BOUNCES, lab = 1..=2, affects = both)]
     pub bounces: u32,
-    /// Lower clamp of z_min as a fraction of the scene's [`scene_size`](super::scene_size) (paper: about 2%).
+    /// Lower clamp of z_min as a fraction of the scene's [`scene_size`](super::scene_size)
+    /// (paper: about 2%).
+    #[setting(default = 0.02, range = Z_MIN_FRACTION, lab = 0.005..=0.1, affects = both)]
     pub z_min_fraction: f32,
     /// Normal threshold of the filter in degrees (paper: 10°).
+    #[setting(default = 10.0, range = NORMAL_THRESHOLD_RANGE, lab = 5.0..=30.0, affects = quality)]
     pub normal_threshold_degrees: f32,
-    /// Take the adaptive second pass (off: uniform sampling at `first_samples`).
+    /// The adaptive second pass (eq. 21); off: uniform sampling at `samples`.
+    #[setting(default = true, affects = both)]
     pub adaptive: bool,
-    /// Filter (off: the unfiltered Monte-Carlo mean).
+    /// The screen-space filter; off: the unfiltered Monte-Carlo mean.
+    #[setting(default = true, affects = both)]
     pub filter: bool,
-    /// Seed of the samples' random numbers.
+    /// Seed of the samples' random numbers (set by the frame).
+    #[serde(skip)]
+    #[setting(default = 0)]
     pub seed: u32,
-    /// Roughness limit of the frame's traced specular pass (0: none): the samples' specular
-    /// BRDF term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    /// Roughness limit of the frame's traced specular pass (0: none; set by the frame): the
+    /// samples' specular BRDF term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    #[serde(skip)]
+    #[setting(default = 0.0)]
     pub specular_limit: f32,
-    /// Degree of the filter's local polynomial fit ([`shine_sh::aaf::LocalFit`]): 0 is the
-    /// paper's gaussian; 2 (default) fits a quadratic and keeps the peaks, valleys and edges of
-    /// the light that the gaussian flattens and tilts.
+    /// Degree of the filter's local polynomial fit with the paper's gaussian weights
+    /// ([`shine_sh::aaf::LocalFit`]): 0 is paper 004's gaussian, 1 linear, 2 quadratic (keeps
+    /// the light's peaks, valleys and edges the gaussian flattens and tilts, but removes less
+    /// noise where the filter has few neighbours; docs/quality.md).
+    #[setting(default = shine_sh::aaf::FILTER_DEGREE, range = shine_sh::aaf::FILTER_DEGREES, affects = quality)]
     pub filter_degree: u32,
-    /// Filter the diffuse part as an irradiance vector (shine's; the paper filters the scalar
-    /// mean): each pixel's `V = M₀ n + (8/3) E[L ω_t]` ([`shine_sh::aaf::TANGENT_SCALE`]),
-    /// neighbours tested by their geometric normals, the result evaluated at each pixel's
-    /// shading normal. A normal map then no longer cuts the filter into tiles and bevels,
-    /// and its detail in the indirect light stays (docs/quality.md: the room's samples saved
-    /// at equal error rose from 2.6× to 5.7×).
+    /// Filter the diffuse light as an irradiance vector (shine's; false is the paper's scalar
+    /// filter, shading normals tested): each pixel's `V = M₀ n + (8/3) E[L ω_t]`
+    /// ([`shine_sh::aaf::TANGENT_SCALE`]), neighbours tested by their geometric normals, the
+    /// result evaluated at each pixel's shading normal, so that a normal map does not cut the
+    /// filter (docs/quality.md: the room's samples saved at equal error rose from 2.6× to 5.7×).
+    #[setting(default = true, affects = quality)]
     pub irradiance_vector: bool,
     /// Least roughness of the BRDF at the samples' hits (path regularisation, Kaplanyan and
     /// Dachsbacher 2013): a point light's highlight on a mirror-like reflector, seen by a
-    /// cosine-weighted ray, is a caustic that Monte Carlo gathering cannot sample (one
-    /// sample in millions carries it); rougher, the same energy spreads into a lobe the rays find.
+    /// cosine-weighted ray, is a caustic that Monte Carlo gathering cannot sample; rougher,
+    /// the same energy spreads into a lobe the rays find.
+    #[setting(default = HIT_ROUGHNESS_MIN, range = HIT_ROUGHNESS_RANGE, affects = quality)]
     pub hit_roughness_min: f32,
-    /// Pixels per refresh (paper 001): 1, or [`amortise::SLICES`]: the sampling passes sample
-    /// one pixel per 2×2 cell per frame and the others keep their sums, reprojected
-    /// ([`AafSlice`](super::AafSlice)).
+    /// Pixels per refresh (paper 001): 1 samples every pixel every frame; 4 samples one pixel
+    /// per 2×2 cell per frame and reprojects the others' sums from the previous frames
+    /// (`aaf_reproject`, [`AafSlice`](super::AafSlice)).
+    #[setting(default = 1, one_of = amortise::SLICE_CHOICES, affects = both)]
     pub slices: u32,
     /// Bytes one storage buffer may hold on the device (`maxStorageBufferRange`; lavapipe's is
-    /// [`MAX_STORAGE_BUFFER`], NVIDIA's 4 GiB): bounds the per-pixel sums and filter rows
-    /// ([`AafParams::check_extent`]).
+    /// [`MAX_STORAGE_BUFFER`], NVIDIA's 4 GiB; set by the frame): bounds the per-pixel sums
+    /// and filter rows ([`AafParams::check_extent`]).
+    #[serde(skip)]
+    #[setting(default = MAX_STORAGE_BUFFER)]
     pub storage_limit: u64,
-}
-
-impl Default for AafParams {
-    /// Paper 004's values (§4.3, §6), except two that are shine's: the filter's quadratic fit
-    /// ([`shine_sh::aaf::FILTER_DEGREE`]; 0 is the paper's) and the hits' least roughness
-    /// ([`HIT_ROUGHNESS_MIN`]).
-    fn default() -> Self {
-        Self {
-            first_samples: 16,
-            mu: shine_sh::aaf::DEFAULT_MU,
-            omega_h: OMEGA_H,
-            alpha: shine_sh::aaf::DEFAULT_ALPHA,
-            gamma: shine_sh::aaf::DEFAULT_GAMMA,
-            spp_min: 16,
-            spp_max: 100,
-            bounces: 1,
-            z_min_fraction: 0.02,
-            normal_threshold_degrees: 10.0,
-            adaptive: true,
-            filter: true,
-            seed: 0,
-            specular_limit: 0.0,
-            filter_degree: shine_sh::aaf::FILTER_DEGREE,
-            irradiance_vector: true,
-            hit_roughness_min: HIT_ROUGHNESS_MIN,
-            slices: 1,
-            storage_limit: MAX_STORAGE_BUFFER,
-        }
-    }
 }
 
 /// What the AAF passes refuse.
@@ -133,6 +144,9 @@ pub enum AafError {
     /// A parameter out of its range.
     #[error("AAF {0}")]
     OutOfRange(#[from] crate::passes::OutOfRange),
+    /// A setting outside its declared domain.
+    #[error("AAF: {0}")]
+    Setting(#[from] crate::declare::OutOfRange),
     /// An amortised dispatch's slice without its marks, or out of range.
     #[error(transparent)]
     Slice(#[from] amortise::AmortiseError),
@@ -153,45 +167,14 @@ pub enum AafError {
 }
 
 impl AafParams {
-    /// Checks every parameter against its range.
+    /// Checks every parameter against its declared range, and the frame's specular limit.
     pub fn validate(&self) -> Result<(), AafError> {
-        use crate::passes::check_range as check;
-        check("first_samples", self.first_samples, &FIRST_SAMPLES)?;
-        check("mu", self.mu, &MU_RANGE)?;
-        check("omega_h", self.omega_h, &OMEGA_H_RANGE)?;
-        check("alpha", self.alpha, &(1e-3..=1.0))?;
-        check("gamma", self.gamma, &(0.0..=10.0))?;
-        check("spp_min", self.spp_min, &SPP_MIN)?;
-        check("spp_max", self.spp_max, &SPP_MAX)?;
-        check("bounces", self.bounces, &BOUNCES)?;
-        check("z_min_fraction", self.z_min_fraction, &Z_MIN_FRACTION)?;
-        check(
-            "filter_degree",
-            self.filter_degree,
-            &shine_sh::aaf::FILTER_DEGREES,
-        )?;
-        check(
-            "hit_roughness_min",
-            self.hit_roughness_min,
-            &HIT_ROUGHNESS_RANGE,
-        )?;
-        check(
+        self.check_in("aaf.")?;
+        crate::passes::check_range(
             "specular_limit",
             self.specular_limit,
             &crate::passes::specular::LIMIT_RANGE,
         )?;
-        check(
-            "normal_threshold_degrees",
-            self.normal_threshold_degrees,
-            &(0.0..=180.0),
-        )?;
-        if !amortise::SLICE_CHOICES.contains(&self.slices) {
-            return Err(AafError::OutOfRange(crate::passes::OutOfRange {
-                name: "slices",
-                value: f64::from(self.slices),
-                expected: format!("one of {:?}", amortise::SLICE_CHOICES),
-            }));
-        }
         Ok(())
     }
 

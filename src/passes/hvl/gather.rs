@@ -45,7 +45,7 @@ pub fn hvl_gather(
                 receivers,
                 &indirect,
                 &unshadowed,
-                &params.shadows,
+                &params.shadows(),
                 slice,
             ),
             None => indirect,
@@ -172,9 +172,9 @@ fn record_gather(
             Window::Sinc => params.conv_bands as f32,
         },
         disc_falloff: u32::from(params.falloff == Falloff::Disc),
-        shadow_rays: params.shadows.rays,
-        seed: params.shadows.seed,
-        near_range: params.near_range,
+        shadow_rays: params.shadow_rays,
+        seed: params.shadow_seed,
+        near_range: params.near_radius,
         pad: [0; 3],
     };
     let name = if slice == amortise::REGATHER_SLICE {
@@ -183,7 +183,7 @@ fn record_gather(
         "hvl_gather"
     };
     let threads = amortise::slice_threads([w, h], slice);
-    let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
+    let sampled = Shadowing::of(params.visibility, &params.shadows()) == Shadowing::Sampled;
     let mut unshadowed = sampled.then(|| receivers.light_image(rg, "hvl_unshadowed"));
     let mut pass = rg.compute(name, shader);
     pass.read("recv_position", &receivers.position)
@@ -289,7 +289,7 @@ pub fn gather_pair_flops(path: GatherPath, b: u32, sampled_shadows: bool) -> u64
 /// RGBA16F output (8, and 8 more for the unshadowed sum of sampled shadows), plus the HVL
 /// records and the BRDF tables once (a few kilobytes every workgroup then reads from cache).
 pub fn gather_cost(params: &HvlParams, receivers: u64) -> PassCost {
-    let sampled = Shadowing::of(params.visibility, &params.shadows) == Shadowing::Sampled;
+    let sampled = Shadowing::of(params.visibility, &params.shadows()) == Shadowing::Sampled;
     let pairs = receivers * u64::from(params.count);
     let per_receiver = 32 + if sampled { 16 } else { 8 };
     let tables = match params.path {

@@ -76,9 +76,12 @@
 use std::ops::RangeInclusive;
 
 use glam::Vec3;
+use serde::{Deserialize, Serialize};
 
+use crate::declare::{OutOfRange, Settings};
 use crate::graph::{Buffer, BufferDesc, Handle, Image, RenderGraph};
 use crate::passes::rsm::{Rsm, RsmProjection};
+use crate::passes::upsample::UpsampleParams;
 use crate::shaders;
 
 pub mod flux;
@@ -200,7 +203,7 @@ pub struct GatherPush {
     pub shadow_rays: u32,
     /// Seed of the sampled shadow rays.
     pub seed: u32,
-    /// R of the near field ([`HvlParams::near_range`]), 0: none.
+    /// R of the near field in world units ([`HvlParams::near_radius`]), 0: none.
     pub near_range: f32,
     /// Padding.
     pub pad: [u32; 3],
@@ -262,69 +265,133 @@ crate::choice::named_choice! {
     }
 }
 
-/// Parameters of the HVL passes.
-#[derive(Debug, Clone, Copy, PartialEq)]
+/// `[hvl]`: the parameters of the Harmonics Virtual Lights passes (paper 003), each declared
+/// once (the settings' keys, ranges and defaults are these fields'). Paper 003's choices but
+/// these: 400 HVLs (fig. 10), r2 radii scaled by 1.5 (§5.3: 1–2), 5 convolution and 3
+/// emission bands, the full path, the sphere's falloff; placed by flux rather than on the
+/// paper's grid (relative RMSE of the cornell box's indirect light 0.64 → 0.34), shadowed by
+/// 8 sampled rays per receiver rather than unshadowed (0.32 → 0.25, energy 1.12 → 0.98;
+/// docs/quality.md), and a traced near field.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
+#[serde(default, deny_unknown_fields)]
+#[settings(check = HvlParams::check_relations)]
 pub struct HvlParams {
-    /// Number of HVLs M. The cache needs 64 ≤ M ≤ 10 000 and M ≤ S² (S the RSM side); the
-    /// gather takes any 1 ≤ M ≤ 10 000 records.
+    /// Number M of HVLs distributed from the RSM (the RSM is cut into M cells; at most
+    /// `rsm.size²`; paper 003 fig. 10: 400).
+    #[setting(default = 400, range = CACHE_COUNT, lab = 64..=1600, affects = both)]
     pub count: u32,
-    /// Where the HVLs are placed on the RSM.
+    /// Where the HVLs are placed on the RSM: `grid` (paper 003 §5.2: cells uniform in the
+    /// RSM's image) or `flux` (texels drawn in proportion to the flux they reflect, radii from
+    /// the local spacing; needs `radius = "r2"`).
+    #[setting(default = Distribution::Flux, affects = quality)]
     pub distribution: Distribution,
-    /// Radius heuristic.
+    /// Radius heuristic: `r1` (eq. 23) or `r2` (eq. 24–26).
+    #[setting(default = RadiusHeuristic::R2, affects = quality)]
     pub radius: RadiusHeuristic,
-    /// User scale k of the radii, in [`RADIUS_SCALE`] (paper 003 §5.3: 1–2).
+    /// User factor k scaling every radius (paper 003 §5.3: good between 1 and 2).
+    #[setting(default = 1.5, range = RADIUS_SCALE, affects = quality)]
     pub radius_scale: f32,
-    /// SH bands of the convolution at the receiver (1–10 in the paper).
+    /// SH bands n of the convolution at shaded points (n² coefficients).
+    #[serde(rename = "convolution_bands")]
+    #[setting(default = 5, range = CONV_BANDS, affects = both)]
     pub conv_bands: u32,
-    /// SH bands of the HVL emission (1–5 in the paper), at most `conv_bands`.
+    /// SH bands of each HVL's emission function, at most `convolution_bands` (the paper's 3).
+    /// Every sender is Lambert today, whose emission is isotropic and needs band 0 only
+    /// (paper 003 eq. 20): more bands change nothing until glossy senders exist.
+    #[setting(default = 3, range = EMISSION_BANDS, affects = both)]
     pub emission_bands: u32,
-    /// Full or zonal convolution.
+    /// Gather path: `full` (any BRDF, O(n²)) or `zonal` (symmetric lobes, O(n)).
+    #[serde(rename = "gather")]
+    #[setting(default = GatherPath::Full, affects = both)]
     pub path: GatherPath,
-    /// Window on the SH bands of each HVL's light.
+    /// Window on each HVL's SH bands against ringing: `none` or `sinc` (paper 003 §4.2,
+    /// Sloan's sinc of width `convolution_bands`).
+    #[setting(default = Window::None, affects = quality)]
     pub window: Window,
-    /// Near-field falloff of each HVL.
+    /// Near-field falloff of each HVL: `sphere` (paper 003 eq. 20–22: the point-light
+    /// irradiance up to the sphere's surface) or `disc` (a Lambertian disc of the same area:
+    /// half of that at the rim).
+    #[setting(default = Falloff::Sphere, affects = quality)]
     pub falloff: Falloff,
-    /// Shadow rays from each receiver to the HVLs through the scene's BVH (not in paper 003,
-    /// whose HVLs are unshadowed).
+    /// Shadow the HVLs through the scene's BVH (shine's extension: paper 003's HVLs are
+    /// unshadowed; false gives the paper's).
+    #[setting(default = true, affects = both)]
     pub visibility: bool,
-    /// How many shadow rays, and the filter of sampled ones (with `visibility`).
-    pub shadows: shadows::ShadowSampling,
-    /// R of the near field in world units ([`near`]): each HVL's diffuse light is scaled by
-    /// `smoothstep(R, 2R, d)` (d its centre's distance) and `hvl_near` traces the rest; 0:
-    /// none (paper 003).
+    /// With `visibility`: shadow rays per receiver, to HVLs drawn in proportion to their
+    /// light and denoised by a ratio estimator (`src/passes/hvl/shadows.rs`); 0 traces one
+    /// ray per receiver and HVL (exact, about 10× the gather's cost).
+    #[setting(default = shadows::RAYS, range = shadows::RAYS_RANGE, affects = both)]
+    pub shadow_rays: u32,
+    /// Radius in receivers of the sampled shadows' ratio filter.
+    #[setting(default = shadows::FILTER_RADIUS, range = shadows::FILTER_RADIUS_RANGE, affects = both)]
+    pub shadow_filter_radius: u32,
+    /// R of the traced near field, as a fraction of the scene's largest side: light from
+    /// surfaces closer than R comes from `near_rays` traced rays instead of the HVLs, which
+    /// cap it, blended over R..2R (`src/passes/hvl/near.rs`). 0: none (paper 003).
+    #[setting(default = near::RANGE, range = near::RANGE_RANGE, lab = 0.0..=0.2, affects = both)]
     pub near_range: f32,
-    /// Receivers per refresh: 1 gathers every receiver every frame; [`crate::passes::amortise::SLICES`]
-    /// gathers one per 2×2 cell and reprojects the rest (paper 001).
+    /// Rays per receiver of the near field.
+    #[setting(default = near::RAYS, range = near::RAYS_RANGE, lab = 1..=16, affects = both)]
+    pub near_rays: u32,
+    /// Receivers per gather refresh (paper 001): 1 gathers every receiver every frame; 4
+    /// gathers one receiver per 2×2 cell per frame and reprojects the others from the
+    /// previous frames (`hvl_resolve`, [`crate::passes::amortise::SLICES`]).
+    #[setting(default = 1, one_of = crate::passes::amortise::SLICE_CHOICES, affects = both)]
     pub slices: u32,
-    /// Roughness limit of the frame's traced specular pass (0: none): the gather's glossy
-    /// term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    /// The sampled shadows' bilateral match (the frame's upsample's; set by the frame).
+    #[serde(skip)]
+    #[setting(default = UpsampleParams::default())]
+    pub shadow_matching: UpsampleParams,
+    /// Seed of the shadow rays' random numbers (the frame index when a history averages
+    /// frames; set by the frame).
+    #[serde(skip)]
+    #[setting(default = 0)]
+    pub shadow_seed: u32,
+    /// R of the near field in world units (`near_range` times the scene's size; set by the
+    /// frame): each HVL's diffuse light is scaled by `smoothstep(R, 2R, d)` (d its centre's
+    /// distance) and `hvl_near` traces the rest; 0: none (paper 003).
+    #[serde(skip)]
+    #[setting(default = 0.0)]
+    pub near_radius: f32,
+    /// Roughness limit of the frame's traced specular pass (0: none; set by the frame): the
+    /// gather's glossy term is scaled by `1 −` [`crate::passes::specular::trace_weight`].
+    #[serde(skip)]
+    #[setting(default = 0.0)]
     pub specular_limit: f32,
 }
 
-impl Default for HvlParams {
-    /// Paper 003's choices but two: 400 HVLs (fig. 10), r2 radii scaled by 1.5 (§5.3: 1–2),
-    /// 5 convolution and 3 emission bands, the full path, the sphere's falloff; placed by flux
-    /// rather than on the paper's grid (relative RMSE of the cornell box's indirect light
-    /// 0.64 → 0.34), and shadowed by 8 sampled rays per receiver rather than unshadowed
-    /// (0.32 → 0.25, energy 1.12 → 0.98; docs/quality.md). The near field (`near_range`) is
-    /// the frame's to set.
-    fn default() -> Self {
-        Self {
-            count: 400,
-            distribution: Distribution::Flux,
-            radius: RadiusHeuristic::R2,
-            radius_scale: 1.5,
-            conv_bands: 5,
-            emission_bands: 3,
-            path: GatherPath::Full,
-            window: Window::None,
-            falloff: Falloff::Sphere,
-            visibility: true,
-            shadows: shadows::ShadowSampling::default(),
-            near_range: 0.0,
-            slices: 1,
-            specular_limit: 0.0,
+impl HvlParams {
+    /// How the gather shadows its HVLs when `visibility` is on.
+    pub fn shadows(&self) -> shadows::ShadowSampling {
+        shadows::ShadowSampling {
+            rays: self.shadow_rays,
+            filter_radius: self.shadow_filter_radius,
+            matching: self.shadow_matching,
+            seed: self.shadow_seed,
         }
+    }
+
+    /// The settings' rules between fields: emission bands at most the convolution's, and
+    /// `r1` radii only on the grid (they take their neighbours from it).
+    fn check_relations(&self, prefix: &str) -> Result<(), OutOfRange> {
+        if self.emission_bands > self.conv_bands {
+            return Err(OutOfRange {
+                field: format!("{prefix}emission_bands"),
+                value: self.emission_bands.to_string(),
+                allowed: format!(
+                    "1..={} (at most hvl.convolution_bands)",
+                    self.conv_bands.min(*EMISSION_BANDS.end())
+                ),
+            });
+        }
+        if self.radius == RadiusHeuristic::R1 && self.distribution == Distribution::Flux {
+            return Err(OutOfRange {
+                field: format!("{prefix}radius"),
+                value: "r1".to_owned(),
+                allowed: "r2 with hvl.distribution = \"flux\" (r1 takes its neighbours from the grid: set hvl.distribution = \"grid\")".to_owned(),
+            });
+        }
+        Ok(())
     }
 }
 

@@ -7,7 +7,7 @@
 //! the bases of the boxes at 0.7–0.8, while point lights without a clamp (IGI) have them right.
 //! The fix splits every sender point by its distance `t` from the receiver with
 //! `f(t) = smoothstep(R, 2R, t)`: the gather scales each HVL's light by `f` of its centre's
-//! distance ([`super::HvlParams::near_range`]), and `hvl_near` traces [`NearField::rays`]
+//! distance ([`super::HvlParams::near_radius`]), and `hvl_near` traces [`NearField::rays`]
 //! cosine-weighted rays up to `2R`, each hit sending `(1 − f(t))` of what it reflects from the
 //! punctual lights (next-event estimation with shadow rays). That is Kollig and Keller's bias
 //! compensation (2004, "Illumination in the presence of weak singularities") with a smooth
@@ -81,7 +81,7 @@ pub struct NearPush {
 /// Adds `hvl_near` and its filter `hvl_near_filter` over `receivers` seen from `camera`, with
 /// R = `range` world units and the rays of `seed`: returns the near field's outgoing radiance
 /// (RGBA16F at receiver resolution), to be added to the gather's (which must have run with
-/// `near_range = range`).
+/// `near_radius = range`).
 #[allow(clippy::too_many_arguments)]
 pub fn hvl_near(
     rg: &mut RenderGraph,

@@ -33,7 +33,7 @@ pub fn gather_variants() -> Vec<(GatherPath, u32, shadows::Shadowing, &'static S
 /// [`HvlError::Variant`].
 pub fn gather_shader(params: &HvlParams) -> Result<&'static ShaderDesc, HvlError> {
     let variants = gather_variants();
-    let shadowing = shadows::Shadowing::of(params.visibility, &params.shadows);
+    let shadowing = shadows::Shadowing::of(params.visibility, &params.shadows());
     variants
         .iter()
         .find(|v| v.0 == params.path && v.1 == params.conv_bands && v.2 == shadowing)
@@ -92,10 +92,10 @@ impl HvlParams {
         if self.visibility {
             self.validate_shadows()?;
         }
-        if !(self.near_range.is_finite() && self.near_range >= 0.0) {
+        if !(self.near_radius.is_finite() && self.near_radius >= 0.0) {
             return Err(HvlError::OutOfRange {
-                name: "near_range",
-                value: f64::from(self.near_range),
+                name: "near_radius",
+                value: f64::from(self.near_radius),
                 expected: "a finite distance ≥ 0 (0: no near field)".to_owned(),
             });
         }
@@ -113,7 +113,7 @@ impl HvlParams {
 impl HvlParams {
     /// Checks the shadow sampling: rays and filter radius in range.
     fn validate_shadows(&self) -> Result<(), HvlError> {
-        let s = &self.shadows;
+        let s = self.shadows();
         for (name, value, range) in [
             ("shadow_rays", s.rays, shadows::RAYS_RANGE),
             (
