@@ -14,6 +14,7 @@ pub mod declare;
 pub mod embed;
 pub mod frame;
 pub mod gpu_scene;
+pub mod lab;
 pub mod passes;
 pub mod profile;
 pub mod reference;

@@ -1,6 +1,10 @@
 //! What `shine render` and `shine profile` share: the scene argument and the settings flags.
 
 use super::CliError;
+use shine::gpu::Device;
+use shine::lab::budget::{self, BudgetChoice};
+use shine::lab::truth::scene_key;
+use shine::profile::roofline::cache_dir;
 use shine::settings::Settings;
 use shine_scene::Scene;
 use shine_scene::environment::Environment;
@@ -46,6 +50,11 @@ pub struct SettingsArgs {
     /// Any setting by its TOML key, e.g. `--set hvl.count=2000` (repeatable).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     overrides: Vec<String>,
+    /// Frame budget in ms: the GI configuration with the least error whose measured cost fits,
+    /// from `shine lab`'s results for this device and scene at this size (a quick lab of a few
+    /// candidates fills them when there are none), over the other settings.
+    #[arg(long)]
+    budget_ms: Option<f64>,
     #[command(flatten)]
     environment: EnvironmentArgs,
 }
@@ -108,6 +117,61 @@ pub fn with_default(what: &str, key: &str) -> String {
 }
 
 impl SettingsArgs {
+    /// With `--budget-ms`: the configuration chosen for `scene` (given as `argument`) at the
+    /// settings' size on `device`, applied to `settings` and printed; `None` without the flag.
+    pub fn apply_budget(
+        &self,
+        settings: &mut Settings,
+        scene: &Scene,
+        argument: &str,
+        device: &Device,
+    ) -> Result<Option<BudgetChoice>, CliError> {
+        let Some(budget_ms) = self.budget_ms else {
+            return Ok(None);
+        };
+        if !(budget_ms.is_finite() && budget_ms > 0.0) {
+            return Err(format!("--budget-ms {budget_ms} must be a positive number of ms").into());
+        }
+        // The lab's costs are of frames without supersampling: an automatic factor is off.
+        if settings.output.ssaa == 0 {
+            settings.output.ssaa = 1;
+        }
+        let extent = [settings.width, settings.height];
+        let key = scene_key(argument).unwrap_or_else(|| argument.to_owned());
+        let table_path = cache_dir().map(|dir| budget::table_path(&dir, device.info()));
+        let table = match &table_path {
+            Some(path) => budget::load_table(path)?,
+            None => budget::BudgetTable::default(),
+        };
+        let choice = match budget::choose(&table, Some(&key), extent, budget_ms) {
+            Some(choice) => choice,
+            None => {
+                let candidates = budget::candidates();
+                eprintln!(
+                    "budget: no lab results for {argument} at {}×{} on {}: a quick lab of {} candidates …",
+                    extent[0],
+                    extent[1],
+                    device.info().name,
+                    candidates.len()
+                );
+                let (entries, seconds) =
+                    budget::quick_lab(device, scene, &key, extent, &candidates)?;
+                eprintln!("budget: the quick lab took {seconds:.1} s");
+                if let Some(path) = &table_path {
+                    budget::record(path, &entries)?;
+                }
+                let refs: Vec<&budget::BudgetEntry> = entries.iter().collect();
+                budget::pick(&refs, budget_ms).ok_or("budget: no candidate could be measured")?
+            }
+        };
+        for (k, v) in &choice.config.set {
+            settings.set(k, v)?;
+        }
+        settings.validate()?;
+        eprintln!("{}", choice.describe());
+        Ok(Some(choice))
+    }
+
     /// The file's settings (or the defaults) with every flag applied, validated.
     pub fn resolve(&self) -> Result<Settings, CliError> {
         self.resolve_from(Settings::default())

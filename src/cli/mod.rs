@@ -3,6 +3,7 @@
 mod compare;
 mod frame_args;
 mod info;
+mod lab;
 mod profile;
 mod progress;
 mod reference;
@@ -39,6 +40,9 @@ enum Command {
     Compare(compare::CompareArgs),
     /// Built-in scenes: list them or export one as .glb.
     Scene(scene::SceneArgs),
+    /// The GI lab: every technique's error, cost and flicker on the given scenes, the Pareto
+    /// front, lab.json/lab.csv and a self-contained index.html.
+    Lab(lab::LabArgs),
     /// Every setting: key, default, values, what it changes (docs/settings.md).
     Settings(settings::SettingsArgs),
     /// Quality studies: error against samples per pixel (`study aaf`: paper 004's Fig. 10).
@@ -54,6 +58,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Reference(args) => reference::run(&args),
         Command::Compare(args) => compare::run(&args),
         Command::Scene(args) => scene::run(&args),
+        Command::Lab(args) => lab::run_lab(&args),
         Command::Settings(args) => settings::run(&args),
         Command::Study(args) => study::run(&args),
     }

@@ -8,6 +8,7 @@ use super::render::DEFAULT_FPS;
 use shine::frame::renderer::Renderer;
 use shine::gpu::{Device, DeviceDesc};
 use shine::gpu_scene::FrameUpdate;
+use shine::lab::budget::BudgetChoice;
 use shine::profile::report::{PassClock, ProfileReport, ReportFormat, write_chrome_trace};
 use shine::profile::roofline::{self, RooflineReport};
 use shine::settings::Settings;
@@ -56,9 +57,12 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
     if args.frames == 0 {
         return Err("--frames must be at least 1".into());
     }
-    let settings = args.settings.resolve()?;
+    let mut settings = args.settings.resolve()?;
     let scene = args.settings.load_scene(&args.scene)?;
     let device = Device::new(&DeviceDesc::from_env())?;
+    let budget = args
+        .settings
+        .apply_budget(&mut settings, &scene, &args.scene, &device)?;
     let clock = match args.clock.as_str() {
         "auto" => PassClock::for_device(device.info().device_type),
         "gpu" => PassClock::Gpu,
@@ -124,7 +128,14 @@ pub fn run(args: &ProfileArgs) -> Result<(), CliError> {
     if format == ReportFormat::Json {
         println!(
             "{}",
-            with_run(&report, roofline.as_ref(), args, &settings, &device)?
+            with_run(
+                &report,
+                roofline.as_ref(),
+                budget.as_ref(),
+                args,
+                &settings,
+                &device
+            )?
         );
     } else {
         println!("{}", report.format(format)?);
@@ -183,6 +194,7 @@ fn roofline_of(
 fn with_run(
     report: &ProfileReport,
     roofline: Option<&RooflineReport>,
+    budget: Option<&BudgetChoice>,
     args: &ProfileArgs,
     settings: &Settings,
     device: &Device,
@@ -198,6 +210,7 @@ fn with_run(
         "driver": info.driver,
         "revision": REVISION,
         "settings": settings,
+        "budget": budget,
     });
     if let Some(object) = value.as_object_mut() {
         object.insert("run".into(), run);

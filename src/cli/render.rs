@@ -61,6 +61,8 @@ pub fn run(args: &RenderArgs) -> Result<(), CliError> {
     }
     let scene = args.settings.load_scene(&args.scene)?;
     let device = Device::new(&DeviceDesc::from_env())?;
+    args.settings
+        .apply_budget(&mut settings, &scene, &args.scene, &device)?;
     let mut renderer = Renderer::new(&device)?;
     renderer.set_scene(&scene, settings.time)?;
     // The orbit turns the scene's own camera (as posed at the first frame) about the centre of

@@ -8,12 +8,17 @@ use crate::frame::renderer::HostSide;
 use crate::frame::renderer::Renderer;
 use crate::gpu_scene::FrameUpdate;
 use crate::gpu_scene::upload_ring::UploadRing;
+use crate::lab::LabError;
+use crate::lab::budget::{self, BudgetChoice};
+use crate::lab::truth::fnv1a;
 use crate::passes::environment_sh;
 use crate::passes::host_gbuffer::{self, HostFrame, HostImages};
+use crate::profile::roofline::cache_dir;
 use crate::settings::Settings;
 use shine_gpu::{Buffer, Device, Sampler, vk};
 use shine_graph::{PassTiming, RenderGraph};
 use shine_scene::Scene;
+use std::path::PathBuf;
 
 /// How a [`GiContext`] is made: fixed for its life (make a new context to change them).
 #[derive(Clone, Debug, PartialEq)]
@@ -30,6 +35,13 @@ pub struct GiContextDesc {
     pub settings: Settings,
     /// The most lights and proxy spheres a scene may bring (a larger one is refused).
     pub budgets: GiBudgets,
+    /// A frame budget in ms: the context picks the GI configuration with the least error whose
+    /// cost fits, from `shine lab`'s results for this device at the display size (every
+    /// scene's, at creation); without results, from a quick lab of a few candidates on the
+    /// first scene (`set_scene`, which then takes seconds). The pick replaces `settings`'
+    /// technique keys; [`GiContext::budget_choice`] tells what was chosen. `None`: `settings`
+    /// as given.
+    pub budget_ms: Option<f64>,
 }
 
 /// Upper bounds on what a scene handed to a [`GiContext`] may hold.
@@ -63,6 +75,7 @@ impl GiContextDesc {
                 ..Settings::default()
             },
             budgets: GiBudgets::default(),
+            budget_ms: None,
         })
     }
 }
@@ -77,6 +90,8 @@ impl GiContextDesc {
 /// come from one thread at a time. Contexts on one device are independent.
 pub struct GiContext {
     renderer: Renderer,
+    /// The device, for the budget's quick lab.
+    device: Device,
     display: [u32; 2],
     budgets: GiBudgets,
     /// The options of the context's description.
@@ -89,17 +104,37 @@ pub struct GiContext {
     nearest: Sampler,
     /// The last dispatched host frame (frame numbers must increase).
     last_frame: Option<u64>,
+    /// The frame budget of the description, and what it chose (`None` until chosen).
+    budget: Option<(f64, Option<BudgetChoice>)>,
 }
 
 impl GiContext {
     /// A context on `device` as `desc` says; nothing of a scene is uploaded yet.
     pub fn new(device: &Device, desc: &GiContextDesc) -> Result<Self, RenderError> {
+        let mut settings = desc.settings.clone();
+        let budget = match desc.budget_ms {
+            Some(ms) if !(ms.is_finite() && ms > 0.0) => {
+                return Err(RenderError::Invalid(format!(
+                    "GI context: budget_ms {ms} must be a positive number of ms"
+                )));
+            }
+            Some(ms) => {
+                let table = budget_table(device)?.1;
+                let choice = budget::choose(&table, None, desc.display, ms);
+                if let Some(c) = &choice {
+                    apply(&mut settings, c)?;
+                }
+                Some((ms, choice))
+            }
+            None => None,
+        };
         Ok(Self {
             renderer: Renderer::with_frames_in_flight(device, desc.frames_in_flight)?,
+            device: device.clone(),
             display: desc.display,
             budgets: desc.budgets,
-            params: frame_params(&desc.settings, desc.display)?,
-            settings: desc.settings.clone(),
+            params: frame_params(&settings, desc.display)?,
+            settings,
             frame_constants: Buffer::storage_for_uploads(
                 device,
                 "host frame",
@@ -116,7 +151,14 @@ impl GiContext {
                     .max_lod(0.0),
             )?,
             last_frame: None,
+            budget,
         })
+    }
+
+    /// What the frame budget chose (`GiContextDesc::budget_ms`): `None` without a budget, or
+    /// before the first scene when there were no lab results to choose from.
+    pub fn budget_choice(&self) -> Option<&BudgetChoice> {
+        self.budget.as_ref().and_then(|(_, c)| c.as_ref())
     }
 
     /// The display size the context was made for.
@@ -145,6 +187,31 @@ impl GiContext {
                  budgets are {} and {}",
                 self.budgets.lights, self.budgets.proxies
             )));
+        }
+        if let Some((ms, None)) = self.budget {
+            let device = self.device.clone();
+            let (path, _) = budget_table(&device)?;
+            let shape = format!(
+                "{:?} {} {} {}",
+                scene.pose_bounds(&scene.pose_at(t)),
+                scene.nodes.len(),
+                scene.meshes.len(),
+                scene.lights.len()
+            );
+            let key = format!("host-{:016x}", fnv1a(shape.as_bytes()));
+            let (entries, _) =
+                budget::quick_lab(&device, scene, &key, self.display, &budget::candidates())
+                    .map_err(lab_error)?;
+            if let Some(path) = path {
+                budget::record(&path, &entries).map_err(lab_error)?;
+            }
+            let refs: Vec<&budget::BudgetEntry> = entries.iter().collect();
+            let choice = budget::pick(&refs, ms).ok_or_else(|| {
+                RenderError::Invalid("GI context: no budget candidate could be measured".into())
+            })?;
+            apply(&mut self.settings, &choice)?;
+            self.params = frame_params(&self.settings, self.display)?;
+            self.budget = Some((ms, Some(choice)));
         }
         self.renderer.set_scene(scene, t)
     }
@@ -268,4 +335,31 @@ fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, R
     // The technique shades the host's G-buffer at its size: nothing to supersample.
     params.composite.ssaa = 1;
     Ok(params)
+}
+
+/// The budget table of `device` (its path under the cache directory, if there is one) and
+/// its entries.
+fn budget_table(device: &Device) -> Result<(Option<PathBuf>, budget::BudgetTable), RenderError> {
+    let path = cache_dir().map(|dir| budget::table_path(&dir, device.info()));
+    let table = match &path {
+        Some(p) => budget::load_table(p).map_err(lab_error)?,
+        None => budget::BudgetTable::default(),
+    };
+    Ok((path, table))
+}
+
+/// `choice`'s settings over `settings`, validated.
+fn apply(settings: &mut Settings, choice: &BudgetChoice) -> Result<(), RenderError> {
+    for (key, value) in &choice.config.set {
+        settings
+            .set(key, value)
+            .map_err(|e| RenderError::Invalid(format!("GI context budget: {e}")))?;
+    }
+    settings.validate()?;
+    Ok(())
+}
+
+/// A lab error as the context reports it.
+fn lab_error(e: LabError) -> RenderError {
+    RenderError::Invalid(format!("GI context budget: {e}"))
 }
