@@ -11,7 +11,7 @@ use std::path::PathBuf;
 
 fn main() {
     git_revision();
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let root = manifest_dir().join("shaders");
     println!("cargo::rerun-if-changed={}", root.display());
     let output = match shader_build::build_all(&root) {
         Ok(output) => output,
@@ -35,11 +35,20 @@ fn main() {
     }
 }
 
+/// The package's folder, as cargo gives it to this run of the script: a compiled script can
+/// be reused for another checkout sharing the target folder (same package, same hash), so
+/// the folder it was compiled in may be gone.
+fn manifest_dir() -> PathBuf {
+    std::env::var_os("CARGO_MANIFEST_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")))
+}
+
 /// Sets `SHINE_GIT_REV` (what `shine profile --format json` reports): the short commit HEAD
 /// points to, or `unknown` outside a git checkout. Uncommitted changes are not marked: the
 /// script reruns when HEAD moves, not when a source file changes.
 fn git_revision() {
-    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let root = manifest_dir();
     let git = |args: &[&str]| {
         std::process::Command::new("git")
             .args(args)
