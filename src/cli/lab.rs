@@ -162,13 +162,13 @@ fn print_fronts(report: &LabReport) {
         );
         for i in shine::lab::pareto::front(&points) {
             let p = points[i];
+            let ratio = match p.motion.flicker_ratio {
+                r if r > 0.0 => format!("{r:.1}×"),
+                _ => "n/a".to_owned(),
+            };
             println!(
-                "  {:<36} {:>9.2} {:>8.3} {:>8.3} {:>7.1}×",
-                p.config.label,
-                p.cost.frame_ms,
-                p.error.relative_rmse,
-                p.error.flip,
-                p.motion.flicker_ratio
+                "  {:<36} {:>9.2} {:>8.3} {:>8.3} {:>8}",
+                p.config.label, p.cost.frame_ms, p.error.relative_rmse, p.error.flip, ratio
             );
         }
     }

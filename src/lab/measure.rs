@@ -36,7 +36,8 @@ pub fn display_exposure(truth: &HdrImage) -> f32 {
     }
 }
 
-/// Truth flicker below which the light is taken as still: no flicker ratio (0) is reported.
+/// Noise-free truth flicker below which no flicker ratio is reported (0): the light holds
+/// still, or the truth's noise outweighs its flicker (more `--sequence-spp` would tell).
 pub const STILL_TRUTH: f64 = 1e-6;
 
 /// `image` times `k` (alpha kept).
@@ -221,15 +222,15 @@ fn motion(
     }
     let truth = truths.sequence_mean();
     let (sequence_rmse, cold_rmse) = (mean_error(&sequence, &truth)?, mean_error(&cold, &truth)?);
-    let truth_flicker = truths.flicker();
+    let yardstick = truths.noise_free_flicker();
     let own = flicker(&sequence);
     Ok(Motion {
         flicker: own,
         cold_flicker: flicker(&cold),
-        truth_flicker,
-        truth_flicker_noise_free: truths.noise_free_flicker(),
-        flicker_ratio: if truth_flicker > STILL_TRUTH {
-            own / truth_flicker
+        truth_flicker: truths.flicker(),
+        truth_flicker_noise_free: yardstick,
+        flicker_ratio: if yardstick > STILL_TRUTH {
+            own / yardstick
         } else {
             0.0
         },

@@ -94,14 +94,14 @@ pub struct Motion {
     pub flicker: f64,
     /// Flicker of the same frames rendered cold (no history), every pixel.
     pub cold_flicker: f64,
-    /// Flicker of the fixed-seed, unjittered truth sequence (the yardstick: its noise barely
-    /// changes between frames).
+    /// Flicker of the fixed-seed, unjittered truth sequence (its noise changes little between
+    /// frames where the light's paths do; a truth with caustics reads high).
     pub truth_flicker: f64,
     /// The truth's flicker with its noise taken out by a second seed (see [`truth`]; 0 where
-    /// the noise outweighs it).
+    /// the noise outweighs it): the yardstick of issue 43.
     pub truth_flicker_noise_free: f64,
-    /// `flicker / truth_flicker`; 0 when the truth holds still
-    /// ([`measure::STILL_TRUTH`]).
+    /// `flicker / truth_flicker_noise_free`; 0 (no ratio) when that is below
+    /// [`measure::STILL_TRUTH`].
     pub flicker_ratio: f64,
     /// Mean per-frame relative RMSE of the sequence against the truth of each frame.
     pub sequence_rmse: f64,

@@ -154,18 +154,27 @@ fn conditions(report: &LabReport) -> String {
     out
 }
 
+/// A flicker ratio as shown: `×1.23`, or `n/a` where the truth gives none (0).
+fn ratio(r: f64) -> String {
+    if r > 0.0 {
+        format!("×{r:.2}")
+    } else {
+        "n/a".to_owned()
+    }
+}
+
 /// One front configuration's figure: its image, its FLIP map under it, and a caption.
 fn figure(dir: &Path, point: &LabPoint) -> Result<String, LabError> {
     let label = escape(&point.config.label);
     Ok(format!(
         "<figure><img alt=\"{label}\" src=\"{}\"><img alt=\"FLIP map of {label}\" src=\"{}\">\
-         <figcaption><b>{label}</b><br>{:.3} ms · rel. RMSE {:.4}<br>flicker ×{:.2}</figcaption>\
+         <figcaption><b>{label}</b><br>{:.3} ms · rel. RMSE {:.4}<br>flicker {}</figcaption>\
          </figure>\n",
         data_uri(dir, &point.image)?,
         data_uri(dir, &point.flip_map)?,
         point.cost.frame_ms,
         point.error.relative_rmse,
-        point.motion.flicker_ratio,
+        ratio(point.motion.flicker_ratio),
     ))
 }
 
@@ -180,7 +189,7 @@ fn table(report: &LabReport, fronts: &[(&str, Vec<&LabPoint>)]) -> String {
         "energy ratio",
         "FLIP",
         "flicker",
-        "truth flicker",
+        "truth flicker (noise-free)",
         "flicker ratio",
         "lag",
     ];
@@ -197,7 +206,7 @@ fn table(report: &LabReport, fronts: &[(&str, Vec<&LabPoint>)]) -> String {
         out.push_str(&format!(
             "<tr{class}><td class=\"text\">{}</td><td class=\"text\">{}</td><td>{:.3}</td>\
              <td>{:.4}</td><td>{:.3}</td><td>{:.4}</td><td>{:.4}</td><td>{:.4}</td>\
-             <td>{:.2}</td><td>{:+.4}</td></tr>\n",
+             <td>{}</td><td>{:+.4}</td></tr>\n",
             escape(&point.scene),
             escape(&point.config.label),
             point.cost.frame_ms,
@@ -205,8 +214,8 @@ fn table(report: &LabReport, fronts: &[(&str, Vec<&LabPoint>)]) -> String {
             point.error.energy_ratio,
             point.error.flip,
             point.motion.flicker,
-            point.motion.truth_flicker,
-            point.motion.flicker_ratio,
+            point.motion.truth_flicker_noise_free,
+            ratio(point.motion.flicker_ratio),
             point.motion.lag,
         ));
     }

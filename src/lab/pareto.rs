@@ -115,9 +115,10 @@ fn placed(p: &LabPoint) -> Option<(f64, f64)> {
 }
 
 /// The colour of a flicker ratio: log2 of it over 1×..[`FLICKER_SPAN`]× on the ramp
-/// (clamped), grey when it is not a number or negative.
+/// (clamped), grey when there is none (0: the truth holds still or is too noisy to say) or it
+/// is not a number.
 fn flicker_colour(ratio: f64) -> RGBColor {
-    if ratio.is_nan() || ratio < 0.0 {
+    if ratio.is_nan() || ratio <= 0.0 {
         return UNKNOWN;
     }
     let t = ratio.log2() / FLICKER_SPAN.log2();
@@ -455,7 +456,7 @@ mod tests {
         let rgb = |[r, g, b, _]: [u8; 4]| RGBColor(r, g, b);
         assert_eq!(flicker_colour(1.0), rgb(ramp(0.0)));
         assert_eq!(flicker_colour(0.5), rgb(ramp(0.0)));
-        assert_eq!(flicker_colour(0.0), rgb(ramp(0.0)));
+        assert_eq!(flicker_colour(0.0), UNKNOWN);
         assert_eq!(flicker_colour(8.0), rgb(ramp(0.5)));
         assert_eq!(flicker_colour(FLICKER_SPAN), rgb(ramp(1.0)));
         assert_eq!(flicker_colour(f64::INFINITY), rgb(ramp(1.0)));
