@@ -14,7 +14,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{LabError, LabPoint};
 use crate::capture::image_io::{LdrImage, write_png};
-use crate::study::plot::{font, ramp};
+use crate::study::plot::{font, ramp, tick};
 
 /// Size of the Pareto plot in pixels.
 pub const PLOT_SIZE: [u32; 2] = [900, 600];
@@ -167,20 +167,6 @@ fn log_ticks([lo, hi]: [f64; 2]) -> Vec<f64> {
         coarse
     } else {
         with(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
-    }
-}
-
-/// A tick label: two significant digits, no trailing zeros (0.015, 0.5, 2, 300).
-fn tick(v: f64) -> String {
-    if !(v.is_finite() && v > 0.0) {
-        return format!("{v}");
-    }
-    let digits = (1 - v.log10().floor() as i32).max(0) as usize;
-    let s = format!("{v:.digits$}");
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.').to_owned()
-    } else {
-        s
     }
 }
 

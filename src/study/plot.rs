@@ -114,8 +114,9 @@ fn one_two_five([lo, hi]: [f64; 2]) -> Vec<f64> {
         .collect()
 }
 
-/// A tick label: two significant digits, no trailing zeros (0.015, 0.5, 2, 300).
-fn tick(v: f64) -> String {
+/// A tick label: two significant digits, no trailing zeros (0.015, 0.5, 2, 300); the lab's
+/// Pareto plot labels its axes with it too.
+pub(crate) fn tick(v: f64) -> String {
     if !(v.is_finite() && v > 0.0) {
         return format!("{v}");
     }
