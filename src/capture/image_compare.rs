@@ -114,6 +114,15 @@ pub fn rmse(image: &HdrImage, reference: &HdrImage) -> Result<f64, CompareError>
     Ok((sum / (3 * n) as f64).sqrt())
 }
 
+/// [`Comparison::relative_rmse`] and [`Comparison::energy_ratio`] alone, without SSIM and
+/// FLIP (what a sequence's every frame is judged by).
+pub fn relative_error(image: &HdrImage, reference: &HdrImage) -> Result<(f64, f64), CompareError> {
+    let rmse = rmse(image, reference)?;
+    let (image_sum, reference_sum) = sums(image, reference)?;
+    let values = 3.0 * f64::from(image.width) * f64::from(image.height);
+    Ok((rmse / (reference_sum / values), image_sum / reference_sum))
+}
+
 /// Sums of `image` and `reference` over pixels and channels (clamped as for the RMSE).
 fn sums(image: &HdrImage, reference: &HdrImage) -> Result<(f64, f64), CompareError> {
     check(image, reference)?;
@@ -263,12 +272,11 @@ pub fn flip_map(image: &HdrImage, reference: &HdrImage) -> Result<LdrImage, Comp
 /// of `image` against `reference`.
 pub fn compare(image: &HdrImage, reference: &HdrImage) -> Result<Comparison, CompareError> {
     let rmse = rmse(image, reference)?;
-    let (image_sum, reference_sum) = sums(image, reference)?;
-    let values = 3.0 * f64::from(image.width) * f64::from(image.height);
+    let (relative_rmse, energy_ratio) = relative_error(image, reference)?;
     Ok(Comparison {
         rmse,
-        relative_rmse: rmse / (reference_sum / values),
-        energy_ratio: image_sum / reference_sum,
+        relative_rmse,
+        energy_ratio,
         psnr: psnr_of_rmse(rmse),
         ssim: ssim(image, reference)?,
         flip: flip(image, reference)?,

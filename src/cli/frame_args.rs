@@ -146,20 +146,16 @@ impl SettingsArgs {
         let choice = match budget::choose(&table, Some(&key), extent, budget_ms) {
             Some(choice) => choice,
             None => {
-                let candidates = budget::candidates();
                 eprintln!(
                     "budget: no lab results for {argument} at {}×{} on {}: a quick lab of {} candidates …",
                     extent[0],
                     extent[1],
                     device.info().name,
-                    candidates.len()
+                    budget::candidates().len()
                 );
                 let (entries, seconds) =
-                    budget::quick_lab(device, scene, &key, extent, &candidates)?;
+                    budget::fill(device, scene, &key, extent, table_path.as_deref())?;
                 eprintln!("budget: the quick lab took {seconds:.1} s");
-                if let Some(path) = &table_path {
-                    budget::record(path, &entries)?;
-                }
                 let refs: Vec<&budget::BudgetEntry> = entries.iter().collect();
                 budget::pick(&refs, budget_ms).ok_or("budget: no candidate could be measured")?
             }

@@ -18,7 +18,6 @@ use crate::settings::Settings;
 use shine_gpu::{Buffer, Device, Sampler, vk};
 use shine_graph::{PassTiming, RenderGraph};
 use shine_scene::Scene;
-use std::path::PathBuf;
 
 /// How a [`GiContext`] is made: fixed for its life (make a new context to change them).
 #[derive(Clone, Debug, PartialEq)]
@@ -119,7 +118,7 @@ impl GiContext {
                 )));
             }
             Some(ms) => {
-                let table = budget_table(device)?.1;
+                let table = budget_table(device)?;
                 let choice = budget::choose(&table, None, desc.display, ms);
                 if let Some(c) = &choice {
                     apply(&mut settings, c)?;
@@ -189,8 +188,8 @@ impl GiContext {
             )));
         }
         if let Some((ms, None)) = self.budget {
-            let device = self.device.clone();
-            let (path, _) = budget_table(&device)?;
+            let device = &self.device;
+            let path = cache_dir().map(|dir| budget::table_path(&dir, device.info()));
             let shape = format!(
                 "{:?} {} {} {}",
                 scene.pose_bounds(&scene.pose_at(t)),
@@ -199,12 +198,8 @@ impl GiContext {
                 scene.lights.len()
             );
             let key = format!("host-{:016x}", fnv1a(shape.as_bytes()));
-            let (entries, _) =
-                budget::quick_lab(&device, scene, &key, self.display, &budget::candidates())
-                    .map_err(lab_error)?;
-            if let Some(path) = path {
-                budget::record(&path, &entries).map_err(lab_error)?;
-            }
+            let (entries, _) = budget::fill(device, scene, &key, self.display, path.as_deref())
+                .map_err(lab_error)?;
             let refs: Vec<&budget::BudgetEntry> = entries.iter().collect();
             let choice = budget::pick(&refs, ms).ok_or_else(|| {
                 RenderError::Invalid("GI context: no budget candidate could be measured".into())
@@ -337,15 +332,14 @@ fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, R
     Ok(params)
 }
 
-/// The budget table of `device` (its path under the cache directory, if there is one) and
-/// its entries.
-fn budget_table(device: &Device) -> Result<(Option<PathBuf>, budget::BudgetTable), RenderError> {
-    let path = cache_dir().map(|dir| budget::table_path(&dir, device.info()));
-    let table = match &path {
-        Some(p) => budget::load_table(p).map_err(lab_error)?,
-        None => budget::BudgetTable::default(),
-    };
-    Ok((path, table))
+/// The budget table of `device` under the cache directory (empty without one).
+fn budget_table(device: &Device) -> Result<budget::BudgetTable, RenderError> {
+    match cache_dir() {
+        Some(dir) => {
+            budget::load_table(&budget::table_path(&dir, device.info())).map_err(lab_error)
+        }
+        None => Ok(budget::BudgetTable::default()),
+    }
 }
 
 /// `choice`'s settings over `settings`, validated.

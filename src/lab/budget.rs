@@ -19,13 +19,13 @@ use serde::{Deserialize, Serialize};
 use shine_scene::Scene;
 
 use super::configs::{base_settings, settings_of};
-use super::measure::still_error;
+use super::measure::{cost, create_parent};
 use super::{LabConfig, LabError, LabPoint, LabSetup};
+use crate::capture::image_compare;
 use crate::capture::image_io::write_bytes_atomically;
 use crate::frame::renderer::Renderer;
 use crate::gpu::{Device, DeviceInfo};
 use crate::gpu_scene::FrameUpdate;
-use crate::profile::report::{PassClock, ProfileReport};
 use crate::reference::{PathTracer, ReferenceParams};
 
 /// One configuration's measured cost and error on one scene at one size.
@@ -167,7 +167,8 @@ pub fn choose(
 
 /// The table's file for `device` under `cache`.
 pub fn table_path(cache: &Path, device: &DeviceInfo) -> PathBuf {
-    let name = super::measure::slug(&format!("{}-{}", device.name, device.driver));
+    let name =
+        crate::study::temporal_plot::file_label(&format!("{}-{}", device.name, device.driver));
     cache.join("lab-results").join(format!("{name}.json"))
 }
 
@@ -197,12 +198,7 @@ pub fn record(path: &Path, entries: &[BudgetEntry]) -> Result<(), LabError> {
         })
     });
     table.entries.extend_from_slice(entries);
-    if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).map_err(|source| LabError::Io {
-            path: parent.to_owned(),
-            source,
-        })?;
-    }
+    create_parent(path)?;
     let json = serde_json::to_string_pretty(&table)
         .map_err(|e| LabError::Invalid(format!("budget table: {e}")))?;
     write_bytes_atomically(path, json.as_bytes())?;
@@ -283,7 +279,6 @@ pub fn quick_lab(
     tracer.accumulate(QUICK_TRUTH_SPP)?;
     let truth = tracer.read()?.full;
     let base = base_settings(&setup);
-    let clock = PassClock::for_device(device.info().device_type);
     let mut entries = Vec::new();
     for config in configs {
         let Ok(settings) = settings_of(&base, config) else {
@@ -294,23 +289,34 @@ pub fn quick_lab(
         let Ok(frame) = renderer.render(&settings) else {
             continue;
         };
-        let error = still_error(&frame.hdr, &truth)?;
-        let timings = renderer.render_timed(&settings, 1 + QUICK_FRAMES, clock, &|_| {
-            FrameUpdate::at(0.0)
-        })?;
-        let first = timings.iter().map(|t| t.frame).min().unwrap_or(0);
-        let measured: Vec<_> = timings.into_iter().filter(|t| t.frame > first).collect();
-        let report = ProfileReport::from_timings(&measured, clock)
-            .map_err(|e| LabError::Invalid(format!("timing failed: {e}")))?;
+        let (relative_rmse, _) = image_compare::relative_error(&frame.hdr, &truth)
+            .map_err(|e| LabError::Invalid(format!("comparison failed: {e}")))?;
+        let cost = cost(device, &mut renderer, &settings, &setup)?;
         entries.push(BudgetEntry {
             scene: key.to_owned(),
             extent,
             config: config.clone(),
-            frame_ms: report.frame.median_ms,
-            relative_rmse: error.relative_rmse,
+            frame_ms: cost.frame_ms,
+            relative_rmse,
         });
     }
     Ok((entries, start.elapsed().as_secs_f64()))
+}
+
+/// [`quick_lab`] of the [`candidates`], recorded in the table at `table` when there is one:
+/// what the budget mode does where the table has nothing for a scene and size.
+pub fn fill(
+    device: &Device,
+    scene: &Scene,
+    key: &str,
+    extent: [u32; 2],
+    table: Option<&Path>,
+) -> Result<(Vec<BudgetEntry>, f64), LabError> {
+    let (entries, seconds) = quick_lab(device, scene, key, extent, &candidates())?;
+    if let Some(path) = table {
+        record(path, &entries)?;
+    }
+    Ok((entries, seconds))
 }
 
 #[cfg(test)]

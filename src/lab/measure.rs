@@ -4,7 +4,7 @@ use std::path::Path;
 
 use shine_scene::Scene;
 
-use super::truth::{Truths, flicker};
+use super::truth::Truths;
 use super::{Cost, LabConfig, LabError, LabPoint, LabSetup, Motion, REGIONS, StillError};
 use crate::capture::image_compare::{self, CompareError};
 use crate::capture::image_io::{HdrImage, write_png};
@@ -14,6 +14,8 @@ use crate::gpu::Device;
 use crate::gpu_scene::FrameUpdate;
 use crate::profile::report::{PassClock, ProfileReport};
 use crate::settings::Settings;
+use crate::study::temporal::flicker;
+use crate::study::temporal_plot::file_label;
 
 /// Middle grey the display images map the truth's mean to: the FLIP maps and the PNGs show
 /// the frame exposed as a person would look at it (FLIP of dim linear values says
@@ -58,31 +60,27 @@ fn compared(e: CompareError) -> LabError {
     LabError::Invalid(format!("comparison failed: {e}"))
 }
 
-/// A name for files: letters, digits, `-` and `.` kept, everything else `_`.
-pub fn slug(text: &str) -> String {
-    text.chars()
-        .map(|c| match c {
-            'a'..='z' | 'A'..='Z' | '0'..='9' | '-' | '.' => c,
-            _ => '_',
-        })
-        .collect()
-}
-
 /// Where a point's files go, relative to the output directory.
 pub fn point_files(scene: &str, label: &str) -> (String, String) {
-    let (s, l) = (slug(scene), slug(label));
+    let (s, l) = (file_label(scene), file_label(label));
     (format!("images/{s}/{l}.png"), format!("flip/{s}/{l}.png"))
+}
+
+/// Creates the folder `path` goes in.
+pub fn create_parent(path: &Path) -> Result<(), LabError> {
+    match path.parent() {
+        Some(parent) => std::fs::create_dir_all(parent).map_err(|source| LabError::Io {
+            path: parent.to_owned(),
+            source,
+        }),
+        None => Ok(()),
+    }
 }
 
 /// Writes `image` exposed by `k`, tonemapped, to `out/relative`.
 pub fn write_display(out: &Path, relative: &str, image: &HdrImage, k: f32) -> Result<(), LabError> {
     let path = out.join(relative);
-    if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).map_err(|source| LabError::Io {
-            path: parent.to_owned(),
-            source,
-        })?;
-    }
+    create_parent(&path)?;
     let texels: Vec<[f32; 3]> = image.texels.iter().map(|t| [t[0], t[1], t[2]]).collect();
     crate::study::plot::write_tonemapped(&path, [image.width, image.height], &texels, k)
         .map_err(|e| LabError::Plot(e.to_string()))
@@ -105,25 +103,15 @@ pub fn measure(
     renderer.set_scene(scene, setup.time)?;
     renderer.update(&FrameUpdate::at(setup.time))?;
     let still = renderer.render(settings)?.hdr;
-    let error = still_error(&still, &truths.still)?;
     let k = display_exposure(&truths.still);
+    let (shown, truth_shown) = (scaled(&still, k), scaled(&truths.still, k));
+    let error = still_error(&still, &truths.still, &shown, &truth_shown)?;
     let (image, flip_map) = point_files(scene_name, &config.label);
     write_display(out, &image, &still, k)?;
-    let map =
-        image_compare::flip_map(&scaled(&still, k), &scaled(&truths.still, k)).map_err(compared)?;
+    let map = image_compare::flip_map(&shown, &truth_shown).map_err(compared)?;
     let map_path = out.join(&flip_map);
-    if let Some(parent) = map_path.parent() {
-        std::fs::create_dir_all(parent).map_err(|source| LabError::Io {
-            path: parent.to_owned(),
-            source,
-        })?;
-    }
+    create_parent(&map_path)?;
     write_png(&map_path, &map)?;
-    let error = StillError {
-        flip: image_compare::flip(&scaled(&still, k), &scaled(&truths.still, k))
-            .map_err(compared)?,
-        ..error
-    };
     let cost = cost(device, &mut renderer, settings, setup)?;
     let motion = motion(&mut renderer, scene, settings, setup, truths)?;
     Ok(LabPoint {
@@ -137,16 +125,22 @@ pub fn measure(
     })
 }
 
-/// Relative RMSE, energy ratio and the per-region figures of `image` against `truth` (FLIP is
-/// filled by the caller, on the display exposure).
-pub fn still_error(image: &HdrImage, truth: &HdrImage) -> Result<StillError, LabError> {
-    let c = image_compare::compare(image, truth).map_err(compared)?;
+/// Relative RMSE, energy ratio and the per-region figures of `image` against `truth`, and
+/// FLIP of the two as shown (`shown`, `truth_shown`: at the display exposure).
+fn still_error(
+    image: &HdrImage,
+    truth: &HdrImage,
+    shown: &HdrImage,
+    truth_shown: &HdrImage,
+) -> Result<StillError, LabError> {
+    let (relative_rmse, energy_ratio) =
+        image_compare::relative_error(image, truth).map_err(compared)?;
     let grid = REGIONS.min(image.width).min(image.height);
     let regions = region_grid(image, truth, grid).map_err(compared)?;
     Ok(StillError {
-        relative_rmse: c.relative_rmse,
-        energy_ratio: c.energy_ratio,
-        flip: c.flip,
+        relative_rmse,
+        energy_ratio,
+        flip: image_compare::flip(shown, truth_shown).map_err(compared)?,
         regions: regions.iter().map(|r| r.relative_rmse).collect(),
         region_energy: regions.iter().map(|r| r.energy_ratio).collect(),
     })
@@ -154,7 +148,7 @@ pub fn still_error(image: &HdrImage, truth: &HdrImage) -> Result<StillError, Lab
 
 /// The frame's median time and each pass's over `cost_frames` after `warmup`, by the
 /// device's clock rule (`shine profile --clock auto`).
-fn cost(
+pub fn cost(
     device: &Device,
     renderer: &mut Renderer,
     settings: &Settings,
@@ -192,9 +186,7 @@ fn cost(
 fn mean_error(frames: &[HdrImage], truth: &[HdrImage]) -> Result<f64, LabError> {
     let mut sum = 0.0;
     for (a, b) in frames.iter().zip(truth) {
-        sum += image_compare::compare(a, b)
-            .map_err(compared)?
-            .relative_rmse;
+        sum += image_compare::relative_error(a, b).map_err(compared)?.0;
     }
     Ok(sum / frames.len().max(1) as f64)
 }

@@ -14,7 +14,7 @@ use plotters::style::text_anchor::{HPos, Pos, VPos};
 
 use super::{LabError, LabPoint};
 use crate::capture::image_io::{LdrImage, write_png};
-use crate::study::plot::{font, ramp, tick};
+use crate::study::plot::{font, one_two_five, ramp, tick};
 
 /// Size of the Pareto plot in pixels.
 pub const PLOT_SIZE: [u32; 2] = [900, 600];
@@ -154,20 +154,15 @@ fn log_ticks([lo, hi]: [f64; 2]) -> Vec<f64> {
     if !(lo > 0.0 && hi >= lo && hi.is_finite()) {
         return Vec::new();
     }
-    let first = lo.log10().floor() as i32;
-    let last = hi.log10().ceil() as i32;
-    let with = |mantissas: &[f64]| -> Vec<f64> {
-        (first..=last)
-            .flat_map(|k| mantissas.iter().map(move |m| m * 10f64.powi(k)))
-            .filter(|v| (lo..=hi).contains(v))
-            .collect()
-    };
-    let coarse = with(&[1.0, 2.0, 5.0]);
+    let coarse = one_two_five([lo, hi]);
     if coarse.len() >= 3 {
-        coarse
-    } else {
-        with(&[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0])
+        return coarse;
     }
+    let (first, last) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    (first..=last)
+        .flat_map(|k| (1..=9).map(move |m| f64::from(m) * 10f64.powi(k)))
+        .filter(|v| (lo..=hi).contains(v))
+        .collect()
 }
 
 /// The drawing of [`write_plot`] into an RGB buffer of `size`.

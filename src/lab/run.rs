@@ -13,12 +13,13 @@ use serde::{Deserialize, Serialize};
 use shine_scene::Scene;
 
 use super::configs::{base_settings, settings_of};
-use super::measure::{display_exposure, measure, slug, write_display};
+use super::measure::{display_exposure, measure, write_display};
 use super::truth::{scene_key, truths};
 use super::{LabConfig, LabError, LabPoint, LabReport, LabSetup, SceneFailure, page, pareto};
 use crate::capture::image_io::write_bytes_atomically;
 use crate::gpu::Device;
 use crate::study::Progress;
+use crate::study::temporal_plot::file_label;
 
 /// The journal's file name in the output directory.
 pub const JOURNAL: &str = "points.jsonl";
@@ -169,7 +170,7 @@ pub fn run(
                 continue;
             }
         };
-        let key = scene_key(scene_name).unwrap_or_else(|| slug(scene_name));
+        let key = scene_key(scene_name).unwrap_or_else(|| file_label(scene_name));
         let truth = truths(
             device,
             &scene,
@@ -188,7 +189,7 @@ pub fn run(
             }
         };
         progress.advance(1, "truth");
-        let truth_png = format!("truth/{}.png", slug(scene_name));
+        let truth_png = format!("truth/{}.png", file_label(scene_name));
         write_display(
             &plan.out,
             &truth_png,
@@ -322,7 +323,7 @@ pub fn write_outputs(out: &Path, report: &LabReport) -> Result<(), LabError> {
     for scene in report.scenes() {
         let points: Vec<&LabPoint> = report.points_of(scene).collect();
         let front = pareto::front(&points);
-        let plot = format!("pareto-{}.png", slug(scene));
+        let plot = format!("pareto-{}.png", file_label(scene));
         pareto::write_plot(&out.join(&plot), scene, &points, &front)?;
         fronts.push((scene.to_owned(), front));
         plots.push((scene.to_owned(), plot));

@@ -6,9 +6,9 @@
 //! first light) about the horizontal x axis through the scene's centre by
 //! [`LabSetup::degrees_per_frame`] a frame: a spot sweeping, a sun turning, a point light
 //! swinging along an arc. (About the vertical axis, a light above the centre pointing down,
-//! as in the Cornell box, would not move at all.) Their truth's flicker is measured noise-free from the two seeds (issue 43):
-//! `mean(d2(A)²) − mean((d2(A) − d2(B))²) / 2` estimates the squared second difference of the
-//! true light, since the two seeds' noises are independent.
+//! as in the Cornell box, would not move at all.) The truth's flicker is measured noise-free
+//! from the two seeds (issue 43): `mean(d2(A)²) − mean((d2(A) − d2(B))²) / 2` estimates the
+//! squared second difference of the true light, since the two seeds' noises are independent.
 
 use std::path::{Path, PathBuf};
 
@@ -20,6 +20,7 @@ use crate::capture::image_io::{HdrImage, read_exr, write_exr};
 use crate::gpu::Device;
 use crate::gpu_scene::FrameUpdate;
 use crate::reference::{PathTracer, ReferenceParams};
+use crate::study::temporal::{flicker, frames_mean};
 
 /// Bumped when the truth's meaning changes (what is traced, how the light moves): cached
 /// truths of another version are not read.
@@ -59,7 +60,7 @@ impl Truths {
             .collect()
     }
 
-    /// The fixed-seed truth's flicker over every pixel: the yardstick.
+    /// The fixed-seed truth's flicker over every pixel (reported beside the noise-free one).
     pub fn flicker(&self) -> f64 {
         flicker(&self.sequences[0])
     }
@@ -105,27 +106,6 @@ pub fn sequence_updates(scene: &Scene, setup: &LabSetup) -> Vec<FrameUpdate> {
         .collect()
 }
 
-/// Squared second temporal difference of every pixel (rgb summed) at each inner frame.
-fn second_differences(frames: &[HdrImage]) -> Vec<Vec<f64>> {
-    frames
-        .windows(3)
-        .map(|w| {
-            (0..w[1].texels.len())
-                .map(|i| {
-                    (0..3)
-                        .map(|c| {
-                            f64::from(
-                                w[2].texels[i][c] - 2.0 * w[1].texels[i][c] + w[0].texels[i][c],
-                            )
-                        })
-                        .map(|d| d * d)
-                        .sum()
-                })
-                .collect()
-        })
-        .collect()
-}
-
 /// `sqrt(mean(d2(A)²) − mean((d2(A) − d2(B))²)/2) / mean(A)`: the flicker of the light both
 /// sequences estimate, without their independent noises (0 where the noise outweighs it).
 pub fn noise_free_flicker(a: &[HdrImage], b: &[HdrImage]) -> f64 {
@@ -148,28 +128,6 @@ pub fn noise_free_flicker(a: &[HdrImage], b: &[HdrImage]) -> f64 {
     }
     let mean = frames_mean(a);
     ((own - apart / 2.0).max(0.0) / n.max(1) as f64).sqrt() / mean
-}
-
-/// RMS of the second temporal difference over the mean of the frames, every pixel (rgb), as
-/// `shine study temporal` defines it.
-pub fn flicker(frames: &[HdrImage]) -> f64 {
-    let d = second_differences(frames);
-    let n: usize = d.iter().map(|f| 3 * f.len()).sum();
-    if n == 0 {
-        return 0.0;
-    }
-    (d.iter().flatten().sum::<f64>() / n as f64).sqrt() / frames_mean(frames)
-}
-
-/// Mean of the frames' rgb channels (at least 1e-12).
-fn frames_mean(frames: &[HdrImage]) -> f64 {
-    let (sum, n) = frames
-        .iter()
-        .flat_map(|f| &f.texels)
-        .fold((0.0f64, 0usize), |(s, n), t| {
-            (s + f64::from(t[0] + t[1] + t[2]), n + 3)
-        });
-    (sum / n.max(1) as f64).max(1e-12)
 }
 
 /// FNV-1a of `bytes`: names cache files after what they hold.

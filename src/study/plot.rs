@@ -102,7 +102,7 @@ fn powers_of_two([lo, hi]: [f64; 2]) -> Vec<f64> {
 }
 
 /// Ticks at 1, 2 and 5 times the powers of ten in `[lo, hi]` (the error axis).
-fn one_two_five([lo, hi]: [f64; 2]) -> Vec<f64> {
+pub(crate) fn one_two_five([lo, hi]: [f64; 2]) -> Vec<f64> {
     if !(lo > 0.0 && hi >= lo && hi.is_finite()) {
         return Vec::new();
     }

@@ -115,7 +115,7 @@ fn relative_rmse(a: &HdrImage, b: &HdrImage) -> f64 {
 }
 
 /// Mean of the frames' rgb channels (at least 1e-12).
-fn frames_mean(frames: &[HdrImage]) -> f64 {
+pub(crate) fn frames_mean(frames: &[HdrImage]) -> f64 {
     let (mut sum, mut m) = (0.0f64, 0usize);
     for f in frames {
         for t in &f.texels {

@@ -10,8 +10,9 @@ use super::StudyError;
 use super::plot::{font, write_drawing, write_map};
 use super::temporal::TemporalReport;
 
-/// A mode's label as part of a file name: letters, digits, `-` and `_` kept, the rest `_`.
-fn file_label(label: &str) -> String {
+/// A label as part of a file name: letters, digits, `-` and `_` kept, the rest `_` (a mode's
+/// flicker map here, the lab's images, plots and budget tables).
+pub(crate) fn file_label(label: &str) -> String {
     label
         .chars()
         .map(|c| {
