@@ -12,6 +12,7 @@ pub mod capture;
 pub mod choice;
 pub mod declare;
 pub mod embed;
+pub mod farm;
 pub mod frame;
 pub mod gpu_scene;
 pub mod lab;

@@ -7,6 +7,7 @@ mod common;
 
 use std::path::PathBuf;
 
+use shine::farm::Shard;
 use shine::lab::budget::{self, BudgetEntry};
 use shine::lab::configs::parse;
 use shine::lab::run::{JOURNAL, LabPlan, run};
@@ -87,6 +88,7 @@ fn a_lab_measures_writes_and_resumes() {
         out: dir.join("out"),
         cache: Some(dir.join("cache")),
         revision: "test".into(),
+        shard: Shard::WHOLE,
     };
     let mut first = Count::default();
     let report = run(&device, &plan, &load, &mut first).unwrap();
@@ -207,7 +209,12 @@ fn a_lab_measures_writes_and_resumes() {
     context.set_scene(&scene, 0.0).unwrap();
     let chosen = context.budget_choice().cloned().unwrap();
     assert!(chosen.fits && chosen.candidates >= 6, "{chosen:?}");
-    let table = budget::load_table(&budget::table_path(&cache, device.info())).unwrap();
+    let table = budget::load_table(&budget::table_path(
+        &cache,
+        &device.info().name,
+        &device.info().driver,
+    ))
+    .unwrap();
     assert!(table.entries.len() >= 6);
     // The least error of the candidates, within an unlimited budget.
     let least = table

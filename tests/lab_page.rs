@@ -142,6 +142,7 @@ fn synthetic(
             reason: "cannot read <buffer 0>".to_owned(),
         }],
         truths,
+        part: None,
     };
     (report, fronts, plots, images)
 }

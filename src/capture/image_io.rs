@@ -255,6 +255,34 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageIoEr
     write_atomically(path, |w| w.write_all(bytes).map_err(|e| io_error(path, e)))
 }
 
+/// Removes the temporary files that writes of `path` ([`write_atomically`]) left behind when
+/// their process was killed: a re-queued task calls it for the files it is about to write, so
+/// no half-written file stays beside them. Only for paths no other running process writes.
+pub fn remove_stale_temporaries(path: &Path) -> Result<(), ImageIoError> {
+    let Some(name) = path.file_name() else {
+        return Ok(());
+    };
+    let prefix = format!(".{}.", name.to_string_lossy());
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    let entries = match std::fs::read_dir(dir) {
+        Ok(entries) => entries,
+        // No folder yet: nothing was left there (the write reports the missing folder).
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
+        Err(e) => return Err(io_error(path, e)),
+    };
+    for entry in entries {
+        let entry = entry.map_err(|e| io_error(path, e))?;
+        let file = entry.file_name().to_string_lossy().into_owned();
+        if file.starts_with(&prefix) && file.ends_with(".tmp") {
+            std::fs::remove_file(entry.path()).map_err(|e| io_error(&entry.path(), e))?;
+        }
+    }
+    Ok(())
+}
+
 /// The I/O error of writing `path`.
 fn io_error(path: &Path, source: std::io::Error) -> ImageIoError {
     ImageIoError::Io {

@@ -73,6 +73,11 @@ impl FramePattern {
         }
     }
 
+    /// The path with `text` in place of the frame field (the path itself when it has none).
+    pub fn with_field(&self, text: &str) -> PathBuf {
+        PathBuf::from(format!("{}{text}{}", self.prefix, self.suffix))
+    }
+
     /// The path of frame `index`.
     pub fn path(&self, index: u32) -> PathBuf {
         match self.width {

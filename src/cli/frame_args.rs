@@ -138,7 +138,8 @@ impl SettingsArgs {
         }
         let extent = [settings.width, settings.height];
         let key = scene_key(argument).unwrap_or_else(|| argument.to_owned());
-        let table_path = cache_dir().map(|dir| budget::table_path(&dir, device.info()));
+        let table_path = cache_dir()
+            .map(|dir| budget::table_path(&dir, &device.info().name, &device.info().driver));
         let table = match &table_path {
             Some(path) => budget::load_table(path)?,
             None => budget::BudgetTable::default(),
@@ -214,6 +215,11 @@ impl SettingsArgs {
 }
 
 impl SettingsArgs {
+    /// The environment map flags (part of what a run is).
+    pub fn environment(&self) -> &EnvironmentArgs {
+        &self.environment
+    }
+
     /// Loads the scene `argument` with the `--environment` map applied.
     pub fn load_scene(&self, argument: &str) -> Result<Scene, CliError> {
         load_scene(argument, &self.environment)

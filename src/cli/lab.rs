@@ -1,9 +1,10 @@
 //! `shine lab SCENE…`: every technique's error, cost and flicker side by side (src/lab/).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use super::CliError;
 use super::frame_args::{EnvironmentArgs, load_scene};
+use shine::farm::{self, Shard};
 use shine::gpu::{Device, DeviceDesc};
 use shine::lab::budget;
 use shine::lab::configs::{default_space, load};
@@ -48,6 +49,11 @@ pub struct LabArgs {
     /// Print the configurations and exit.
     #[arg(long)]
     list: bool,
+    /// Measure only part i (from 0) of n of the points (scene by scene, configuration by
+    /// configuration, contiguous), into `--out`/part-i-of-n, for `shine merge`. Without it, a
+    /// Slurm array task's SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT give it.
+    #[arg(long)]
+    shard: Option<Shard>,
     #[command(flatten)]
     environment: EnvironmentArgs,
 }
@@ -105,16 +111,31 @@ pub fn run_lab(args: &LabArgs) -> Result<(), CliError> {
         println!("{} configurations", configs.len());
         return Ok(());
     }
+    let (shard, from) = farm::resolve(args.shard)?;
+    let out = if shard.is_whole() {
+        args.out.clone()
+    } else {
+        args.out.join(part_folder(shard))
+    };
     let device = Device::new(&DeviceDesc::from_env())?;
     let cache = cache_dir();
     let plan = LabPlan {
         scenes: args.scenes.clone(),
         configs,
         setup,
-        out: args.out.clone(),
+        out: out.clone(),
         cache: cache.clone(),
         revision: super::profile::REVISION.to_owned(),
+        shard,
     };
+    if !shard.is_whole() {
+        let total = (plan.scenes.len() * plan.configs.len()) as u32;
+        let points = shard.range(total);
+        eprintln!(
+            "part {shard} from {from}: points {}..{} of {total}",
+            points.start, points.end
+        );
+    }
     let per_scene = 1 + plan.configs.len() as u64;
     let bar = super::progress::bar(
         per_scene * plan.scenes.len() as u64,
@@ -133,10 +154,10 @@ pub fn run_lab(args: &LabArgs) -> Result<(), CliError> {
         &|scene| load_scene(scene, environment).map_err(|e| e.to_string()),
         &mut progress,
     )?;
-    if let Some(cache) = &cache {
-        let key = |s: &str| scene_key(s).unwrap_or_else(|| s.to_owned());
-        let entries = budget::entries_of(&report.points, &report.setup, &key);
-        budget::record(&budget::table_path(cache, device.info()), &entries)?;
+    // A part leaves the device's budget table to the merge: parts running at once would
+    // overwrite each other's entries.
+    if let (Some(cache), true) = (&cache, shard.is_whole()) {
+        record_budget(cache, &report)?;
     }
     print_fronts(&report);
     for f in &report.failures {
@@ -146,8 +167,22 @@ pub fn run_lab(args: &LabArgs) -> Result<(), CliError> {
         "{} points in {:.1} min; wrote {}",
         report.points.len(),
         start.elapsed().as_secs_f64() / 60.0,
-        args.out.join("index.html").display()
+        out.join("index.html").display()
     );
+    Ok(())
+}
+
+/// The folder of part `shard` under a lab's `--out`.
+pub fn part_folder(shard: Shard) -> String {
+    format!("part-{}-of-{}", shard.index, shard.count)
+}
+
+/// Adds `report`'s points to its device's budget table in `cache`.
+pub fn record_budget(cache: &Path, report: &LabReport) -> Result<(), CliError> {
+    let key = |s: &str| scene_key(s).unwrap_or_else(|| s.to_owned());
+    let entries = budget::entries_of(&report.points, &report.setup, &key);
+    let table = budget::table_path(cache, &report.device, &report.driver);
+    budget::record(&table, &entries)?;
     Ok(())
 }
 

@@ -4,6 +4,7 @@ mod compare;
 mod frame_args;
 mod info;
 mod lab;
+mod merge;
 mod profile;
 mod progress;
 mod reference;
@@ -43,6 +44,9 @@ enum Command {
     /// The GI lab: every technique's error, cost and flicker on the given scenes, the Pareto
     /// front, lab.json/lab.csv and a self-contained index.html.
     Lab(lab::LabArgs),
+    /// Joins the parts of a sharded run: a reference's partial sums, a sequence's manifests
+    /// (docs/many-machines.md).
+    Merge(merge::MergeArgs),
     /// Every setting: key, default, values, what it changes (docs/settings.md).
     Settings(settings::SettingsArgs),
     /// Quality studies: error against samples per pixel (`study aaf`: paper 004's Fig. 10).
@@ -59,6 +63,7 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
         Command::Compare(args) => compare::run(&args),
         Command::Scene(args) => scene::run(&args),
         Command::Lab(args) => lab::run_lab(&args),
+        Command::Merge(args) => merge::run(&args),
         Command::Settings(args) => settings::run(&args),
         Command::Study(args) => study::run(&args),
     }

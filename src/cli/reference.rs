@@ -7,9 +7,12 @@ use super::frame_args::{EnvironmentArgs, load_scene};
 use glam::Vec3;
 use shine::capture::image_io::{LdrImage, OutputFormat, write_exr, write_png};
 use shine::capture::tonemap::{DEFAULT_TONEMAP, encode_ldr};
+use shine::farm::partial::{PartialHeader, PartialSums};
+use shine::farm::{self, Shard};
 use shine::gpu::{Device, DeviceDesc};
-use shine::reference::{PathTracer, ReferenceParams};
-use std::path::PathBuf;
+use shine::lab::truth::scene_key;
+use shine::reference::{PathTracer, ReferenceImages, ReferenceParams};
+use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 /// Arguments of `shine reference`.
@@ -60,14 +63,90 @@ pub struct ReferenceArgs {
     /// Scene time in seconds (animations).
     #[arg(long, default_value_t = 0.0)]
     time: f32,
+    /// Trace only part i (from 0) of n of the --spp samples (global sample indices
+    /// i·spp/n..(i+1)·spp/n) and write their sums to -o (a partial-sum file, `.part` by
+    /// convention) for `shine merge`. Without it, a Slurm array task's SLURM_ARRAY_TASK_ID
+    /// and SLURM_ARRAY_TASK_COUNT give it.
+    #[arg(long, conflicts_with = "seconds")]
+    shard: Option<Shard>,
+}
+
+/// Which image of a reference is written.
+fn component(args: &ReferenceArgs) -> &'static str {
+    if args.indirect_only {
+        "indirect"
+    } else if args.direct_only {
+        "direct"
+    } else {
+        "full"
+    }
+}
+
+/// What makes two processes' samples parts of one reference.
+fn run_of(args: &ReferenceArgs, params: &ReferenceParams) -> serde_json::Value {
+    serde_json::json!({
+        "scene": scene_key(&args.scene).unwrap_or_else(|| args.scene.clone()),
+        "environment": format!("{:?}", args.environment),
+        "spp": args.spp,
+        "bounces": params.bounces,
+        "jitter": params.jitter,
+        "emissive_lighting": params.emissive_lighting,
+        "light_sampling": params.light_sampling,
+        "seed": params.seed,
+        "time": args.time,
+        "component": component(args),
+    })
+}
+
+/// Writes `images`' `component` (`full`, `direct` or `indirect`) to `path`: linear EXR, or a
+/// PNG preview (tonemapped with the default operator, sRGB-encoded).
+pub(super) fn write_reference(
+    path: &Path,
+    images: &ReferenceImages,
+    component: &str,
+) -> Result<(), CliError> {
+    let image = match component {
+        "indirect" => &images.indirect,
+        "direct" => &images.direct,
+        "full" => &images.full,
+        other => return Err(format!("unknown reference component `{other}`").into()),
+    };
+    match OutputFormat::from_path(path)? {
+        OutputFormat::Exr => write_exr(path, image)?,
+        OutputFormat::Png => {
+            let texels = image
+                .texels
+                .iter()
+                .map(|t| encode_ldr(DEFAULT_TONEMAP, Vec3::new(t[0], t[1], t[2])))
+                .collect();
+            let ldr = LdrImage {
+                width: image.width,
+                height: image.height,
+                texels,
+            };
+            write_png(path, &ldr)?;
+        }
+    }
+    Ok(())
 }
 
 /// Renders the reference and writes it atomically.
 pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
-    // Refuse a bad output path before any work.
-    let format = OutputFormat::from_path(&args.output)?;
+    let (shard, from) = farm::resolve(args.shard)?;
+    // Refuse a bad output path before any work (a part is not an image).
+    if shard.is_whole() {
+        OutputFormat::from_path(&args.output)?;
+    }
     if args.spp == 0 {
         return Err("--spp must be at least 1".into());
+    }
+    let samples = shard.range(args.spp);
+    if samples.is_empty() {
+        return Err(format!(
+            "shard {shard} ({from}) holds no sample of --spp {}: use at most {} shards",
+            args.spp, args.spp
+        )
+        .into());
     }
     let budget = match args.seconds {
         Some(s) if !(s.is_finite() && s > 0.0) => {
@@ -89,55 +168,53 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
     let scene = load_scene(&args.scene, &args.environment)?;
     let device = Device::new(&DeviceDesc::from_env())?;
     let mut tracer = PathTracer::new(&device, &scene, args.time, &params)?;
+    tracer.start_at_sample(samples.start);
+    let spp = samples.end - samples.start;
     let bar = super::progress::bar(
-        u64::from(args.spp),
+        u64::from(spp),
         "{bar:40} {pos}/{len} spp, {elapsed} elapsed, {eta} left",
     );
     let start = Instant::now();
     let step = tracer.samples_per_dispatch();
-    while tracer.samples() < args.spp {
+    while tracer.samples() < spp {
         // The budget stops after the submission that exceeds it: at least one always runs.
         if tracer.samples() > 0 && budget.is_some_and(|b| start.elapsed() >= b) {
             break;
         }
-        let now = step.min(args.spp - tracer.samples());
+        let now = step.min(spp - tracer.samples());
         tracer.accumulate(now)?;
         bar.inc(u64::from(now));
     }
     bar.finish_and_clear();
     let elapsed = start.elapsed().as_secs_f64();
-    let images = tracer.read()?;
-    let image = if args.indirect_only {
-        &images.indirect
-    } else if args.direct_only {
-        &images.direct
+    let written = if shard.is_whole() {
+        write_reference(&args.output, &tracer.read()?, component(args))?;
+        String::new()
     } else {
-        &images.full
+        let part = PartialSums {
+            header: PartialHeader {
+                run: run_of(args, &params),
+                shard,
+                samples: [samples.start, samples.end],
+                width: args.width,
+                height: args.height,
+            },
+            sums: tracer.read_sums()?,
+        };
+        part.write(&args.output)?;
+        format!(
+            ", part {shard} from {from}: samples {}..{}",
+            samples.start, samples.end
+        )
     };
-    match format {
-        OutputFormat::Exr => write_exr(&args.output, image)?,
-        // A preview: tonemapped with the default operator, sRGB-encoded.
-        OutputFormat::Png => {
-            let texels = image
-                .texels
-                .iter()
-                .map(|t| encode_ldr(DEFAULT_TONEMAP, Vec3::new(t[0], t[1], t[2])))
-                .collect();
-            let ldr = LdrImage {
-                width: image.width,
-                height: image.height,
-                texels,
-            };
-            write_png(&args.output, &ldr)?;
-        }
-    }
-    let pixel_samples = f64::from(images.samples) * f64::from(args.width) * f64::from(args.height);
+    let pixel_samples =
+        f64::from(tracer.samples()) * f64::from(args.width) * f64::from(args.height);
     println!(
-        "wrote {} ({}×{}, {} spp, {} bounce(s), {:.1} s, {:.1} ns per sample per pixel)",
+        "wrote {} ({}×{}, {} spp{written}, {} bounce(s), {:.1} s, {:.1} ns per sample per pixel)",
         args.output.display(),
         args.width,
         args.height,
-        images.samples,
+        tracer.samples(),
         args.bounces,
         elapsed,
         elapsed * 1e9 / pixel_samples.max(1.0)

@@ -189,7 +189,8 @@ impl GiContext {
         }
         if let Some((ms, None)) = self.budget {
             let device = &self.device;
-            let path = cache_dir().map(|dir| budget::table_path(&dir, device.info()));
+            let path = cache_dir()
+                .map(|dir| budget::table_path(&dir, &device.info().name, &device.info().driver));
             let shape = format!(
                 "{:?} {} {} {}",
                 scene.pose_bounds(&scene.pose_at(t)),
@@ -335,9 +336,12 @@ fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, R
 /// The budget table of `device` under the cache directory (empty without one).
 fn budget_table(device: &Device) -> Result<budget::BudgetTable, RenderError> {
     match cache_dir() {
-        Some(dir) => {
-            budget::load_table(&budget::table_path(&dir, device.info())).map_err(lab_error)
-        }
+        Some(dir) => budget::load_table(&budget::table_path(
+            &dir,
+            &device.info().name,
+            &device.info().driver,
+        ))
+        .map_err(lab_error),
         None => Ok(budget::BudgetTable::default()),
     }
 }

@@ -24,7 +24,7 @@ use super::{LabConfig, LabError, LabPoint, LabSetup};
 use crate::capture::image_compare;
 use crate::capture::image_io::write_bytes_atomically;
 use crate::frame::renderer::Renderer;
-use crate::gpu::{Device, DeviceInfo};
+use crate::gpu::Device;
 use crate::gpu_scene::FrameUpdate;
 use crate::reference::{PathTracer, ReferenceParams};
 
@@ -165,10 +165,9 @@ pub fn choose(
     pick(&merged.iter().collect::<Vec<_>>(), budget_ms)
 }
 
-/// The table's file for `device` under `cache`.
-pub fn table_path(cache: &Path, device: &DeviceInfo) -> PathBuf {
-    let name =
-        crate::study::temporal_plot::file_label(&format!("{}-{}", device.name, device.driver));
+/// The table's file for the device named `device` with driver `driver` under `cache`.
+pub fn table_path(cache: &Path, device: &str, driver: &str) -> PathBuf {
+    let name = crate::study::temporal_plot::file_label(&format!("{device}-{driver}"));
     cache.join("lab-results").join(format!("{name}.json"))
 }
 

@@ -194,6 +194,36 @@ pub struct LabReport {
     pub failures: Vec<SceneFailure>,
     /// Each scene's truth (tonemapped PNG), relative to the output directory.
     pub truths: Vec<(String, String)>,
+    /// Which part of a sharded run this report holds (`shine lab --shard`; `None`: the whole).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub part: Option<LabPart>,
+}
+
+/// The part of a sharded lab a report holds: its shard of the run's points, numbered scene
+/// by scene, configuration by configuration ([`LabPart::index`]), and the run's whole plan, so
+/// that `shine merge` can tell a missing part or a part of another run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LabPart {
+    /// Which part.
+    pub shard: crate::farm::Shard,
+    /// Every scene of the run, as given.
+    pub scenes: Vec<String>,
+    /// Every configuration's label, in order.
+    pub configs: Vec<String>,
+}
+
+impl LabPart {
+    /// The number of the point of scene `scene` and configuration `config` (indices into the
+    /// run's lists).
+    pub fn index(&self, scene: usize, config: usize) -> u32 {
+        (scene * self.configs.len() + config) as u32
+    }
+
+    /// Whether this part measures that point.
+    pub fn holds(&self, scene: usize, config: usize) -> bool {
+        let total = (self.scenes.len() * self.configs.len()) as u32;
+        self.shard.range(total).contains(&self.index(scene, config))
+    }
 }
 
 impl LabReport {

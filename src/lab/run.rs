@@ -15,8 +15,11 @@ use shine_scene::Scene;
 use super::configs::{base_settings, settings_of};
 use super::measure::{display_exposure, measure, write_display};
 use super::truth::{scene_key, truths};
-use super::{LabConfig, LabError, LabPoint, LabReport, LabSetup, SceneFailure, page, pareto};
+use super::{
+    LabConfig, LabError, LabPart, LabPoint, LabReport, LabSetup, SceneFailure, page, pareto,
+};
 use crate::capture::image_io::write_bytes_atomically;
+use crate::farm::Shard;
 use crate::gpu::Device;
 use crate::study::Progress;
 use crate::study::temporal_plot::file_label;
@@ -39,6 +42,24 @@ pub struct LabPlan {
     pub cache: Option<PathBuf>,
     /// The binary's git revision.
     pub revision: String,
+    /// The part of the points this run measures (`Shard::WHOLE`: all).
+    pub shard: Shard,
+}
+
+impl LabPlan {
+    /// The part this plan measures, `None` for the whole run.
+    pub fn part(&self) -> Option<LabPart> {
+        (!self.shard.is_whole()).then(|| LabPart {
+            shard: self.shard,
+            scenes: self.scenes.clone(),
+            configs: self.configs.iter().map(|c| c.label.clone()).collect(),
+        })
+    }
+
+    /// Whether this plan measures configuration `config` of scene `scene` (indices).
+    fn holds(&self, scene: usize, config: usize) -> bool {
+        self.part().is_none_or(|part| part.holds(scene, config))
+    }
 }
 
 /// One line of the journal.
@@ -147,11 +168,18 @@ pub fn run(
     };
     let base = base_settings(&plan.setup);
     let mut truth_images = Vec::new();
-    for scene_name in &plan.scenes {
+    for (scene_index, scene_name) in plan.scenes.iter().enumerate() {
+        if !(0..plan.configs.len()).any(|c| plan.holds(scene_index, c)) {
+            continue;
+        }
         let todo: Vec<&LabConfig> = plan
             .configs
             .iter()
-            .filter(|c| !done(&entries, scene_name, Some(&c.label)))
+            .enumerate()
+            .filter(|(c, config)| {
+                plan.holds(scene_index, *c) && !done(&entries, scene_name, Some(&config.label))
+            })
+            .map(|(_, config)| config)
             .collect();
         progress.stage(scene_name, 1 + todo.len() as u64);
         let fail = |reason: String| Entry::Failure {
@@ -242,8 +270,11 @@ fn assemble(
     truths: Vec<(String, String)>,
 ) -> LabReport {
     let mut points = Vec::new();
-    for scene in &plan.scenes {
-        for config in &plan.configs {
+    for (scene_index, scene) in plan.scenes.iter().enumerate() {
+        for (config_index, config) in plan.configs.iter().enumerate() {
+            if !plan.holds(scene_index, config_index) {
+                continue;
+            }
             let found = entries.iter().find_map(|e| match e {
                 Entry::Point(p) if &p.scene == scene && p.config.label == config.label => {
                     Some(p.as_ref().clone())
@@ -268,6 +299,7 @@ fn assemble(
         points,
         failures,
         truths,
+        part: plan.part(),
     }
 }
 

@@ -150,6 +150,8 @@ pub struct PathTracer {
     environment_sampler: Sampler,
     accumulation: Buffer,
     params: ReferenceParams,
+    /// Global index of the first sample accumulated ([`PathTracer::start_at_sample`]).
+    first_sample: u32,
     samples: u32,
 }
 
@@ -225,6 +227,7 @@ impl PathTracer {
             )?,
             accumulation,
             params: *params,
+            first_sample: 0,
             samples: 0,
         })
     }
@@ -237,6 +240,15 @@ impl PathTracer {
         self.texels_current = false;
         self.samples = 0;
         Ok(())
+    }
+
+    /// Restarts the accumulation at global sample index `first`: every pixel's random numbers
+    /// are keyed by (seed, pixel, global sample index), so the samples `first..first + k` are
+    /// those a tracer started at 0 draws after `first` samples (a shard of a reference:
+    /// [`crate::farm::partial`]).
+    pub fn start_at_sample(&mut self, first: u32) {
+        self.first_sample = first;
+        self.samples = 0;
     }
 
     /// Samples per pixel accumulated so far.
@@ -296,7 +308,7 @@ impl PathTracer {
             light_count,
             flags: self.params.flags(),
             seed: self.params.seed,
-            first_sample: self.samples,
+            first_sample: self.first_sample.saturating_add(self.samples),
             samples,
             environment_sampling: self.environment_sampling,
             textures: self.textures,
@@ -324,10 +336,35 @@ impl PathTracer {
 
     /// Reads the running means back (black before the first sample).
     pub fn read(&self) -> Result<ReferenceImages, RenderError> {
+        let sums = self.read_sums()?;
+        Ok(ReferenceImages::from_sums(
+            [self.params.width, self.params.height],
+            &sums,
+            self.samples,
+        ))
+    }
+
+    /// Reads the running sums back: the planes direct, indirect and full, each row-major, of
+    /// (sum of r, g, b, samples) per pixel.
+    pub fn read_sums(&self) -> Result<Vec<[f32; 4]>, RenderError> {
         let bytes = self.device.read_buffer(&self.accumulation)?;
         let sums: &[[f32; 4]] = bytemuck::try_cast_slice(&bytes)
             .map_err(|e| RenderError::Invalid(format!("accumulation readback: {e}")))?;
-        let pixels = self.params.width as usize * self.params.height as usize;
+        Ok(sums.to_vec())
+    }
+
+    /// The scene the tracer renders.
+    pub fn scene(&self) -> &GpuScene {
+        &self.scene
+    }
+}
+
+impl ReferenceImages {
+    /// The means of `sums` ([`PathTracer::read_sums`]'s planes) over an image of `extent`,
+    /// from `samples` samples per pixel.
+    pub fn from_sums(extent: [u32; 2], sums: &[[f32; 4]], samples: u32) -> Self {
+        let [width, height] = extent;
+        let pixels = width as usize * height as usize;
         let plane = |k: usize| -> HdrImage {
             let texels = sums
                 .iter()
@@ -339,22 +376,17 @@ impl PathTracer {
                 })
                 .collect();
             HdrImage {
-                width: self.params.width,
-                height: self.params.height,
+                width,
+                height,
                 texels,
             }
         };
-        Ok(ReferenceImages {
+        Self {
             direct: plane(0),
             indirect: plane(1),
             full: plane(2),
-            samples: self.samples,
-        })
-    }
-
-    /// The scene the tracer renders.
-    pub fn scene(&self) -> &GpuScene {
-        &self.scene
+            samples,
+        }
     }
 }
 

@@ -89,6 +89,19 @@ impl Executor {
         self.frame
     }
 
+    /// Numbers the next frame `frame`, which must not be below [`Executor::frame`]: a shard of
+    /// a sequence starts at its own frame number, so that what is keyed by the frame number
+    /// (jitter sequences, amortised slices, history ping-pong) matches a one-process run.
+    /// Call with no frame in flight. Returns whether the number was taken (false: `frame` lies
+    /// behind the next frame, nothing changed).
+    pub fn skip_to_frame(&mut self, frame: u64) -> bool {
+        let forward = frame >= self.frame;
+        if forward {
+            self.frame = frame;
+        }
+        forward
+    }
+
     /// Device memory the executor holds: `(transients, temporal)` bytes: the aliased heaps of
     /// every kept transient set (one per plan and frame slot) and the temporal and history
     /// resources kept across frames.

@@ -300,6 +300,21 @@ impl Renderer {
         Ok(())
     }
 
+    /// Numbers the next frame `frame` (forward only), as frame `frame` of a sequence whose
+    /// earlier frames another process renders: what depends on the frame number (TAA's
+    /// jitter, amortised slices, IGI's interleaving) then matches a one-process run. The
+    /// histories stay empty until this renderer's own frames fill them.
+    pub fn skip_to_frame(&mut self, frame: u64) -> Result<(), RenderError> {
+        if self.executor.skip_to_frame(frame) {
+            Ok(())
+        } else {
+            Err(RenderError::Invalid(format!(
+                "cannot number the next frame {frame}: frame {} is next already",
+                self.executor.frame()
+            )))
+        }
+    }
+
     /// Renders one frame with `settings` and reads its HDR and LDR images back.
     pub fn render(&mut self, settings: &Settings) -> Result<FrameImage, RenderError> {
         settings.validate()?;

@@ -1,0 +1,344 @@
+//! `shine merge`: joins the parts of a sharded run: a reference's partial sums into the
+//! reference, a sequence's manifests into the sequence's. A part of another run, a missing
+//! part and a part given twice are refused, naming the part.
+
+use std::path::{Path, PathBuf};
+
+use super::Shard;
+use super::manifest::{FrameFile, SequenceManifest};
+use super::partial::{PartialHeader, PartialSums};
+use crate::lab::{LabPart, LabReport};
+
+/// Why parts were not merged.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// No part was given.
+    #[error("no part to merge")]
+    Empty,
+    /// A part of a shard index or frame range no file holds.
+    #[error("missing: {0}")]
+    Missing(String),
+    /// Two files hold the same part.
+    #[error("{what} given twice: {first} and {second}")]
+    Duplicate {
+        /// The part.
+        what: String,
+        /// One file holding it.
+        first: PathBuf,
+        /// The other.
+        second: PathBuf,
+    },
+    /// A part belongs to another run than the first part.
+    #[error("{part} is not part of the run of {first}: {why}")]
+    OtherRun {
+        /// The odd part.
+        part: PathBuf,
+        /// The first part.
+        first: PathBuf,
+        /// What differs.
+        why: String,
+    },
+    /// A part could not be read, or holds what its run cannot.
+    #[error("{0}")]
+    Part(String),
+}
+
+/// The first key (dotted path) where two run descriptions differ.
+fn difference(a: &serde_json::Value, b: &serde_json::Value, at: &str) -> Option<String> {
+    match (a, b) {
+        (serde_json::Value::Object(x), serde_json::Value::Object(y)) => {
+            let keys = x.keys().chain(y.keys());
+            for key in keys {
+                let path = if at.is_empty() {
+                    key.clone()
+                } else {
+                    format!("{at}.{key}")
+                };
+                match (x.get(key), y.get(key)) {
+                    (Some(p), Some(q)) => {
+                        if let Some(d) = difference(p, q, &path) {
+                            return Some(d);
+                        }
+                    }
+                    _ => return Some(format!("`{path}` is in one only")),
+                }
+            }
+            None
+        }
+        _ if a == b => None,
+        _ => Some(format!("`{at}` is {a} there, {b} here")),
+    }
+}
+
+/// Refuses `part`'s `run` unless it equals `first`'s.
+fn same_run(
+    first: (&Path, &serde_json::Value),
+    part: (&Path, &serde_json::Value),
+) -> Result<(), MergeError> {
+    match difference(first.1, part.1, "") {
+        None => Ok(()),
+        Some(why) => Err(MergeError::OtherRun {
+            part: part.0.to_owned(),
+            first: first.0.to_owned(),
+            why,
+        }),
+    }
+}
+
+/// A reference merged from its parts: the header of the whole run and its sums.
+#[derive(Debug)]
+pub struct MergedReference {
+    /// The run, with shard 0/1 and every sample.
+    pub header: PartialHeader,
+    /// The summed planes ([`PartialSums::sums`]).
+    pub sums: Vec<[f32; 4]>,
+}
+
+/// Adds the partial sums `parts` (file, part) of one reference, in shard order, after checking
+/// that they are every shard of one run exactly once and that their samples tile `0..spp`.
+pub fn merge_references(parts: &[(PathBuf, PartialSums)]) -> Result<MergedReference, MergeError> {
+    let (first_path, first) = parts.first().ok_or(MergeError::Empty)?;
+    let count = first.header.shard.count;
+    let mut by_index: Vec<Option<(&Path, &PartialSums)>> = vec![None; count as usize];
+    for (path, part) in parts {
+        same_run((first_path, &first.header.run), (path, &part.header.run))?;
+        let shard = part.header.shard;
+        if shard.count != count
+            || (part.header.width, part.header.height) != (first.header.width, first.header.height)
+        {
+            return Err(MergeError::OtherRun {
+                part: path.clone(),
+                first: first_path.clone(),
+                why: format!(
+                    "it is part {shard} of {}×{}, the first part {} of {}×{}",
+                    part.header.width,
+                    part.header.height,
+                    first.header.shard,
+                    first.header.width,
+                    first.header.height
+                ),
+            });
+        }
+        let slot = &mut by_index[shard.index as usize];
+        if let Some((other, _)) = slot {
+            return Err(MergeError::Duplicate {
+                what: format!("part {shard}"),
+                first: other.to_path_buf(),
+                second: path.clone(),
+            });
+        }
+        *slot = Some((path, part));
+    }
+    let mut next = 0u32;
+    let mut sums = vec![[0.0f32; 4]; first.sums.len()];
+    for (index, slot) in by_index.iter().enumerate() {
+        let shard = Shard {
+            index: index as u32,
+            count,
+        };
+        let Some((path, part)) = slot else {
+            return Err(MergeError::Missing(format!("part {shard}")));
+        };
+        let [start, end] = part.header.samples;
+        if start != next || end < start {
+            return Err(MergeError::Part(format!(
+                "{}: part {shard} holds samples {start}..{end}, where the parts before it end \
+                 at {next}",
+                path.display()
+            )));
+        }
+        next = end;
+        for (sum, add) in sums.iter_mut().zip(&part.sums) {
+            for c in 0..4 {
+                sum[c] += add[c];
+            }
+        }
+    }
+    Ok(MergedReference {
+        header: PartialHeader {
+            shard: Shard::WHOLE,
+            samples: [0, next],
+            ..first.header.clone()
+        },
+        sums,
+    })
+}
+
+/// Joins the manifests `parts` (file, manifest) of one sequence into the manifest of the
+/// whole, to be written at `output`: they must be of one run and cover every frame once,
+/// and every frame file must still hold what its shard wrote.
+pub fn merge_sequences(
+    parts: &[(PathBuf, SequenceManifest)],
+    output: &Path,
+) -> Result<SequenceManifest, MergeError> {
+    let (first_path, first) = parts.first().ok_or(MergeError::Empty)?;
+    let mut sorted: Vec<&(PathBuf, SequenceManifest)> = parts.iter().collect();
+    for (path, part) in &sorted {
+        same_run((first_path, &first.run), (path, &part.run))?;
+        if part.frames != first.frames {
+            return Err(MergeError::OtherRun {
+                part: path.clone(),
+                first: first_path.clone(),
+                why: format!("{} frames, not {}", part.frames, first.frames),
+            });
+        }
+    }
+    sorted.sort_by_key(|(_, part)| part.written);
+    let mut merged = SequenceManifest::new(first.run.clone(), first.frames, [0, first.frames], 0);
+    let mut next = 0u32;
+    let mut last: Option<&Path> = None;
+    for (path, part) in sorted {
+        let [start, end] = part.written;
+        if start > next {
+            return Err(MergeError::Missing(format!(
+                "frames {next}..{start} of {} (no part covers them)",
+                first.frames
+            )));
+        }
+        if start < next {
+            return Err(MergeError::Duplicate {
+                what: format!("frames {start}..{}", next.min(end)),
+                first: last.unwrap_or(path).to_path_buf(),
+                second: path.clone(),
+            });
+        }
+        part.verify(path)
+            .map_err(|e| MergeError::Part(e.to_string()))?;
+        for file in &part.files {
+            let at = SequenceManifest::resolve(file, path);
+            let beside = at.parent() == output.parent();
+            merged.files.push(FrameFile {
+                path: match (beside, at.file_name()) {
+                    (true, Some(name)) => PathBuf::from(name),
+                    _ => std::path::absolute(&at).map_err(|e| MergeError::Part(e.to_string()))?,
+                },
+                ..file.clone()
+            });
+        }
+        next = end;
+        last = Some(path);
+    }
+    if next < first.frames {
+        return Err(MergeError::Missing(format!(
+            "frames {next}..{} of {} (no part covers them)",
+            first.frames, first.frames
+        )));
+    }
+    Ok(merged)
+}
+
+/// Joins the reports `parts` (file, report) of one sharded lab: they must be parts of one
+/// run (conditions, scenes, configurations, device, driver, revision), each shard once. The
+/// points come out in the run's order; a scene's failure reported by several parts once.
+pub fn merge_labs(parts: &[(PathBuf, LabReport)]) -> Result<LabReport, MergeError> {
+    let (first_path, first) = parts.first().ok_or(MergeError::Empty)?;
+    let whole = |path: &Path| {
+        MergeError::Part(format!(
+            "{}: a whole lab's report, not a part of one (`shine lab --shard`)",
+            path.display()
+        ))
+    };
+    let first_part = first.part.as_ref().ok_or_else(|| whole(first_path))?;
+    let identity = |r: &LabReport, part: &LabPart| {
+        serde_json::json!({
+            "setup": r.setup,
+            "device": r.device,
+            "driver": r.driver,
+            "revision": r.revision,
+            "scenes": part.scenes,
+            "configs": part.configs,
+            "shards": part.shard.count,
+        })
+    };
+    let run = identity(first, first_part);
+    let count = first_part.shard.count;
+    let mut by_index: Vec<Option<(&Path, &LabReport)>> = vec![None; count as usize];
+    for (path, report) in parts {
+        let part = report.part.as_ref().ok_or_else(|| whole(path))?;
+        same_run((first_path, &run), (path, &identity(report, part)))?;
+        let slot = &mut by_index[part.shard.index as usize];
+        if let Some((other, _)) = slot {
+            return Err(MergeError::Duplicate {
+                what: format!("part {}", part.shard),
+                first: other.to_path_buf(),
+                second: path.clone(),
+            });
+        }
+        *slot = Some((path, report));
+    }
+    let mut merged = LabReport {
+        points: Vec::new(),
+        failures: Vec::new(),
+        truths: Vec::new(),
+        part: None,
+        ..first.clone()
+    };
+    for (index, slot) in by_index.iter().enumerate() {
+        let Some((_, report)) = slot else {
+            let shard = Shard {
+                index: index as u32,
+                count,
+            };
+            return Err(MergeError::Missing(format!("part {shard}")));
+        };
+        merged.points.extend(report.points.iter().cloned());
+        for failure in &report.failures {
+            if !merged.failures.contains(failure) {
+                merged.failures.push(failure.clone());
+            }
+        }
+        for truth in &report.truths {
+            if !merged.truths.contains(truth) {
+                merged.truths.push(truth.clone());
+            }
+        }
+    }
+    Ok(merged)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::farm::partial::PartialHeader;
+
+    fn part(index: u32, count: u32, samples: [u32; 2]) -> (PathBuf, PartialSums) {
+        (
+            PathBuf::from(format!("ref.{index}.part")),
+            PartialSums {
+                header: PartialHeader {
+                    run: serde_json::json!({"scene": "s", "spp": 8, "seed": 0}),
+                    shard: Shard { index, count },
+                    samples,
+                    width: 1,
+                    height: 1,
+                },
+                sums: vec![[samples[1] as f32 - samples[0] as f32, 0.0, 0.0, 1.0]; 3],
+            },
+        )
+    }
+
+    #[test]
+    fn references_add_their_parts() {
+        let merged = merge_references(&[part(1, 2, [4, 8]), part(0, 2, [0, 4])]).unwrap();
+        assert_eq!(merged.header.samples, [0, 8]);
+        assert_eq!(merged.sums[0], [8.0, 0.0, 0.0, 2.0]);
+    }
+
+    #[test]
+    fn a_missing_or_doubled_part_is_named() {
+        let err = merge_references(&[part(0, 3, [0, 2]), part(2, 3, [5, 8])]).unwrap_err();
+        assert_eq!(err.to_string(), "missing: part 1/3");
+        let err = merge_references(&[part(0, 2, [0, 4]), part(0, 2, [0, 4])]).unwrap_err();
+        assert!(
+            matches!(&err, MergeError::Duplicate { what, .. } if what == "part 0/2"),
+            "{err}"
+        );
+        let mut other = part(1, 2, [4, 8]);
+        other.1.header.run["seed"] = serde_json::json!(7);
+        let err = merge_references(&[part(0, 2, [0, 4]), other]).unwrap_err();
+        assert!(
+            err.to_string().contains("`seed` is 0 there, 7 here"),
+            "{err}"
+        );
+    }
+}
