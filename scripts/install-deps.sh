@@ -7,6 +7,9 @@ set -euo pipefail
 packages=(libvulkan1 mesa-vulkan-drivers vulkan-validationlayers)
 # Chromium, headless: the lab page test (tests/lab_page.rs) drives it.
 packages+=(chromium)
+# A single-node Slurm cluster (scripts/slurm/local-cluster.sh): tests/slurm.rs runs the sbatch
+# templates on it.
+packages+=(slurm-wlm munge)
 # Node.js runs the Khronos glTF validator over the built-in scenes (crates/scene/tests).
 if ! command -v npm >/dev/null 2>&1; then
     packages+=(nodejs npm)

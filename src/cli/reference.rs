@@ -5,7 +5,9 @@
 use super::CliError;
 use super::frame_args::{EnvironmentArgs, load_scene};
 use glam::Vec3;
-use shine::capture::image_io::{LdrImage, OutputFormat, write_exr, write_png};
+use shine::capture::image_io::{
+    LdrImage, OutputFormat, remove_stale_temporaries, write_exr, write_png,
+};
 use shine::capture::tonemap::{DEFAULT_TONEMAP, encode_ldr};
 use shine::farm::partial::{PartialHeader, PartialSums};
 use shine::farm::{self, Shard};
@@ -165,6 +167,10 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
         light_sampling: !args.no_light_sampling,
         seed: args.seed,
     };
+    if !shard.is_whole() {
+        // A re-queued task finds the temporary file its killed run left: it is no part.
+        remove_stale_temporaries(&args.output)?;
+    }
     let scene = load_scene(&args.scene, &args.environment)?;
     let device = Device::new(&DeviceDesc::from_env())?;
     let mut tracer = PathTracer::new(&device, &scene, args.time, &params)?;
