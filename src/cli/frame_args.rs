@@ -1,9 +1,9 @@
 //! What `shine render` and `shine profile` share: the scene argument and the settings flags.
 
 use super::CliError;
+use shine::farm::identity::scene_key;
 use shine::gpu::Device;
 use shine::lab::budget::{self, BudgetChoice};
-use shine::lab::truth::scene_key;
 use shine::profile::roofline::cache_dir;
 use shine::settings::Settings;
 use shine_scene::Scene;

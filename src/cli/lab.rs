@@ -4,12 +4,12 @@ use std::path::{Path, PathBuf};
 
 use super::CliError;
 use super::frame_args::{EnvironmentArgs, load_scene};
+use shine::farm::identity::scene_key;
 use shine::farm::{self, Shard};
 use shine::gpu::{Device, DeviceDesc};
 use shine::lab::budget;
 use shine::lab::configs::{default_space, load};
 use shine::lab::run::{LabPlan, run};
-use shine::lab::truth::scene_key;
 use shine::lab::{LabReport, LabSetup};
 use shine::profile::roofline::cache_dir;
 use shine::study::Progress;

@@ -5,9 +5,10 @@
 
 use super::CliError;
 use shine::farm::manifest::SequenceManifest;
-use shine::farm::merge::{merge_labs, merge_references, merge_sequences};
+use shine::farm::merge::{merge_references, merge_sequences};
 use shine::farm::partial::PartialSums;
 use shine::lab::LabReport;
+use shine::lab::merge::merge_labs;
 use shine::lab::run::write_outputs;
 use shine::profile::roofline::cache_dir;
 use shine::reference::ReferenceImages;

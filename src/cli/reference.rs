@@ -9,10 +9,10 @@ use shine::capture::image_io::{
     LdrImage, OutputFormat, remove_stale_temporaries, write_exr, write_png,
 };
 use shine::capture::tonemap::{DEFAULT_TONEMAP, encode_ldr};
+use shine::farm::identity::scene_key;
 use shine::farm::partial::{PartialHeader, PartialSums};
 use shine::farm::{self, Shard};
 use shine::gpu::{Device, DeviceDesc};
-use shine::lab::truth::scene_key;
 use shine::reference::{PathTracer, ReferenceImages, ReferenceParams};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};

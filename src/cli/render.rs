@@ -9,12 +9,12 @@ use super::frame_args::SettingsArgs;
 use shine::capture::image_io::{OutputFormat, remove_stale_temporaries, write_frame};
 use shine::capture::sequence::{FramePattern, orbit};
 use shine::farm::frames::{FrameRange, SequenceSlice, longest_history};
+use shine::farm::identity::scene_key;
 use shine::farm::manifest::SequenceManifest;
 use shine::farm::{self, Shard};
 use shine::frame::renderer::Renderer;
 use shine::gpu::{Device, DeviceDesc};
 use shine::gpu_scene::{CameraPose, FrameUpdate};
-use shine::lab::truth::scene_key;
 use shine::settings::Settings;
 use std::path::PathBuf;
 

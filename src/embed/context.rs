@@ -1,6 +1,7 @@
 //! [`GiContext`]: shine as a GI pass inside a host engine's frame.
 
 use super::inputs::GiDispatch;
+use crate::farm::identity::fnv1a;
 use crate::frame::RenderError;
 use crate::frame::memory::MemoryReport;
 use crate::frame::params::FrameParams;
@@ -10,7 +11,6 @@ use crate::gpu_scene::FrameUpdate;
 use crate::gpu_scene::upload_ring::UploadRing;
 use crate::lab::LabError;
 use crate::lab::budget::{self, BudgetChoice};
-use crate::lab::truth::fnv1a;
 use crate::passes::environment_sh;
 use crate::passes::host_gbuffer::{self, HostFrame, HostImages};
 use crate::profile::roofline::cache_dir;

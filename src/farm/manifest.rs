@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use serde::{Deserialize, Serialize};
 
+use super::identity::fnv1a;
 use crate::capture::image_io::write_bytes_atomically;
 use crate::capture::sequence::FramePattern;
-use crate::lab::truth::fnv1a;
 
 /// The `kind` of a sequence manifest (merge tells part kinds apart by it).
 pub const SEQUENCE_KIND: &str = "shine-sequence";

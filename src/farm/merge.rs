@@ -1,5 +1,5 @@
 //! `shine merge`: joins the parts of a sharded run: a reference's partial sums into the
-//! reference, a sequence's manifests into the sequence's. A part of another run, a missing
+//! reference, a sequence's manifests into the sequence's (a lab's reports: `lab::merge`). A part of another run, a missing
 //! part and a part given twice are refused, naming the part.
 
 use std::path::{Path, PathBuf};
@@ -7,7 +7,6 @@ use std::path::{Path, PathBuf};
 use super::Shard;
 use super::manifest::{FrameFile, SequenceManifest};
 use super::partial::{PartialHeader, PartialSums};
-use crate::lab::{LabPart, LabReport};
 
 /// Why parts were not merged.
 #[derive(Debug, thiserror::Error)]
@@ -70,8 +69,8 @@ fn difference(a: &serde_json::Value, b: &serde_json::Value, at: &str) -> Option<
     }
 }
 
-/// Refuses `part`'s `run` unless it equals `first`'s.
-fn same_run(
+/// Refuses `part`'s `run` unless it equals `first`'s, naming the first key that differs.
+pub fn same_run(
     first: (&Path, &serde_json::Value),
     part: (&Path, &serde_json::Value),
 ) -> Result<(), MergeError> {
@@ -223,75 +222,6 @@ pub fn merge_sequences(
             "frames {next}..{} of {} (no part covers them)",
             first.frames, first.frames
         )));
-    }
-    Ok(merged)
-}
-
-/// Joins the reports `parts` (file, report) of one sharded lab: they must be parts of one
-/// run (conditions, scenes, configurations, device, driver, revision), each shard once. The
-/// points come out in the run's order; a scene's failure reported by several parts once.
-pub fn merge_labs(parts: &[(PathBuf, LabReport)]) -> Result<LabReport, MergeError> {
-    let (first_path, first) = parts.first().ok_or(MergeError::Empty)?;
-    let whole = |path: &Path| {
-        MergeError::Part(format!(
-            "{}: a whole lab's report, not a part of one (`shine lab --shard`)",
-            path.display()
-        ))
-    };
-    let first_part = first.part.as_ref().ok_or_else(|| whole(first_path))?;
-    let identity = |r: &LabReport, part: &LabPart| {
-        serde_json::json!({
-            "setup": r.setup,
-            "device": r.device,
-            "driver": r.driver,
-            "revision": r.revision,
-            "scenes": part.scenes,
-            "configs": part.configs,
-            "shards": part.shard.count,
-        })
-    };
-    let run = identity(first, first_part);
-    let count = first_part.shard.count;
-    let mut by_index: Vec<Option<(&Path, &LabReport)>> = vec![None; count as usize];
-    for (path, report) in parts {
-        let part = report.part.as_ref().ok_or_else(|| whole(path))?;
-        same_run((first_path, &run), (path, &identity(report, part)))?;
-        let slot = &mut by_index[part.shard.index as usize];
-        if let Some((other, _)) = slot {
-            return Err(MergeError::Duplicate {
-                what: format!("part {}", part.shard),
-                first: other.to_path_buf(),
-                second: path.clone(),
-            });
-        }
-        *slot = Some((path, report));
-    }
-    let mut merged = LabReport {
-        points: Vec::new(),
-        failures: Vec::new(),
-        truths: Vec::new(),
-        part: None,
-        ..first.clone()
-    };
-    for (index, slot) in by_index.iter().enumerate() {
-        let Some((_, report)) = slot else {
-            let shard = Shard {
-                index: index as u32,
-                count,
-            };
-            return Err(MergeError::Missing(format!("part {shard}")));
-        };
-        merged.points.extend(report.points.iter().cloned());
-        for failure in &report.failures {
-            if !merged.failures.contains(failure) {
-                merged.failures.push(failure.clone());
-            }
-        }
-        for truth in &report.truths {
-            if !merged.truths.contains(truth) {
-                merged.truths.push(truth.clone());
-            }
-        }
     }
     Ok(merged)
 }

@@ -9,8 +9,10 @@
 //! - [`partial`]: a reference's partial sums, keyed by the global sample index.
 //! - [`manifest`]: what a sequence shard wrote, so a merge can tell a missing frame.
 //! - [`merge`]: `shine merge`, refusing a missing or duplicated part by name.
+//! - [`identity`]: the keys a run's scene is known by across machines.
 
 pub mod frames;
+pub mod identity;
 pub mod manifest;
 pub mod merge;
 pub mod partial;

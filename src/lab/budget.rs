@@ -31,7 +31,7 @@ use crate::reference::{PathTracer, ReferenceParams};
 /// One configuration's measured cost and error on one scene at one size.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BudgetEntry {
-    /// The scene's key ([`super::truth::scene_key`]).
+    /// The scene's key ([`crate::farm::identity::scene_key`]).
     pub scene: String,
     /// Frame width and height it was measured at.
     pub extent: [u32; 2],

@@ -23,6 +23,7 @@
 pub mod budget;
 pub mod configs;
 pub mod measure;
+pub mod merge;
 pub mod page;
 pub mod pareto;
 pub mod run;

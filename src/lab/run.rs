@@ -14,12 +14,13 @@ use shine_scene::Scene;
 
 use super::configs::{base_settings, settings_of};
 use super::measure::{display_exposure, measure, write_display};
-use super::truth::{scene_key, truths};
+use super::truth::truths;
 use super::{
     LabConfig, LabError, LabPart, LabPoint, LabReport, LabSetup, SceneFailure, page, pareto,
 };
 use crate::capture::image_io::write_bytes_atomically;
 use crate::farm::Shard;
+use crate::farm::identity::scene_key;
 use crate::gpu::Device;
 use crate::study::Progress;
 use crate::study::temporal_plot::file_label;

@@ -130,23 +130,6 @@ pub fn noise_free_flicker(a: &[HdrImage], b: &[HdrImage]) -> f64 {
     ((own - apart / 2.0).max(0.0) / n.max(1) as f64).sqrt() / mean
 }
 
-/// FNV-1a of `bytes`: names cache files after what they hold.
-pub fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    })
-}
-
-/// The key of a scene's truths: the built-in's name, or a hash of the file's bytes (so an
-/// edited file is traced again); `None` when the file cannot be read.
-pub fn scene_key(scene: &str) -> Option<String> {
-    if scene.starts_with("builtin:") {
-        return Some(scene.replace(':', "-"));
-    }
-    let bytes = std::fs::read(scene).ok()?;
-    Some(format!("file-{:016x}", fnv1a(&bytes)))
-}
-
 /// The cache folder of one scene's truths under `setup`.
 fn cache_folder(root: &Path, key: &str, setup: &LabSetup) -> PathBuf {
     let conditions = format!(
