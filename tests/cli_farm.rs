@@ -209,6 +209,29 @@ fn reference_parts_merge_into_the_one_process_reference() {
     std::fs::write(&truncated, &bytes[..bytes.len() - 100]).unwrap();
     let out = shine(&["merge", &quarters[0], &truncated, "-o", &merged]);
     fails_cleanly(&out, "torn.part");
+    // Inside a Slurm array task, a reference becomes a part, which is no image; a single frame
+    // stays whole.
+    let in_array = |args: &[&str]| {
+        std::process::Command::new(env!("CARGO_BIN_EXE_shine"))
+            .args(args)
+            .env("SLURM_ARRAY_TASK_ID", "1")
+            .env("SLURM_ARRAY_TASK_COUNT", "2")
+            .output()
+            .unwrap()
+    };
+    let out = in_array(&["reference", "builtin:cornell-box", "-o", &path("task.exr")]);
+    fails_cleanly(&out, "name -o something.part");
+    let frame = path("task-frame.exr");
+    let out = in_array(&[
+        "render",
+        "builtin:cornell-box",
+        "--width",
+        "16",
+        "-o",
+        &frame,
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    assert!(Path::new(&frame).exists());
     // A time budget cannot be split into parts.
     let out = shine(&[
         "reference",

@@ -68,7 +68,7 @@ pub struct ReferenceArgs {
     /// Trace only part i (from 0) of n of the --spp samples (global sample indices
     /// i·spp/n..(i+1)·spp/n) and write their sums to -o (a partial-sum file, `.part` by
     /// convention) for `shine merge`. Without it, a Slurm array task's SLURM_ARRAY_TASK_ID
-    /// and SLURM_ARRAY_TASK_COUNT give it.
+    /// and SLURM_ARRAY_TASK_COUNT give it; --shard 0/1 traces the whole reference there.
     #[arg(long, conflicts_with = "seconds")]
     shard: Option<Shard>,
 }
@@ -135,9 +135,16 @@ pub(super) fn write_reference(
 /// Renders the reference and writes it atomically.
 pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
     let (shard, from) = farm::resolve(args.shard)?;
-    // Refuse a bad output path before any work (a part is not an image).
+    // Refuse a bad output path before any work: a whole reference is an image, a part is not
+    // (an array task over several scenes that meant whole references says --shard 0/1).
     if shard.is_whole() {
         OutputFormat::from_path(&args.output)?;
+    } else if OutputFormat::from_path(&args.output).is_ok() {
+        return Err(format!(
+            "part {shard} ({from}) writes partial sums, not an image: name -o something.part \
+             and join the parts with `shine merge`, or give --shard 0/1 for the whole reference"
+        )
+        .into());
     }
     if args.spp == 0 {
         return Err("--spp must be at least 1".into());

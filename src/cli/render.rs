@@ -50,7 +50,8 @@ pub struct RenderArgs {
     frame_range: Option<FrameRange>,
     /// Write only part i (from 0) of n of the sequence's frames, contiguous (a --frame-range).
     /// Without it and --frame-range, a Slurm array task's SLURM_ARRAY_TASK_ID and
-    /// SLURM_ARRAY_TASK_COUNT give it.
+    /// SLURM_ARRAY_TASK_COUNT give it for a sequence; --shard 0/1 renders the whole sequence
+    /// there.
     #[arg(long)]
     shard: Option<Shard>,
     /// Frames rendered unwritten before the first written frame of a --frame-range or
@@ -184,7 +185,11 @@ fn slice_of(
     let (range, part) = match (args.frame_range, args.shard) {
         (Some(range), _) => (range, format!("--frame-range {range}")),
         (None, given) => {
-            let (shard, from) = farm::resolve(given)?;
+            // A single frame is not split: an array task rendering a frame of its own keeps it.
+            let (shard, from) = match given {
+                None if frames == 1 => (Shard::WHOLE, "one process"),
+                _ => farm::resolve(given)?,
+            };
             if shard.is_whole() {
                 if args.warm_up.is_some() {
                     return Err("--warm-up needs --frame-range or --shard".into());
@@ -194,7 +199,8 @@ fn slice_of(
             let r = shard.range(frames);
             if r.is_empty() {
                 return Err(format!(
-                    "shard {shard} ({from}) holds no frame of a {frames}-frame sequence: use                      at most {frames} shards"
+                    "shard {shard} ({from}) holds no frame of a {frames}-frame sequence: use \
+                     at most {frames} shards"
                 )
                 .into());
             }
