@@ -14,6 +14,9 @@ usage() { echo "usage: $0 up DIR [CPUS] | down DIR" >&2; exit 2; }
 [ $# -ge 2 ] || usage
 action=$1
 dir=$(realpath -m "$2")
+case $dir in
+    *[[:space:]]*) echo "error: slurm.conf cannot hold a path with spaces: $dir" >&2; exit 2 ;;
+esac
 cpus=${3:-4}
 # The controller and the node: this machine under its own short name (slurmctld refuses a
 # SlurmctldHost that is not its host name).

@@ -276,7 +276,16 @@ pub fn remove_stale_temporaries(path: &Path) -> Result<(), ImageIoError> {
     for entry in entries {
         let entry = entry.map_err(|e| io_error(path, e))?;
         let file = entry.file_name().to_string_lossy().into_owned();
-        if file.starts_with(&prefix) && file.ends_with(".tmp") {
+        // Exactly `.{name}.{pid}-{counter}.tmp`, what `write_atomically` names them.
+        let ours = file
+            .strip_prefix(&prefix)
+            .and_then(|rest| rest.strip_suffix(".tmp"))
+            .and_then(|id| id.split_once('-'))
+            .is_some_and(|(pid, n)| {
+                let digits = |t: &str| !t.is_empty() && t.bytes().all(|b| b.is_ascii_digit());
+                digits(pid) && digits(n)
+            });
+        if ours {
             std::fs::remove_file(entry.path()).map_err(|e| io_error(&entry.path(), e))?;
         }
     }
@@ -490,6 +499,25 @@ mod tests {
             );
         }
         assert!(scratch.entries().is_empty());
+    }
+
+    #[test]
+    fn stale_temporaries_of_one_file_are_removed_and_no_other() {
+        let scratch = Scratch::new("stale");
+        for name in [
+            ".ref.4242-0.tmp",
+            ".ref.7-13.tmp",
+            ".ref.part.4242-0.tmp",
+            ".ref.x.tmp",
+            "ref",
+        ] {
+            std::fs::write(scratch.0.join(name), b"x").unwrap();
+        }
+        remove_stale_temporaries(&scratch.0.join("ref")).unwrap();
+        assert_eq!(
+            scratch.entries(),
+            [".ref.part.4242-0.tmp", ".ref.x.tmp", "ref"]
+        );
     }
 
     #[test]

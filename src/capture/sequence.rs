@@ -73,7 +73,8 @@ impl FramePattern {
         }
     }
 
-    /// The path with `text` in place of the frame field (the path itself when it has none).
+    /// The path with `text` in place of the frame field (appended to the path when it has
+    /// none: `x.png` gives `x.png` + `text`).
     pub fn with_field(&self, text: &str) -> PathBuf {
         PathBuf::from(format!("{}{text}{}", self.prefix, self.suffix))
     }

@@ -34,15 +34,16 @@ pub fn run(args: &MergeArgs) -> Result<(), CliError> {
     if PartialSums::is_partial(first) {
         return merge_reference_parts(args);
     }
-    if SequenceManifest::read(first)?.is_some() {
+    if matches!(SequenceManifest::read(first), Ok(Some(_))) {
         return merge_sequence_parts(args);
     }
     if read_lab(first).is_ok() {
         return merge_lab_parts(args);
     }
     Err(format!(
-        "{}: not a part shine merges (a `shine reference --shard` part or a sequence \
-         manifest)",
+        "{}: not a part shine merges: a `shine reference --shard` part, a sequence manifest \
+         (`shine render --shard`, beside the frames) or a lab part's lab.json (`shine lab \
+         --shard`)",
         first.display()
     )
     .into())

@@ -44,8 +44,8 @@ enum Command {
     /// The GI lab: every technique's error, cost and flicker on the given scenes, the Pareto
     /// front, lab.json/lab.csv and a self-contained index.html.
     Lab(lab::LabArgs),
-    /// Joins the parts of a sharded run: a reference's partial sums, a sequence's manifests
-    /// (docs/many-machines.md).
+    /// Joins the parts of a sharded run: a reference's partial sums, a sequence's manifests,
+    /// a lab's reports (docs/many-machines.md).
     Merge(merge::MergeArgs),
     /// Every setting: key, default, values, what it changes (docs/settings.md).
     Settings(settings::SettingsArgs),

@@ -149,6 +149,12 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
     if args.spp == 0 {
         return Err("--spp must be at least 1".into());
     }
+    if !shard.is_whole() && args.seconds.is_some() {
+        return Err(format!(
+            "part {shard} ({from}) must trace its samples whole: --seconds would stop it early"
+        )
+        .into());
+    }
     let samples = shard.range(args.spp);
     if samples.is_empty() {
         return Err(format!(

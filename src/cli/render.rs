@@ -204,6 +204,12 @@ fn slice_of(
                 )
                 .into());
             }
+            if given.is_none() {
+                eprintln!(
+                    "rendering part {shard} of the sequence, from the Slurm array task \
+                     (--shard 0/1 renders it whole)"
+                );
+            }
             let range = FrameRange {
                 start: r.start,
                 end: r.end,

@@ -7,6 +7,7 @@ use std::ops::Range;
 use std::str::FromStr;
 
 use crate::passes::accumulate::TAA_MAX_FRAMES;
+use crate::passes::amortise::RESOLVE_ALPHA;
 use crate::settings::Settings;
 
 /// Frames rendered, unwritten, before a slice's first frame, in units of its longest history
@@ -123,8 +124,10 @@ impl SequenceSlice {
 }
 
 /// The longest memory, in frames, of the histories a sequence rendered with `settings` keeps:
-/// the indirect light's (`history.frames`), TAA's ([`TAA_MAX_FRAMES`]) when on, and the
-/// automatic exposure's (1 / `output.adaptation`) when the frames are tonemapped (`ldr`) with it.
+/// the indirect light's (`history.frames`), TAA's ([`TAA_MAX_FRAMES`]) when on, the automatic
+/// exposure's (1 / `output.adaptation`) when the frames are tonemapped (`ldr`) with it, and an
+/// amortised technique's (`*.slices` frames per refresh, each refresh blending in
+/// [`RESOLVE_ALPHA`] of the fresh light: slices / α).
 pub fn longest_history(settings: &Settings, ldr: bool) -> u32 {
     let taa = if settings.output.taa {
         TAA_MAX_FRAMES
@@ -136,7 +139,27 @@ pub fn longest_history(settings: &Settings, ldr: bool) -> u32 {
     } else {
         1
     };
-    settings.history.max_frames.max(taa).max(exposure)
+    let slices = [
+        settings.hvl.slices,
+        settings.igi.slices,
+        settings.aaf.slices,
+        settings.proxy.slices,
+        settings.cubes.slices,
+    ]
+    .into_iter()
+    .max()
+    .unwrap_or(1);
+    let amortised = if slices > 1 {
+        (slices as f32 / RESOLVE_ALPHA).ceil() as u32
+    } else {
+        1
+    };
+    settings
+        .history
+        .max_frames
+        .max(taa)
+        .max(exposure)
+        .max(amortised)
 }
 
 #[cfg(test)]
@@ -165,5 +188,21 @@ mod tests {
         assert!(SequenceSlice::new(range, 47, 8).is_err());
         assert_eq!(SequenceSlice::warm_up(1), 0);
         assert_eq!(SequenceSlice::warm_up(4), 4 * WARM_UP_HISTORIES);
+    }
+
+    #[test]
+    fn every_history_counts() {
+        let mut settings = Settings::default();
+        settings.history.max_frames = 1;
+        settings.output.auto_exposure = false;
+        assert_eq!(longest_history(&settings, true), 1);
+        settings.hvl.slices = 4;
+        assert_eq!(longest_history(&settings, false), 8);
+        settings.output.taa = true;
+        assert_eq!(longest_history(&settings, false), TAA_MAX_FRAMES);
+        settings.output.auto_exposure = true;
+        settings.output.adaptation = 0.01;
+        assert_eq!(longest_history(&settings, false), TAA_MAX_FRAMES);
+        assert_eq!(longest_history(&settings, true), 100);
     }
 }

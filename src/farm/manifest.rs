@@ -92,14 +92,9 @@ impl SequenceManifest {
     /// Records frame `frame`, written to `path`, by reading it back (its size and hash).
     pub fn add(&mut self, frame: u32, path: &Path, manifest: &Path) -> Result<(), ManifestError> {
         let bytes = std::fs::read(path).map_err(|e| io(path, e))?;
-        let beside = path.parent().map(normal) == manifest.parent().map(normal);
-        let recorded = match (beside, path.file_name()) {
-            (true, Some(name)) => PathBuf::from(name),
-            _ => std::path::absolute(path).map_err(|e| io(path, e))?,
-        };
         self.files.push(FrameFile {
             frame,
-            path: recorded,
+            path: Self::recorded(path, manifest)?,
             bytes: bytes.len() as u64,
             fnv1a: format!("{:016x}", fnv1a(&bytes)),
         });
@@ -128,6 +123,16 @@ impl SequenceManifest {
         serde_json::from_value(value)
             .map(Some)
             .map_err(|e| io(path, e))
+    }
+
+    /// How a manifest at `manifest` names the file `path`: by its name when it lies beside the
+    /// manifest, else by its absolute path.
+    pub fn recorded(path: &Path, manifest: &Path) -> Result<PathBuf, ManifestError> {
+        let beside = path.parent().map(normal) == manifest.parent().map(normal);
+        match (beside, path.file_name()) {
+            (true, Some(name)) => Ok(PathBuf::from(name)),
+            _ => std::path::absolute(path).map_err(|e| io(path, e)),
+        }
     }
 
     /// The path of `file` as this manifest, read from `manifest`, names it.

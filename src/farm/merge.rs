@@ -1,5 +1,6 @@
 //! `shine merge`: joins the parts of a sharded run: a reference's partial sums into the
-//! reference, a sequence's manifests into the sequence's (a lab's reports: `lab::merge`). A part of another run, a missing
+//! reference, a sequence's manifests into the sequence's (a lab's reports:
+//! `lab::merge`). A part of another run, a missing
 //! part and a part given twice are refused, naming the part.
 
 use std::path::{Path, PathBuf};
@@ -93,32 +94,26 @@ pub struct MergedReference {
     pub sums: Vec<[f32; 4]>,
 }
 
-/// Adds the partial sums `parts` (file, part) of one reference, in shard order, after checking
-/// that they are every shard of one run exactly once and that their samples tile `0..spp`.
-pub fn merge_references(parts: &[(PathBuf, PartialSums)]) -> Result<MergedReference, MergeError> {
-    let (first_path, first) = parts.first().ok_or(MergeError::Empty)?;
-    let count = first.header.shard.count;
-    let mut by_index: Vec<Option<(&Path, &PartialSums)>> = vec![None; count as usize];
+/// The parts of a run with `count` shards, by shard index: each shard exactly once, or the
+/// missing or doubled one named. `shard_of` reads a part's shard (after the caller checked
+/// that it belongs to the run).
+pub fn by_shard<T>(
+    parts: &[(PathBuf, T)],
+    count: u32,
+    shard_of: impl Fn(&T) -> Shard,
+) -> Result<Vec<(&Path, &T)>, MergeError> {
+    let mut slots: Vec<Option<(&Path, &T)>> = vec![None; count as usize];
     for (path, part) in parts {
-        same_run((first_path, &first.header.run), (path, &part.header.run))?;
-        let shard = part.header.shard;
-        if shard.count != count
-            || (part.header.width, part.header.height) != (first.header.width, first.header.height)
-        {
-            return Err(MergeError::OtherRun {
-                part: path.clone(),
-                first: first_path.clone(),
-                why: format!(
-                    "it is part {shard} of {}×{}, the first part {} of {}×{}",
-                    part.header.width,
-                    part.header.height,
-                    first.header.shard,
-                    first.header.width,
-                    first.header.height
-                ),
-            });
-        }
-        let slot = &mut by_index[shard.index as usize];
+        let shard = shard_of(part);
+        let slot = slots
+            .get_mut(shard.index as usize)
+            .filter(|_| shard.count == count)
+            .ok_or_else(|| {
+                MergeError::Part(format!(
+                    "{}: part {shard} is not one of {count} parts",
+                    path.display()
+                ))
+            })?;
         if let Some((other, _)) = slot {
             return Err(MergeError::Duplicate {
                 what: format!("part {shard}"),
@@ -128,22 +123,47 @@ pub fn merge_references(parts: &[(PathBuf, PartialSums)]) -> Result<MergedRefere
         }
         *slot = Some((path, part));
     }
+    slots
+        .into_iter()
+        .enumerate()
+        .map(|(index, slot)| {
+            slot.ok_or_else(|| {
+                let shard = Shard {
+                    index: index as u32,
+                    count,
+                };
+                MergeError::Missing(format!("part {shard}"))
+            })
+        })
+        .collect()
+}
+
+/// Adds the partial sums `parts` (file, part) of one reference, in shard order, after checking
+/// that they are every shard of one run exactly once and that their samples tile `0..spp`.
+pub fn merge_references(parts: &[(PathBuf, PartialSums)]) -> Result<MergedReference, MergeError> {
+    let (first_path, first) = parts.first().ok_or(MergeError::Empty)?;
+    for (path, part) in parts {
+        same_run((first_path, &first.header.run), (path, &part.header.run))?;
+        let size = |p: &PartialSums| (p.header.width, p.header.height);
+        if size(part) != size(first) {
+            return Err(MergeError::OtherRun {
+                part: path.clone(),
+                first: first_path.clone(),
+                why: format!("{:?} pixels, not {:?}", size(part), size(first)),
+            });
+        }
+    }
+    let ordered = by_shard(parts, first.header.shard.count, |p| p.header.shard)?;
     let mut next = 0u32;
     let mut sums = vec![[0.0f32; 4]; first.sums.len()];
-    for (index, slot) in by_index.iter().enumerate() {
-        let shard = Shard {
-            index: index as u32,
-            count,
-        };
-        let Some((path, part)) = slot else {
-            return Err(MergeError::Missing(format!("part {shard}")));
-        };
+    for (path, part) in ordered {
         let [start, end] = part.header.samples;
         if start != next || end < start {
             return Err(MergeError::Part(format!(
-                "{}: part {shard} holds samples {start}..{end}, where the parts before it end \
-                 at {next}",
-                path.display()
+                "{}: part {} holds samples {start}..{end}, where the parts before it end at \
+                 {next}",
+                path.display(),
+                part.header.shard
             )));
         }
         next = end;
@@ -152,6 +172,13 @@ pub fn merge_references(parts: &[(PathBuf, PartialSums)]) -> Result<MergedRefere
                 sum[c] += add[c];
             }
         }
+    }
+    let spp = first.header.run.get("spp").and_then(|v| v.as_u64());
+    if spp.is_some_and(|spp| spp != u64::from(next)) {
+        return Err(MergeError::Part(format!(
+            "the parts hold samples 0..{next} of a {}-spp reference",
+            spp.unwrap_or(0)
+        )));
     }
     Ok(MergedReference {
         header: PartialHeader {
@@ -181,6 +208,15 @@ pub fn merge_sequences(
                 why: format!("{} frames, not {}", part.frames, first.frames),
             });
         }
+        let [start, end] = part.written;
+        let listed: Vec<u32> = part.files.iter().map(|f| f.frame).collect();
+        if start >= end || end > part.frames || listed != (start..end).collect::<Vec<_>>() {
+            return Err(MergeError::Part(format!(
+                "{}: frames {start}..{end} of {} listed as {listed:?}: the manifest is damaged",
+                path.display(),
+                part.frames
+            )));
+        }
     }
     sorted.sort_by_key(|(_, part)| part.written);
     let mut merged = SequenceManifest::new(first.run.clone(), first.frames, [0, first.frames], 0);
@@ -205,12 +241,9 @@ pub fn merge_sequences(
             .map_err(|e| MergeError::Part(e.to_string()))?;
         for file in &part.files {
             let at = SequenceManifest::resolve(file, path);
-            let beside = at.parent() == output.parent();
             merged.files.push(FrameFile {
-                path: match (beside, at.file_name()) {
-                    (true, Some(name)) => PathBuf::from(name),
-                    _ => std::path::absolute(&at).map_err(|e| MergeError::Part(e.to_string()))?,
-                },
+                path: SequenceManifest::recorded(&at, output)
+                    .map_err(|e| MergeError::Part(e.to_string()))?,
                 ..file.clone()
             });
         }

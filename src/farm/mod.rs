@@ -31,14 +31,33 @@ pub const SLURM_TASK_ID: &str = "SLURM_ARRAY_TASK_ID";
 pub const SLURM_TASK_COUNT: &str = "SLURM_ARRAY_TASK_COUNT";
 /// The smallest task index of the job array.
 pub const SLURM_TASK_MIN: &str = "SLURM_ARRAY_TASK_MIN";
+/// The largest task index of the job array.
+pub const SLURM_TASK_MAX: &str = "SLURM_ARRAY_TASK_MAX";
 
-/// Part `index` of `count` equal, contiguous parts of a run (0-based: `0/4` … `3/4`).
+/// Part `index` of `count` equal, contiguous parts of a run (0-based: `0/4` … `3/4`). Read
+/// from a file, it is checked as [`Shard::new`] checks it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+#[serde(try_from = "UncheckedShard")]
 pub struct Shard {
     /// Which part, `0..count`.
     pub index: u32,
     /// How many parts.
     pub count: u32,
+}
+
+/// A shard as a file states it, before [`Shard::new`]'s checks.
+#[derive(serde::Deserialize)]
+struct UncheckedShard {
+    index: u32,
+    count: u32,
+}
+
+impl TryFrom<UncheckedShard> for Shard {
+    type Error = ShardError;
+
+    fn try_from(s: UncheckedShard) -> Result<Self, Self::Error> {
+        Shard::new(s.index, s.count)
+    }
 }
 
 /// Why a shard was refused.
@@ -102,13 +121,21 @@ impl Shard {
             None => 0,
         };
         // Arrays with steps or gaps (`--array=0-7:2`, `--array=1,5`) do not number their tasks
-        // 0..count from the minimum: refused here rather than leaving parts unrendered.
-        let index = id.checked_sub(min).filter(|i| *i < count).ok_or_else(|| {
-            ShardError::Environment(format!(
-                "array task {id} is not one of {count} tasks numbered from {min}: use a \
-                 contiguous --array=A-B, or give --shard i/n"
-            ))
-        })?;
+        // min..min + count: every task refuses, rather than some running and parts missing.
+        let max = match var(SLURM_TASK_MAX) {
+            Some(max) => number(SLURM_TASK_MAX, &max)?,
+            None => min.saturating_add(count).saturating_sub(1),
+        };
+        let contiguous = max.checked_sub(min).map(|span| span + 1) == Some(count);
+        let index = id
+            .checked_sub(min)
+            .filter(|i| *i < count && contiguous)
+            .ok_or_else(|| {
+                ShardError::Environment(format!(
+                    "array task {id} is not one of {count} tasks numbered {min}..={max} in a \
+                     contiguous array: use --array=A-B, or give --shard i/n"
+                ))
+            })?;
         Self::new(index, count).map(Some)
     }
 
@@ -174,6 +201,17 @@ mod tests {
     }
 
     #[test]
+    fn shards_read_from_files_are_checked() {
+        let read = |text: &str| serde_json::from_str::<Shard>(text);
+        assert_eq!(
+            read(r#"{"index":1,"count":2}"#).unwrap(),
+            Shard { index: 1, count: 2 }
+        );
+        assert!(read(r#"{"index":5,"count":2}"#).is_err());
+        assert!(read(r#"{"index":0,"count":4000000000}"#).is_err());
+    }
+
+    #[test]
     fn ranges_tile_the_whole_once() {
         for total in [0, 1, 7, 16, 600] {
             for count in [1, 3, 4, 7] {
@@ -216,7 +254,13 @@ mod tests {
         const OUTSIDE: &[(&str, &str)] = &[(SLURM_TASK_ID, "5"), (SLURM_TASK_COUNT, "4")];
         const NOT_A_NUMBER: &[(&str, &str)] = &[(SLURM_TASK_ID, "x"), (SLURM_TASK_COUNT, "4")];
         const NO_COUNT: &[(&str, &str)] = &[(SLURM_TASK_ID, "1")];
-        for bad in [OUTSIDE, NOT_A_NUMBER, NO_COUNT] {
+        const STEPPED: &[(&str, &str)] = &[
+            (SLURM_TASK_ID, "2"),
+            (SLURM_TASK_COUNT, "4"),
+            (SLURM_TASK_MIN, "0"),
+            (SLURM_TASK_MAX, "6"),
+        ];
+        for bad in [OUTSIDE, NOT_A_NUMBER, NO_COUNT, STEPPED] {
             let got = Shard::from_vars(env(bad));
             assert!(matches!(got, Err(ShardError::Environment(_))), "{bad:?}");
         }

@@ -120,13 +120,14 @@ impl PartialSums {
             sums: Vec::new(),
         };
         let expected = part.texels();
-        if data.len() != expected * 16 {
+        if expected.checked_mul(16) != Some(data.len()) {
             return Err(error(format!(
-                "{} bytes of sums where {}×{} needs {}: the file is truncated or damaged",
+                "{} bytes of sums where {}×{} needs {} planes of 16 bytes per pixel: the file is \
+                 truncated or damaged",
                 data.len(),
                 part.header.width,
                 part.header.height,
-                expected * 16
+                PLANES
             )));
         }
         let sums = data
@@ -139,9 +140,13 @@ impl PartialSums {
         Ok(Self { sums, ..part })
     }
 
-    /// Texels of the sums: [`PLANES`] × width × height.
+    /// Texels of the sums: [`PLANES`] × width × height (`usize::MAX` when that overflows, which
+    /// no file matches).
     fn texels(&self) -> usize {
-        PLANES * self.header.width as usize * self.header.height as usize
+        (self.header.width as usize)
+            .checked_mul(self.header.height as usize)
+            .and_then(|pixels| pixels.checked_mul(PLANES))
+            .unwrap_or(usize::MAX)
     }
 }
 

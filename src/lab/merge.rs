@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use super::{LabPart, LabReport};
 use crate::farm::Shard;
-use crate::farm::merge::{MergeError, same_run};
+use crate::farm::merge::{MergeError, by_shard, same_run};
 
 /// Joins the reports `parts` (file, report) of one sharded lab: they must be parts of one
 /// run (conditions, scenes, configurations, device, driver, revision), each shard once. The
@@ -30,21 +30,13 @@ pub fn merge_labs(parts: &[(PathBuf, LabReport)]) -> Result<LabReport, MergeErro
         })
     };
     let run = identity(first, first_part);
-    let count = first_part.shard.count;
-    let mut by_index: Vec<Option<(&Path, &LabReport)>> = vec![None; count as usize];
     for (path, report) in parts {
         let part = report.part.as_ref().ok_or_else(|| whole(path))?;
         same_run((first_path, &run), (path, &identity(report, part)))?;
-        let slot = &mut by_index[part.shard.index as usize];
-        if let Some((other, _)) = slot {
-            return Err(MergeError::Duplicate {
-                what: format!("part {}", part.shard),
-                first: other.to_path_buf(),
-                second: path.clone(),
-            });
-        }
-        *slot = Some((path, report));
     }
+    let ordered = by_shard(parts, first_part.shard.count, |r| {
+        r.part.as_ref().map_or(Shard::WHOLE, |p| p.shard)
+    })?;
     let mut merged = LabReport {
         points: Vec::new(),
         failures: Vec::new(),
@@ -52,14 +44,7 @@ pub fn merge_labs(parts: &[(PathBuf, LabReport)]) -> Result<LabReport, MergeErro
         part: None,
         ..first.clone()
     };
-    for (index, slot) in by_index.iter().enumerate() {
-        let Some((_, report)) = slot else {
-            let shard = Shard {
-                index: index as u32,
-                count,
-            };
-            return Err(MergeError::Missing(format!("part {shard}")));
-        };
+    for (_, report) in ordered {
         merged.points.extend(report.points.iter().cloned());
         for failure in &report.failures {
             if !merged.failures.contains(failure) {
