@@ -7,7 +7,7 @@ mod common;
 
 use std::path::Path;
 
-use common::cli::{fails_cleanly, scratch, shine, text};
+use common::cli::{assert_same_files, fails_cleanly, scratch, shine, text, worst_relative};
 use shine::capture::image_io::read_exr;
 
 /// Runs `shine` and fails the test unless it succeeds; what it printed.
@@ -19,11 +19,8 @@ fn ok(args: &[&str]) -> String {
 
 /// Asserts that frames `frames` of `a` and `b` (`f_NN.exr`) are the same files.
 fn same_frames(a: &Path, b: &Path, frames: std::ops::Range<u32>) {
-    for k in frames {
-        let name = format!("f_{k:02}.exr");
-        let x = std::fs::read(a.join(&name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        assert!(x == std::fs::read(b.join(&name)).unwrap(), "{name} differs");
-    }
+    let names: Vec<String> = frames.map(|k| format!("f_{k:02}.exr")).collect();
+    assert_same_files(a, b, &names);
 }
 
 #[test]
@@ -165,12 +162,7 @@ fn reference_parts_merge_into_the_one_process_reference() {
         read_exr(Path::new(&halves)).unwrap(),
         read_exr(&dir.join("one.exr")).unwrap(),
     );
-    let worst = a
-        .texels
-        .iter()
-        .zip(&b.texels)
-        .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / (y[c].abs() + 1e-6)))
-        .fold(0.0f32, f32::max);
+    let worst = worst_relative(&a.texels, &b.texels);
     assert!(worst <= 1e-5, "halves differ by {worst} relative");
 
     // Missing, doubled and foreign parts are refused by name.

@@ -10,7 +10,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
 
-use common::cli::{scratch, text};
+use common::cli::{assert_same_files, scratch, text, worst_relative};
 use shine::capture::image_io::read_exr;
 
 /// Longest wait for a job array and its merge.
@@ -208,12 +208,8 @@ fn shine(args: &[&str]) -> Output {
 
 /// Asserts that every frame `0..frames` of `dir` equals the one in `one` bit for bit.
 fn same_frames(dir: &Path, one: &Path, frames: u32) {
-    for k in 0..frames {
-        let name = format!("frame_{k:04}.png");
-        let a = std::fs::read(dir.join(&name)).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let b = std::fs::read(one.join(&name)).unwrap();
-        assert!(a == b, "{name} differs from the one-process run's");
-    }
+    let names: Vec<String> = (0..frames).map(|k| format!("frame_{k:04}.png")).collect();
+    assert_same_files(dir, one, &names);
 }
 
 /// Asserts that `dir` holds no temporary file of an interrupted write.
@@ -360,13 +356,7 @@ fn job_arrays_on_a_real_slurm_equal_one_process_runs() {
     // The reference: the one-process one up to the order of additions.
     let merged = read_exr(&refs.join("reference.exr")).unwrap();
     let single = read_exr(&one_ref).unwrap();
-    assert_eq!(merged.texels.len(), single.texels.len());
-    let worst = merged
-        .texels
-        .iter()
-        .zip(&single.texels)
-        .flat_map(|(a, b)| (0..3).map(move |c| (a[c] - b[c]).abs() / (b[c].abs() + 1e-6)))
-        .fold(0.0f32, f32::max);
+    let worst = worst_relative(&merged.texels, &single.texels);
     assert!(
         worst <= MERGE_TOLERANCE,
         "merged reference differs by {worst} (relative)"

@@ -130,14 +130,9 @@ fn flicker_colour(ratio: f64) -> RGBColor {
 /// A logarithmic axis range around `values` (positive, finite), with some room; a decade
 /// at least.
 fn log_range(values: impl Iterator<Item = f64>) -> [f64; 2] {
-    let (lo, hi) = values
-        .filter(|v| v.is_finite() && *v > 0.0)
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
-            (lo.min(v), hi.max(v))
-        });
-    if lo > hi {
+    let Some((lo, hi)) = crate::study::plot::positive_bounds(values) else {
         return [0.1, 1.0];
-    }
+    };
     let (lo, hi) = (lo / 1.3, hi * 1.3);
     let short = 10.0 / (hi / lo);
     if short > 1.0 {

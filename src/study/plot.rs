@@ -73,16 +73,22 @@ pub struct ErrorPlot {
     pub font: Option<String>,
 }
 
-/// A logarithmic axis range around `values` (positive, finite), with some room.
-fn log_range(values: impl Iterator<Item = f64>) -> [f64; 2] {
+/// The least and greatest of `values` that are positive and finite (what a logarithmic axis
+/// can show); `None` when there is none.
+pub fn positive_bounds(values: impl Iterator<Item = f64>) -> Option<(f64, f64)> {
     let (lo, hi) = values
         .filter(|v| v.is_finite() && *v > 0.0)
         .fold((f64::INFINITY, 0.0f64), |(lo, hi), v| {
             (lo.min(v), hi.max(v))
         });
-    if lo > hi {
+    (lo <= hi).then_some((lo, hi))
+}
+
+/// A logarithmic axis range around `values` (positive, finite), with some room.
+fn log_range(values: impl Iterator<Item = f64>) -> [f64; 2] {
+    let Some((lo, hi)) = positive_bounds(values) else {
         return [0.1, 1.0];
-    }
+    };
     let (lo, hi) = (lo / 1.25, hi * 1.25);
     if hi / lo < 2.0 {
         [lo / 2.0, hi * 2.0]

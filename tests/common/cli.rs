@@ -35,3 +35,28 @@ pub fn fails_cleanly(out: &Output, needle: &str) {
     assert!(all.contains(needle), "expected `{needle}` in:\n{all}");
     assert!(!all.contains("panicked"), "{all}");
 }
+
+/// Asserts that each file named in `names` is the same, byte for byte, in `a` and in `b`.
+pub fn assert_same_files(a: &std::path::Path, b: &std::path::Path, names: &[String]) {
+    for name in names {
+        let x = std::fs::read(a.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let y = std::fs::read(b.join(name)).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(
+            x == y,
+            "{name} differs between {} and {}",
+            a.display(),
+            b.display()
+        );
+    }
+}
+
+/// The largest per-channel difference of two RGBA images relative to `reference`'s value
+/// (plus 1e-6, for black pixels).
+pub fn worst_relative(image: &[[f32; 4]], reference: &[[f32; 4]]) -> f32 {
+    assert_eq!(image.len(), reference.len(), "image sizes differ");
+    image
+        .iter()
+        .zip(reference)
+        .flat_map(|(x, y)| (0..3).map(move |c| (x[c] - y[c]).abs() / (y[c].abs() + 1e-6)))
+        .fold(0.0f32, f32::max)
+}
