@@ -16,11 +16,11 @@
 
 use std::f32::consts::PI;
 
-use glam::{Mat4, Quat, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use serde_json::json;
 
 use super::shapes::{self, MeshData};
-use super::tracks::Tracks;
+use super::tracks::{Tracks, aim};
 use super::walker::{self, Path};
 use crate::environment::{self, Environment};
 use crate::error::Result;
@@ -161,13 +161,6 @@ fn curtain(x: f32, z0: f32, z1: f32, top: f32, bottom: f32) -> (MeshData, [Morph
     };
     let targets = [target(&billow), target(&sway)];
     (mesh, targets)
-}
-
-/// A node rotation that points its -Z from `from` towards `to`.
-fn aim(from: Vec3, to: Vec3) -> Quat {
-    let look = Mat4::look_at_rh(from, to, Vec3::Y).inverse();
-    let (_, rotation, _) = look.to_scale_rotation_translation();
-    rotation.normalize()
 }
 
 /// Builds the scene as GLB bytes.

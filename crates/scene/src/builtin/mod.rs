@@ -13,6 +13,10 @@
 //! - `marbles`: 96 balls of six materials (gold, chrome, clay, plastics) on a wide ground
 //!   under a low sun and an evening sky, each with its proxy sphere; a scene nothing was tuned
 //!   on, and the one the proxies' neighbour lists are measured on (issue 18).
+//! - `motion-sweep`, `motion-orbit`, `motion-sun`, `motion-crossing`, `motion-dolly`: one
+//!   static room with one thing moving in each (a spot's sweep, a point light's orbit, a sun's
+//!   turn, a box crossing a fixed spot's beam, the camera), for the temporal studies (issue 43;
+//!   [`motions`]).
 //!
 //! `assets/<name>.glb` holds the exported files; a test checks they equal what [`build`]
 //! produces now.
@@ -20,6 +24,7 @@
 mod animated;
 mod cornell_box;
 mod marbles;
+mod motions;
 mod room;
 pub mod shapes;
 mod spheres;
@@ -35,7 +40,18 @@ use crate::scene::Scene;
 
 /// Names of the built-in scenes.
 pub fn names() -> &'static [&'static str] {
-    &["cornell-box", "spheres", "room", "animated", "marbles"]
+    &[
+        "cornell-box",
+        "spheres",
+        "room",
+        "animated",
+        "marbles",
+        motions::NAMES[0],
+        motions::NAMES[1],
+        motions::NAMES[2],
+        motions::NAMES[3],
+        motions::NAMES[4],
+    ]
 }
 
 /// The built-in scene `name` as GLB bytes.
@@ -46,7 +62,7 @@ pub fn build(name: &str) -> Result<Vec<u8>> {
         "room" => Ok(room::build()),
         "animated" => animated::build(),
         "marbles" => Ok(marbles::build()),
-        _ => Err(Error::UnknownBuiltin {
+        _ => motions::build(name).ok_or_else(|| Error::UnknownBuiltin {
             name: name.to_string(),
             known: names().join(", "),
         }),

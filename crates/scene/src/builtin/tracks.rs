@@ -1,5 +1,6 @@
 //! Animation channels of a built-in scene, gathered into one glTF animation.
 
+use glam::{Mat4, Quat, Vec3};
 use serde_json::{Value, json};
 
 use crate::glb_writer::GlbWriter;
@@ -43,4 +44,11 @@ impl Tracks {
             json!({"name": name, "samplers": self.samplers, "channels": self.channels}),
         );
     }
+}
+
+/// A node rotation that points its -Z from `from` towards `to` (a camera's or a light's aim).
+pub(super) fn aim(from: Vec3, to: Vec3) -> Quat {
+    let look = Mat4::look_at_rh(from, to, Vec3::Y).inverse();
+    let (_, rotation, _) = look.to_scale_rotation_translation();
+    rotation.normalize()
 }
