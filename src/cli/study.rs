@@ -57,6 +57,10 @@ pub struct TemporalStudyArgs {
     /// Frames rendered first and not measured (temporal state settles).
     #[arg(long, default_value_t = 4)]
     warmup: u32,
+    /// Judge the indirect light alone: every mode renders `output.component=indirect`, the
+    /// truth is its indirect light.
+    #[arg(long)]
+    indirect: bool,
     /// A mode, `LABEL=KEY=VALUE;KEY=VALUE…` (settings keys as `--set` takes them), repeated;
     /// default: `hvl=gi=hvl` and `hvl/4=gi=hvl;hvl.slices=4`.
     #[arg(long = "mode")]
@@ -186,6 +190,7 @@ fn run_temporal(args: &TemporalStudyArgs) -> Result<(), CliError> {
         time: args.time,
         truth_spp: args.truth_spp,
         warmup: args.warmup,
+        indirect: args.indirect,
     };
     let out = args
         .out

@@ -19,6 +19,7 @@ use crate::capture::image_io::HdrImage;
 use crate::frame::renderer::Renderer;
 use crate::gpu::Device;
 use crate::gpu_scene::FrameUpdate;
+use crate::passes::composite::Component;
 use crate::reference::{PathTracer, ReferenceParams};
 use crate::settings::Settings;
 
@@ -44,6 +45,9 @@ pub struct TemporalConfig {
     pub truth_spp: u32,
     /// Frames rendered before the measured ones (not measured: temporal state settles).
     pub warmup: u32,
+    /// Judge the indirect light alone: every mode renders `output.component = indirect` and
+    /// the truth is its indirect light (issue 43: what pops is the GI).
+    pub indirect: bool,
 }
 
 /// What the study measured for one mode.
@@ -67,6 +71,9 @@ pub struct ModeResult {
     pub cold_still_flicker: f64,
     /// Relative RMSE of the last cold frame (what the sequence's last frame is judged by).
     pub cold_last_rmse: f64,
+    /// Mean over the cold frames of the relative RMSE against the truth frame: the lag a
+    /// history adds is `relative_rmse - cold_relative_rmse`.
+    pub cold_relative_rmse: f64,
     /// The sequence's flicker at each inner frame k (1..frames-1): RMS over pixels of
     /// I(k+1) - 2 I(k) + I(k-1) over the mean of the frames.
     pub flicker_by_frame: Vec<f64>,
@@ -87,8 +94,11 @@ pub struct TemporalReport {
     pub warmup: u32,
     /// Width and height of the frames.
     pub extent: [u32; 2],
-    /// Flicker of the path-traced truth (the yardstick).
+    /// Flicker of the path-traced truth (the yardstick), its noise taken out: two fixed-seed
+    /// truths A and B, `sqrt(mean(d2(A)·d2(B)))` over the mean ([`flicker_noise_free`]).
     pub truth_flicker: f64,
+    /// Flicker of truth A alone, noise included (what one fixed-seed truth reads).
+    pub truth_flicker_one_seed: f64,
     /// Where the truth holds still: the pixels whose per-pixel truth flicker is at most its
     /// median (moving objects and their shadows are out; surfaces only a moving light
     /// changes are in). Row-major.
@@ -156,6 +166,32 @@ pub fn flicker(frames: &[HdrImage]) -> f64 {
     }
     let se: f64 = d.iter().flatten().sum();
     (se / n as f64).sqrt() / frames_mean(frames)
+}
+
+/// The flicker of a sequence whose two renders `a` and `b` differ only by their noise (two
+/// seeds): the issue's `mean(d2(A)²) − mean((d2(A) − d2(B))²)/2`, symmetrised in A and B,
+/// which is `mean(d2(A)·d2(B))`: independent noise averages out of the product and the
+/// signal's second difference stays. Its square root over the mean of both; 0 where the noise
+/// leaves a negative estimate.
+pub fn flicker_noise_free(a: &[HdrImage], b: &[HdrImage]) -> f64 {
+    let (mut product, mut n) = (0.0f64, 0usize);
+    for (wa, wb) in a.windows(3).zip(b.windows(3)) {
+        let pixels = wa[0].texels.len();
+        for i in 0..pixels {
+            for k in 0..3 {
+                let d = |w: &[HdrImage]| {
+                    f64::from(w[2].texels[i][k] - 2.0 * w[1].texels[i][k] + w[0].texels[i][k])
+                };
+                product += d(wa) * d(wb);
+                n += 1;
+            }
+        }
+    }
+    if n == 0 {
+        return 0.0;
+    }
+    let mean = 0.5 * (frames_mean(a) + frames_mean(b));
+    (product / n as f64).max(0.0).sqrt() / mean
 }
 
 /// [`flicker`] over the pixels where `mask` holds (RMS and mean both over them).
@@ -234,7 +270,7 @@ pub fn run(
     let times: Vec<f32> = (config.warmup..config.warmup + config.frames)
         .map(at)
         .collect();
-    progress.stage("truth", u64::from(config.frames));
+    progress.stage("truth", 2 * u64::from(config.frames));
     let params = ReferenceParams {
         width: first.settings.width,
         height: first.settings.height,
@@ -242,30 +278,38 @@ pub fn run(
         emissive_lighting: false,
         ..ReferenceParams::default()
     };
-    let mut tracer = PathTracer::new(device, scene, times[0], &params)?;
-    let mut truth = Vec::new();
-    for &t in &times {
-        tracer.update(&FrameUpdate::at(t))?;
-        tracer.accumulate(config.truth_spp)?;
-        truth.push(tracer.read()?.full);
-        progress.advance(1, "path tracing");
-    }
+    let truth = truth_sequence(device, scene, &times, config, &params, progress)?;
+    let truth_b = truth_sequence(
+        device,
+        scene,
+        &times,
+        config,
+        &ReferenceParams {
+            seed: params.seed.wrapping_add(1),
+            ..params
+        },
+        progress,
+    )?;
     let (truth_flicker_by_frame, truth_flicker_map) = flicker_parts(&truth);
     let still = calm_half(&truth_flicker_map);
     let mut results = Vec::new();
     for mode in modes {
         progress.stage(&mode.label, 2 * u64::from(config.frames));
+        let mut settings = mode.settings.clone();
+        if config.indirect {
+            settings.output.component = Component::Indirect;
+        }
         let mut renderer = Renderer::new(device)?;
         renderer.set_scene(scene, config.time)?;
         for k in 0..config.warmup {
             renderer.update(&FrameUpdate::at(at(k)))?;
-            renderer.render(&mode.settings)?;
+            renderer.render(&settings)?;
         }
         let (mut images, mut ms) = (Vec::new(), Vec::new());
         for &t in &times {
             renderer.update(&FrameUpdate::at(t))?;
             let start = Instant::now();
-            let frame = renderer.render(&mode.settings)?;
+            let frame = renderer.render(&settings)?;
             ms.push(start.elapsed().as_secs_f64() * 1e3);
             images.push(frame.hdr);
             progress.advance(1, &mode.label);
@@ -274,16 +318,18 @@ pub fn run(
         let mut cold = Vec::new();
         for &t in &times {
             renderer.set_scene(scene, t)?;
-            cold.push(renderer.render(&mode.settings)?.hdr);
+            cold.push(renderer.render(&settings)?.hdr);
             progress.advance(1, &format!("{} (cold)", mode.label));
         }
         ms.sort_by(f64::total_cmp);
-        let error = images
-            .iter()
-            .zip(&truth)
-            .map(|(a, b)| relative_rmse(a, b))
-            .sum::<f64>()
-            / images.len() as f64;
+        let error = |frames: &[HdrImage]| {
+            frames
+                .iter()
+                .zip(&truth)
+                .map(|(a, b)| relative_rmse(a, b))
+                .sum::<f64>()
+                / frames.len() as f64
+        };
         let last = |frames: &[HdrImage]| match (frames.last(), truth.last()) {
             (Some(a), Some(b)) => relative_rmse(a, b),
             _ => 0.0,
@@ -292,13 +338,14 @@ pub fn run(
         results.push(ModeResult {
             label: mode.label.clone(),
             ms_per_frame: ms[ms.len() / 2],
-            relative_rmse: error,
+            relative_rmse: error(&images),
             flicker: flicker(&images),
             still_flicker: flicker_masked(&images, &still),
             last_rmse: last(&images),
             cold_flicker: flicker(&cold),
             cold_still_flicker: flicker_masked(&cold, &still),
             cold_last_rmse: last(&cold),
+            cold_relative_rmse: error(&cold),
             flicker_by_frame,
             flicker_map,
         });
@@ -309,13 +356,40 @@ pub fn run(
         frames: config.frames,
         warmup: config.warmup,
         extent: [first.settings.width, first.settings.height],
-        truth_flicker: flicker(&truth),
+        truth_flicker: flicker_noise_free(&truth, &truth_b),
+        truth_flicker_one_seed: flicker(&truth),
         truth_still_flicker: flicker_masked(&truth, &still),
         still,
         truth_flicker_by_frame,
         truth_flicker_map,
         modes: results,
     })
+}
+
+/// One fixed-seed truth sequence at `times`: the full frame, or its indirect light when
+/// `config.indirect`.
+fn truth_sequence(
+    device: &Device,
+    scene: &Scene,
+    times: &[f32],
+    config: &TemporalConfig,
+    params: &ReferenceParams,
+    progress: &mut dyn Progress,
+) -> Result<Vec<HdrImage>, StudyError> {
+    let mut tracer = PathTracer::new(device, scene, times[0], params)?;
+    let mut frames = Vec::with_capacity(times.len());
+    for &t in times {
+        tracer.update(&FrameUpdate::at(t))?;
+        tracer.accumulate(config.truth_spp)?;
+        let images = tracer.read()?;
+        frames.push(if config.indirect {
+            images.indirect
+        } else {
+            images.full
+        });
+        progress.advance(1, &format!("path tracing (seed {})", params.seed));
+    }
+    Ok(frames)
 }
 
 #[cfg(test)]
@@ -352,5 +426,42 @@ mod tests {
         assert_eq!(still, vec![false, true]);
         assert_eq!(flicker_masked(&pop, &still), 0.0);
         assert!((flicker_masked(&pop, &[true, true]) - flicker(&pop)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn two_seeds_take_the_noise_out_of_the_truths_flicker() {
+        // A steady ramp under independent noise: one seed flickers by its noise alone, the
+        // pair reads nearly nothing; a pop common to both seeds is kept.
+        let noise = |seed: u32, k: u32| {
+            let mut h = u64::from(seed) << 32 | u64::from(k);
+            h = (h ^ (h >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            h = (h ^ (h >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+            0.05 * (((h ^ (h >> 31)) >> 40) as f32 / (1u64 << 24) as f32 - 0.5)
+        };
+        let seq = |seed: u32, pop: f32| -> Vec<HdrImage> {
+            (0..32u32)
+                .map(|k| HdrImage {
+                    width: 256,
+                    height: 1,
+                    texels: (0..256u32)
+                        .map(|i| {
+                            let jump = if k == 15 { pop } else { 0.0 };
+                            let a = 1.0 + 0.01 * k as f32 + jump + noise(seed, 256 * k + i);
+                            [a, a, a, 1.0]
+                        })
+                        .collect(),
+                })
+                .collect()
+        };
+        let (a, b) = (seq(1, 0.0), seq(2, 0.0));
+        assert!(flicker(&a) > 0.02, "{}", flicker(&a));
+        assert!(flicker_noise_free(&a, &b) < 0.3 * flicker(&a));
+        let (a, b) = (seq(1, 0.5), seq(2, 0.5));
+        let estimate = flicker_noise_free(&a, &b);
+        assert!(
+            estimate > 0.5 * flicker(&a),
+            "{estimate} against {}",
+            flicker(&a)
+        );
     }
 }
