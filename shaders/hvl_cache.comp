@@ -139,9 +139,13 @@ void main() {
     hvls.h[index].position_radius = position_radius;
     hvls.h[index].normal_distance = normal_distance;
     hvls.h[index].flux = flux_valid;
-    for (int l = 0; l < 8; ++l) {
+    for (int l = 0; l < HVL_EMISSION_MAX_BANDS; ++l) {
         hvls.h[index].emission[l] = emission_scale * hvl_sender_emission(l);
     }
+    // Identity: the grid holds the primary light's cells alone, cell `index`.
+    hvls.h[index].light = 0u;
+    hvls.h[index].sample_index = index;
+    hvls.h[index].pad = 0u;
 #else
     vec4 position_radius = source.h[index].position_radius;
     float d = source.h[index].normal_distance.w;
@@ -186,8 +190,11 @@ void main() {
     hvls.h[index].position_radius = position_radius;
     hvls.h[index].normal_distance = source.h[index].normal_distance;
     hvls.h[index].flux = source.h[index].flux;
-    for (int l = 0; l < 8; ++l) {
+    for (int l = 0; l < HVL_EMISSION_MAX_BANDS; ++l) {
         hvls.h[index].emission[l] = source.h[index].emission[l];
     }
+    hvls.h[index].light = source.h[index].light;
+    hvls.h[index].sample_index = source.h[index].sample_index;
+    hvls.h[index].pad = 0u;
 #endif
 }

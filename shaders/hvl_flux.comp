@@ -1,37 +1,53 @@
 // HVL cache by flux (shine's distribution, hvl.distribution = "flux"; paper 003 §5.2 cuts one
-// light's RSM uniformly instead, hvl_cache.comp) over the RSM faces of every light: a spot or
-// directional light has one face, a point light six (cube faces). M texels of all the faces
-// are drawn in proportion to their flux weight w = r + g + b (0 for an empty texel), so the
-// HVL budget is split between the lights by the flux they reflect. The faces' rows are
-// numbered one after the other, face by face (a global row r). HVL m takes the row where the
-// running sum of the row totals passes (m + 1/2)/M of the total, then the texel of that row
-// where the row's running sum passes v_m of its total, v_m the base-2 radical inverse of m
-// (the Hammersley set, warped by the flux). Every HVL carries Phi/M of the weight:
-// flux = texel flux * Phi / (M w), from its own texel's position and normal. Its radius is r2
-// from the local spacing (shine_sh::hvl::radius_spacing) times the user scale.
+// light's RSM uniformly instead, hvl_cache.comp) over the RSM faces of every light (a spot or
+// directional light has one face, a point light six cube faces, consecutive). Texels are drawn
+// in proportion to their flux weight w = r + g + b (0 for an empty texel).
 //
-// Comparisons are written as products (a * 2M > (2m + 1) * total), never quotients. IEEE
+// Samples with identities (issue 43). Light k (its faces' rows numbered one after the other)
+// owns the progressive sequence j = 0, 1, 2, ... of Halton points (phi_2(j), phi_3(j)), warped
+// through its own flux: sample j takes the light's row where the light's running row sum
+// passes phi_2(j) of its total Phi_k, then the texel of that row where the row's running sum
+// passes phi_3(j) of the row's total. A point's place depends on j and on that light's flux
+// alone, never on the budget or on the other lights, so when a light moves its samples slide
+// with it, and when a light's share changes the others' stay put.
+// The budget: M' = M - (N - 1) samples (N lights) split by flux, s_k = M' Phi_k / Phi; light k
+// keeps n_k = ceil(s_k) samples, the last faded by the fractional part of s_k (weight
+// clamp(s_k - j, 0, 1)), so a share that grows fades its newest sample in instead of redrawing
+// the set. Sum n_k <= M. Every sample carries Phi / M' times its weight.
+// Positions come from a continuous inverse: where the target falls within its texel's share
+// of the running sum (f in [0, 1) across the row, g down the rows) places the sample between
+// texel centres, bilinearly among the texel and its neighbours on the side it leans to that
+// lie on the same surface (hvl_flux_blend).
+// Record m = offset_k + j (offsets in light order) stores its identity (light, j); empty slots
+// are zero (the buffer is cleared first).
+//
+// Comparisons that pick texels are written as products (a > u * total), never quotients: IEEE
 // products and sums are correctly rounded on every Vulkan device, so the GPU picks the same
 // texels as the CPU twin (shine::reference::hvl_flux).
 //
 // `cdf` holds T running sums (face f's S_f * S_f at texel_offset_f, row by row), then the R
-// row totals (global row order), then their R running sums (T = sum S_f^2, R = sum S_f).
+// row totals (global row order), then the R running sums of the row totals, restarted at each
+// light's first row, then the light table: [Phi, M', 0, 0] and per light k [Phi_k, s_k, n_k,
+// offset_k] (T = sum S_f^2, R = sum S_f).
 // `rows`: one invocation per row of one face (a dispatch per face): its running sums and total.
-// `marginal`: one invocation: the running sums of the row totals.
-// `build`: one invocation per HVL, a dispatch per face: HVL m is written by the dispatch of
-// the face its row falls in (by face 0 as an empty record when no face holds any flux).
+// `marginal`: one invocation per light (a dispatch per light): its rows' running sums, Phi_k.
+// `budget`: one invocation: Phi, M', and every light's s_k, n_k and offset_k.
+// `build`: one invocation per sample j of one light, a dispatch per face: sample j is written
+// by the dispatch of the face its row falls in.
 //! variant rows HVL_FLUX_ROWS=1
 //! variant marginal HVL_FLUX_MARGINAL=1
+//! variant budget HVL_FLUX_BUDGET=1
 //! variant build HVL_FLUX_BUILD=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #define SH_BANDS 5
 #include "sh.glsl"
 #include "hvl.glsl"
+#include "sample_identity.glsl"
 
 layout(local_size_x = 64) in;
 
-#ifndef HVL_FLUX_MARGINAL
+#if defined(HVL_FLUX_ROWS) || defined(HVL_FLUX_BUILD)
 layout(set = 0, binding = 0, rgba32f) readonly uniform image2D rsm_position;
 layout(set = 0, binding = 2, rgba32f) readonly uniform image2D rsm_flux;
 #endif
@@ -68,10 +84,22 @@ layout(push_constant) uniform Push {
     uint count;
     // user radius scale k (1-2, paper 003 §5.3)
     float radius_scale;
-    uint pad;
+    // this face's light: its first global row, its row count, its place k in the light order,
+    // its index in the scene (the samples' identity)
+    uint light_row_offset;
+    uint light_rows;
+    uint light_order;
+    uint light_id;
+    // N: lights
+    uint light_count;
 } push;
 
-#ifndef HVL_FLUX_MARGINAL
+// The light table's first float.
+uint light_table() {
+    return push.texels_total + 2u * push.rows_total;
+}
+
+#if defined(HVL_FLUX_ROWS) || defined(HVL_FLUX_BUILD)
 // The flux weight of texel t: r + g + b of its flux, 0 for an empty texel
 // (shine::reference::hvl_flux::texel_weight).
 float texel_weight(ivec2 t) {
@@ -103,12 +131,98 @@ void main() {
         return;
     }
     float sum = 0.0;
-    for (uint r = 0u; r < push.rows_total; ++r) {
-        sum += cdf.c[push.texels_total + r];
-        cdf.c[push.texels_total + push.rows_total + r] = sum;
+    uint first = push.texels_total + push.light_row_offset;
+    for (uint r = 0u; r < push.light_rows; ++r) {
+        sum += cdf.c[first + r];
+        cdf.c[first + push.rows_total + r] = sum;
+    }
+    cdf.c[light_table() + 4u * (push.light_order + 1u)] = sum;
+}
+#elif defined(HVL_FLUX_BUDGET)
+void main() {
+    if (gl_GlobalInvocationID.x != 0u) {
+        return;
+    }
+    uint table = light_table();
+    float total = 0.0;
+    for (uint k = 0u; k < push.light_count; ++k) {
+        total += cdf.c[table + 4u * (k + 1u)];
+    }
+    uint budget = hvl_flux_budget(push.count, push.light_count);
+    cdf.c[table] = total;
+    cdf.c[table + 1u] = float(budget);
+    uint offset = 0u;
+    for (uint k = 0u; k < push.light_count; ++k) {
+        uint e = table + 4u * (k + 1u);
+        float light_total = cdf.c[e];
+        uint n = total > 0.0 ? hvl_flux_light_count(budget, light_total, total) : 0u;
+        n = min(n, push.count - offset);
+        cdf.c[e + 1u] = total > 0.0 ? float(budget) * light_total / total : 0.0;
+        cdf.c[e + 2u] = float(n);
+        cdf.c[e + 3u] = float(offset);
+        offset += n;
     }
 }
 #else
+// A sample's surface, blended from its texel and the neighbours it leans towards.
+struct HvlFluxTexel {
+    vec3 position;
+    vec3 normal;
+    // rgb of the flux over its weight (r + g + b = 1)
+    vec3 chroma;
+    // the flux weight, bilinear (the local density of samples, for the radius)
+    float weight;
+};
+
+// The continuous inverse: a sample at fraction (f, g) of texel t's share lies between t's
+// centre and the neighbours on the side it leans to, with bilinear weights, over the
+// neighbours on t's own surface: not empty, on the face, normals within acos
+// HVL_FLUX_BLEND_NORMAL_COS and the step to them within the plane (its component along t's
+// normal at most HVL_FLUX_BLEND_PLANE of its length). At a crease or an RSM depth step the
+// sample stops at its texel's edge and steps to the other surface there (the stable rule):
+// blending across put HVLs in mid-air and lost 4% of the cornell box's indirect light.
+const float HVL_FLUX_BLEND_NORMAL_COS = 0.9;
+const float HVL_FLUX_BLEND_PLANE = 0.25;
+HvlFluxTexel hvl_flux_blend(ivec2 t, float f, float g) {
+    ivec2 dir = ivec2(f < 0.5 ? -1 : 1, g < 0.5 ? -1 : 1);
+    vec2 lean = abs(vec2(f, g) - 0.5);
+    vec3 position = vec3(0.0);
+    vec3 normal = vec3(0.0);
+    vec3 flux = vec3(0.0);
+    float weight = 0.0;
+    float total = 0.0;
+    int s = int(push.face_size);
+    vec3 own_position = imageLoad(rsm_position, t).xyz;
+    vec3 own_normal = normalize(imageLoad(rsm_normal, t).xyz);
+    for (int b = 0; b < 2; ++b) {
+        for (int a = 0; a < 2; ++a) {
+            ivec2 q = t + ivec2(a * dir.x, b * dir.y);
+            if (q.x < 0 || q.y < 0 || q.x >= s || q.y >= s || imageLoad(rsm_position, q).w == 0.0) {
+                continue;
+            }
+            vec3 step_to = imageLoad(rsm_position, q).xyz - own_position;
+            bool same_surface = dot(normalize(imageLoad(rsm_normal, q).xyz), own_normal) >= HVL_FLUX_BLEND_NORMAL_COS
+                && abs(dot(step_to, own_normal)) <= HVL_FLUX_BLEND_PLANE * length(step_to);
+            if (!same_surface) {
+                continue;
+            }
+            float k = (a == 1 ? lean.x : 1.0 - lean.x) * (b == 1 ? lean.y : 1.0 - lean.y);
+            float w = texel_weight(q);
+            position += k * imageLoad(rsm_position, q).xyz;
+            normal += k * normalize(imageLoad(rsm_normal, q).xyz);
+            flux += k * imageLoad(rsm_flux, q).rgb;
+            weight += k * w;
+            total += k;
+        }
+    }
+    HvlFluxTexel o;
+    o.position = position / total;
+    o.normal = normalize(normal);
+    o.chroma = flux / weight;
+    o.weight = weight / total;
+    return o;
+}
+
 // The first x of a face row (its running sums from `first`) whose running sum exceeds
 // `target`, or, when none does (target at the row's total), reaches it: a texel of positive
 // weight either way.
@@ -128,63 +242,72 @@ uint find_column(uint first, float target, float row_total) {
     return lo;
 }
 
-void write_hvl(uint m, vec4 position_radius, vec4 normal_distance, vec4 flux_valid, float emission_scale) {
+void write_hvl(uint m, vec4 position_radius, vec4 normal_distance, vec4 flux_valid, uint sample_index) {
     // Field by field: naga cannot read the OpCopyLogical of a whole-struct store.
     hvls.h[m].position_radius = position_radius;
     hvls.h[m].normal_distance = normal_distance;
     hvls.h[m].flux = flux_valid;
-    for (int l = 0; l < 8; ++l) {
-        hvls.h[m].emission[l] = emission_scale * hvl_sender_emission(l);
+    for (int l = 0; l < HVL_EMISSION_MAX_BANDS; ++l) {
+        hvls.h[m].emission[l] = hvl_sender_emission(l);
     }
+    hvls.h[m].light = push.light_id;
+    hvls.h[m].sample_index = sample_index;
+    hvls.h[m].pad = 0u;
 }
 
 void main() {
-    uint m = gl_GlobalInvocationID.x;
-    if (m >= push.count) {
+    uint j = gl_GlobalInvocationID.x;
+    uint table = light_table();
+    uint e = table + 4u * (push.light_order + 1u);
+    float light_total = cdf.c[e];
+    float share = cdf.c[e + 1u];
+    uint n = uint(cdf.c[e + 2u]);
+    if (j >= n) {
         return;
     }
-    uint marginal = push.texels_total + push.rows_total;
-    float total = cdf.c[marginal + push.rows_total - 1u];
-    if (!(total > 0.0)) {
-        if (push.row_offset == 0u) {
-            write_hvl(m, vec4(0.0), vec4(0.0), vec4(0.0), 0.0);
-        }
-        return;
-    }
-    // The global row: the first whose running sum a passes (m + 1/2)/M of the total.
-    float goal = float(2u * m + 1u) * total;
-    float twice_count = float(2u * push.count);
+    uint slot = uint(cdf.c[e + 3u]) + j;
+    // The light's row: the first whose running sum passes phi_2(j) of the light's total.
+    uint marginal = push.texels_total + push.rows_total + push.light_row_offset;
+    float row_goal = hvl_flux_phi2(j) * light_total;
     uint lo = 0u;
-    uint hi = push.rows_total - 1u;
+    uint hi = push.light_rows - 1u;
     while (lo < hi) {
         uint mid = (lo + hi) / 2u;
-        if (cdf.c[marginal + mid] * twice_count > goal) {
+        if (cdf.c[marginal + mid] > row_goal) {
             hi = mid;
         } else {
             lo = mid + 1u;
         }
     }
-    if (lo < push.row_offset || lo >= push.row_offset + push.face_size) {
+    uint row = push.light_row_offset + lo;
+    if (row < push.row_offset || row >= push.row_offset + push.face_size) {
         return;
     }
     uint s = push.face_size;
-    uint y = lo - push.row_offset;
-    // The texel: where the row's running sum passes v_m of its total (24-bit radical inverse,
-    // exact in float).
-    float row_total = cdf.c[push.texels_total + lo];
-    float v = float(bitfieldReverse(m) >> 8u) * (1.0 / 16777216.0);
-    ivec2 t = ivec2(find_column(push.texel_offset + y * s, v * row_total, row_total), y);
-    float w = texel_weight(t);
-    vec3 p = imageLoad(rsm_position, t).xyz;
-    vec3 n = normalize(imageLoad(rsm_normal, t).xyz);
+    uint y = row - push.row_offset;
+    // The texel: where the row's running sum passes phi_3(j) of its total.
+    float row_total = cdf.c[push.texels_total + row];
+    float target = hvl_flux_phi3(j, row_total);
+    uint first = push.texel_offset + y * s;
+    uint x = find_column(first, target, row_total);
+    // Where the targets fall within the texel's share: f across, g down.
+    float w = texel_weight(ivec2(x, y));
+    float before_x = x > 0u ? cdf.c[first + x - 1u] : 0.0;
+    float f = clamp((target - before_x) / w, 0.0, 1.0);
+    float before_y = lo > 0u ? cdf.c[marginal + lo - 1u] : 0.0;
+    float g = clamp((row_goal - before_y) / row_total, 0.0, 1.0);
+    HvlFluxTexel t = hvl_flux_blend(ivec2(x, y), f, g);
     bool ortho = push.light_direction_ortho.w > 0.5;
     vec3 axis = push.light_direction_ortho.xyz;
-    vec3 from_light = p - push.light_position_extent.xyz;
+    vec3 from_light = t.position - push.light_position_extent.xyz;
     float d = ortho ? dot(from_light, axis) : length(from_light);
     vec3 to_surface = ortho ? axis : from_light / d;
-    float area = hvl_rsm_texel_area(ortho, push.light_position_extent.w, float(s), d, dot(to_surface, axis), dot(n, -to_surface));
-    float r = hvl_radius_spacing(area, w, total, float(push.count)) * push.radius_scale;
-    vec3 flux = imageLoad(rsm_flux, t).rgb * (total / (float(push.count) * w));
-    write_hvl(m, vec4(p, r), vec4(n, d), vec4(flux, 1.0), 1.0);
+    float area = hvl_rsm_texel_area(ortho, push.light_position_extent.w, float(s), d, dot(to_surface, axis), dot(t.normal, -to_surface));
+    float total = cdf.c[table];
+    float budget = cdf.c[table + 1u];
+    float r = hvl_radius_spacing(area, t.weight, total, budget) * push.radius_scale;
+    float fade = clamp(share - float(j), 0.0, 1.0);
+    vec3 flux = t.chroma * (total * fade / budget);
+    write_hvl(slot, vec4(t.position, r), vec4(t.normal, d), vec4(flux, 1.0), j);
 }
 #endif

@@ -5,10 +5,11 @@
 // SH_OUT coefficients of rgb as two uints (packHalf2x16(r, g), packHalf2x16(b, 0)), row-major
 // pixels, coefficient-minor. CPU twin: shine::reference::igi::vpl_sh.
 //
-// Pixel px uses set s = igi_set(px): the VPLs of global index i = s + k n m < M, k = 0, 1, ...,
-// VPL record igi_vpl_cell(i) of the HVL cache layout (shaders/include/hvl.glsl). The set holds
-// |S_s| = ceil((M - s) / nm) of the M VPLs, so each contribution is scaled by M / |S_s| (an
-// unbiased estimate of the sum over all VPLs).
+// Pixel px uses set s = igi_set(px): the VPLs whose identity puts them in set s
+// (igi_sample_set of the record's sample index, shaders/include/sample_identity.glsl), so a VPL
+// keeps its set when the records reorder (issue 43). Each contribution is scaled by n m: the
+// discontinuity filter (sh_filter.comp) counts every set of the pattern equally, so the
+// filtered sum is the sum over all VPLs.
 //! variant o2 SH_BANDS=2
 //! variant o3 SH_BANDS=3
 //! variant o4 SH_BANDS=4
@@ -18,6 +19,7 @@
 #include "igi.glsl"
 #include "amortise.glsl"
 #include "hvl.glsl"
+#include "sample_identity.glsl"
 #define TRACE_NODES_BINDING 6
 #define TRACE_TRIANGLES_BINDING 7
 #define TRACE_TOP_BINDING 8
@@ -61,8 +63,9 @@ layout(push_constant) uniform Push {
     uvec2 pattern;
     // VPL count M
     uint vpl_count;
-    // permutation stride (coprime with M)
-    uint stride;
+    // footprint k: each VPL spread over a disc of radius k r_j
+    // (shine::passes::igi::IgiParams::footprint)
+    float footprint;
     // 0: every pixel; 1 + k: the pixel at (k & 1, k >> 1) of every 2x2 cell;
     // AMORTISE_REGATHER_SLICE: the pixels `marks` marks (amortised frames,
     // src/passes/amortise.rs); each pixel gathers its own set
@@ -106,45 +109,47 @@ void main() {
 #endif
         uint sets = push.pattern.x * push.pattern.y;
         uint s = igi_set(px, push.pattern);
-        if (s < push.vpl_count) {
-            uint members = (push.vpl_count - s + sets - 1u) / sets;
-            float scale = float(push.vpl_count) / float(members);
-            for (uint i = s; i < push.vpl_count; i += sets) {
-                uint j = igi_vpl_cell(i, push.stride, push.vpl_count);
-                // Field by field: naga cannot read a whole-struct copy out of a buffer.
-                vec4 position_radius = vpls.h[j].position_radius;
-                vec4 flux = vpls.h[j].flux;
-                if (flux.a == 0.0) {
-                    continue;
-                }
-                vec3 v = position_radius.xyz - x;
-                float dist = length(v);
-                if (!(dist > 0.0)) {
-                    continue;
-                }
-                vec3 w = v / dist;
-                // Light from below the geometric surface cannot reach x.
-                if (dot(w, ng) <= 0.0) {
-                    continue;
-                }
-                vec3 e = igi_vpl_irradiance(flux.rgb, vpls.h[j].normal_distance.xyz, w, dist, push.camera_clamp.w) * scale;
-                if (all(equal(e, vec3(0.0)))) {
-                    continue;
-                }
-                if (trace_occluded(origin, w, 0.0, length(position_radius.xyz - origin) * IGI_SHADOW_END)) {
-                    continue;
-                }
-#ifdef IGI_IRRADIANCE
-                acc[0] += e * max(0.0, dot(n, w));
-                acc[1] += e * (lobe_norm * pow(max(0.0, dot(r, w)), exponent));
-#else
-                float y[SH_COEFFS];
-                sh_basis(w, y);
-                for (int k = 0; k < SH_COEFFS; ++k) {
-                    acc[k] += e * y[k];
-                }
-#endif
+        // Each set's sum stands for all the VPLs: the filter over whole pattern tiles counts
+        // every set equally, so n m times each set's sum totals the full sum there.
+        float scale = float(sets);
+        for (uint j = 0u; j < push.vpl_count; ++j) {
+            if (igi_sample_set(vpls.h[j].sample_index, sets) != s) {
+                continue;
             }
+            // Field by field: naga cannot read a whole-struct copy out of a buffer.
+            vec4 position_radius = vpls.h[j].position_radius;
+            vec4 flux = vpls.h[j].flux;
+            if (flux.a == 0.0) {
+                continue;
+            }
+            vec3 v = position_radius.xyz - x;
+            float dist = length(v);
+            if (!(dist > 0.0)) {
+                continue;
+            }
+            vec3 w = v / dist;
+            // Light from below the geometric surface cannot reach x.
+            if (dot(w, ng) <= 0.0) {
+                continue;
+            }
+            float footprint = push.footprint * position_radius.w;
+            vec3 e = igi_vpl_irradiance(flux.rgb, vpls.h[j].normal_distance.xyz, w, dist, push.camera_clamp.w, footprint) * scale;
+            if (all(equal(e, vec3(0.0)))) {
+                continue;
+            }
+            if (trace_occluded(origin, w, 0.0, length(position_radius.xyz - origin) * IGI_SHADOW_END)) {
+                continue;
+            }
+#ifdef IGI_IRRADIANCE
+            acc[0] += e * max(0.0, dot(n, w));
+            acc[1] += e * (lobe_norm * pow(max(0.0, dot(r, w)), exponent));
+#else
+            float y[SH_COEFFS];
+            sh_basis(w, y);
+            for (int k = 0; k < SH_COEFFS; ++k) {
+                acc[k] += e * y[k];
+            }
+#endif
         }
     }
     for (int k = 0; k < SH_OUT; ++k) {

@@ -183,6 +183,7 @@ fn accumulate_matches_the_cpu_twin() {
             max_frames,
             clip,
             geometry,
+            reseed: false,
         };
         let cpu = accumulate_cpu(&inputs, &params);
         let gpu = accumulate_gpu(&device, &inputs, &params);
@@ -213,6 +214,7 @@ fn disocclusion_rejects_history() {
         max_frames: 8,
         clip: 0.0,
         geometry: true,
+        reseed: false,
     };
     for (geometry, keeps) in [
         (Vec4::new(0.0, 0.0, 1.0, 2.0), true),

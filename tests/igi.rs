@@ -90,7 +90,8 @@ fn synthetic_gbuffer() -> GBufferData {
     g
 }
 
-/// 64 VPLs on a tilted "ceiling" above the scene, facing down, colourful fluxes, two invalid.
+/// 64 VPLs on a tilted "ceiling" above the scene, facing down, colourful fluxes, two invalid;
+/// their identities are a permutation of the records (as when lights' shares reorder them).
 fn synthetic_vpls() -> Vec<Hvl> {
     (0..64u32)
         .map(|k| {
@@ -103,7 +104,10 @@ fn synthetic_vpls() -> Vec<Hvl> {
                 position_radius: p.extend(0.1).to_array(),
                 normal_distance: n.extend(2.0).to_array(),
                 flux: flux.extend(if valid { 1.0 } else { 0.0 }).to_array(),
-                emission: [0.0; 8],
+                emission: [0.0; 5],
+                light: k % 2,
+                sample_index: (k * 37) % 64,
+                pad: 0,
             }
         })
         .collect()
@@ -716,8 +720,8 @@ fn mean(image: &HdrImage) -> f64 {
 }
 
 /// The default IGI frame (4×4 sets of 256 VPLs, SH order 3, one-tile filter, GGX tables,
-/// d_min = 0.1 m)
-/// against the path-traced one-bounce indirect light; the clamp's energy loss measured.
+/// d_min = 0.1 m, footprint k = 1)
+/// against the path-traced one-bounce indirect light; the clamps' energy loss measured.
 #[test]
 fn room_igi_against_the_path_traced_reference() {
     let reference = room_reference();
@@ -737,21 +741,26 @@ fn room_igi_against_the_path_traced_reference() {
         "IGI (SH, Phong lobe of paper 000 §3.3.2): PSNR {:.2} dB, SSIM {:.4}",
         phong.psnr, phong.ssim
     );
-    let unclamped = room_igi(|s| s.igi.clamp_distance = 0.0);
+    let unclamped = room_igi(|s| {
+        s.igi.clamp_distance = 0.0;
+        s.igi.footprint = 0.0;
+    });
     let u = compare(&unclamped, &reference.indirect).expect("compare");
     println!(
-        "without the clamp: PSNR {:.2} dB; the clamp removes {:.1}% of the mean indirect radiance",
+        "without the clamps: PSNR {:.2} dB; the clamps remove {:.1}% of the mean indirect radiance",
         u.psnr,
         100.0 * (1.0 - mean(&igi) / mean(&unclamped))
     );
     // Measured (lavapipe, reference at 64 spp whose noise lowers PSNR and SSIM), default GGX
-    // tables: RMSE 0.047, PSNR 26.6 dB, SSIM 0.78, mean ratio 0.95; the Phong lobe of paper 000
-    // §3.3.2: PSNR 26.7 dB, SSIM 0.78; without the clamp PSNR 26.2 dB and the clamp removes 5.5%
-    // of the mean indirect radiance. The chrome torus (roughness 0.05) dominates the error: its
-    // mirror lobe sees the order-3 SH radiance blurred (paper 000 §4.4).
-    assert!(c.psnr > 25.0 && c.ssim > 0.72, "{c:?}");
+    // tables: RMSE 0.037, PSNR 28.7 dB, SSIM 0.86, mean ratio 0.85; the Phong lobe of paper 000
+    // §3.3.2: PSNR 28.7 dB, SSIM 0.85. Before the VPLs had identities and footprints (issue
+    // 43): PSNR 26.6 dB, SSIM 0.78, mean ratio 0.95, the d_min clamp alone removing 5.5%. The
+    // footprint trades light near the VPLs (bright corners) for a light that does not flicker
+    // as they move (docs/quality.md). The chrome torus (roughness 0.05) dominates the error:
+    // its mirror lobe sees the order-3 SH radiance blurred (paper 000 §4.4).
+    assert!(c.psnr > 27.5 && c.ssim > 0.82, "{c:?}");
     assert!(
-        (0.85..=1.15).contains(&ratio),
+        (0.8..=1.15).contains(&ratio),
         "IGI / reference mean {ratio}"
     );
 }

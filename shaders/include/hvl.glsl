@@ -19,8 +19,13 @@ struct Hvl {
     vec4 normal_distance;
     // rgb: flux Phi_j (W); a: 1 for a valid HVL, 0 for an empty cell
     vec4 flux;
-    // ZH coefficients (about n_j) of the sender's F' (paper 003 eq. 20), 5 used, 3 padding
-    float emission[8];
+    // ZH coefficients (about n_j) of the sender's F' (paper 003 eq. 20)
+    float emission[HVL_EMISSION_MAX_BANDS];
+    // identity: the light's index in the scene and the sample's index in that light's
+    // sequence (the flux distribution) or its grid cell; survives reordering (IGI's sets)
+    uint light;
+    uint sample_index;
+    uint pad;
 };
 
 // One HVL as the gather reads it: shine::passes::hvl::GatherHvl, written from the cache by

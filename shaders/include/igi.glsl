@@ -15,11 +15,14 @@ const float IGI_PHONG_MAX = 1e4;
 
 // Irradiance-weight E_j of one VPL at a receiver (paper 000 §3.2, a Lambertian VPL of
 // Instant Radiosity): the VPL's radiant intensity I = Phi max(0, n_j . -w) / pi over the squared
-// distance, clamped: E_j = I / max(d^2, d_min^2). w: unit direction receiver -> VPL.
+// distance, clamped: E_j = I / max(d, d_min, rho)^2. w: unit direction receiver -> VPL.
+// rho = k r_j is the VPL's footprint (shine's, issue 43; 0 gives the paper's clamp alone): a
+// receiver nearer the VPL than its neighbours are apart sees a bounded light instead of a
+// 1/d^2 spike that sweeps across the wall as the VPL moves.
 // The incident radiance is E_j delta(w): its SH projection (eq. 1) is E_j Y(w).
-vec3 igi_vpl_irradiance(vec3 flux, vec3 vpl_normal, vec3 w, float dist, float clamp_distance) {
+vec3 igi_vpl_irradiance(vec3 flux, vec3 vpl_normal, vec3 w, float dist, float clamp_distance, float footprint) {
     float cos_sender = max(0.0, -dot(vpl_normal, w));
-    float d = max(max(dist, clamp_distance), IGI_MIN_DISTANCE);
+    float d = max(max(max(dist, clamp_distance), footprint), IGI_MIN_DISTANCE);
     return flux * (cos_sender / (IGI_PI * d * d));
 }
 
@@ -54,13 +57,6 @@ void igi_brdf_phong(vec3 r, float exponent, out float b[SH_COEFFS]) {
 // The set of pixel px in an n x m interleaving pattern (paper 000 §2.3): s = (x mod n) + n (y mod m).
 uint igi_set(ivec2 px, uvec2 pattern) {
     return uint(px.x) % pattern.x + pattern.x * (uint(px.y) % pattern.y);
-}
-
-// VPL k of set s (k-th member, global index i = s + k n m) and its cell in the RSM grid: the
-// fixed permutation cell = i * stride mod M (stride coprime with M, near M (sqrt 5 - 1)/2) so that
-// a set's VPLs spread over the whole RSM instead of one column of its grid.
-uint igi_vpl_cell(uint i, uint stride, uint count) {
-    return (i * stride) % count;
 }
 
 #endif

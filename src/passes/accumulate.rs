@@ -79,6 +79,12 @@ pub struct AccumulateParams {
     /// (0: history not clipped).
     #[setting(default = DEFAULT_CLIP, range = CLIP_RANGE, affects = quality)]
     pub clip: f32,
+    /// New random numbers every frame for the traced parts (sampled shadows, near field, sky,
+    /// specular), so the history averages their noise (true), or each pixel's rays kept from
+    /// frame to frame (false): their noise then holds still, as a fixed-seed path tracer's
+    /// does, and only a real change of the light moves it (issue 43; docs/quality.md).
+    #[setting(default = false, affects = quality)]
+    pub reseed: bool,
     /// The indirect light's history: linear radiance, the background passes through. Without
     /// it, TAA: the background accumulates too, a still pixel ([`TAA_STILL_PIXELS`]) keeps
     /// history of any surface of its 3×3 neighbourhood, and the blend is in the space
@@ -97,6 +103,7 @@ impl AccumulateParams {
         Self {
             max_frames: TAA_MAX_FRAMES,
             clip: TAA_CLIP,
+            reseed: false,
             geometry: false,
         }
     }

@@ -35,6 +35,8 @@ pub struct Rsm {
     pub projection: RsmProjection,
     /// Side S of the RSM in texels.
     pub size: u32,
+    /// The index in the scene of the light this face belongs to.
+    pub light: u32,
 }
 
 /// The projection of an RSM: it decides the r2 heuristic and the distance `d_j` to the light.
@@ -83,6 +85,7 @@ pub fn rsm(
             RsmProjection::Perspective { fov: view.extent }
         },
         size,
+        light,
     };
     let pipeline = scene_pipeline(
         &shaders::GBUFFER_VERT_PLAIN,

@@ -7,6 +7,7 @@
 //! [`zh_eval`] (a rotated ZH vector evaluated at a direction) and [`zh_dot`] (dot product of two
 //! rotated ZH vectors, the O(n) zonal path). Everything else calls shine-sh.
 
+use bytemuck::Zeroable;
 use glam::{DVec3, Vec3, Vec4};
 use shine_sh::brdf_table::BrdfModel;
 use shine_sh::hvl::{
@@ -57,6 +58,9 @@ pub fn visibility_ray(x: Vec3, n: Vec3, hvl: &Hvl) -> (Vec3, Vec3) {
 pub struct RsmData {
     /// Side S.
     pub size: u32,
+    /// The index in the scene of the light this face belongs to (a point light's six faces
+    /// share one, consecutive in a face list): the flux distribution's sample identity.
+    pub light: u32,
     /// `rsm_position` texels (w = 1 valid, 0 empty).
     pub position: Vec<Vec4>,
     /// `rsm_normal` texels.
@@ -231,8 +235,8 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
         RsmProjection::Perspective { .. } => p.distance(rsm.light_position),
         RsmProjection::Orthographic { .. } => (p - rsm.light_position).dot(direction),
     };
-    let mut emission = [0.0f32; 8];
-    emission[..EMISSION_MAX_BANDS].copy_from_slice(&sender_emission_zh(EMISSION_MAX_BANDS)?);
+    let mut emission = [0.0f32; EMISSION_MAX_BANDS];
+    emission.copy_from_slice(&sender_emission_zh(EMISSION_MAX_BANDS)?);
     let mut hvls = Vec::with_capacity(count as usize);
     for m in 0..count {
         let (lo, hi) = grid.cell(m);
@@ -257,10 +261,8 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
         }
         let hvl = match rep {
             None => Hvl {
-                position_radius: [0.0; 4],
-                normal_distance: [0.0; 4],
-                flux: [0.0; 4],
-                emission: [0.0; 8],
+                sample_index: m,
+                ..Hvl::zeroed()
             },
             Some(t) => {
                 let p = rsm.position[t].truncate();
@@ -275,6 +277,9 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
                     normal_distance: n.extend(d).to_array(),
                     flux: flux.extend(1.0).to_array(),
                     emission,
+                    light: 0,
+                    sample_index: m,
+                    pad: 0,
                 }
             }
         };
@@ -590,11 +595,11 @@ mod tests {
             normal_distance: [0.0, 1.0, 0.0, 2.0],
             flux: [1.0, 1.0, 1.0, 1.0],
             emission: {
-                let mut e = [0.0; 8];
-                let zh = sender_emission_zh(EMISSION_MAX_BANDS).unwrap();
-                e[..zh.len()].copy_from_slice(&zh);
+                let mut e = [0.0; EMISSION_MAX_BANDS];
+                e.copy_from_slice(&sender_emission_zh(EMISSION_MAX_BANDS).unwrap());
                 e
             },
+            ..Hvl::zeroed()
         };
         // Receivers straight above the HVL (facing away from its surface normal would send
         // nothing), their normals towards the centre or tilted by 60°.

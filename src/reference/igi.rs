@@ -7,9 +7,10 @@ use glam::{Mat3, Vec3, Vec4};
 use shine_sh::rotation::ShRotation;
 use shine_sh::{ShError, basis, kernels, zonal};
 
+use super::hvl_flux::sample_set;
 use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::Hvl;
-use crate::passes::igi::{FilterMode, Glossy, IgiParams, permutation_stride, pixel_set, vpl_cell};
+use crate::passes::igi::{FilterMode, Glossy, IgiParams, pixel_set};
 use crate::passes::specular::trace_weight;
 
 /// `IGI_MIN_DISTANCE` of igi.glsl (metres).
@@ -36,10 +37,18 @@ pub struct GBufferData {
     pub material: Vec<Vec4>,
 }
 
-/// `igi_vpl_irradiance`: E_j = Φ max(0, n_j·−ω) / (π max(d, d_min)²).
-pub fn vpl_irradiance(flux: Vec3, vpl_normal: Vec3, w: Vec3, dist: f32, clamp: f32) -> Vec3 {
+/// `igi_vpl_irradiance`: E_j = Φ max(0, n_j·−ω) / (π max(d, d_min, ρ)²), ρ the VPL's
+/// footprint (0: paper 000's clamp alone).
+pub fn vpl_irradiance(
+    flux: Vec3,
+    vpl_normal: Vec3,
+    w: Vec3,
+    dist: f32,
+    clamp: f32,
+    footprint: f32,
+) -> Vec3 {
     let cos_sender = (-vpl_normal.dot(w)).max(0.0);
-    let d = dist.max(clamp).max(MIN_DISTANCE);
+    let d = dist.max(clamp).max(footprint).max(MIN_DISTANCE);
     flux * (cos_sender / (std::f32::consts::PI * d * d))
 }
 
@@ -110,7 +119,14 @@ pub fn trace_offset(p: Vec3, n: Vec3) -> Vec3 {
 
 /// One VPL's contribution at a receiver: `(ω, E_j)` before visibility, or `None` when it is
 /// invalid, at the receiver, or below the geometric surface. `scale` is `M / |S_s|`.
-fn contribution(vpl: &Hvl, x: Vec3, ng: Vec3, clamp: f32, scale: f32) -> Option<(Vec3, Vec3)> {
+fn contribution(
+    vpl: &Hvl,
+    x: Vec3,
+    ng: Vec3,
+    params: &IgiParams,
+    scale: f32,
+) -> Option<(Vec3, Vec3)> {
+    let footprint = params.footprint * vpl.position_radius[3];
     if vpl.flux[3] == 0.0 {
         return None;
     }
@@ -125,7 +141,7 @@ fn contribution(vpl: &Hvl, x: Vec3, ng: Vec3, clamp: f32, scale: f32) -> Option<
     }
     let normal = Vec4::from(vpl.normal_distance).truncate();
     let flux = Vec4::from(vpl.flux).truncate();
-    let e = vpl_irradiance(flux, normal, w, dist, clamp) * scale;
+    let e = vpl_irradiance(flux, normal, w, dist, params.clamp_distance, footprint) * scale;
     (e != Vec3::ZERO).then_some((w, e))
 }
 
@@ -140,7 +156,6 @@ pub fn vpl_sh(
     occluded: impl Fn(Vec3, Vec3, f32) -> bool,
 ) -> Result<Vec<Vec<Vec3>>, ShError> {
     let count = params.vpl_count;
-    let stride = permutation_stride(count);
     let sets = params.n * params.m;
     let bands = params.sh_order as usize;
     let coefficients = params.coefficients() as usize;
@@ -158,13 +173,15 @@ pub fn vpl_sh(
             let exponent = phong_exponent(g.material[p].x);
             let lobe_norm = (exponent + 1.0) / std::f32::consts::TAU;
             let s = pixel_set(p as u32 % w, p as u32 / w, params.pattern());
-            if s < count {
-                let members = (count - s).div_ceil(sets);
-                let scale = count as f32 / members as f32;
-                for i in (s..count).step_by(sets as usize) {
-                    let vpl = &vpls[vpl_cell(i, stride, count) as usize];
-                    let Some((dir, e)) = contribution(vpl, x, ng, params.clamp_distance, scale)
-                    else {
+            // n m times each set's sum: the filter counts every set equally.
+            let scale = sets as f32;
+            {
+                for vpl in vpls
+                    .iter()
+                    .take(count as usize)
+                    .filter(|v| sample_set(v.sample_index, sets) == s)
+                {
+                    let Some((dir, e)) = contribution(vpl, x, ng, params, scale) else {
                         continue;
                     };
                     let target = Vec4::from(vpl.position_radius).truncate();
@@ -317,7 +334,7 @@ pub fn brute_force(
             let ks = ks * (1.0 - trace_weight(g.material[p].x, params.specular_limit));
             let mut sum = Vec3::ZERO;
             for vpl in &vpls[..params.vpl_count as usize] {
-                let Some((dir, e)) = contribution(vpl, x, ng, params.clamp_distance, 1.0) else {
+                let Some((dir, e)) = contribution(vpl, x, ng, params, 1.0) else {
                     continue;
                 };
                 let target = Vec4::from(vpl.position_radius).truncate();

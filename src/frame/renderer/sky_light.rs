@@ -14,9 +14,11 @@ use crate::passes::receivers::Receivers;
 use crate::passes::sky::{self, SkyParams};
 
 /// The seed the Monte-Carlo passes add to theirs: the frame index when a history averages the
-/// frames, else 0 (a still frame then looks the same every time).
+/// frames and `history.reseed` asks for new rays each frame, else 0: every pixel keeps its
+/// rays from frame to frame, so their noise holds still as a fixed-seed path tracer's does
+/// (issue 43), and a still frame looks the same every time.
 pub(super) fn history_seed(rg: &RenderGraph, p: &FrameParams) -> u32 {
-    if p.history.is_some() {
+    if p.history.is_some_and(|h| h.reseed) {
         rg.frame() as u32
     } else {
         0

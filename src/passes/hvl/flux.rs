@@ -1,6 +1,8 @@
 //! The flux distribution's passes ([`Distribution::Flux`](super::Distribution::Flux)):
-//! `hvl_flux_rows` per RSM face, `hvl_flux_marginal`, then `hvl_cache` per face
-//! (`shaders/hvl_flux.comp`; CPU twin [`crate::reference::hvl_flux`]).
+//! `hvl_flux_rows` per RSM face, `hvl_flux_marginal` per light, `hvl_flux_budget`, then
+//! `hvl_cache` per face (`shaders/hvl_flux.comp`; CPU twin [`crate::reference::hvl_flux`]).
+//! Each light owns a progressive sample sequence whose members keep their identity from frame
+//! to frame (issue 43; the shader's header tells how).
 
 use glam::Vec3;
 
@@ -9,7 +11,7 @@ use crate::graph::{Buffer, BufferDesc, Handle, RenderGraph};
 use crate::passes::rsm::Rsm;
 use crate::shaders;
 
-/// Push constants of `shaders/hvl_flux.comp` (every stage), 64 bytes.
+/// Push constants of `shaders/hvl_flux.comp` (every stage), 80 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FluxPush {
@@ -32,20 +34,62 @@ pub struct FluxPush {
     pub count: u32,
     /// User radius scale k.
     pub radius_scale: f32,
-    /// Padding.
-    pub pad: u32,
+    /// The face's light: its first row in the global row order.
+    pub light_row_offset: u32,
+    /// The face's light: its rows (the sum of its faces' sides).
+    pub light_rows: u32,
+    /// The face's light: its place k in the light order.
+    pub light_order: u32,
+    /// The face's light: its index in the scene (the samples' identity).
+    pub light_id: u32,
+    /// N: lights.
+    pub light_count: u32,
 }
 
 /// Largest `cdf` buffer, bytes: the storage-buffer range every Vulkan device allows (2²⁷).
 pub const MAX_CDF_BYTES: u64 = 1 << 27;
 
-/// Bytes of the `cdf` buffer for faces of these sides: T running sums, then R row totals and
-/// their R running sums.
-pub fn cdf_bytes(sides: impl IntoIterator<Item = u32>) -> u64 {
+/// Bytes of the `cdf` buffer for faces of these sides and `lights` lights: T running sums,
+/// R row totals and their R running sums, then the light table (4 floats and 4 per light).
+pub fn cdf_bytes(sides: impl IntoIterator<Item = u32>, lights: usize) -> u64 {
     let (texels, rows) = sides.into_iter().fold((0u64, 0u64), |(t, r), s| {
         (t + u64::from(s) * u64::from(s), r + u64::from(s))
     });
-    4 * (texels + 2 * rows)
+    4 * (texels + 2 * rows + 4 * (lights as u64 + 1))
+}
+
+/// A light's run of faces: its place in the light order, its scene index, its faces, and its
+/// rows in the global row order.
+struct LightRun {
+    order: u32,
+    id: u32,
+    faces: std::ops::Range<usize>,
+    row_offset: u32,
+    rows: u32,
+}
+
+/// The faces grouped into runs of one light each (a point light's six cube faces are
+/// consecutive), in order.
+fn light_runs(faces: &[Rsm]) -> Vec<LightRun> {
+    let mut runs: Vec<LightRun> = Vec::new();
+    let mut row = 0;
+    for (f, face) in faces.iter().enumerate() {
+        match runs.last_mut() {
+            Some(run) if run.id == face.light => {
+                run.faces.end = f + 1;
+                run.rows += face.size;
+            }
+            _ => runs.push(LightRun {
+                order: runs.len() as u32,
+                id: face.light,
+                faces: f..f + 1,
+                row_offset: row,
+                rows: face.size,
+            }),
+        }
+        row += face.size;
+    }
+    runs
 }
 
 /// Adds the flux distribution's passes over `faces` (the primary light's first), writing
@@ -56,7 +100,8 @@ pub(super) fn flux_cache(
     params: &HvlParams,
     hvls: &mut Handle<Buffer>,
 ) -> Result<(), HvlError> {
-    let bytes = cdf_bytes(faces.iter().map(|f| f.size));
+    let runs = light_runs(faces);
+    let bytes = cdf_bytes(faces.iter().map(|f| f.size), runs.len());
     if bytes > MAX_CDF_BYTES {
         return Err(HvlError::Size {
             name: "hvl_flux_cdf",
@@ -68,7 +113,10 @@ pub(super) fn flux_cache(
     let texels_total: u32 = faces.iter().map(|f| f.size * f.size).sum();
     let mut pushes = Vec::with_capacity(faces.len());
     let (mut texel_offset, mut row_offset) = (0, 0);
-    for face in faces {
+    for (run, face) in runs
+        .iter()
+        .flat_map(|run| faces[run.faces.clone()].iter().map(move |face| (run, face)))
+    {
         let (extent, ortho) = encode_projection(face.projection);
         pushes.push(FluxPush {
             light_position_extent: face.light_position.extend(extent).to_array(),
@@ -84,12 +132,18 @@ pub(super) fn flux_cache(
             texels_total,
             count: params.count,
             radius_scale: params.radius_scale,
-            pad: 0,
+            light_row_offset: run.row_offset,
+            light_rows: run.rows,
+            light_order: run.order,
+            light_id: run.id,
+            light_count: runs.len() as u32,
         });
         texel_offset += face.size * face.size;
         row_offset += face.size;
     }
     let mut cdf = rg.create_buffer("hvl_flux_cdf", BufferDesc::new(bytes));
+    // Slots no light keeps stay empty records.
+    rg.fill_buffer("hvl_cache_clear", hvls, 0);
     for (f, (face, push)) in faces.iter().zip(&pushes).enumerate() {
         rg.compute(&face_name("hvl_flux_rows", f), &shaders::HVL_FLUX_COMP_ROWS)
             .read("rsm_position", &face.position)
@@ -98,7 +152,16 @@ pub(super) fn flux_cache(
             .push(push)
             .dispatch([face.size, 1, 1]);
     }
-    rg.compute("hvl_flux_marginal", &shaders::HVL_FLUX_COMP_MARGINAL)
+    for run in &runs {
+        rg.compute(
+            &face_name("hvl_flux_marginal", run.order as usize),
+            &shaders::HVL_FLUX_COMP_MARGINAL,
+        )
+        .write("cdf", &mut cdf)
+        .push(&pushes[run.faces.start])
+        .dispatch([1, 1, 1]);
+    }
+    rg.compute("hvl_flux_budget", &shaders::HVL_FLUX_COMP_BUDGET)
         .write("cdf", &mut cdf)
         .push(&pushes[0])
         .dispatch([1, 1, 1]);
@@ -115,8 +178,8 @@ pub(super) fn flux_cache(
     Ok(())
 }
 
-/// A pass's name for face `f`: `base` for the primary light's face (the name the profiles
-/// and the grid distribution use), `base f` for the others.
+/// A pass's name for face (or light) `f`: `base` for the primary light's (the name the
+/// profiles and the grid distribution use), `base f` for the others.
 fn face_name(base: &str, f: usize) -> String {
     if f == 0 {
         base.to_owned()

@@ -111,9 +111,16 @@ pub struct Hvl {
     pub normal_distance: [f32; 4],
     /// rgb: flux `Φ_j` (W); a: 1 for a valid HVL, 0 for an empty cell.
     pub flux: [f32; 4],
-    /// ZH coefficients (about `n_j`) of the sender's `F'` (eq. 20); [`EMISSION_MAX_BANDS`]
-    /// used, the rest zero padding.
-    pub emission: [f32; 8],
+    /// ZH coefficients (about `n_j`) of the sender's `F'` (eq. 20).
+    pub emission: [f32; EMISSION_MAX_BANDS],
+    /// Identity, part 1: the index in the scene of the light this HVL bounces (0 on the grid).
+    pub light: u32,
+    /// Identity, part 2: the sample's index in its light's sequence (by flux) or its grid
+    /// cell. IGI's interleaved set follows from it ([`crate::reference::hvl_flux::sample_set`]),
+    /// so a VPL keeps its set when the records reorder.
+    pub sample_index: u32,
+    /// Padding to 16 bytes.
+    pub pad: u32,
 }
 
 impl Hvl {

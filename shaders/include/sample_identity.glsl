@@ -1,0 +1,61 @@
+// Samples with identities (issue 43): the progressive low-discrepancy points each light owns in
+// its RSM, the budget split between lights, and the interleaved set a sample belongs to. CPU
+// twin: shine::reference::hvl_flux (same names without the hvl_flux_ / igi_ prefix); the GPU
+// twin tests in tests/hvl.rs and tests/igi.rs tie them. Integer digit arithmetic and correctly
+// rounded products only, so both sides agree bit for bit.
+#ifndef SAMPLE_IDENTITY_GLSL
+#define SAMPLE_IDENTITY_GLSL
+
+// Base-3 digits of the radical inverse (15 digits: exact for j < 3^15) and 1 / 3^15 as f32.
+const uint HVL_FLUX_PHI3_DIGITS = 15u;
+const float HVL_FLUX_INV_3_15 = uintBitsToFloat(0x3395a96eu);
+// Base-5 digits of the set key (9 digits: 5^9 times the most sets, 64, fits a uint).
+const uint IGI_SET_DIGITS = 9u;
+const uint IGI_SET_SCALE = 1953125u;
+
+// The base-b radical inverse of j to `digits` digits, as the integer numerator over b^digits.
+uint radical_inverse_digits(uint j, uint b, uint digits) {
+    uint r = 0u;
+    for (uint d = 0u; d < digits; ++d) {
+        r = r * b + j % b;
+        j /= b;
+    }
+    return r;
+}
+
+// phi_2(j): the base-2 radical inverse to 24 bits, exact in f32.
+float hvl_flux_phi2(uint j) {
+    return float(bitfieldReverse(j) >> 8u) * (1.0 / 16777216.0);
+}
+
+// phi_3(j) times `total`: the target of the column search, as two correctly rounded products.
+float hvl_flux_phi3(uint j, float total) {
+    return float(radical_inverse_digits(j, 3u, HVL_FLUX_PHI3_DIGITS)) * total * HVL_FLUX_INV_3_15;
+}
+
+// M' = M - (N - 1) samples split between N lights (at least 1), so that the N rounded-up
+// counts sum to at most M.
+uint hvl_flux_budget(uint count, uint lights) {
+    return count > lights ? count - (lights - 1u) : 1u;
+}
+
+// n_k = ceil(M' Phi_k / Phi), decided by products: the least n with n Phi >= M' Phi_k.
+uint hvl_flux_light_count(uint budget, float light_total, float total) {
+    float goal = float(budget) * light_total;
+    uint n = uint(ceil(goal / total));
+    while (n > 0u && float(n - 1u) * total >= goal) {
+        --n;
+    }
+    while (float(n) * total < goal) {
+        ++n;
+    }
+    return n;
+}
+
+// The interleaved set (of `sets`) of sample j: floor(phi_5(j) sets), so that each light's
+// samples spread evenly over the sets and a sample keeps its set when the records reorder.
+uint igi_sample_set(uint j, uint sets) {
+    return radical_inverse_digits(j, 5u, IGI_SET_DIGITS) * sets / IGI_SET_SCALE;
+}
+
+#endif
