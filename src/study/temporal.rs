@@ -10,8 +10,10 @@
 
 use std::time::Instant;
 
+use glam::Vec2;
 use serde::Serialize;
 use shine_scene::Scene;
+use shine_scene::bvh::{Bvh, Ray};
 
 use super::metrics;
 use super::{Progress, StudyError};
@@ -19,7 +21,9 @@ use crate::capture::image_io::HdrImage;
 use crate::frame::renderer::Renderer;
 use crate::gpu::Device;
 use crate::gpu_scene::FrameUpdate;
+use crate::gpu_scene::frame_update::FrameState;
 use crate::passes::composite::Component;
+use crate::passes::gbuffer::unjittered_camera_view;
 use crate::reference::{PathTracer, ReferenceParams};
 use crate::settings::Settings;
 
@@ -63,6 +67,10 @@ pub struct ModeResult {
     pub flicker: f64,
     /// Flicker where the truth holds still: over the pixels of [`TemporalReport::still`].
     pub still_flicker: f64,
+    /// Flicker over the pixels no moving object covers ([`TemporalReport::uncovered`]).
+    pub uncovered_flicker: f64,
+    /// The cold frames' flicker over [`TemporalReport::uncovered`].
+    pub cold_uncovered_flicker: f64,
     /// Relative RMSE of the sequence's last frame.
     pub last_rmse: f64,
     /// Flicker of the cold frames (each rendered from a fresh scene at its time).
@@ -106,6 +114,16 @@ pub struct TemporalReport {
     pub still: Vec<bool>,
     /// The truth's flicker over [`TemporalReport::still`].
     pub truth_still_flicker: f64,
+    /// The pixels no moving object covers in any frame (every pixel where nothing but lights
+    /// and the camera moves), from primary rays through the scene's BVH at each frame's time:
+    /// a silhouette crossing a pixel is a true jump that would hide popping on the walls.
+    /// Row-major.
+    #[serde(skip)]
+    pub uncovered: Vec<bool>,
+    /// Share of the pixels in [`TemporalReport::uncovered`].
+    pub uncovered_share: f64,
+    /// The truth's flicker over [`TemporalReport::uncovered`], its noise taken out.
+    pub truth_uncovered_flicker: f64,
     /// The truth's flicker at each inner frame.
     pub truth_flicker_by_frame: Vec<f64>,
     /// Per-pixel flicker of the truth.
@@ -174,10 +192,17 @@ pub fn flicker(frames: &[HdrImage]) -> f64 {
 /// signal's second difference stays. Its square root over the mean of both; 0 where the noise
 /// leaves a negative estimate.
 pub fn flicker_noise_free(a: &[HdrImage], b: &[HdrImage]) -> f64 {
+    let pixels = a.first().map_or(0, |f| f.texels.len());
+    flicker_noise_free_masked(a, b, &vec![true; pixels])
+}
+
+/// [`flicker_noise_free`] over the pixels where `mask` holds (the product and the mean both
+/// over them).
+pub fn flicker_noise_free_masked(a: &[HdrImage], b: &[HdrImage], mask: &[bool]) -> f64 {
     let (mut product, mut n) = (0.0f64, 0usize);
     for (wa, wb) in a.windows(3).zip(b.windows(3)) {
         let pixels = wa[0].texels.len();
-        for i in 0..pixels {
+        for i in (0..pixels).filter(|&i| mask.get(i).copied().unwrap_or(false)) {
             for k in 0..3 {
                 let d = |w: &[HdrImage]| {
                     f64::from(w[2].texels[i][k] - 2.0 * w[1].texels[i][k] + w[0].texels[i][k])
@@ -190,8 +215,68 @@ pub fn flicker_noise_free(a: &[HdrImage], b: &[HdrImage]) -> f64 {
     if n == 0 {
         return 0.0;
     }
-    let mean = 0.5 * (frames_mean(a) + frames_mean(b));
+    let masked_mean = |frames: &[HdrImage]| {
+        let (mut sum, mut m) = (0.0f64, 0usize);
+        for f in frames {
+            for (t, _) in f.texels.iter().zip(mask).filter(|(_, m)| **m) {
+                sum += f64::from(t[0] + t[1] + t[2]);
+                m += 3;
+            }
+        }
+        (sum / m.max(1) as f64).max(1e-12)
+    };
+    let mean = 0.5 * (masked_mean(a) + masked_mean(b));
     (product / n as f64).max(0.0).sqrt() / mean
+}
+
+/// The pixels of a `width`×`height` view of `scene` that no moving object covers at any of
+/// `times`: each pixel centre's primary ray (unjittered camera of that time) through the
+/// scene's BVH posed at that time hits an instance whose world matrix is the same at every
+/// time, or nothing. Skinned or morphing meshes count as still (the motion scenes have none).
+pub fn uncovered_pixels(scene: &Scene, times: &[f32], width: u32, height: u32) -> Vec<bool> {
+    let states: Vec<FrameState> = times
+        .iter()
+        .map(|&t| FrameState::evaluate(scene, &FrameUpdate::at(t)))
+        .collect();
+    let instances: Vec<Vec<[[f32; 4]; 4]>> = states
+        .iter()
+        .map(|s| {
+            scene
+                .instances(&s.pose.world)
+                .iter()
+                .map(|i| i.world)
+                .collect()
+        })
+        .collect();
+    let moving: Vec<bool> = (0..instances.first().map_or(0, Vec::len))
+        .map(|i| instances.iter().any(|w| w.get(i) != instances[0].get(i)))
+        .collect();
+    let mut uncovered = vec![true; (width * height) as usize];
+    for state in &states {
+        let bvh = Bvh::from_scene(scene, &state.pose.world);
+        let view = unjittered_camera_view(state, width, height);
+        let to_world = view.view_proj().inverse();
+        for (p, keep) in uncovered.iter_mut().enumerate() {
+            let (x, y) = ((p as u32 % width) as f32, (p as u32 / width) as f32);
+            let ndc = Vec2::new(
+                2.0 * (x + 0.5) / width as f32 - 1.0,
+                2.0 * (y + 0.5) / height as f32 - 1.0,
+            );
+            let near = to_world.project_point3(ndc.extend(0.0));
+            let far = to_world.project_point3(ndc.extend(0.5));
+            let ray = Ray {
+                origin: near,
+                dir: far - near,
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            };
+            if let Some(hit) = bvh.intersect(&ray) {
+                let instance = bvh.triangles[hit.triangle].instance as usize;
+                *keep &= !moving.get(instance).copied().unwrap_or(false);
+            }
+        }
+    }
+    uncovered
 }
 
 /// [`flicker`] over the pixels where `mask` holds (RMS and mean both over them).
@@ -292,6 +377,7 @@ pub fn run(
     )?;
     let (truth_flicker_by_frame, truth_flicker_map) = flicker_parts(&truth);
     let still = calm_half(&truth_flicker_map);
+    let uncovered = uncovered_pixels(scene, &times, first.settings.width, first.settings.height);
     let mut results = Vec::new();
     for mode in modes {
         progress.stage(&mode.label, 2 * u64::from(config.frames));
@@ -341,6 +427,8 @@ pub fn run(
             relative_rmse: error(&images),
             flicker: flicker(&images),
             still_flicker: flicker_masked(&images, &still),
+            uncovered_flicker: flicker_masked(&images, &uncovered),
+            cold_uncovered_flicker: flicker_masked(&cold, &uncovered),
             last_rmse: last(&images),
             cold_flicker: flicker(&cold),
             cold_still_flicker: flicker_masked(&cold, &still),
@@ -360,6 +448,10 @@ pub fn run(
         truth_flicker_one_seed: flicker(&truth),
         truth_still_flicker: flicker_masked(&truth, &still),
         still,
+        uncovered_share: uncovered.iter().filter(|u| **u).count() as f64
+            / uncovered.len().max(1) as f64,
+        truth_uncovered_flicker: flicker_noise_free_masked(&truth, &truth_b, &uncovered),
+        uncovered,
         truth_flicker_by_frame,
         truth_flicker_map,
         modes: results,

@@ -50,49 +50,53 @@ fn percentile(values: &[f32], q: f32) -> f32 {
 }
 
 impl TemporalReport {
-    /// The report as a table: the sequence's cost, error and flicker (everywhere, and where
-    /// the truth holds still), the last frame's error, and the same for cold frames.
+    /// The report as a table: the sequence's cost, error (the lag: against the cold frames'
+    /// error) and flicker over every pixel and over the pixels no moving object covers, each
+    /// also as a multiple of the truth's, and the same for the cold frames. The JSON report
+    /// also holds the flicker where the truth holds still and the last frames' errors.
     pub fn table(&self) -> String {
         let mut out = format!(
-            "{} over {} frames after {} of warm-up; flicker of the path-traced truth {:.4} (two seeds, noise out; one seed reads {:.4}), where it holds still {:.4}\n",
+            "{} over {} frames after {} of warm-up; flicker of the path-traced truth {:.4} (two seeds, noise out; one seed reads {:.4}); over the {:.0}% of pixels no moving object covers {:.4}\n",
             self.scene,
             self.frames,
             self.warmup,
             self.truth_flicker,
             self.truth_flicker_one_seed,
-            self.truth_still_flicker,
+            100.0 * self.uncovered_share,
+            self.truth_uncovered_flicker,
         );
         out.push_str(&format!(
-            "{:<20} {:>8} {:>9} {:>8} {:>7} {:>8} {:>9} | {:>9} {:>8} {:>7} {:>8} {:>9}\n",
+            "{:<12} {:>8} {:>8} {:>8} {:>6} {:>8} {:>6} | {:>8} {:>8} {:>6} {:>8} {:>6}\n",
             "mode",
             "ms/frame",
             "rel.RMSE",
             "flicker",
             "×truth",
-            "still",
-            "last RMSE",
+            "uncov.",
+            "×truth",
             "rel.RMSE",
             "cold fl.",
             "×truth",
-            "still",
-            "last RMSE"
+            "uncov.",
+            "×truth",
         ));
         let times = |f: f64| f / self.truth_flicker.max(1e-12);
+        let times_uncovered = |f: f64| f / self.truth_uncovered_flicker.max(1e-12);
         for m in &self.modes {
             out.push_str(&format!(
-                "{:<20} {:>8.1} {:>9.4} {:>8.4} {:>7.2} {:>8.4} {:>9.4} | {:>9.4} {:>8.4} {:>7.2} {:>8.4} {:>9.4}\n",
+                "{:<12} {:>8.1} {:>8.4} {:>8.4} {:>6.2} {:>8.4} {:>6.2} | {:>8.4} {:>8.4} {:>6.2} {:>8.4} {:>6.2}\n",
                 m.label,
                 m.ms_per_frame,
                 m.relative_rmse,
                 m.flicker,
                 times(m.flicker),
-                m.still_flicker,
-                m.last_rmse,
+                m.uncovered_flicker,
+                times_uncovered(m.uncovered_flicker),
                 m.cold_relative_rmse,
                 m.cold_flicker,
                 times(m.cold_flicker),
-                m.cold_still_flicker,
-                m.cold_last_rmse
+                m.cold_uncovered_flicker,
+                times_uncovered(m.cold_uncovered_flicker),
             ));
         }
         out
