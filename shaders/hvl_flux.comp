@@ -3,19 +3,17 @@
 // directional light has one face, a point light six cube faces, consecutive). Texels are drawn
 // in proportion to their flux weight w = r + g + b (0 for an empty texel).
 //
-// Samples with identities (issue 43). Sample group k (one RSM face, as the host groups them:
-// shine::passes::hvl::flux; push names it a "light", and a group of several faces would
-// number their rows one after the other) owns the progressive sequence j = 0, 1, 2, ... of
-// Halton points (phi_2(j), phi_3(j)), warped through its own flux: sample j takes the group's
-// row where its running row sum passes phi_2(j) of its total Phi_k, then the texel of that row
-// where the row's running sum passes phi_3(j) of the row's total. A point's place depends on j
-// and on that face's flux alone, never on the budget or on the other faces, so when a light
-// moves its samples slide with it, and when a face's share changes the others' stay put.
-// The budget: M' = M - (N - 1) samples (N groups) split by flux, s_k = M' Phi_k / Phi; group k
+// Samples with identities (issue 43). Light k (its faces' rows numbered one after the other)
+// owns the progressive sequence j = 0, 1, 2, ... of Halton points (phi_2(j), phi_3(j)), warped
+// through its own flux: sample j takes the light's row where the light's running row sum
+// passes phi_2(j) of its total Phi_k, then the texel of that row where the row's running sum
+// passes phi_3(j) of the row's total. A point's place depends on j and on that light's flux
+// alone, never on the budget or on the other lights, so when a light moves its samples slide
+// with it, and when a light's share changes the others' stay put.
+// The budget: M' = M - (N - 1) samples (N lights) split by flux, s_k = M' Phi_k / Phi; light k
 // keeps n_k = ceil(s_k) samples, the last faded by the fractional part of s_k (weight
 // clamp(s_k - j, 0, 1)), so a share that grows fades its newest sample in instead of redrawing
-// the set. Sum n_k <= M. Every sample carries Phi / M' times its weight; its identity is
-// (light, sample_base + j).
+// the set. Sum n_k <= M. Every sample carries Phi / M' times its weight.
 // Positions come from a continuous inverse: where the target falls within its texel's share
 // of the running sum (f in [0, 1) across the row, g down the rows) places the sample between
 // texel centres, bilinearly among the texel and its neighbours on the side it leans to that
@@ -92,13 +90,8 @@ layout(push_constant) uniform Push {
     uint light_rows;
     uint light_order;
     uint light_id;
-    // N: sample groups (RSM faces)
+    // N: lights
     uint light_count;
-    // this face's first sample identity (shine::passes::hvl::flux::FACE_SAMPLE_STRIDE)
-    uint sample_base;
-    uint pad0;
-    uint pad1;
-    uint pad2;
 } push;
 
 // The light table's first float.
@@ -258,7 +251,7 @@ void write_hvl(uint m, vec4 position_radius, vec4 normal_distance, vec4 flux_val
         hvls.h[m].emission[l] = hvl_sender_emission(l);
     }
     hvls.h[m].light = push.light_id;
-    hvls.h[m].sample_index = push.sample_base + sample_index;
+    hvls.h[m].sample_index = sample_index;
     hvls.h[m].pad = 0u;
 }
 

@@ -1,9 +1,9 @@
 //! CPU twin of `shaders/hvl_flux.comp` and `shaders/include/sample_identity.glsl`: the HVL
 //! cache of [`Distribution::Flux`] over the RSM faces of every light, with samples that keep
-//! their identity (issue 43). Each RSM face k owns the progressive Halton sequence
+//! their identity (issue 43). Light k owns the progressive Halton sequence
 //! `(φ₂(j), φ₃(j))`, j = 0, 1, …, warped through its own flux; the budget M' = M − (N − 1) is
-//! split by flux between the N faces, `s_k = M' Φ_k / Φ`, face k keeping `⌈s_k⌉` samples,
-//! the last faded by the fractional part of `s_k`; each sample sits where its targets fall within its texel's share
+//! split by flux, `s_k = M' Φ_k / Φ`, light k keeping `⌈s_k⌉` samples, the last faded by the
+//! fractional part of `s_k`; each sample sits where its targets fall within its texel's share
 //! of the running sums (the continuous inverse), blended with the neighbours it leans to on
 //! its own surface.
 //! The draws use the shader's f32 sums and products in the same order, so both pick the same
@@ -17,7 +17,6 @@ use glam::{Vec3, Vec4};
 use shine_sh::hvl::{RsmFootprint, radius_spacing, rsm_texel_area};
 
 use super::hvl::{RsmData, sender_emission_zh};
-use crate::passes::hvl::flux::FACE_SAMPLE_STRIDE;
 use crate::passes::hvl::{EMISSION_MAX_BANDS, Hvl, HvlError, HvlParams};
 use crate::passes::rsm::RsmProjection;
 
@@ -100,14 +99,11 @@ pub fn sample_set(j: u32, sets: u32) -> u32 {
     radical_inverse_digits(j, 5, SET_DIGITS) * sets / SET_SCALE
 }
 
-/// A sample group: one RSM face and its rows (GLSL calls it a light).
+/// The faces of one light (consecutive in the face list) and their rows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightFaces {
-    /// The light's index in the scene (the samples' identity, part 1).
+    /// The light's index in the scene (the samples' identity).
     pub light: u32,
-    /// The group's first sample identity: its face's place among its light's faces times
-    /// [`FACE_SAMPLE_STRIDE`].
-    pub sample_base: u32,
     /// Its faces in the face list.
     pub faces: Range<usize>,
     /// Its first row in the global row order.
@@ -116,23 +112,23 @@ pub struct LightFaces {
     pub rows: usize,
 }
 
-/// The sample groups, one per face in order (as `shine::passes::hvl::flux` groups them): a
-/// sample never jumps from one cube face to another as the flux shifts between them.
+/// The faces grouped by light, in order: each run of consecutive faces of one light.
 pub fn light_faces(faces: &[RsmData]) -> Vec<LightFaces> {
     let mut groups: Vec<LightFaces> = Vec::new();
     let mut row = 0;
     for (f, face) in faces.iter().enumerate() {
-        let within = match groups.last() {
-            Some(last) if last.light == face.light => last.sample_base / FACE_SAMPLE_STRIDE + 1,
-            _ => 0,
-        };
-        groups.push(LightFaces {
-            light: face.light,
-            sample_base: within * FACE_SAMPLE_STRIDE,
-            faces: f..f + 1,
-            row_offset: row,
-            rows: face.size as usize,
-        });
+        match groups.last_mut() {
+            Some(g) if g.light == face.light => {
+                g.faces.end = f + 1;
+                g.rows += face.size as usize;
+            }
+            _ => groups.push(LightFaces {
+                light: face.light,
+                faces: f..f + 1,
+                row_offset: row,
+                rows: face.size as usize,
+            }),
+        }
         row += face.size as usize;
     }
     groups
@@ -369,7 +365,7 @@ pub fn build_flux_cache(faces: &[RsmData], params: &HvlParams) -> Result<Vec<Hvl
                 flux: Vec4::from((flux, 1.0)).to_array(),
                 emission,
                 light: group.light,
-                sample_index: group.sample_base + j,
+                sample_index: j,
                 pad: 0,
             };
         }

@@ -11,7 +11,7 @@ use crate::graph::{Buffer, BufferDesc, Handle, RenderGraph};
 use crate::passes::rsm::Rsm;
 use crate::shaders;
 
-/// Push constants of `shaders/hvl_flux.comp` (every stage), 96 bytes.
+/// Push constants of `shaders/hvl_flux.comp` (every stage), 80 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct FluxPush {
@@ -42,18 +42,9 @@ pub struct FluxPush {
     pub light_order: u32,
     /// The face's light: its index in the scene (the samples' identity).
     pub light_id: u32,
-    /// N: sample groups (RSM faces).
+    /// N: lights.
     pub light_count: u32,
-    /// The face's first sample identity: its place among its light's faces times
-    /// [`FACE_SAMPLE_STRIDE`].
-    pub sample_base: u32,
-    /// Padding to the block's 16-byte multiple.
-    pub pad: [u32; 3],
 }
-
-/// Sample identities per RSM face: face f of a light numbers its samples from f times this
-/// (a face keeps fewer than [`super::MAX_HVLS`] samples).
-pub const FACE_SAMPLE_STRIDE: u32 = 1 << 16;
 
 /// Largest `cdf` buffer, bytes: the storage-buffer range every Vulkan device allows (2²⁷).
 pub const MAX_CDF_BYTES: u64 = 1 << 27;
@@ -67,37 +58,35 @@ pub fn cdf_bytes(sides: impl IntoIterator<Item = u32>, lights: usize) -> u64 {
     4 * (texels + 2 * rows + 4 * (lights as u64 + 1))
 }
 
-/// A sample group: one RSM face, its place in the face order, its light's scene index, its
-/// first sample identity, and its rows in the global row order.
+/// A light's run of faces: its place in the light order, its scene index, its faces, and its
+/// rows in the global row order.
 struct LightRun {
     order: u32,
     id: u32,
     faces: std::ops::Range<usize>,
-    sample_base: u32,
     row_offset: u32,
     rows: u32,
 }
 
-/// One sample group per face: each face (a point light's cube face too) owns its sequence, so
-/// a sample never jumps from one cube face to another as the flux shifts between them; the
-/// faces' shares change by fading their newest samples (issue 43: a point light's samples
-/// grouped over its six faces flickered 1.5× more on `motion-orbit`).
+/// The faces grouped into runs of one light each (a point light's six cube faces are
+/// consecutive), in order.
 fn light_runs(faces: &[Rsm]) -> Vec<LightRun> {
     let mut runs: Vec<LightRun> = Vec::new();
     let mut row = 0;
     for (f, face) in faces.iter().enumerate() {
-        let within = match runs.last() {
-            Some(last) if last.id == face.light => last.sample_base / FACE_SAMPLE_STRIDE + 1,
-            _ => 0,
-        };
-        runs.push(LightRun {
-            order: f as u32,
-            id: face.light,
-            faces: f..f + 1,
-            sample_base: within * FACE_SAMPLE_STRIDE,
-            row_offset: row,
-            rows: face.size,
-        });
+        match runs.last_mut() {
+            Some(run) if run.id == face.light => {
+                run.faces.end = f + 1;
+                run.rows += face.size;
+            }
+            _ => runs.push(LightRun {
+                order: runs.len() as u32,
+                id: face.light,
+                faces: f..f + 1,
+                row_offset: row,
+                rows: face.size,
+            }),
+        }
         row += face.size;
     }
     runs
@@ -148,8 +137,6 @@ pub(super) fn flux_cache(
             light_order: run.order,
             light_id: run.id,
             light_count: runs.len() as u32,
-            sample_base: run.sample_base,
-            pad: [0; 3],
         });
         texel_offset += face.size * face.size;
         row_offset += face.size;
