@@ -179,7 +179,12 @@ void main() {
         // The box always holds the pixel's own light: where nothing changes, history is kept.
         vec3 lo = min(light, mean - push.clip * sigma);
         vec3 hi = max(light, mean + push.clip * sigma);
-        history.rgb = clamp(history.rgb, lo, hi);
+        vec3 clipped = clamp(history.rgb, lo, hi);
+        float moved = luminance(abs(history.rgb - clipped));
+        if (geometry && moved > ACCUMULATE_CHANGE * max(luminance(clipped), luminance(light))) {
+            history.a = 0.0;
+        }
+        history.rgb = clipped;
     }
     // A moving pixel under TAA keeps a short history: its jittered edges alternate between
     // surfaces, and a long history would carry one surface's light onto the other.

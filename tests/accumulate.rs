@@ -249,6 +249,55 @@ fn disocclusion_rejects_history() {
     common::assert_clean(&device);
 }
 
+/// A history the clip moves by more than `ACCUMULATE_CHANGE` of its luminance restarts (a
+/// light switched off is gone at once); one it moves by less keeps counting, and TAA never
+/// restarts this way.
+#[test]
+fn a_large_change_of_the_light_restarts_the_history() {
+    use shine::passes::accumulate::ACCUMULATE_CHANGE;
+    let device = common::device();
+    let extent = [3u32, 3];
+    let position = vec![Vec4::new(0.0, 0.0, 0.0, 2.0); 9];
+    let normal = vec![Vec3::Z; 9];
+    let current = vec![Vec3::splat(1.0); 9];
+    let history_geometry = vec![Vec4::new(0.0, 0.0, 1.0, 2.0); 9];
+    let motion = vec![Vec2::ZERO; 9];
+    // A flat neighbourhood: the clip box is the light itself, so the clip moves a history of
+    // 1 + e by e.
+    for (excess, geometry, restarts) in [
+        (3.0, true, true),
+        (1.5 * ACCUMULATE_CHANGE, true, true),
+        (0.5 * ACCUMULATE_CHANGE, true, false),
+        (3.0, false, false),
+    ] {
+        let history_light = vec![Vec4::new(1.0 + excess, 1.0 + excess, 1.0 + excess, 4.0); 9];
+        let inputs = AccumulateInputs {
+            extent,
+            current: &current,
+            position: &position,
+            normal: &normal,
+            motion: &motion,
+            history_geometry: &history_geometry,
+            history_light: &history_light,
+            has_history: true,
+        };
+        let params = AccumulateParams {
+            max_frames: 8,
+            clip: 3.0,
+            geometry,
+            reseed: false,
+        };
+        let gpu = accumulate_gpu(&device, &inputs, &params);
+        let cpu = accumulate_cpu(&inputs, &params);
+        let count = if restarts { 1.0 } else { 5.0 };
+        for (g, c) in gpu.iter().zip(&cpu) {
+            assert!((*g - *c).abs().max_element() <= 4e-3, "{g} against {c}");
+            assert_eq!(g.w, count, "excess {excess}, geometry {geometry}: {g}");
+        }
+    }
+    common::assert_clean(&device);
+}
+
 /// A static scene accumulated over frames renders its single frame (every frame's light is
 /// the same, so the blend changes nothing), for HVL and IGI. HVL's sampled shadows and near
 /// field draw new rays every frame of a history, so HVL runs without them here (the shadows'

@@ -163,9 +163,11 @@ fn agx_constants_match_the_shader() {
 #[test]
 fn accumulate_constant_matches_the_shader() {
     use shine::passes::accumulate::{
-        ACCUMULATE_MIN_WEIGHT, TAA_MIN_INVERSE, TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
+        ACCUMULATE_CHANGE, ACCUMULATE_MIN_WEIGHT, TAA_MIN_INVERSE, TAA_MOVING_FRAMES,
+        TAA_STILL_PIXELS,
     };
     let file = "include/accumulate.glsl";
+    assert_eq!(glsl_float(file, "ACCUMULATE_CHANGE"), ACCUMULATE_CHANGE);
     assert_eq!(
         glsl_float(file, "ACCUMULATE_MIN_WEIGHT"),
         ACCUMULATE_MIN_WEIGHT

@@ -9,6 +9,7 @@ use shine::gpu::{Device, DeviceDesc};
 use shine::passes::aaf::AafParams;
 use shine::study::aaf::AafStudyConfig;
 use shine::study::report::StudyFormat;
+use shine::study::switch_off::SwitchOff;
 use shine::study::temporal::{self, TemporalConfig, TemporalMode};
 use shine::study::{Progress, aaf};
 use std::path::PathBuf;
@@ -61,6 +62,10 @@ pub struct TemporalStudyArgs {
     /// truth is its indirect light.
     #[arg(long)]
     indirect: bool,
+    /// Switch light N (its index in the scene) off halfway through the measured frames, and
+    /// report each mode's frames until its light is gone (below 5% of what it gave).
+    #[arg(long, value_name = "N")]
+    switch_off: Option<usize>,
     /// A mode, `LABEL=KEY=VALUE;KEY=VALUE…` (settings keys as `--set` takes them), repeated;
     /// default: `hvl=gi=hvl` and `hvl/4=gi=hvl;hvl.slices=4`.
     #[arg(long = "mode")]
@@ -191,12 +196,20 @@ fn run_temporal(args: &TemporalStudyArgs) -> Result<(), CliError> {
         truth_spp: args.truth_spp,
         warmup: args.warmup,
         indirect: args.indirect,
+        switch_off: None,
     };
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| default_out("temporal", &args.scene));
     let scene = load_scene(&args.scene, &args.environment)?;
+    let config = TemporalConfig {
+        switch_off: args
+            .switch_off
+            .map(|light| SwitchOff::new(&scene, light, config.frames as usize))
+            .transpose()?,
+        ..config
+    };
     let device = Device::new(&DeviceDesc::from_env())?;
     let mut bars = Bars::default();
     let report = temporal::run(&device, &scene, &args.scene, &config, &modes, &mut bars)?;

@@ -27,6 +27,12 @@ use crate::shaders;
 /// history is rejected (`ACCUMULATE_MIN_WEIGHT` in shaders/include/accumulate.glsl).
 pub const ACCUMULATE_MIN_WEIGHT: f32 = 0.01;
 
+/// The indirect light's history restarts where the clip moved it by more than this share of
+/// its luminance (`ACCUMULATE_CHANGE`): the light changed beyond the neighbourhood's noise (a
+/// light switched off, a beam sweeping past), and a history that kept counting would trail
+/// it (issue 43, docs/quality.md).
+pub const ACCUMULATE_CHANGE: f32 = 0.25;
+
 /// Motion in pixels below which TAA counts a pixel as still: its history may then show any
 /// surface of its 3×3 neighbourhood, so a still silhouette, whose jittered samples alternate
 /// between two surfaces, keeps its history; a moving pixel's must show its own surface

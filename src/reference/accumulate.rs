@@ -5,7 +5,8 @@ use glam::{Vec2, Vec3, Vec4};
 
 use crate::capture::tonemap::luminance;
 use crate::passes::accumulate::{
-    ACCUMULATE_MIN_WEIGHT, AccumulateParams, TAA_MIN_INVERSE, TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
+    ACCUMULATE_CHANGE, ACCUMULATE_MIN_WEIGHT, AccumulateParams, TAA_MIN_INVERSE, TAA_MOVING_FRAMES,
+    TAA_STILL_PIXELS,
 };
 use crate::passes::amortise::same_surface;
 
@@ -149,7 +150,14 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                 let sigma = Vec3::new(variance.x.sqrt(), variance.y.sqrt(), variance.z.sqrt());
                 let lo = light.min(mean - params.clip * sigma);
                 let hi = light.max(mean + params.clip * sigma);
-                past = past.clamp(lo, hi);
+                let clipped = past.clamp(lo, hi);
+                let moved = luminance((past - clipped).abs());
+                if params.geometry
+                    && moved > ACCUMULATE_CHANGE * luminance(clipped).max(luminance(light))
+                {
+                    history.w = 0.0;
+                }
+                past = clipped;
             }
             let longest = if params.geometry || still {
                 params.max_frames

@@ -15,6 +15,7 @@ pub mod metrics;
 pub mod plot;
 pub mod report;
 pub mod runner;
+pub mod switch_off;
 pub mod temporal;
 pub mod temporal_plot;
 

@@ -16,6 +16,7 @@ use shine_scene::Scene;
 use shine_scene::bvh::{Bvh, Ray};
 
 use super::metrics;
+use super::switch_off::SwitchOff;
 use super::{Progress, StudyError};
 use crate::capture::image_io::HdrImage;
 use crate::frame::renderer::Renderer;
@@ -52,6 +53,9 @@ pub struct TemporalConfig {
     /// Judge the indirect light alone: every mode renders `output.component = indirect` and
     /// the truth is its indirect light (issue 43: what pops is the GI).
     pub indirect: bool,
+    /// A light switched off halfway through the measured frames (truth, sequences and cold
+    /// frames alike), and each mode's frames until its light is gone reported.
+    pub switch_off: Option<SwitchOff>,
 }
 
 /// What the study measured for one mode.
@@ -71,6 +75,12 @@ pub struct ModeResult {
     pub uncovered_flicker: f64,
     /// The cold frames' flicker over [`TemporalReport::uncovered`].
     pub cold_uncovered_flicker: f64,
+    /// With [`TemporalConfig::switch_off`]: what the sequence keeps of the light at each frame
+    /// from the switch on ([`SwitchOff::residual`]).
+    pub switch_off_residual: Vec<f64>,
+    /// With [`TemporalConfig::switch_off`]: frames until the light is gone from the sequence
+    /// ([`SwitchOff::frames_until_gone`]; 1: in the first frame without it).
+    pub switch_off_frames: Option<u32>,
     /// Relative RMSE of the sequence's last frame.
     pub last_rmse: f64,
     /// Flicker of the cold frames (each rendered from a fresh scene at its time).
@@ -129,6 +139,8 @@ pub struct TemporalReport {
     /// Per-pixel flicker of the truth.
     #[serde(skip)]
     pub truth_flicker_map: Vec<f32>,
+    /// The light switched off, if one was.
+    pub switch_off: Option<SwitchOff>,
     /// One result per mode.
     pub modes: Vec<ModeResult>,
 }
@@ -355,6 +367,15 @@ pub fn run(
     let times: Vec<f32> = (config.warmup..config.warmup + config.frames)
         .map(at)
         .collect();
+    // The measured frames' updates: the scene as animated, the switched-off light off.
+    let updates: Vec<FrameUpdate> = times
+        .iter()
+        .enumerate()
+        .map(|(k, &t)| match &config.switch_off {
+            Some(off) => off.update(scene, k, t),
+            None => FrameUpdate::at(t),
+        })
+        .collect();
     progress.stage("truth", 2 * u64::from(config.frames));
     let params = ReferenceParams {
         width: first.settings.width,
@@ -363,11 +384,11 @@ pub fn run(
         emissive_lighting: false,
         ..ReferenceParams::default()
     };
-    let truth = truth_sequence(device, scene, &times, config, &params, progress)?;
+    let truth = truth_sequence(device, scene, &updates, config, &params, progress)?;
     let truth_b = truth_sequence(
         device,
         scene,
-        &times,
+        &updates,
         config,
         &ReferenceParams {
             seed: params.seed.wrapping_add(1),
@@ -392,8 +413,8 @@ pub fn run(
             renderer.render(&settings)?;
         }
         let (mut images, mut ms) = (Vec::new(), Vec::new());
-        for &t in &times {
-            renderer.update(&FrameUpdate::at(t))?;
+        for update in &updates {
+            renderer.update(update)?;
             let start = Instant::now();
             let frame = renderer.render(&settings)?;
             ms.push(start.elapsed().as_secs_f64() * 1e3);
@@ -402,8 +423,9 @@ pub fn run(
         }
         // Cold: every frame from a fresh scene at its time, so nothing carries over.
         let mut cold = Vec::new();
-        for &t in &times {
-            renderer.set_scene(scene, t)?;
+        for update in &updates {
+            renderer.set_scene(scene, update.time)?;
+            renderer.update(update)?;
             cold.push(renderer.render(&settings)?.hdr);
             progress.advance(1, &format!("{} (cold)", mode.label));
         }
@@ -421,7 +443,15 @@ pub fn run(
             _ => 0.0,
         };
         let (flicker_by_frame, flicker_map) = flicker_parts(&images);
+        let switch_off_residual = config
+            .switch_off
+            .map(|off| off.residual(&images, &cold))
+            .unwrap_or_default();
         results.push(ModeResult {
+            switch_off_frames: config
+                .switch_off
+                .and_then(|_| SwitchOff::frames_until_gone(&switch_off_residual)),
+            switch_off_residual,
             label: mode.label.clone(),
             ms_per_frame: ms[ms.len() / 2],
             relative_rmse: error(&images),
@@ -454,24 +484,26 @@ pub fn run(
         uncovered,
         truth_flicker_by_frame,
         truth_flicker_map,
+        switch_off: config.switch_off,
         modes: results,
     })
 }
 
-/// One fixed-seed truth sequence at `times`: the full frame, or its indirect light when
+/// One fixed-seed truth sequence of `updates`: the full frame, or its indirect light when
 /// `config.indirect`.
 fn truth_sequence(
     device: &Device,
     scene: &Scene,
-    times: &[f32],
+    updates: &[FrameUpdate],
     config: &TemporalConfig,
     params: &ReferenceParams,
     progress: &mut dyn Progress,
 ) -> Result<Vec<HdrImage>, StudyError> {
-    let mut tracer = PathTracer::new(device, scene, times[0], params)?;
-    let mut frames = Vec::with_capacity(times.len());
-    for &t in times {
-        tracer.update(&FrameUpdate::at(t))?;
+    let first = updates.first().map_or(config.time, |u| u.time);
+    let mut tracer = PathTracer::new(device, scene, first, params)?;
+    let mut frames = Vec::with_capacity(updates.len());
+    for update in updates {
+        tracer.update(update)?;
         tracer.accumulate(config.truth_spp)?;
         let images = tracer.read()?;
         frames.push(if config.indirect {

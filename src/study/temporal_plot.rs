@@ -80,6 +80,22 @@ impl TemporalReport {
             "uncov.",
             "×truth",
         ));
+        if let Some(off) = &self.switch_off {
+            out.push_str(&format!(
+                "light {} off from measured frame {}; frames until gone (< 5%):{}\n",
+                off.light,
+                off.frame,
+                self.modes
+                    .iter()
+                    .map(|m| format!(
+                        " {} {}",
+                        m.label,
+                        m.switch_off_frames
+                            .map_or_else(|| "never".to_owned(), |f| f.to_string())
+                    ))
+                    .collect::<String>()
+            ));
+        }
         let times = |f: f64| f / self.truth_flicker.max(1e-12);
         let times_uncovered = |f: f64| f / self.truth_uncovered_flicker.max(1e-12);
         for m in &self.modes {
