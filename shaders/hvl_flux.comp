@@ -4,10 +4,11 @@
 // in proportion to their flux weight w = r + g + b (0 for an empty texel).
 //
 // Samples with identities (issue 43). Light k (its faces' rows numbered one after the other)
-// owns the progressive sequence j = 0, 1, 2, ... of Halton points (phi_2(j), phi_3(j)), warped
-// through its own flux: sample j takes the light's row where the light's running row sum
-// passes phi_2(j) of its total Phi_k, then the texel of that row where the row's running sum
-// passes phi_3(j) of the row's total. A point's place depends on j and on that light's flux
+// owns the progressive sequence j = 0, 1, 2, ... of Sobol (0, 2)-sequence points (u_j, v_j)
+// (sobol_02, random.glsl: every prefix of 2^k points is stratified), warped through its own
+// flux: sample j takes the light's row where the light's running row sum passes u_j of its
+// total Phi_k, then the texel of that row where the row's running sum passes v_j of the row's
+// total. A point's place depends on j and on that light's flux
 // alone, never on the budget or on the other lights, so when a light moves its samples slide
 // with it, and when a light's share changes the others' stay put.
 // The budget: M' = M - (N - 1) samples (N lights) split by flux, s_k = M' Phi_k / Phi; light k
@@ -44,6 +45,7 @@
 #include "sh.glsl"
 #include "hvl.glsl"
 #include "sample_identity.glsl"
+#include "random.glsl"
 
 layout(local_size_x = 64) in;
 
@@ -266,9 +268,11 @@ void main() {
         return;
     }
     uint slot = uint(cdf.c[e + 3u]) + j;
-    // The light's row: the first whose running sum passes phi_2(j) of the light's total.
+    // The light's row: the first whose running sum passes u_j of the light's total.
     uint marginal = push.texels_total + push.rows_total + push.light_row_offset;
-    float row_goal = hvl_flux_phi2(j) * light_total;
+    // Sample j's point: the (0, 2)-sequence's j-th, no shift.
+    vec2 point = sobol_02(j, uvec2(0u));
+    float row_goal = point.x * light_total;
     uint lo = 0u;
     uint hi = push.light_rows - 1u;
     while (lo < hi) {
@@ -285,9 +289,9 @@ void main() {
     }
     uint s = push.face_size;
     uint y = row - push.row_offset;
-    // The texel: where the row's running sum passes phi_3(j) of its total.
+    // The texel: where the row's running sum passes v_j of its total.
     float row_total = cdf.c[push.texels_total + row];
-    float target = hvl_flux_phi3(j, row_total);
+    float target = point.y * row_total;
     uint first = push.texel_offset + y * s;
     uint x = find_column(first, target, row_total);
     // Where the targets fall within the texel's share: f across, g down.

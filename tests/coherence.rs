@@ -1,5 +1,5 @@
 //! Temporal coherence of the flux distribution (issues 23 and 43): each light owns a
-//! progressive Halton sequence in its RSM, warped through its current flux by a continuous
+//! progressive Sobol (0, 2)-sequence in its RSM, warped through its current flux by a continuous
 //! inverse, so a small turn of the light moves every sample a little and keeps every sample's
 //! identity, and a change in one light's share leaves the other lights' samples in place.
 //! Checked on the CPU twin of `hvl_flux` (tests/hvl.rs ties it to the GPU sample for sample).

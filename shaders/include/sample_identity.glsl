@@ -1,14 +1,11 @@
-// Samples with identities (issue 43): the progressive low-discrepancy points each light owns in
-// its RSM, the budget split between lights, and the interleaved set a sample belongs to. CPU
+// Samples with identities (issue 43): the budget split between lights and the interleaved set a
+// sample belongs to (the points each light owns in its RSM are sobol_02 of random.glsl). CPU
 // twin: shine::reference::hvl_flux (same names without the hvl_flux_ / igi_ prefix); the GPU
 // twin tests in tests/hvl.rs and tests/igi.rs tie them. Integer digit arithmetic and correctly
 // rounded products only, so both sides agree bit for bit.
 #ifndef SAMPLE_IDENTITY_GLSL
 #define SAMPLE_IDENTITY_GLSL
 
-// Base-3 digits of the radical inverse (15 digits: exact for j < 3^15) and 1 / 3^15 as f32.
-const uint HVL_FLUX_PHI3_DIGITS = 15u;
-const float HVL_FLUX_INV_3_15 = uintBitsToFloat(0x3395a96eu);
 // Base-5 digits of the set key (9 digits: 5^9 times the most sets, 64, fits a uint).
 const uint IGI_SET_DIGITS = 9u;
 const uint IGI_SET_SCALE = 1953125u;
@@ -21,16 +18,6 @@ uint radical_inverse_digits(uint j, uint b, uint digits) {
         j /= b;
     }
     return r;
-}
-
-// phi_2(j): the base-2 radical inverse to 24 bits, exact in f32.
-float hvl_flux_phi2(uint j) {
-    return float(bitfieldReverse(j) >> 8u) * (1.0 / 16777216.0);
-}
-
-// phi_3(j) times `total`: the target of the column search, as two correctly rounded products.
-float hvl_flux_phi3(uint j, float total) {
-    return float(radical_inverse_digits(j, 3u, HVL_FLUX_PHI3_DIGITS)) * total * HVL_FLUX_INV_3_15;
 }
 
 // M' = M - (N - 1) samples split between N lights (at least 1), so that the N rounded-up

@@ -1,7 +1,7 @@
 //! CPU twin of `shaders/hvl_flux.comp` and `shaders/include/sample_identity.glsl`: the HVL
 //! cache of [`Distribution::Flux`] over the RSM faces of every light, with samples that keep
-//! their identity (issue 43). Light k owns the progressive Halton sequence
-//! `(φ₂(j), φ₃(j))`, j = 0, 1, …, warped through its own flux; the budget M' = M − (N − 1) is
+//! their identity (issue 43). Light k owns the progressive Sobol (0, 2)-sequence
+//! `(u_j, v_j)` ([`shine_sh::sequence::sobol_02`]), j = 0, 1, …, warped through its own flux; the budget M' = M − (N − 1) is
 //! split by flux, `s_k = M' Φ_k / Φ`, light k keeping `⌈s_k⌉` samples, the last faded by the
 //! fractional part of `s_k`; each sample sits where its targets fall within its texel's share
 //! of the running sums (the continuous inverse), blended with the neighbours it leans to on
@@ -15,15 +15,12 @@ use std::ops::Range;
 
 use glam::{Vec3, Vec4};
 use shine_sh::hvl::{RsmFootprint, radius_spacing, rsm_texel_area};
+use shine_sh::sequence::sobol_02;
 
 use super::hvl::{RsmData, sender_emission_zh};
 use crate::passes::hvl::{EMISSION_MAX_BANDS, Hvl, HvlError, HvlParams};
 use crate::passes::rsm::RsmProjection;
 
-/// Base-3 digits of φ₃ (exact for j < 3¹⁵; GLSL `HVL_FLUX_PHI3_DIGITS`).
-const PHI3_DIGITS: u32 = 15;
-/// 1 / 3¹⁵ rounded to f32, by its bits (GLSL `HVL_FLUX_INV_3_15`).
-const INV_3_15: u32 = 0x3395_a96e;
 /// Smallest cosine between a texel's normal and a neighbour's that a sample blends across
 /// (GLSL `HVL_FLUX_BLEND_NORMAL_COS`).
 pub const BLEND_NORMAL_COS: f32 = 0.9;
@@ -56,16 +53,6 @@ pub fn radical_inverse_digits(mut j: u32, b: u32, digits: u32) -> u32 {
         j /= b;
     }
     r
-}
-
-/// φ₂(j): the base-2 radical inverse of `j` to 24 bits, exact in f32 (GLSL `hvl_flux_phi2`).
-pub fn phi2(j: u32) -> f32 {
-    (j.reverse_bits() >> 8) as f32 * (1.0 / 16_777_216.0)
-}
-
-/// φ₃(j) times `total`, as the shader's two products (GLSL `hvl_flux_phi3`).
-pub fn phi3(j: u32, total: f32) -> f32 {
-    radical_inverse_digits(j, 3, PHI3_DIGITS) as f32 * total * f32::from_bits(INV_3_15)
 }
 
 /// The samples M' split between `lights` lights: `M − (N − 1)`, at least 1, so that the
@@ -233,7 +220,8 @@ pub fn draw(faces: &[RsmData], cdf: &[f32], k: usize, j: u32) -> Option<Draw> {
         return None;
     }
     let marginal = &cdf[texels + rows + group.row_offset..][..group.rows];
-    let row_goal = phi2(j) * light_total;
+    let [u, v] = sobol_02(j, [0, 0]);
+    let row_goal = u * light_total;
     let lo = first_passing(group.rows, |r| marginal[r] > row_goal);
     let row = group.row_offset + lo;
     let (mut face, mut row_offset, mut texel_offset) = (0, 0, 0);
@@ -245,7 +233,7 @@ pub fn draw(faces: &[RsmData], cdf: &[f32], k: usize, j: u32) -> Option<Draw> {
     let s = faces[face].size as usize;
     let y = row - row_offset;
     let row_total = cdf[texels + row];
-    let target = phi3(j, row_total);
+    let target = v * row_total;
     let at_total = target >= row_total;
     let sums = &cdf[texel_offset + y * s..texel_offset + (y + 1) * s];
     let x = first_passing(s, |x| {
