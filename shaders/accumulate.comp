@@ -181,7 +181,10 @@ void main() {
         vec3 hi = max(light, mean + push.clip * sigma);
         vec3 clipped = clamp(history.rgb, lo, hi);
         float moved = luminance(abs(history.rgb - clipped));
-        if (geometry && moved > ACCUMULATE_CHANGE * max(luminance(clipped), luminance(light))) {
+        // Only where the view holds still: a moving pixel's history is a reprojection, which
+        // the clip already judges, and restarting it there shows the raw frame.
+        bool view_still = length(motion * vec2(push.extent)) < TAA_STILL_PIXELS;
+        if (geometry && view_still && moved > ACCUMULATE_CHANGE * max(luminance(clipped), luminance(light))) {
             history.a = 0.0;
         }
         history.rgb = clipped;

@@ -270,8 +270,9 @@ void main() {
     uint slot = uint(cdf.c[e + 3u]) + j;
     // The light's row: the first whose running sum passes u_j of the light's total.
     uint marginal = push.texels_total + push.rows_total + push.light_row_offset;
-    // Sample j's point: the (0, 2)-sequence's j-th, no shift.
-    vec2 point = sobol_02(j, uvec2(0u));
+    // Sample j's point: the (0, 2)-sequence's j-th, shifted by a half (a digital shift keeps
+    // the stratification) so a light's first sample sits at the middle of its flux.
+    vec2 point = sobol_02(j, uvec2(HVL_FLUX_SOBOL_SHIFT));
     float row_goal = point.x * light_total;
     uint lo = 0u;
     uint hi = push.light_rows - 1u;

@@ -38,7 +38,10 @@ void main() {
     float r = position_radius.w;
     float emission[8];
     SH_UNROLL for (int l = 0; l < 8; ++l) {
-        emission[l] = l < HVL_EMISSION_MAX_BANDS ? hvls.h[j].emission[l] : 0.0;
+        emission[l] = 0.0;
+    }
+    SH_UNROLL for (int l = 0; l < HVL_EMISSION_MAX_BANDS; ++l) {
+        emission[l] = hvls.h[j].emission[l];
     }
     float a[HVL_EMISSION_MAX_BANDS];
     hvl_zh_poly(emission, int(push.emission_bands), a);

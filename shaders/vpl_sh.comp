@@ -63,7 +63,7 @@ layout(push_constant) uniform Push {
     uvec2 pattern;
     // VPL count M
     uint vpl_count;
-    // footprint k: each VPL spread over a disc of radius k r_j
+    // footprint k: each VPL evaluated no closer than k r_j
     // (shine::passes::igi::IgiParams::footprint)
     float footprint;
     // 0: every pixel; 1 + k: the pixel at (k & 1, k >> 1) of every 2x2 cell;

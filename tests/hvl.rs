@@ -651,8 +651,9 @@ fn assert_same_flux_cache(gpu: &[Hvl], cpu: &[Hvl], total_weight: f32, label: &s
     );
 }
 
-/// The flux distribution on the GPU against `build_flux_cache`: the same texels (positions and
-/// normals exactly), fluxes and radii to float rounding (the GPU's `tan` and division: 1e-4).
+/// The flux distribution on the GPU against `build_flux_cache`: the same samples in the same
+/// slots, positions, normals, fluxes and radii to float rounding (the GPU's `tan` and
+/// divisions: 1e-4).
 /// The HVLs carry the whole flux weight, and the tilted quadrant, which reflects a known
 /// share of the weight, holds that share of the HVLs to within the pattern's stratification.
 #[test]

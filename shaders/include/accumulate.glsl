@@ -10,9 +10,10 @@
 const float ACCUMULATE_MIN_WEIGHT = 0.01;
 
 // The indirect light's history restarts where the clip moved it by more than this share of
-// its luminance (issue 43): the light changed beyond the neighbourhood's noise (a light
-// switched off, a beam sweeping past), and a history that kept counting would trail it.
-const float ACCUMULATE_CHANGE = 0.25;
+// its luminance and the view holds still (issue 43): the light changed beyond the
+// neighbourhood's noise (a light switched off), and a history that kept counting would trail
+// it.
+const float ACCUMULATE_CHANGE = 0.5;
 
 // Motion (pixels) below which TAA counts a pixel as still: its history may show any surface
 // of its 3×3 neighbourhood.

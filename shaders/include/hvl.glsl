@@ -21,8 +21,9 @@ struct Hvl {
     vec4 flux;
     // ZH coefficients (about n_j) of the sender's F' (paper 003 eq. 20)
     float emission[HVL_EMISSION_MAX_BANDS];
-    // identity: the light's index in the scene and the sample's index in that light's
-    // sequence (the flux distribution) or its grid cell; survives reordering (IGI's sets)
+    // identity: the light's index in the scene (0 on the grid) and the sample's index in that
+    // light's sequence (the flux distribution) or its grid cell; survives reordering (IGI's
+    // sets)
     uint light;
     uint sample_index;
     uint pad;

@@ -20,20 +20,28 @@ uint radical_inverse_digits(uint j, uint b, uint digits) {
     return r;
 }
 
+// The digital shift of the flux samples' Sobol points (shine::reference::hvl_flux::SOBOL_SHIFT):
+// a half in both dimensions, so a light's first sample sits at the middle of its flux.
+const uint HVL_FLUX_SOBOL_SHIFT = 0x80000000u;
+
 // M' = M - (N - 1) samples split between N lights (at least 1), so that the N rounded-up
 // counts sum to at most M.
 uint hvl_flux_budget(uint count, uint lights) {
     return count > lights ? count - (lights - 1u) : 1u;
 }
 
-// n_k = ceil(M' Phi_k / Phi), decided by products: the least n with n Phi >= M' Phi_k.
+// n_k = ceil(M' Phi_k / Phi), decided by products: the least n with n Phi >= M' Phi_k, at most
+// M'; 0 unless 0 < Phi_k and Phi is finite (no loop can run away on extreme flux).
 uint hvl_flux_light_count(uint budget, float light_total, float total) {
     float goal = float(budget) * light_total;
-    uint n = uint(ceil(goal / total));
+    if (!(light_total > 0.0) || !(total > 0.0) || isinf(total) || isinf(goal)) {
+        return 0u;
+    }
+    uint n = min(uint(ceil(goal / total)), budget);
     while (n > 0u && float(n - 1u) * total >= goal) {
         --n;
     }
-    while (float(n) * total < goal) {
+    while (n < budget && float(n) * total < goal) {
         ++n;
     }
     return n;

@@ -28,10 +28,10 @@ use crate::shaders;
 pub const ACCUMULATE_MIN_WEIGHT: f32 = 0.01;
 
 /// The indirect light's history restarts where the clip moved it by more than this share of
-/// its luminance (`ACCUMULATE_CHANGE`): the light changed beyond the neighbourhood's noise (a
-/// light switched off, a beam sweeping past), and a history that kept counting would trail
-/// it (issue 43, docs/quality.md).
-pub const ACCUMULATE_CHANGE: f32 = 0.25;
+/// its luminance and the view holds still (`ACCUMULATE_CHANGE`): the light changed beyond the
+/// neighbourhood's noise (a light switched off), and a history that kept counting would trail
+/// it (issue 43, docs/quality.md). A moving pixel's history is a reprojection the clip judges.
+pub const ACCUMULATE_CHANGE: f32 = 0.5;
 
 /// Motion in pixels below which TAA counts a pixel as still: its history may then show any
 /// surface of its 3×3 neighbourhood, so a still silhouette, whose jittered samples alternate

@@ -2,7 +2,7 @@
 //! (paper 000): the `igi_vpls`, `vpl_sh` and `sh_filter` passes.
 //!
 //! 1. **VPLs** ([`vpls`]): the primary light's RSM cut into exactly M cells by the HVL cache
-//!    pass ([`super::hvl::hvl_cache`], r2 radii unused): each cell is one Lambertian VPL at its
+//!    pass ([`super::hvl::hvl_cache`], its r2 radii the VPLs' footprints): each cell is one Lambertian VPL at its
 //!    texel nearest the centre, with the cell's summed reflected flux Φ_j, radiant intensity
 //!    `I(ω) = Φ_j max(0, n_j·ω)/π`.
 //!    With `distribution = flux` (shine's, [`hvl::Distribution::Flux`]) the VPLs are every
@@ -18,7 +18,7 @@
 //!    equally, so the filtered sum is the full VPL sum.
 //! 3. **vpl_sh** ([`vpl_sh`]): per pixel, every VPL of its set not below the geometric surface is
 //!    tested with a shadow ray through the BVH (`trace_occluded`, shaders/include/trace.glsl)
-//!    and its incident radiance `E_j δ(ω_j)`, `E_j = I_j(−ω_j) / max(d², d_min²)`, projected to
+//!    and its incident radiance `E_j δ(ω_j)`, `E_j = I_j(−ω_j) / max(d, d_min, k r_j)²`, projected to
 //!    SH (§3.2: `L_lm += E_j Y_lm(ω_j)`), 4/9/16 coefficients for SH order 2/3/4. Classic IGI
 //!    ([`FilterMode::Irradiance`]) stores instead the irradiance about the shading normal,
 //!    `Σ E_j max(0, n·ω_j)`, and the glossy radiance `Σ E_j phong(r·ω_j)`.

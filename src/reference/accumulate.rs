@@ -152,7 +152,9 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                 let hi = light.max(mean + params.clip * sigma);
                 let clipped = past.clamp(lo, hi);
                 let moved = luminance((past - clipped).abs());
+                let view_still = (inp.motion[i] * size).length() < TAA_STILL_PIXELS;
                 if params.geometry
+                    && view_still
                     && moved > ACCUMULATE_CHANGE * luminance(clipped).max(luminance(light))
                 {
                     history.w = 0.0;

@@ -11,8 +11,6 @@
 //!
 //! [`Distribution::Flux`]: crate::passes::hvl::Distribution::Flux
 
-use std::ops::Range;
-
 use glam::{Vec3, Vec4};
 use shine_sh::hvl::{RsmFootprint, radius_spacing, rsm_texel_area};
 use shine_sh::sequence::sobol_02;
@@ -28,6 +26,9 @@ pub const BLEND_NORMAL_COS: f32 = 0.9;
 /// fraction of the step (GLSL `HVL_FLUX_BLEND_PLANE`): beyond it the neighbour is across a
 /// depth step.
 pub const BLEND_PLANE: f32 = 0.25;
+/// The digital shift of the flux samples' Sobol points (GLSL `HVL_FLUX_SOBOL_SHIFT`): a half
+/// in both dimensions, so a light's first sample sits at the middle of its flux.
+pub const SOBOL_SHIFT: u32 = 1 << 31;
 /// Base-5 digits of a sample's set key (GLSL `IGI_SET_DIGITS`): 5⁹ times the most sets (64)
 /// fits a u32.
 const SET_DIGITS: u32 = 9;
@@ -65,15 +66,18 @@ pub fn budget(count: u32, lights: u32) -> u32 {
     }
 }
 
-/// `n_k = ⌈M' Φ_k / Φ⌉`, decided by products: the least n with `n Φ ≥ M' Φ_k` (GLSL
-/// `hvl_flux_light_count`).
+/// `n_k = ⌈M' Φ_k / Φ⌉`, decided by products: the least n with `n Φ ≥ M' Φ_k`, at most M';
+/// 0 unless `0 < Φ_k` and Φ is finite (GLSL `hvl_flux_light_count`).
 pub fn light_count(budget: u32, light_total: f32, total: f32) -> u32 {
     let goal = budget as f32 * light_total;
-    let mut n = (goal / total).ceil() as u32;
+    if !(light_total > 0.0 && total > 0.0) || total.is_infinite() || goal.is_infinite() {
+        return 0;
+    }
+    let mut n = ((goal / total).ceil() as u32).min(budget);
     while n > 0 && (n - 1) as f32 * total >= goal {
         n -= 1;
     }
-    while (n as f32) * total < goal {
+    while n < budget && (n as f32) * total < goal {
         n += 1;
     }
     n
@@ -91,8 +95,6 @@ pub fn sample_set(j: u32, sets: u32) -> u32 {
 pub struct LightFaces {
     /// The light's index in the scene (the samples' identity).
     pub light: u32,
-    /// Its faces in the face list.
-    pub faces: Range<usize>,
     /// Its first row in the global row order.
     pub row_offset: usize,
     /// Its rows (the sum of its faces' sides).
@@ -103,15 +105,13 @@ pub struct LightFaces {
 pub fn light_faces(faces: &[RsmData]) -> Vec<LightFaces> {
     let mut groups: Vec<LightFaces> = Vec::new();
     let mut row = 0;
-    for (f, face) in faces.iter().enumerate() {
+    for face in faces {
         match groups.last_mut() {
             Some(g) if g.light == face.light => {
-                g.faces.end = f + 1;
                 g.rows += face.size as usize;
             }
             _ => groups.push(LightFaces {
                 light: face.light,
-                faces: f..f + 1,
                 row_offset: row,
                 rows: face.size as usize,
             }),
@@ -220,7 +220,7 @@ pub fn draw(faces: &[RsmData], cdf: &[f32], k: usize, j: u32) -> Option<Draw> {
         return None;
     }
     let marginal = &cdf[texels + rows + group.row_offset..][..group.rows];
-    let [u, v] = sobol_02(j, [0, 0]);
+    let [u, v] = sobol_02(j, [SOBOL_SHIFT; 2]);
     let row_goal = u * light_total;
     let lo = first_passing(group.rows, |r| marginal[r] > row_goal);
     let row = group.row_offset + lo;

@@ -118,7 +118,8 @@ pub fn trace_offset(p: Vec3, n: Vec3) -> Vec3 {
 }
 
 /// One VPL's contribution at a receiver: `(ω, E_j)` before visibility, or `None` when it is
-/// invalid, at the receiver, or below the geometric surface. `scale` is `M / |S_s|`.
+/// invalid, at the receiver, or below the geometric surface. `scale` is n·m (the filter counts
+/// every set equally).
 fn contribution(
     vpl: &Hvl,
     x: Vec3,
@@ -175,29 +176,27 @@ pub fn vpl_sh(
             let s = pixel_set(p as u32 % w, p as u32 / w, params.pattern());
             // n m times each set's sum: the filter counts every set equally.
             let scale = sets as f32;
+            for vpl in vpls
+                .iter()
+                .take(count as usize)
+                .filter(|v| sample_set(v.sample_index, sets) == s)
             {
-                for vpl in vpls
-                    .iter()
-                    .take(count as usize)
-                    .filter(|v| sample_set(v.sample_index, sets) == s)
-                {
-                    let Some((dir, e)) = contribution(vpl, x, ng, params, scale) else {
-                        continue;
-                    };
-                    let target = Vec4::from(vpl.position_radius).truncate();
-                    if occluded(origin, dir, (target - origin).length() * SHADOW_END) {
-                        continue;
+                let Some((dir, e)) = contribution(vpl, x, ng, params, scale) else {
+                    continue;
+                };
+                let target = Vec4::from(vpl.position_radius).truncate();
+                if occluded(origin, dir, (target - origin).length() * SHADOW_END) {
+                    continue;
+                }
+                match params.mode {
+                    FilterMode::Irradiance => {
+                        acc[0] += e * n.dot(dir).max(0.0);
+                        acc[1] += e * (lobe_norm * r.dot(dir).max(0.0).powf(exponent));
                     }
-                    match params.mode {
-                        FilterMode::Irradiance => {
-                            acc[0] += e * n.dot(dir).max(0.0);
-                            acc[1] += e * (lobe_norm * r.dot(dir).max(0.0).powf(exponent));
-                        }
-                        FilterMode::Sh => {
-                            let y = basis::eval_basis(dir, bands)?;
-                            for (a, yk) in acc.iter_mut().zip(y) {
-                                *a += e * yk;
-                            }
+                    FilterMode::Sh => {
+                        let y = basis::eval_basis(dir, bands)?;
+                        for (a, yk) in acc.iter_mut().zip(y) {
+                            *a += e * yk;
                         }
                     }
                 }

@@ -82,6 +82,9 @@ impl SwitchOff {
     /// Frames until the light is gone (residual below [`GONE_BELOW`] from then on), counting
     /// the first frame without it as 1; `None` when it never goes.
     pub fn frames_until_gone(residual: &[f64]) -> Option<u32> {
+        if residual.is_empty() {
+            return None;
+        }
         let last_kept = residual.iter().rposition(|r| *r >= GONE_BELOW);
         match last_kept {
             None => Some(1),
@@ -104,5 +107,6 @@ mod tests {
             Some(4)
         );
         assert_eq!(SwitchOff::frames_until_gone(&[0.5, 0.2, 0.06]), None);
+        assert_eq!(SwitchOff::frames_until_gone(&[]), None);
     }
 }
