@@ -212,8 +212,9 @@ pub struct Draw {
 /// light keeps fewer than `j + 1` samples.
 pub fn draw(faces: &[RsmData], cdf: &[f32], k: usize, j: u32) -> Option<Draw> {
     let rows: usize = faces.iter().map(|f| f.size as usize).sum();
-    let texels = cdf.len() - 2 * rows - 4 * (light_faces(faces).len() + 1);
-    let group = light_faces(faces).swap_remove(k);
+    let groups = light_faces(faces);
+    let texels = cdf.len() - 2 * rows - 4 * (groups.len() + 1);
+    let group = &groups[k];
     let e = texels + 2 * rows + 4 * (k + 1);
     let (light_total, share, n, offset) = (cdf[e], cdf[e + 1], cdf[e + 2], cdf[e + 3]);
     if j >= n as u32 {

@@ -227,17 +227,8 @@ pub fn flicker_noise_free_masked(a: &[HdrImage], b: &[HdrImage], mask: &[bool]) 
     if n == 0 {
         return 0.0;
     }
-    let masked_mean = |frames: &[HdrImage]| {
-        let (mut sum, mut m) = (0.0f64, 0usize);
-        for f in frames {
-            for (t, _) in f.texels.iter().zip(mask).filter(|(_, m)| **m) {
-                sum += f64::from(t[0] + t[1] + t[2]);
-                m += 3;
-            }
-        }
-        (sum / m.max(1) as f64).max(1e-12)
-    };
-    let mean = 0.5 * (masked_mean(a) + masked_mean(b));
+    let mean_of = |frames: &[HdrImage]| masked_mean(frames, mask).unwrap_or(0.0).max(1e-12);
+    let mean = 0.5 * (mean_of(a) + mean_of(b));
     (product / n as f64).max(0.0).sqrt() / mean
 }
 
@@ -301,6 +292,15 @@ pub fn flicker_masked(frames: &[HdrImage], mask: &[bool]) -> f64 {
             n += 3;
         }
     }
+    match masked_mean(frames, mask) {
+        Some(mean) if n > 0 => (se / n as f64).sqrt() / mean.max(1e-12),
+        _ => 0.0,
+    }
+}
+
+/// Mean of the frames' rgb channels over the pixels where `mask` holds; `None` where it holds
+/// nowhere.
+fn masked_mean(frames: &[HdrImage], mask: &[bool]) -> Option<f64> {
     let (mut sum, mut m) = (0.0f64, 0usize);
     for f in frames {
         for (t, _) in f.texels.iter().zip(mask).filter(|(_, m)| **m) {
@@ -308,10 +308,7 @@ pub fn flicker_masked(frames: &[HdrImage], mask: &[bool]) -> f64 {
             m += 3;
         }
     }
-    if n == 0 || m == 0 {
-        return 0.0;
-    }
-    (se / n as f64).sqrt() / (sum / m as f64).max(1e-12)
+    (m > 0).then(|| sum / m as f64)
 }
 
 /// The pixels whose value in `map` is at most its (lower) median: the calmer half.
