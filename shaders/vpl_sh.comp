@@ -7,7 +7,8 @@
 //
 // Pixel px uses set s = igi_set(px): the VPLs whose identity puts them in set s
 // (igi_sample_set of the record's sample index, shaders/include/sample_identity.glsl), so a VPL
-// keeps its set when the records reorder (issue 43). Each contribution is scaled by n m: the
+// keeps its set when the records reorder (issue 43), walked in record order from the list
+// igi_sets.comp groups them in. Each contribution is scaled by n m: the
 // discontinuity filter (sh_filter.comp) counts every set of the pattern equally, so the
 // filtered sum is the sum over all VPLs.
 //! variant o2 SH_BANDS=2
@@ -39,6 +40,12 @@ layout(set = 0, binding = 4, std430) readonly buffer Vpls {
     Hvl h[];
 } vpls;
 
+// igi_sets.comp: first[s]..first[s + 1] index the records of set s.
+layout(set = 0, binding = 11, std430) readonly buffer Sets {
+    uint first[IGI_SETS_MAX + 1u];
+    uint index[];
+} sets;
+
 layout(set = 0, binding = 5, std430) buffer VplSh {
     uint c[];
 } vpl_sh;
@@ -61,7 +68,7 @@ layout(push_constant) uniform Push {
     uvec2 extent;
     // interleaving pattern n, m
     uvec2 pattern;
-    // VPL count M
+    // VPL count M (igi_sets holds the records' grouping)
     uint vpl_count;
     // footprint k: each VPL evaluated no closer than k r_j
     // (shine::passes::igi::IgiParams::footprint)
@@ -107,21 +114,16 @@ void main() {
         float exponent = igi_phong_exponent(imageLoad(gb_material, px).r);
         float lobe_norm = (exponent + 1.0) / (2.0 * IGI_PI);
 #endif
-        uint sets = push.pattern.x * push.pattern.y;
         uint s = igi_set(px, push.pattern);
         // Each set's sum stands for all the VPLs: the filter over whole pattern tiles counts
         // every set equally, so n m times each set's sum totals the full sum there.
-        float scale = float(sets);
-        for (uint j = 0u; j < push.vpl_count; ++j) {
-            if (igi_sample_set(vpls.h[j].sample_index, sets) != s) {
-                continue;
-            }
+        float scale = float(push.pattern.x * push.pattern.y);
+        uint end = sets.first[s + 1u];
+        for (uint i = sets.first[s]; i < end; ++i) {
+            uint j = sets.index[i];
             // Field by field: naga cannot read a whole-struct copy out of a buffer.
             vec4 position_radius = vpls.h[j].position_radius;
             vec4 flux = vpls.h[j].flux;
-            if (flux.a == 0.0) {
-                continue;
-            }
             vec3 v = position_radius.xyz - x;
             float dist = length(v);
             if (!(dist > 0.0)) {

@@ -325,6 +325,7 @@ fn run_gpu(
         None => {
             let lights =
                 rg.import_gpu_buffer(&vpl_buffer, uploaded_state(), ExternalState::UNDEFINED);
+            let lights = igi::sets(&mut rg, lights, params).expect("igi_sets");
             let trace = gpu_bvh.import(&mut rg, uploaded_state());
             let amortised = match (&slice, &slice_buffers) {
                 (Some(s), Some((into, marks))) => IgiSlice {

@@ -307,3 +307,11 @@ fn bvh_image_rows_match_the_shader() {
         shine::gpu_scene::bvh::TRACE_ROW_TEXELS
     );
 }
+
+#[test]
+fn igi_sets_max_matches_the_shader() {
+    assert_eq!(
+        glsl_uint("include/sample_identity.glsl", "IGI_SETS_MAX"),
+        shine::passes::igi::SETS_MAX
+    );
+}

@@ -6,6 +6,9 @@
 #ifndef SAMPLE_IDENTITY_GLSL
 #define SAMPLE_IDENTITY_GLSL
 
+// Most sets of an interleaving pattern, 8 x 8 (shine::passes::igi::SETS_MAX).
+const uint IGI_SETS_MAX = 64u;
+
 // Base-5 digits of the set key (9 digits: 5^9 times the most sets, 64, fits a uint).
 const uint IGI_SET_DIGITS = 9u;
 const uint IGI_SET_SCALE = 1953125u;

@@ -112,6 +112,7 @@ impl PreparedIgi {
     ) -> Result<Handle<Image>, RenderError> {
         let (g, params, camera) = (inputs.gbuffer, &self.params, inputs.camera);
         let lights = igi::vpls(rg, inputs.rsm, params)?;
+        let lights = igi::sets(rg, lights, params)?;
         let Some(amortised) = self.amortised else {
             let sh = igi::vpl_sh(
                 rg,

@@ -16,6 +16,8 @@
 //!    lights' shares change (issue 43; this replaces a fixed permutation of record indices).
 //!    Each contribution is scaled by nm: the filter over whole pattern tiles counts every set
 //!    equally, so the filtered sum is the full VPL sum.
+//!    [`sets`] groups the records by set once a frame (`igi_sets`), so that a pixel walks only
+//!    its own set's list, in record order.
 //! 3. **vpl_sh** ([`vpl_sh`]): per pixel, every VPL of its set not below the geometric surface is
 //!    tested with a shadow ray through the BVH (`trace_occluded`, shaders/include/trace.glsl)
 //!    and its incident radiance `E_j δ(ω_j)`, `E_j = I_j(−ω_j) / max(d, d_min, k r_j)²`, projected to
@@ -97,6 +99,8 @@ pub const COEFFICIENT_WORDS: u32 = (COEFFICIENT_BYTES / 4) as u32;
 
 /// Interleaving pattern sides n and m (paper 000 §2.2 uses 4×4 and 8×8 patterns).
 pub const PATTERN: RangeInclusive<u32> = 1..=8;
+/// Most sets n m of a pattern (`IGI_SETS_MAX` of shaders/igi_sets.comp, one thread each).
+pub const SETS_MAX: u32 = *PATTERN.end() * *PATTERN.end();
 /// VPL counts: the RSM is cut into cells by the HVL cache pass, one VPL each.
 pub const VPL_COUNT: RangeInclusive<u32> = hvl::CACHE_COUNT;
 /// SH orders of the per-pixel incident radiance (paper 000 §3.1 uses 3).
@@ -240,6 +244,16 @@ pub struct VplShPush {
     pub pad: u32,
 }
 
+/// Push constants of `shaders/igi_sets.comp` (8 bytes).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SetsPush {
+    /// VPL count M.
+    pub vpl_count: u32,
+    /// Sets n m of the pattern.
+    pub sets: u32,
+}
+
 /// Push constants of `shaders/sh_filter.comp` (64 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -381,6 +395,56 @@ pub fn vpls(
     Ok(hvl::hvl_cache(rg, rsm, &cache)?)
 }
 
+/// Bytes of the `igi_sets` buffer for `vpl_count` records: [`SETS_MAX`] + 1 first slots, then
+/// one index per record.
+pub fn sets_bytes(vpl_count: u32) -> u64 {
+    4 * (u64::from(SETS_MAX) + 1 + u64::from(vpl_count))
+}
+
+/// The VPLs `vpls` (of [`vpls`]) and their grouping by interleaved set (of [`sets`]): what
+/// [`vpl_sh`] reads.
+#[derive(Debug, Clone, Copy)]
+pub struct VplSets {
+    /// The VPL records (layout of [`hvl::Hvl`]).
+    pub vpls: Handle<Buffer>,
+    /// `igi_sets`: first[s] of each set, then the record indices grouped by set.
+    pub sets: Handle<Buffer>,
+}
+
+/// Adds `igi_sets`: the valid records of `vpls` grouped by interleaved set (the set of their
+/// sample identity), in record order within a set; returns both for [`vpl_sh`].
+pub fn sets(
+    rg: &mut RenderGraph,
+    vpls: Handle<Buffer>,
+    params: &IgiParams,
+) -> Result<VplSets, IgiError> {
+    params.validate()?;
+    check_vpls(&vpls, params)?;
+    let mut sets = rg.create_buffer("igi_sets", BufferDesc::new(sets_bytes(params.vpl_count)));
+    let push = SetsPush {
+        vpl_count: params.vpl_count,
+        sets: params.n * params.m,
+    };
+    rg.compute("igi_sets", &shaders::IGI_SETS_COMP)
+        .read("vpls", &vpls)
+        .write("sets", &mut sets)
+        .push(&push)
+        .dispatch([1, 1, 1]);
+    Ok(VplSets { vpls, sets })
+}
+
+/// [`IgiError::OutOfRange`] unless `vpls` holds `params.vpl_count` records.
+fn check_vpls(vpls: &Handle<Buffer>, params: &IgiParams) -> Result<(), IgiError> {
+    if vpls.desc().size < hvl::cache_bytes(params.vpl_count) {
+        return Err(IgiError::OutOfRange(super::OutOfRange {
+            name: "vpls buffer bytes",
+            value: vpls.desc().size as f64,
+            expected: "at least vpl_count × 80 bytes".to_owned(),
+        }));
+    }
+    Ok(())
+}
+
 /// Adds `vpl_sh` (`igi_regather` for the regather slice): the per-pixel incident radiance of
 /// the pixel's VPL set, shadowed through `bvh`, as `params.coefficients()` packed rgb
 /// coefficients per pixel, at the pixels of `slice` ([`IgiSlice::default`]: every pixel, into
@@ -388,7 +452,7 @@ pub fn vpls(
 pub fn vpl_sh(
     rg: &mut RenderGraph,
     g: &GBuffer,
-    vpls: &Handle<Buffer>,
+    vpls: &VplSets,
     bvh: &TraceImages,
     camera: Vec3,
     params: &IgiParams,
@@ -398,12 +462,12 @@ pub fn vpl_sh(
     amortise::check_slice(slice.slice, slice.marks.is_some())?;
     let regather = slice.slice == amortise::REGATHER_SLICE;
     let bytes = params.sh_bytes(g.extent)?;
-    let need = hvl::cache_bytes(params.vpl_count);
-    if vpls.desc().size < need {
+    check_vpls(&vpls.vpls, params)?;
+    if vpls.sets.desc().size < sets_bytes(params.vpl_count) {
         return Err(IgiError::OutOfRange(super::OutOfRange {
-            name: "vpls buffer bytes",
-            value: vpls.desc().size as f64,
-            expected: "at least vpl_count × 80 bytes".to_owned(),
+            name: "igi_sets buffer bytes",
+            value: vpls.sets.desc().size as f64,
+            expected: "(65 + vpl_count) × 4 bytes (igi::sets)".to_owned(),
         }));
     }
     let shader = shader("vpl_sh.comp", params, false)?;
@@ -438,7 +502,8 @@ pub fn vpl_sh(
     bvh.bind(&mut pass);
     // Read only by the regather slice; the G-buffer's normals (any full-resolution RGBA16F
     // image the frame writes) fill the binding of the others.
-    pass.read("vpls", vpls)
+    pass.read("vpls", &vpls.vpls)
+        .read("sets", &vpls.sets)
         .read("marks", slice.marks.as_ref().unwrap_or(&g.normal))
         .write("vpl_sh", &mut sh)
         .push(&push)
