@@ -20,7 +20,7 @@ use std::time::{Duration, Instant};
 /// Arguments of `shine reference`.
 #[derive(clap::Args, Debug)]
 pub struct ReferenceArgs {
-    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room, animated, marbles).
+    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room, animated, marbles, metals, motion-sweep, motion-orbit, motion-sun, motion-crossing, motion-dolly).
     scene: String,
     /// Output image: .exr (linear HDR radiance) or .png (a tonemapped preview).
     #[arg(short, long)]

@@ -24,7 +24,7 @@ pub const DEFAULT_FPS: f32 = 60.0;
 /// Arguments of `shine render`.
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
-    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room, animated, marbles).
+    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room, animated, marbles, metals, motion-sweep, motion-orbit, motion-sun, motion-crossing, motion-dolly).
     scene: String,
     /// Output image: .png (tonemapped, sRGB) or .exr (linear HDR). With --frames N > 1 the
     /// name needs a frame field, %d or %04d (out/frame_%04d.png), and every frame is written.

@@ -84,7 +84,7 @@ pub struct TemporalStudyArgs {
 /// Arguments of `shine study aaf`.
 #[derive(clap::Args, Debug)]
 pub struct AafStudyArgs {
-    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room, animated, marbles).
+    /// Scene: a .gltf/.glb file or `builtin:NAME` (cornell-box, spheres, room, animated, marbles, metals, motion-sweep, motion-orbit, motion-sun, motion-crossing, motion-dolly).
     scene: String,
     /// Image width in pixels.
     #[arg(long, default_value_t = 128)]

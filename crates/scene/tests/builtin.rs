@@ -301,3 +301,35 @@ fn animated_walks_morphs_and_sweeps_for_300_frames() {
             .any(|m| m.metallic == 0.0 && m.roughness < 0.2)
     );
 }
+
+#[test]
+fn metals_has_four_metal_spheres_two_lights_and_nothing_else() {
+    let s = Scene::builtin("metals").unwrap();
+    assert!(s.environment.is_none() && s.animations.is_empty());
+    let kinds: Vec<_> = s.lights.iter().map(|l| l.light_kind()).collect();
+    assert_eq!(kinds, [Some(LightKind::Spot), Some(LightKind::Point)]);
+    assert!(s.materials.iter().all(|m| m.emissive == [0.0; 3]));
+    for (name, roughness) in [
+        ("chrome", 0.03),
+        ("silver", 0.1),
+        ("gold", 0.3),
+        ("copper", 0.5),
+    ] {
+        let i = s.material_names.iter().position(|n| n == name).unwrap();
+        let m = &s.materials[i];
+        assert!(
+            m.metallic == 1.0 && (m.roughness - roughness).abs() < 1e-6,
+            "{name}"
+        );
+    }
+    // The room is closed: 5 m × 2.8 m × 5 m.
+    let b = s.bounds(&s.rest_world_transforms());
+    assert!(
+        (b.extent() - glam::Vec3::new(5.0, 2.8, 5.0)).length() < 1e-4,
+        "{b:?}"
+    );
+    let Projection::Perspective { yfov, .. } = s.cameras[0].projection else {
+        panic!("perspective camera expected")
+    };
+    assert!((0.85..=1.0).contains(&yfov), "{yfov}");
+}

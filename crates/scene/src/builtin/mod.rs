@@ -17,6 +17,9 @@
 //!   static room with one thing moving in each (a spot's sweep, a point light's orbit, a sun's
 //!   turn, a box crossing a fixed spot's beam, the camera), for the temporal studies (issue 43;
 //!   [`motions`]).
+//! - `metals`: four metal spheres (chrome, silver, gold, copper; roughness 0.03 to 0.5) in a
+//!   closed matte room under a warm spot and a cool point light, for measuring a specular
+//!   denoiser at one sample per pixel; nothing was tuned on it ([`metals`]).
 //!
 //! `assets/<name>.glb` holds the exported files; a test checks they equal what [`build`]
 //! produces now.
@@ -24,6 +27,7 @@
 mod animated;
 mod cornell_box;
 mod marbles;
+mod metals;
 mod motions;
 mod room;
 pub mod shapes;
@@ -51,6 +55,7 @@ pub fn names() -> &'static [&'static str] {
         motions::NAMES[2],
         motions::NAMES[3],
         motions::NAMES[4],
+        "metals",
     ]
 }
 
@@ -62,6 +67,7 @@ pub fn build(name: &str) -> Result<Vec<u8>> {
         "room" => Ok(room::build()),
         "animated" => animated::build(),
         "marbles" => Ok(marbles::build()),
+        "metals" => Ok(metals::build()),
         _ => motions::build(name).ok_or_else(|| Error::UnknownBuiltin {
             name: name.to_string(),
             known: names().join(", "),
