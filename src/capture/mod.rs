@@ -3,6 +3,7 @@
 
 pub mod image_compare;
 pub mod image_io;
+pub mod noise_free;
 pub mod regions;
 pub mod sequence;
 pub mod tonemap;

@@ -6,6 +6,7 @@
 use super::CliError;
 use shine::capture::image_compare::{compare, flip_map};
 use shine::capture::image_io::{HdrImage, read_exr, read_png_linear, write_png};
+use shine::capture::noise_free as nf;
 use shine::capture::regions::{
     Region, Surface, error_heatmap, masked_metrics, region_grid, surface_metrics,
 };
@@ -41,6 +42,12 @@ pub struct CompareArgs {
     /// surface; surfaces under 1% of the pixels are left out.
     #[arg(long)]
     surfaces: Option<PathBuf>,
+    /// A second reference of another seed: the truth becomes the two references' mean, and the
+    /// relative RMSE with the truth's own noise subtracted and the 99.9th percentile of the
+    /// per-pixel error are reported, over every pixel and over --mask
+    /// (`shine::capture::noise_free`).
+    #[arg(long)]
+    second_reference: Option<PathBuf>,
 }
 
 /// Reads an image to compare: EXR as radiance, PNG decoded from sRGB to the light it displays.
@@ -75,13 +82,35 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
              compare EXR files for radiance"
         );
     }
+    let mask = match &args.mask {
+        Some(path) => Some(read_image(path)?.0),
+        None => None,
+    };
+    let noise_free = match &args.second_reference {
+        Some(path) => {
+            let second = read_image(path)?.0;
+            let mut reports = vec![(
+                "every pixel",
+                nf::noise_free(&image, &reference, &second, None)?,
+            )];
+            if let Some(mask) = &mask {
+                let pixels = nf::mask_pixels(mask);
+                reports.push((
+                    "mask",
+                    nf::noise_free(&image, &reference, &second, Some(&pixels))?,
+                ));
+            }
+            reports
+        }
+        None => Vec::new(),
+    };
     let c = compare(&image, &reference)?;
     let regions = match args.regions {
         0 => Vec::new(),
         n => region_grid(&image, &reference, n)?,
     };
-    let masked = match &args.mask {
-        Some(path) => Some(masked_metrics(&image, &reference, &read_image(path)?.0)?),
+    let masked = match &mask {
+        Some(mask) => Some(masked_metrics(&image, &reference, mask)?),
         None => None,
     };
     let surfaces = match &args.surfaces {
@@ -120,6 +149,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
             "height": image.height,
             "regions": regions,
             "surfaces": surfaces,
+            "noise_free": noise_free.iter().map(|(over, m)| serde_json::json!({"over": over, "metrics": m})).collect::<Vec<_>>(),
             "mask": masked.map(|(pixels, mean, energy, relative)| serde_json::json!({
                 "pixels": pixels,
                 "reference_mean": mean,
@@ -139,10 +169,34 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         if let Some((pixels, _, energy, relative)) = masked {
             println!("masked ({pixels} pixels): energy {energy:.4}, RMSE/mean {relative:.4}");
         }
+        print_noise_free(&noise_free);
         print_regions(&regions, args.regions);
         print_surfaces(&surfaces);
     }
     Ok(())
+}
+
+/// One line per pixel set: the metrics against the two seeds' mean.
+fn print_noise_free(reports: &[(&str, nf::NoiseFree)]) {
+    if reports.is_empty() {
+        return;
+    }
+    println!(
+        "against the two references' mean (pixels, energy, RMSE/mean, noise-free RMSE/mean, seeds' RMSE/mean, p{} |error|/mean)",
+        nf::PERCENTILE
+    );
+    for (over, m) in reports {
+        println!(
+            "  {over}: {} px, energy {:.4}, RMSE/mean {:.4}, noise-free {:.4}, seeds {:.4}, p{} {:.4}",
+            m.pixels,
+            m.energy_ratio,
+            m.relative_rmse,
+            m.noise_free_relative_rmse,
+            m.truth_noise,
+            nf::PERCENTILE,
+            m.error_percentile
+        );
+    }
 }
 
 /// One line per surface: its normal, pixels, energy ratio and relative RMSE.
