@@ -9,7 +9,10 @@
 // reference sees in a mirror. Emission of the hit surfaces adds nothing (the GI techniques'
 // convention).
 // The mean is weighted by specular_trace_weight(roughness, limit): pixels rougher than the
-// limit keep their SH glossy term and are skipped here. No CPU twin: tests/specular.rs checks
+// limit keep their SH glossy term and are skipped here. With the denoiser after it
+// (config.z = 1, src/passes/denoise.rs) alpha holds the samples' mean parallax d / (z + d)
+// (d the hit distance, 1 where a ray escapes; z the pixel's distance from the eye), the
+// footprint of the reflection the filter spans; else 0. No CPU twin: tests/specular.rs checks
 // the pass against the path tracer.
 #version 460
 #extension GL_GOOGLE_include_directive : require
@@ -33,7 +36,8 @@ layout(push_constant) uniform Push {
     uvec4 frame;
     // xyz: camera position, w: the roughness limit of the pass.
     vec4 camera;
-    // x: samples per pixel, y: 1 when the environment lights the hits, z, w: unused.
+    // x: samples per pixel, y: 1 when the environment lights the hits, z: 1 to store the
+    // parallax in alpha (the denoiser follows), w: unused.
     uvec4 config;
 } push;
 
@@ -69,6 +73,9 @@ void main() {
     float a = brdf_alpha(roughness_metallic.x);
     uint samples = max(push.config.x, 1u);
     vec3 sum = vec3(0.0);
+    float eye_distance = length(push.camera.xyz - position.xyz);
+    float parallax = 0.0;
+    float parallax_count = 0.0;
     for (uint s = 0u; s < samples; ++s) {
         rng_state = pcg(pcg(pcg(pixel.x ^ pcg(push.frame.w)) + pixel.y) + s);
         vec3 h = sample_ggx_half(n, a, vec2(rand(), rand()));
@@ -85,7 +92,9 @@ void main() {
         brdf_metallic_roughness_parts(n, l, v, albedo, roughness_metallic.y, roughness_metallic.x, diffuse, f_s);
         TraceHit hit;
         vec3 incoming;
+        parallax_count += 1.0;
         if (trace_closest(origin, l, 0.0, PT_FAR, hit)) {
+            parallax += hit.t / (eye_distance + hit.t);
             Vertex x = shade(hit, l);
             incoming = punctual_lights(x, -l);
             if (push.config.y != 0u) {
@@ -96,6 +105,7 @@ void main() {
                 }
             }
         } else {
+            parallax += 1.0;
             incoming = environment_radiance(l);
         }
         vec3 radiance = pdf > 0.0 ? f_s * nl * incoming / pdf : vec3(0.0);
@@ -103,5 +113,6 @@ void main() {
             sum += radiance;
         }
     }
-    imageStore(specular, ixy, vec4(share * sum / float(samples), 0.0));
+    float alpha = push.config.z != 0u ? (parallax_count > 0.0 ? parallax / parallax_count : 1.0) : 0.0;
+    imageStore(specular, ixy, vec4(share * sum / float(samples), alpha));
 }

@@ -315,3 +315,22 @@ fn igi_sets_max_matches_the_shader() {
         shine::passes::igi::SETS_MAX
     );
 }
+
+#[test]
+fn denoise_constants_match_the_shader() {
+    use shine::reference::denoise as d;
+    for (name, value) in [
+        ("DENOISE_LOBE_FRACTION", d::LOBE_FRACTION),
+        ("DENOISE_MAX_LOBE_ANGLE", d::MAX_LOBE_ANGLE),
+        ("DENOISE_MAX_RADIUS", d::MAX_RADIUS),
+        ("DENOISE_PLANE_SIGMA", d::PLANE_SIGMA),
+        ("DENOISE_MIN_NORMAL_TOLERANCE", d::MIN_NORMAL_TOLERANCE),
+        ("DENOISE_ROUGHNESS_SIGMA", d::ROUGHNESS_SIGMA),
+        ("DENOISE_LUMINANCE_SIGMA", d::LUMINANCE_SIGMA),
+        ("DENOISE_MIN_WEIGHT", d::MIN_WEIGHT),
+        ("DENOISE_FIREFLY_RATIO", d::FIREFLY_RATIO),
+        ("DENOISE_MATCH", d::MATCH),
+    ] {
+        assert_eq!(glsl_float("include/denoise.glsl", name), value, "{name}");
+    }
+}

@@ -54,6 +54,9 @@ pub enum RenderError {
     /// The specular pass refused its parameters.
     #[error(transparent)]
     Specular(#[from] crate::passes::specular::SpecularError),
+    /// The denoiser refused its parameters.
+    #[error(transparent)]
+    Denoise(#[from] crate::passes::denoise::DenoiseError),
     /// A host's environment map could not be projected.
     #[error(transparent)]
     EnvironmentSh(#[from] EnvironmentShError),

@@ -6,6 +6,7 @@ use crate::passes::aaf::AafParams;
 use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{Component, CompositeParams};
 use crate::passes::cubes::CubeParams;
+use crate::passes::denoise::DenoiseParams;
 use crate::passes::direct::{SHADOW_DEPTH_BIAS, SHADOW_NORMAL_OFFSET, ShadowParams};
 use crate::passes::exposure::ExposureParams;
 use crate::passes::hvl::HvlParams;
@@ -48,6 +49,8 @@ pub struct FrameParams {
     /// Traced specular reflections, when on and the frame has a GI technique (the techniques'
     /// `specular_limit` is its limit then, else 0).
     pub specular: Option<SpecularParams>,
+    /// The traced specular's filter, when the specular pass runs and `denoise.enabled`.
+    pub denoise: Option<DenoiseParams>,
     /// The sky light, when on and the frame has no proxies (which shadow the environment
     /// themselves), `gi = none` included: the sky's light is direct light, though it travels
     /// in the indirect image. Declared only for a scene with an environment.
@@ -132,6 +135,7 @@ impl FrameParams {
                 ..settings.aaf
             }),
             specular,
+            denoise: specular.and(settings.denoise.enabled.then_some(settings.denoise)),
             sky: (settings.sky.enabled && !gi.contains(GiTechnique::Proxy)).then_some(settings.sky),
             cavity: settings.cavity.enabled.then(|| settings.cavity.params()),
             cubes: settings.cubes.enabled.then_some(settings.cubes),

@@ -58,6 +58,12 @@ pub fn diffuse_fresnel_factor(n_dot_v: f32) -> f32 {
     DIFFUSE_FRESNEL_SCALE * (1.0 - n_dot_v.clamp(0.0, 1.0)).powf(DIFFUSE_FRESNEL_POWER)
 }
 
+/// GGX α of a perceptual roughness, `roughness²` kept away from a delta lobe (≥ 10⁻³; GLSL
+/// `brdf_alpha`).
+pub fn alpha(roughness: f32) -> f32 {
+    (roughness * roughness).max(1e-3)
+}
+
 /// Diffuse and specular weights `(kd, ks)` of the metallic-roughness material for indirect
 /// light (HVL, IGI, AAF; GLSL `brdf_indirect_weights`), with `F0 = mix(0.04, albedo,
 /// metallic)`:

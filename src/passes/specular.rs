@@ -117,13 +117,15 @@ pub struct SpecularPush {
     pub frame: [u32; 4],
     /// xyz camera position, w the roughness limit.
     pub camera: [f32; 4],
-    /// Samples per pixel, 1 when the environment lights the hits, then unused.
+    /// Samples per pixel, 1 when the environment lights the hits, 1 to store the hits'
+    /// parallax in alpha (the denoiser follows), unused.
     pub config: [u32; 4],
 }
 
 /// Adds the `specular` pass over the G-buffer `g` seen from `camera`; returns the reflected
-/// radiance towards the camera (RGBA16F, full resolution, a = 0). `seed` is added to the
-/// parameters' (the frame index when a history averages the frames).
+/// radiance towards the camera (RGBA16F, full resolution; a = the hits' mean parallax
+/// d / (z + d) when `parallax`, for [`crate::passes::denoise::specular`], else 0). `seed` is
+/// added to the parameters' (the frame index when a history averages the frames).
 pub fn specular(
     rg: &mut RenderGraph,
     g: &GBuffer,
@@ -131,6 +133,7 @@ pub fn specular(
     camera: glam::Vec3,
     params: &SpecularParams,
     seed: u32,
+    parallax: bool,
 ) -> Result<Handle<Image>, SpecularError> {
     params.validate()?;
     let [w, h] = g.extent;
@@ -150,7 +153,12 @@ pub fn specular(
         .push(&SpecularPush {
             frame: [w, h, scene.light_count, frame_seed],
             camera: camera.extend(params.limit).to_array(),
-            config: [params.samples, u32::from(scene.environment_lighting), 0, 0],
+            config: [
+                params.samples,
+                u32::from(scene.environment_lighting),
+                u32::from(parallax),
+                0,
+            ],
         })
         .dispatch([w, h, 1]);
     Ok(out)

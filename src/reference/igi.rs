@@ -54,7 +54,7 @@ pub fn vpl_irradiance(
 
 /// `igi_phong_exponent`: 0.5/α² − 0.5 with α = max(roughness², 1e-3), clamped to 1..=1e4.
 pub fn phong_exponent(roughness: f32) -> f32 {
-    let a = (roughness * roughness).max(1e-3);
+    let a = crate::passes::brdf_tables::alpha(roughness);
     (0.5 / (a * a) - 0.5).clamp(1.0, PHONG_MAX)
 }
 

@@ -15,6 +15,7 @@
 
 pub mod aaf;
 pub mod accumulate;
+pub mod denoise;
 pub mod hvl;
 pub mod hvl_flux;
 pub mod igi;

@@ -43,6 +43,7 @@ use crate::passes::aaf::AafParams;
 use crate::passes::accumulate::AccumulateParams;
 use crate::passes::composite::{self, Component};
 use crate::passes::cubes::CubeParams;
+use crate::passes::denoise::DenoiseParams;
 use crate::passes::hvl::HvlParams;
 use crate::passes::igi::IgiParams;
 use crate::passes::proxy::ProxySettings;
@@ -109,6 +110,9 @@ pub struct Settings {
     /// Traced specular reflections (issue 21).
     #[setting(section)]
     pub specular: SpecularParams,
+    /// The filter of the traced specular at one sample per pixel (issue 47).
+    #[setting(section)]
+    pub denoise: DenoiseParams,
     /// The sky light of frames without proxies (issue 16).
     #[setting(section)]
     pub sky: SkyParams,

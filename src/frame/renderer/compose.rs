@@ -17,9 +17,9 @@ use crate::passes::cubes;
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::{Distribution, near};
-use crate::passes::specular;
 use crate::passes::traced_scene::TracedScene;
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
+use crate::passes::{denoise, specular};
 use shine_graph::{Handle, Image, RenderGraph};
 
 impl Renderer {
@@ -376,15 +376,25 @@ impl Renderer {
         let full = igi_full.or(aaf_full);
         let techniques = sum(rg, "gi_add_full", upsampled, full)?;
         // The sharp part of the glossy lobes, which the techniques above leave out.
+        // Filtered (`[denoise]`) in the lobe's footprint: one or two rays a pixel are grainy.
         let reflections = match (p.specular, &traced) {
-            (Some(params), Some(traced)) => Some(specular::specular(
-                rg,
-                g,
-                traced,
-                camera.eye,
-                &params,
-                sky_light::history_seed(rg, p),
-            )?),
+            (Some(params), Some(traced)) => {
+                let raw = specular::specular(
+                    rg,
+                    g,
+                    traced,
+                    camera.eye,
+                    &params,
+                    sky_light::history_seed(rg, p),
+                    p.denoise.is_some(),
+                )?;
+                Some(match p.denoise {
+                    Some(denoise) => {
+                        denoise::specular(rg, g, &raw, camera, params.limit, &denoise)?
+                    }
+                    None => raw,
+                })
+            }
             _ => None,
         };
         sum(rg, "specular_add", techniques, reflections)

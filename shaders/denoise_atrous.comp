@@ -1,0 +1,95 @@
+// denoise_atrous (issue 47; src/passes/denoise.rs): one iteration of the edge-stopping à-trous
+// filter (SVGF, Schied et al. 2017, eq. 1-5) over a demodulated traced signal. Centre p takes
+// the normalised sum over the 5×5 taps q = p + step (i, j), i, j in -2..2, of
+//   w = h(i) h(j) · lobe(|q − p|², r_p) · geometry(p, q) · luminance(l_p, l_q, var_p)
+// (shaders/include/denoise.glsl: the B3 kernel h, the footprint gaussian of radius r_p from
+// `denoise_radius`, the plane / normal / roughness test, SVGF's luminance weight), and its
+// variance Σ w² var_q / (Σ w)² (SVGF eq. 6) for the next iteration's luminance weight. The
+// last iteration (push.remodulate) multiplies by the specular pass's share · ks again and
+// writes the radiance with a = 0. Untraced pixels (radius −1) neither give nor take.
+// CPU twin: shine::reference::denoise::atrous.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "brdf.glsl"
+#include "denoise.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba16f) readonly uniform image2D denoise_in;
+layout(set = 0, binding = 1, rgba16f) readonly uniform image2D denoise_footprint;
+layout(set = 0, binding = 2, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 3, rgba16f) readonly uniform image2D gb_normal;
+layout(set = 0, binding = 4, rgba8) readonly uniform image2D gb_albedo;
+layout(set = 0, binding = 5, rgba8) readonly uniform image2D gb_material;
+layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D denoise_out;
+
+// shine::passes::denoise::AtrousPush (32 bytes).
+layout(push_constant) uniform Push {
+    // xyz: camera position; w: the specular pass's roughness limit
+    vec4 camera;
+    // image size
+    uvec2 extent;
+    // tap spacing 2^i
+    uint step;
+    // 1: the last iteration, remodulated
+    uint remodulate;
+} push;
+
+void main() {
+    uvec2 xy = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(xy, push.extent))) {
+        return;
+    }
+    ivec2 p = ivec2(xy);
+    float radius = imageLoad(denoise_footprint, p).r;
+    if (radius < 0.0) {
+        imageStore(denoise_out, p, vec4(0.0));
+        return;
+    }
+    vec4 centre = imageLoad(denoise_in, p);
+    vec3 x_p = imageLoad(gb_position, p).xyz;
+    vec3 n_p = normalize(imageLoad(gb_normal, p).xyz);
+    vec2 material_p = imageLoad(gb_material, p).rg;
+    float dist_p = length(push.camera.xyz - x_p);
+    float l_p = luminance(centre.rgb);
+    float tolerance = denoise_normal_tolerance(brdf_alpha(material_p.x));
+    vec3 sum = vec3(0.0);
+    float variance = 0.0;
+    float weight_sum = 0.0;
+    ivec2 last = ivec2(push.extent) - 1;
+    int step = int(push.step);
+    for (int j = -2; j <= 2; ++j) {
+        for (int i = -2; i <= 2; ++i) {
+            ivec2 offset = step * ivec2(i, j);
+            ivec2 c = p + offset;
+            if (any(lessThan(c, ivec2(0))) || any(greaterThan(c, last))) {
+                continue;
+            }
+            float lobe = denoise_lobe_weight(float(offset.x * offset.x + offset.y * offset.y), radius);
+            if (lobe == 0.0 || imageLoad(denoise_footprint, c).r < 0.0) {
+                continue;
+            }
+            vec4 q = imageLoad(denoise_in, c);
+            float w = denoise_kernel(i) * denoise_kernel(j) * lobe
+                * denoise_geometry_weight(x_p, n_p, dist_p, material_p.x, tolerance,
+                    imageLoad(gb_position, c).xyz, normalize(imageLoad(gb_normal, c).xyz),
+                    imageLoad(gb_material, c).r)
+                * denoise_luminance_weight(l_p, luminance(q.rgb), centre.a);
+            sum += w * q.rgb;
+            variance += w * w * q.a;
+            weight_sum += w;
+        }
+    }
+    vec3 value = sum / weight_sum;
+    variance /= weight_sum * weight_sum;
+    if (push.remodulate != 0u) {
+        vec3 kd;
+        vec3 ks;
+        brdf_indirect_weights(imageLoad(gb_albedo, p).rgb, material_p.y,
+            dot(n_p, (push.camera.xyz - x_p) / dist_p), kd, ks);
+        float share = specular_trace_weight(material_p.x, push.camera.w);
+        imageStore(denoise_out, p, vec4(value * max(share * ks, vec3(DENOISE_MIN_WEIGHT)), 0.0));
+    } else {
+        imageStore(denoise_out, p, vec4(value, variance));
+    }
+}

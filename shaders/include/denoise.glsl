@@ -1,0 +1,95 @@
+// The denoiser of the traced signals (issue 47; src/passes/denoise.rs): an edge-stopping
+// à-trous filter (SVGF, Schied et al. 2017: a 5×5 B3-spline kernel whose taps spread by 2^i at
+// iteration i, weighted by geometry and by the luminance difference over the local standard
+// deviation) whose spatial extent is the reflected lobe's footprint in the image (after NRD's
+// hit-distance-driven radius): a mirror keeps its pixel, a rough lobe gathers from as far as
+// its reflection blurs. CPU twin: shine::reference::denoise (same names without the denoise_
+// prefix); tests/denoise.rs compares the passes with it.
+#ifndef DENOISE_GLSL
+#define DENOISE_GLSL
+#include "color.glsl"
+
+// Share f of the GGX half-vector distribution inside the lobe the filter spans: the NDF's CDF
+// over tan²θ_h is t² / (α² + t²), so tan θ_h = α sqrt(f / (1 − f)); f = 1/2: the median.
+const float DENOISE_LOBE_FRACTION = 0.5;
+// Widest reflected half-angle the filter spans, radians (lobes rougher than specular.limit
+// are the SH techniques').
+const float DENOISE_MAX_LOBE_ANGLE = 1.0;
+// Largest footprint radius, pixels (3 iterations reach 14 pixels).
+const float DENOISE_MAX_RADIUS = 16.0;
+// σ_p: a neighbour's distance off the centre's tangent plane, relative to the view distance.
+const float DENOISE_PLANE_SIGMA = 0.02;
+// Least normal tolerance 1 − cos φ (a mirror's lobe would otherwise part a plane's own f16
+// normals).
+const float DENOISE_MIN_NORMAL_TOLERANCE = 1e-4;
+// σ_r: roughness difference over which two lobes stop mixing.
+const float DENOISE_ROUGHNESS_SIGMA = 0.05;
+// σ_l of SVGF's luminance weight, in standard deviations of the centre.
+const float DENOISE_LUMINANCE_SIGMA = 4.0;
+// Smallest demodulation weight share · ks divided by (keeps grazing, barely traced pixels
+// finite).
+const float DENOISE_MIN_WEIGHT = 1e-3;
+// The firefly clamp: a pixel's luminance at most this many times the largest of its matching
+// 3×3 neighbours' (a local maximum of ordinary noise is left to the filter; a lone sample
+// that found a bright light is cut).
+const float DENOISE_FIREFLY_RATIO = 2.0;
+// A neighbour counts for the firefly clamp and the variance when its geometry weight is at
+// least this.
+const float DENOISE_MATCH = 0.25;
+
+// The reflected lobe's half-angle θ for GGX α: twice the half vector's angle.
+float denoise_lobe_angle(float alpha) {
+    float t = alpha * sqrt(DENOISE_LOBE_FRACTION / (1.0 - DENOISE_LOBE_FRACTION));
+    return min(2.0 * atan(t), DENOISE_MAX_LOBE_ANGLE);
+}
+
+// tan θ of the reflected lobe.
+float denoise_lobe_tan(float alpha) {
+    return tan(denoise_lobe_angle(alpha));
+}
+
+// How far apart two normals may be for their reflections to share a lobe: 1 − cos θ (at
+// least DENOISE_MIN_NORMAL_TOLERANCE). On a curved mirror neighbours reflect other
+// directions and stay apart; on a rough lobe they mix (NRD's lobe-driven normal weight).
+float denoise_normal_tolerance(float alpha) {
+    return max(1.0 - cos(denoise_lobe_angle(alpha)), DENOISE_MIN_NORMAL_TOLERANCE);
+}
+
+// Footprint radius in pixels of a lobe of GGX α whose reflected points lie at parallax
+// d / (z + d) (d the hit distance, z the receiver's distance from the eye; 1 where rays
+// escape): the reflection of a point spread by tan θ at d, seen from z + d, spans
+// tan θ · d / (z + d) radians; `pixel_angle` is the angle one pixel subtends there.
+float denoise_radius(float alpha, float parallax, float pixel_angle) {
+    return min(denoise_lobe_tan(alpha) * parallax / pixel_angle, DENOISE_MAX_RADIUS);
+}
+
+// The B3-spline tap of offset i in -2..2: 1/16, 1/4, 3/8, 1/4, 1/16.
+float denoise_kernel(int i) {
+    int a = abs(i);
+    return a == 0 ? 0.375 : (a == 1 ? 0.25 : 0.0625);
+}
+
+// How much neighbour q (position, normal, roughness) stands for centre p seen from `dist_p`,
+// whose lobe's normal tolerance is `tolerance` (denoise_normal_tolerance): off p's tangent
+// plane, normals apart (exp(−(1 − n_p·n_q) / tolerance), about exp(−φ²/θ²)), roughness apart.
+float denoise_geometry_weight(vec3 x_p, vec3 n_p, float dist_p, float rough_p, float tolerance, vec3 x_q, vec3 n_q, float rough_q) {
+    float plane = abs(dot(n_p, x_q - x_p)) / (DENOISE_PLANE_SIGMA * dist_p);
+    float normal = (1.0 - dot(n_p, n_q)) / tolerance;
+    return exp(-plane - normal - abs(rough_p - rough_q) / DENOISE_ROUGHNESS_SIGMA);
+}
+
+// SVGF's luminance weight: exp(−|l_p − l_q| / (σ_l sqrt(var_p) + ε)).
+float denoise_luminance_weight(float l_p, float l_q, float variance) {
+    return exp(-abs(l_p - l_q) / (DENOISE_LUMINANCE_SIGMA * sqrt(max(variance, 0.0)) + 1e-6));
+}
+
+// The footprint's gaussian at squared pixel offset `offset2` for `radius` pixels (σ = radius);
+// under half a pixel, the centre alone.
+float denoise_lobe_weight(float offset2, float radius) {
+    if (radius < 0.5) {
+        return offset2 == 0.0 ? 1.0 : 0.0;
+    }
+    return exp(-offset2 / (2.0 * radius * radius));
+}
+
+#endif

@@ -1,0 +1,134 @@
+// specular_prep (issue 47; src/passes/denoise.rs): the specular pass's one-sample radiance made
+// ready for the à-trous filter (denoise_atrous.comp). Per traced pixel p:
+// - demodulated: divided by share · ks (specular_trace_weight times the Schlick Fresnel at
+//   n·v, brdf_indirect_weights), so the albedo's colour and texture and the trace share stay
+//   out of the filter and come back in its last iteration;
+// - the firefly clamp (push.clamp): the luminance l_p of the demodulated value is held to
+//   DENOISE_FIREFLY_RATIO times the largest of its 3×3 neighbours on the same surface
+//   (geometry weight ≥ DENOISE_MATCH), so a lone bright pixel no neighbour confirms is cut to
+//   what its neighbourhood holds (the energy
+//   it removes: docs/quality.md, frames with `denoise.clamp` on and off);
+// - the luminance variance over that 3×3 (the clamped centre and its matching neighbours,
+//   equal weights), SVGF's guide of the luminance weight;
+// - the footprint radius in pixels (denoise_radius) from its roughness and the parallax
+//   d / (z + d) the specular pass stores in alpha, averaged over the same neighbours.
+// Writes `denoise_signal` (rgb demodulated, a variance) and `denoise_footprint` (r: radius in pixels; -1
+// where nothing is traced). CPU twin: shine::reference::denoise::specular_prep.
+#version 460
+#extension GL_GOOGLE_include_directive : require
+#include "brdf.glsl"
+#include "denoise.glsl"
+
+layout(local_size_x = 8, local_size_y = 8) in;
+
+layout(set = 0, binding = 0, rgba16f) readonly uniform image2D specular;
+layout(set = 0, binding = 1, rgba32f) readonly uniform image2D gb_position;
+layout(set = 0, binding = 2, rgba16f) readonly uniform image2D gb_normal;
+layout(set = 0, binding = 3, rgba8) readonly uniform image2D gb_albedo;
+layout(set = 0, binding = 4, rgba8) readonly uniform image2D gb_material;
+layout(set = 0, binding = 5, rgba16f) writeonly uniform image2D denoise_signal;
+layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D denoise_footprint;
+
+// shine::passes::denoise::PrepPush (32 bytes).
+layout(push_constant) uniform Push {
+    // xyz: camera position; w: the specular pass's roughness limit
+    vec4 camera;
+    // image size
+    uvec2 extent;
+    // angle one pixel subtends at the eye (perspective), radians
+    float pixel_angle;
+    // 1: the firefly clamp on
+    uint clamp_fireflies;
+} push;
+
+// What one pixel holds for the filter: demodulated radiance, parallax, geometry; traced false
+// where the specular pass left it out.
+struct Texel {
+    bool traced;
+    vec3 demodulated;
+    float parallax;
+    vec3 position;
+    vec3 normal;
+    float dist;
+    float roughness;
+};
+
+Texel texel(ivec2 c) {
+    Texel t;
+    vec4 position = imageLoad(gb_position, c);
+    vec3 n = imageLoad(gb_normal, c).xyz;
+    vec2 roughness_metallic = imageLoad(gb_material, c).rg;
+    t.position = position.xyz;
+    t.roughness = roughness_metallic.x;
+    t.dist = length(push.camera.xyz - position.xyz);
+    float share = specular_trace_weight(roughness_metallic.x, push.camera.w);
+    t.traced = position.w != 0.0 && share > 0.0 && dot(n, n) > 0.0 && t.dist > 0.0;
+    if (!t.traced) {
+        return t;
+    }
+    t.normal = normalize(n);
+    float nv = dot(t.normal, (push.camera.xyz - position.xyz) / t.dist);
+    t.traced = nv > 0.0;
+    vec3 kd;
+    vec3 ks;
+    brdf_indirect_weights(imageLoad(gb_albedo, c).rgb, roughness_metallic.y, nv, kd, ks);
+    vec4 s = imageLoad(specular, c);
+    t.demodulated = s.rgb / max(share * ks, vec3(DENOISE_MIN_WEIGHT));
+    t.parallax = s.a;
+    return t;
+}
+
+void main() {
+    uvec2 xy = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(xy, push.extent))) {
+        return;
+    }
+    ivec2 p = ivec2(xy);
+    Texel centre = texel(p);
+    if (!centre.traced) {
+        imageStore(denoise_signal, p, vec4(0.0));
+        imageStore(denoise_footprint, p, vec4(-1.0));
+        return;
+    }
+    ivec2 last = ivec2(push.extent) - 1;
+    float tolerance = denoise_normal_tolerance(brdf_alpha(centre.roughness));
+    float bound = -1.0;
+    float sum = 0.0;
+    float sum2 = 0.0;
+    float parallax = centre.parallax;
+    float count = 1.0;
+    for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+            ivec2 c = p + ivec2(dx, dy);
+            if ((dx == 0 && dy == 0) || any(lessThan(c, ivec2(0))) || any(greaterThan(c, last))) {
+                continue;
+            }
+            Texel q = texel(c);
+            if (!q.traced || denoise_geometry_weight(centre.position, centre.normal, centre.dist,
+                    centre.roughness, tolerance, q.position, q.normal, q.roughness) < DENOISE_MATCH) {
+                continue;
+            }
+            float l = luminance(q.demodulated);
+            bound = max(bound, l);
+            sum += l;
+            sum2 += l * l;
+            parallax += q.parallax;
+            count += 1.0;
+        }
+    }
+    vec3 value = centre.demodulated;
+    float l_p = luminance(value);
+    bound *= DENOISE_FIREFLY_RATIO;
+    if (push.clamp_fireflies != 0u && bound >= 0.0 && l_p > bound) {
+        value *= bound / l_p;
+        l_p = bound;
+    }
+    sum += l_p;
+    sum2 += l_p * l_p;
+    float mean = sum / count;
+    float variance = max(sum2 / count - mean * mean, 0.0);
+    float radius = denoise_radius(brdf_alpha(centre.roughness), parallax / count,
+        push.pixel_angle);
+    imageStore(denoise_signal, p, vec4(value, variance));
+    imageStore(denoise_footprint, p, vec4(radius, 0.0, 0.0, 0.0));
+}

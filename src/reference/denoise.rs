@@ -1,0 +1,264 @@
+//! CPU twin of the traced signals' denoiser (issue 47): `shaders/include/denoise.glsl` (same
+//! names without the `denoise_` prefix), `shaders/specular_prep.comp` ([`specular_prep`]) and
+//! `shaders/denoise_atrous.comp` ([`atrous`]). `tests/denoise.rs` compares the passes with it;
+//! [`crate::passes::denoise`] explains the filter.
+
+use glam::{Vec3, Vec4};
+
+use crate::capture::tonemap::luminance;
+use crate::passes::brdf_tables::{alpha, indirect_weights};
+use crate::passes::specular::trace_weight;
+
+/// `DENOISE_LOBE_FRACTION`: share f of the GGX half vectors inside the spanned lobe.
+pub const LOBE_FRACTION: f32 = 0.5;
+/// `DENOISE_MAX_LOBE_ANGLE`: widest reflected half-angle spanned, radians.
+pub const MAX_LOBE_ANGLE: f32 = 1.0;
+/// `DENOISE_MAX_RADIUS`: largest footprint radius, pixels.
+pub const MAX_RADIUS: f32 = 16.0;
+/// `DENOISE_PLANE_SIGMA`: distance off the tangent plane, relative to the view distance.
+pub const PLANE_SIGMA: f32 = 0.02;
+/// `DENOISE_MIN_NORMAL_TOLERANCE`: least normal tolerance 1 − cos φ.
+pub const MIN_NORMAL_TOLERANCE: f32 = 1e-4;
+/// `DENOISE_ROUGHNESS_SIGMA`: roughness difference over which lobes stop mixing.
+pub const ROUGHNESS_SIGMA: f32 = 0.05;
+/// `DENOISE_LUMINANCE_SIGMA`: SVGF's σ_l, in standard deviations of the centre.
+pub const LUMINANCE_SIGMA: f32 = 4.0;
+/// `DENOISE_FIREFLY_RATIO`: a pixel's luminance at most this many times its largest matching
+/// neighbour's.
+pub const FIREFLY_RATIO: f32 = 2.0;
+/// `DENOISE_MATCH`: least geometry weight of a neighbour in the clamp and the variance.
+pub const MATCH: f32 = 0.25;
+/// `DENOISE_MIN_WEIGHT`: smallest demodulation weight share · ks.
+pub const MIN_WEIGHT: f32 = 1e-3;
+
+/// `denoise_lobe_angle`: the reflected lobe's half-angle for GGX `alpha`.
+pub fn lobe_angle(alpha: f32) -> f32 {
+    let t = alpha * (LOBE_FRACTION / (1.0 - LOBE_FRACTION)).sqrt();
+    (2.0 * t.atan()).min(MAX_LOBE_ANGLE)
+}
+
+/// `denoise_lobe_tan`: tan of [`lobe_angle`].
+pub fn lobe_tan(alpha: f32) -> f32 {
+    lobe_angle(alpha).tan()
+}
+
+/// `denoise_normal_tolerance`: 1 − cos of [`lobe_angle`], at least [`MIN_NORMAL_TOLERANCE`].
+pub fn normal_tolerance(alpha: f32) -> f32 {
+    (1.0 - lobe_angle(alpha).cos()).max(MIN_NORMAL_TOLERANCE)
+}
+
+/// `denoise_radius`: footprint radius in pixels at `parallax` d / (z + d).
+pub fn radius(alpha: f32, parallax: f32, pixel_angle: f32) -> f32 {
+    (lobe_tan(alpha) * parallax / pixel_angle).min(MAX_RADIUS)
+}
+
+/// `denoise_kernel`: the B3-spline tap of offset `i` in −2..=2.
+pub fn kernel(i: i32) -> f32 {
+    match i.abs() {
+        0 => 0.375,
+        1 => 0.25,
+        _ => 0.0625,
+    }
+}
+
+/// One side of a geometry test: position, unit normal, distance from the eye, roughness
+/// (the normal tolerance is the centre's, from its roughness).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Surface {
+    /// World position.
+    pub position: Vec3,
+    /// Unit shading normal.
+    pub normal: Vec3,
+    /// Distance from the eye.
+    pub dist: f32,
+    /// Perceptual roughness.
+    pub roughness: f32,
+}
+
+/// `denoise_geometry_weight`: how much `q` stands for `p`.
+pub fn geometry_weight(p: &Surface, q: &Surface) -> f32 {
+    let plane = p.normal.dot(q.position - p.position).abs() / (PLANE_SIGMA * p.dist);
+    let normal = (1.0 - p.normal.dot(q.normal)) / normal_tolerance(alpha(p.roughness));
+    (-plane - normal - (p.roughness - q.roughness).abs() / ROUGHNESS_SIGMA).exp()
+}
+
+/// `denoise_luminance_weight`: SVGF's exp(−|l_p − l_q| / (σ_l √var_p + ε)).
+pub fn luminance_weight(l_p: f32, l_q: f32, variance: f32) -> f32 {
+    (-(l_p - l_q).abs() / (LUMINANCE_SIGMA * variance.max(0.0).sqrt() + 1e-6)).exp()
+}
+
+/// `denoise_lobe_weight`: the footprint's gaussian at squared offset `offset2`.
+pub fn lobe_weight(offset2: f32, radius: f32) -> f32 {
+    if radius < 0.5 {
+        return if offset2 == 0.0 { 1.0 } else { 0.0 };
+    }
+    (-offset2 / (2.0 * radius * radius)).exp()
+}
+
+/// The G-buffer the denoiser reads, row-major texels as the images hold them (normals not
+/// normalised; albedo and material in 0..1).
+#[derive(Debug, Clone, Copy)]
+pub struct Guide<'a> {
+    /// Width and height.
+    pub extent: [u32; 2],
+    /// `gb_position` (w = view depth, 0 on the background).
+    pub position: &'a [Vec4],
+    /// `gb_normal`.
+    pub normal: &'a [Vec4],
+    /// `gb_albedo`.
+    pub albedo: &'a [Vec4],
+    /// `gb_material` (r roughness, g metallic).
+    pub material: &'a [Vec4],
+    /// Eye position.
+    pub camera: Vec3,
+    /// The specular pass's roughness limit.
+    pub limit: f32,
+}
+
+impl Guide<'_> {
+    fn index(&self, x: i32, y: i32) -> Option<usize> {
+        let [w, h] = self.extent.map(|e| e as i32);
+        (x >= 0 && y >= 0 && x < w && y < h).then(|| (y * w + x) as usize)
+    }
+
+    /// The pixel's surface and its demodulation weight share · ks (floored at
+    /// [`MIN_WEIGHT`]); `None` where the specular pass traces nothing.
+    fn surface(&self, i: usize) -> Option<(Surface, Vec3)> {
+        let position = self.position[i];
+        let n = self.normal[i].truncate();
+        let material = self.material[i];
+        let dist = (self.camera - position.truncate()).length();
+        let share = trace_weight(material.x, self.limit);
+        if position.w == 0.0 || share <= 0.0 || n.dot(n) <= 0.0 || dist <= 0.0 {
+            return None;
+        }
+        let normal = n.normalize();
+        let nv = normal.dot((self.camera - position.truncate()) / dist);
+        if nv <= 0.0 {
+            return None;
+        }
+        let (_, ks) = indirect_weights(self.albedo[i].truncate(), material.y, nv);
+        let surface = Surface {
+            position: position.truncate(),
+            normal,
+            dist,
+            roughness: material.x,
+        };
+        Some((surface, (share * ks).max(Vec3::splat(MIN_WEIGHT))))
+    }
+}
+
+/// `specular_prep`: per pixel the demodulated, firefly-clamped (`clamp`) radiance with its
+/// 3×3 luminance variance in w, and the footprint radius in pixels (−1 where nothing is
+/// traced), from the specular pass's output (rgb radiance, a parallax).
+pub fn specular_prep(
+    g: &Guide<'_>,
+    specular: &[Vec4],
+    pixel_angle: f32,
+    clamp: bool,
+) -> (Vec<Vec4>, Vec<f32>) {
+    let count = (g.extent[0] * g.extent[1]) as usize;
+    let mut signal = vec![Vec4::ZERO; count];
+    let mut radii = vec![-1.0; count];
+    for y in 0..g.extent[1] as i32 {
+        for x in 0..g.extent[0] as i32 {
+            let Some(i) = g.index(x, y) else { continue };
+            let Some((centre, weight)) = g.surface(i) else {
+                continue;
+            };
+            let mut bound = -1.0f32;
+            let (mut sum, mut sum2) = (0.0f32, 0.0f32);
+            let mut parallax = specular[i].w;
+            let mut n = 1.0f32;
+            for (dx, dy) in (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))) {
+                let Some(j) = g.index(x + dx, y + dy).filter(|_| (dx, dy) != (0, 0)) else {
+                    continue;
+                };
+                let Some((q, q_weight)) = g.surface(j) else {
+                    continue;
+                };
+                if geometry_weight(&centre, &q) < MATCH {
+                    continue;
+                }
+                let l = luminance(specular[j].truncate() / q_weight);
+                bound = bound.max(l);
+                sum += l;
+                sum2 += l * l;
+                parallax += specular[j].w;
+                n += 1.0;
+            }
+            bound *= FIREFLY_RATIO;
+            let mut value = specular[i].truncate() / weight;
+            let mut l_p = luminance(value);
+            if clamp && bound >= 0.0 && l_p > bound {
+                value *= bound / l_p;
+                l_p = bound;
+            }
+            sum += l_p;
+            sum2 += l_p * l_p;
+            let mean = sum / n;
+            let variance = (sum2 / n - mean * mean).max(0.0);
+            signal[i] = value.extend(variance);
+            radii[i] = radius(alpha(centre.roughness), parallax / n, pixel_angle);
+        }
+    }
+    (signal, radii)
+}
+
+/// `denoise_atrous`: one iteration at tap spacing `step` over `signal` (rgb, variance in w);
+/// with `remodulate` the last one, the radiance times share · ks with w = 0.
+pub fn atrous(
+    g: &Guide<'_>,
+    signal: &[Vec4],
+    radii: &[f32],
+    step: i32,
+    remodulate: bool,
+) -> Vec<Vec4> {
+    let mut out = vec![Vec4::ZERO; signal.len()];
+    for y in 0..g.extent[1] as i32 {
+        for x in 0..g.extent[0] as i32 {
+            let Some(i) = g.index(x, y) else { continue };
+            let r = radii[i];
+            let Some((p, weight)) = g.surface(i).filter(|_| r >= 0.0) else {
+                continue;
+            };
+            let centre = signal[i];
+            let l_p = luminance(centre.truncate());
+            let (mut sum, mut variance, mut weight_sum) = (Vec3::ZERO, 0.0f32, 0.0f32);
+            for j in -2..=2 {
+                for k in -2..=2 {
+                    let (ox, oy) = (step * k, step * j);
+                    let Some(c) = g.index(x + ox, y + oy) else {
+                        continue;
+                    };
+                    let lobe = lobe_weight((ox * ox + oy * oy) as f32, r);
+                    if lobe == 0.0 || radii[c] < 0.0 {
+                        continue;
+                    }
+                    let q = signal[c];
+                    let surface = Surface {
+                        position: g.position[c].truncate(),
+                        normal: g.normal[c].truncate().normalize(),
+                        dist: 0.0,
+                        roughness: g.material[c].x,
+                    };
+                    let w = kernel(k)
+                        * kernel(j)
+                        * lobe
+                        * geometry_weight(&p, &surface)
+                        * luminance_weight(l_p, luminance(q.truncate()), centre.w);
+                    sum += w * q.truncate();
+                    variance += w * w * q.w;
+                    weight_sum += w;
+                }
+            }
+            let value = sum / weight_sum;
+            out[i] = if remodulate {
+                (value * weight).extend(0.0)
+            } else {
+                value.extend(variance / (weight_sum * weight_sum))
+            };
+        }
+    }
+    out
+}
