@@ -27,6 +27,7 @@
 #define ENVIRONMENT_BINDING 19
 #define ENVIRONMENT_SAMPLER_BINDING 20
 #include "environment.glsl"
+#include "denoise.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -37,7 +38,8 @@ layout(push_constant) uniform Push {
     // xyz: camera position, w: the roughness limit of the pass.
     vec4 camera;
     // x: samples per pixel, y: 1 when the environment lights the hits, z: 1 to store the
-    // parallax in alpha (the denoiser follows), w: unused.
+    // parallax in alpha (the denoiser follows), w: 1 to share the frame's x · traced-pixels
+    // rays by the lobes' widths (`budget`, denoise_ray_count).
     uvec4 config;
 } push;
 
@@ -51,6 +53,10 @@ layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_nor
 layout(set = 0, binding = 15, rgba8) readonly uniform image2D gb_albedo;
 layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
 layout(set = 0, binding = 12, rgba16f) writeonly uniform image2D specular;
+// specular_budget_total.comp: the frame's total claim on the rays and its traced pixels.
+layout(set = 0, binding = 21, std430) readonly buffer Budget {
+    vec2 total;
+} budget;
 
 void main() {
     uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -72,6 +78,12 @@ void main() {
     vec3 albedo = imageLoad(gb_albedo, ixy).rgb;
     float a = brdf_alpha(roughness_metallic.x);
     uint samples = max(push.config.x, 1u);
+    if (push.config.w != 0u) {
+        // Its own stream (the samples' streams below restart per sample).
+        rng_state = pcg(pcg(pixel.x ^ pcg(push.frame.w ^ 0x9e3779b9u)) + pixel.y);
+        samples = denoise_ray_count(denoise_ray_weight(a, share), samples, budget.total.y,
+            budget.total.x, rand());
+    }
     vec3 sum = vec3(0.0);
     float eye_distance = length(push.camera.xyz - position.xyz);
     float parallax = 0.0;

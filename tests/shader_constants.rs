@@ -323,6 +323,7 @@ fn denoise_constants_match_the_shader() {
         ("DENOISE_LOBE_FRACTION", d::LOBE_FRACTION),
         ("DENOISE_MAX_LOBE_ANGLE", d::MAX_LOBE_ANGLE),
         ("DENOISE_MAX_RADIUS", d::MAX_RADIUS),
+        ("DENOISE_MIN_PARALLAX", d::MIN_PARALLAX),
         ("DENOISE_PLANE_SIGMA", d::PLANE_SIGMA),
         ("DENOISE_MIN_NORMAL_TOLERANCE", d::MIN_NORMAL_TOLERANCE),
         ("DENOISE_ROUGHNESS_SIGMA", d::ROUGHNESS_SIGMA),
@@ -330,6 +331,8 @@ fn denoise_constants_match_the_shader() {
         ("DENOISE_MIN_WEIGHT", d::MIN_WEIGHT),
         ("DENOISE_FIREFLY_RATIO", d::FIREFLY_RATIO),
         ("DENOISE_MATCH", d::MATCH),
+        ("DENOISE_RAY_FLOOR", d::RAY_FLOOR),
+        ("DENOISE_RAY_MAX_FACTOR", d::RAY_MAX_FACTOR),
     ] {
         assert_eq!(glsl_float("include/denoise.glsl", name), value, "{name}");
     }

@@ -15,6 +15,10 @@ const float DENOISE_LOBE_FRACTION = 0.5;
 // Widest reflected half-angle the filter spans, radians (lobes rougher than specular.limit
 // are the SH techniques').
 const float DENOISE_MAX_LOBE_ANGLE = 1.0;
+// Least parallax the footprint takes: what nearly touches the receiver is seen sharp, but two
+// rays a pixel leave it as noisy as the rest (0.5: builtin:metals' gold 0.208 -> 0.204 of the
+// truth, tests/specular.rs's rough sphere over a floor 0.345 -> 0.323).
+const float DENOISE_MIN_PARALLAX = 0.5;
 // Largest footprint radius, pixels (3 iterations reach 14 pixels).
 const float DENOISE_MAX_RADIUS = 16.0;
 // σ_p: a neighbour's distance off the centre's tangent plane, relative to the view distance.
@@ -24,8 +28,9 @@ const float DENOISE_PLANE_SIGMA = 0.02;
 const float DENOISE_MIN_NORMAL_TOLERANCE = 1e-4;
 // σ_r: roughness difference over which two lobes stop mixing.
 const float DENOISE_ROUGHNESS_SIGMA = 0.05;
-// σ_l of SVGF's luminance weight, in standard deviations of the centre.
-const float DENOISE_LUMINANCE_SIGMA = 4.0;
+// σ_l of SVGF's luminance weight, in standard deviations of the centre (SVGF's 4 kept the
+// gold sphere of builtin:metals at 0.215 of the truth, 8 at 0.208; docs/quality.md).
+const float DENOISE_LUMINANCE_SIGMA = 8.0;
 // Smallest demodulation weight share · ks divided by (keeps grazing, barely traced pixels
 // finite).
 const float DENOISE_MIN_WEIGHT = 1e-3;
@@ -57,10 +62,34 @@ float denoise_normal_tolerance(float alpha) {
 
 // Footprint radius in pixels of a lobe of GGX α whose reflected points lie at parallax
 // d / (z + d) (d the hit distance, z the receiver's distance from the eye; 1 where rays
-// escape): the reflection of a point spread by tan θ at d, seen from z + d, spans
-// tan θ · d / (z + d) radians; `pixel_angle` is the angle one pixel subtends there.
+// escape; at least DENOISE_MIN_PARALLAX): the reflection of a point spread by tan θ at d,
+// seen from z + d, spans tan θ · d / (z + d) radians; `pixel_angle` is the angle one pixel
+// subtends there.
 float denoise_radius(float alpha, float parallax, float pixel_angle) {
-    return min(denoise_lobe_tan(alpha) * parallax / pixel_angle, DENOISE_MAX_RADIUS);
+    return min(denoise_lobe_tan(alpha) * max(parallax, DENOISE_MIN_PARALLAX) / pixel_angle, DENOISE_MAX_RADIUS);
+}
+
+// Least claim of a traced pixel on the frame's specular rays (a mirror's lobe still needs
+// its ray).
+const float DENOISE_RAY_FLOOR = 0.02;
+// Most rays one pixel takes, in multiples of specular.samples.
+const float DENOISE_RAY_MAX_FACTOR = 4.0;
+
+// A traced pixel's claim on the frame's specular rays: its trace share times the lobe's
+// width tan θ plus a floor (the wider the lobe, the more its rays disagree; a mirror's two
+// rays see the same point). 0 where nothing is traced.
+float denoise_ray_weight(float alpha, float share) {
+    return share > 0.0 ? share * (DENOISE_RAY_FLOOR + denoise_lobe_tan(alpha)) : 0.0;
+}
+
+// Rays of a pixel of claim `weight` when `samples` rays per traced pixel are shared among
+// `traced` pixels claiming `total` in all: one each, plus its claim's share of the other
+// (samples − 1) · traced, at most DENOISE_RAY_MAX_FACTOR · samples, rounded up with
+// probability its fraction (`u` in [0, 1)) so the frame's total stays the budget on average.
+uint denoise_ray_count(float weight, uint samples, float traced, float total, float u) {
+    float spare = float(max(samples, 1u) - 1u);
+    float n = total > 0.0 ? 1.0 + spare * traced * weight / total : float(samples);
+    return uint(floor(min(n, DENOISE_RAY_MAX_FACTOR * float(samples)) + u));
 }
 
 // The B3-spline tap of offset i in -2..2: 1/16, 1/4, 3/8, 1/4, 1/16.
