@@ -109,6 +109,34 @@ fn error(image: &HdrImage, truth: &HdrImage, pixels: &[usize]) -> (f32, f32) {
     )
 }
 
+/// A metal sphere of `roughness` above a grey floor lit by a point light, no environment.
+fn sphere_over_lit_floor(roughness: f32) -> Scene {
+    let light = Light {
+        position: [1.5, 4.0, 1.0],
+        kind: 1,
+        direction: [0.0, -1.0, 0.0],
+        range: 0.0,
+        color: [1.0; 3],
+        intensity: 40.0,
+        inner_cone_angle: 0.0,
+        outer_cone_angle: 0.0,
+        node: u32::MAX,
+        _pad: 0,
+    };
+    common::scenes::mesh_scene(
+        &[
+            (
+                common::scenes::sphere(CENTRE, RADIUS, true),
+                metal(roughness),
+            ),
+            (common::scenes::floor(8.0, 0.0), common::scenes::matte(0.6)),
+        ],
+        camera(),
+        vec![light],
+        None,
+    )
+}
+
 /// A metal sphere (roughness 0.3, under the pass's limit) in a uniform environment: every
 /// reflection ray escapes, so each pixel is the environment times the GGX lobe's directional
 /// albedo. The pass (64 rays) matches the path tracer (256 paths) to 2% in energy and 6%
@@ -152,27 +180,7 @@ fn a_metal_sphere_reflects_a_uniform_environment() {
 #[test]
 fn a_metal_sphere_reflects_a_lit_floor() {
     let device = common::device();
-    let light = Light {
-        position: [1.5, 4.0, 1.0],
-        kind: 1,
-        direction: [0.0, -1.0, 0.0],
-        range: 0.0,
-        color: [1.0; 3],
-        intensity: 40.0,
-        inner_cone_angle: 0.0,
-        outer_cone_angle: 0.0,
-        node: u32::MAX,
-        _pad: 0,
-    };
-    let scene = common::scenes::mesh_scene(
-        &[
-            (common::scenes::sphere(CENTRE, RADIUS, true), metal(0.1)),
-            (common::scenes::floor(8.0, 0.0), common::scenes::matte(0.6)),
-        ],
-        camera(),
-        vec![light],
-        None,
-    );
+    let scene = sphere_over_lit_floor(0.1);
     let pixels = sphere_pixels(&device, &scene);
     // light that scattered twice: the lit floor seen in the metal
     let truth = truth(&device, &scene, 256).indirect;
@@ -204,27 +212,7 @@ fn a_metal_sphere_reflects_a_lit_floor() {
 #[test]
 fn the_denoiser_lowers_a_rough_spheres_error_and_keeps_its_energy() {
     let device = common::device();
-    let light = Light {
-        position: [1.5, 4.0, 1.0],
-        kind: 1,
-        direction: [0.0, -1.0, 0.0],
-        range: 0.0,
-        color: [1.0; 3],
-        intensity: 40.0,
-        inner_cone_angle: 0.0,
-        outer_cone_angle: 0.0,
-        node: u32::MAX,
-        _pad: 0,
-    };
-    let scene = common::scenes::mesh_scene(
-        &[
-            (common::scenes::sphere(CENTRE, RADIUS, true), metal(0.3)),
-            (common::scenes::floor(8.0, 0.0), common::scenes::matte(0.6)),
-        ],
-        camera(),
-        vec![light],
-        None,
-    );
+    let scene = sphere_over_lit_floor(0.3);
     let pixels = sphere_pixels(&device, &scene);
     let truth = truth(&device, &scene, 1024).indirect;
     let run = |settings: &[(&str, &str)]| {

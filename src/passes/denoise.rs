@@ -10,14 +10,20 @@
 //! 1. **specular_prep**: the radiance divided by `share · ks` (the trace share of the lobe and
 //!    Schlick's Fresnel at n·v, the albedo's colour), so texture and colour stay sharp; a
 //!    firefly clamp (a pixel's luminance at most twice the largest of its 3×3 neighbours on
-//!    the same surface); the 3×3 luminance variance; the footprint radius `r = tan θ · d / (z + d) /
-//!    pixel angle` in pixels, θ the reflected lobe's median half-angle (twice the GGX half
-//!    vector's, `tan θ_h = α`), `d / (z + d)` the parallax of the hits the specular pass stores.
+//!    the same surface); the 3×3 luminance variance; the footprint radius
+//!    `r = tan θ · max(d / (z + d), ½) / pixel angle` in pixels, θ the reflected lobe's median
+//!    half-angle (twice the GGX half vector's, `tan θ_h = α`), `d / (z + d)` the parallax of
+//!    the hits the specular pass stores (at least ½: what touches the receiver is seen sharp,
+//!    but two rays leave it as noisy as the rest).
 //! 2. **denoise_atrous** × [`DenoiseParams::iterations`]: 5×5 B3 taps spaced 2^i, weighted by
 //!    the footprint's gaussian (σ = r), the tangent-plane distance, the normals (within the
 //!    lobe's angle: `exp(−(1 − n_p·n_q) / (1 − cos θ))`, so a curved mirror's neighbours,
-//!    which reflect other directions, stay apart), the roughness and SVGF's luminance weight; the variance filtered with the squared weights. The last
-//!    iteration multiplies by `share · ks` again.
+//!    which reflect other directions, stay apart), the roughness and SVGF's luminance weight;
+//!    the variance filtered with the squared weights. The last iteration multiplies by
+//!    `share · ks` again.
+//!
+//! Measured (docs/quality.md): `builtin:metals` at one sample, the gold sphere (roughness 0.3)
+//! 0.341 → 0.204 of the truth, the chrome one unchanged; 4–8% of a 256² frame on lavapipe.
 //!
 //! # Decisions
 //!
