@@ -4,6 +4,9 @@
 //! `MSE_noise-free = MSE(X, T) − MSE(A, B) / 4` (floored at 0). A one-sample frame judged
 //! against a 1024-spp truth is then judged on its own error, not the truth's grain.
 //!
+//! Channels are clamped to [0, 1] and NaN read as 0, as every metric of
+//! [`crate::capture::image_compare`] sees them.
+//!
 //! Also the tail of the per-pixel error: the q-th percentile of |X − T| (mean of the three
 //! channels) over the pixels, relative to T's mean there: speckles, which the RMSE averages
 //! away.
@@ -129,13 +132,15 @@ mod tests {
 
     #[test]
     fn the_truths_noise_is_taken_out() {
-        // Truth 1 everywhere; seeds 1 ± 0.2 (σ² = 0.04); an image off by 0.1 everywhere.
+        // Truth 0.5 everywhere (inside the metrics' dynamic range); seeds 0.5 ± 0.1; an image
+        // off by 0.05 everywhere.
         let n = 1000;
-        let a: Vec<f32> = (0..n).map(|i| if i % 2 == 0 { 1.2 } else { 0.8 }).collect();
-        let b: Vec<f32> = (0..n).map(|i| if i % 4 < 2 { 0.8 } else { 1.2 }).collect();
-        let x = vec![1.1f32; n];
+        let a: Vec<f32> = (0..n).map(|i| if i % 2 == 0 { 0.6 } else { 0.4 }).collect();
+        let b: Vec<f32> = (0..n).map(|i| if i % 4 < 2 { 0.4 } else { 0.6 }).collect();
+        let x = vec![0.55f32; n];
         let m = noise_free(&image(&x), &image(&a), &image(&b), None).expect("metrics");
-        // T = (A + B)/2 is 1 ± 0.2 or 1: MSE(X, T) = 0.01 + 0.02, MSE(A, B)/4 = 0.08/4 = 0.02.
+        // T = (A + B)/2 is 0.5, 0.4, 0.6, 0.5: MSE(X, T) = 0.0075, MSE(A, B)/4 = 0.02/4, so the
+        // noise-free RMSE is 0.05, a tenth of the mean.
         assert!((m.noise_free_relative_rmse - 0.1).abs() < 1e-6, "{m:?}");
         assert!(m.relative_rmse > 0.17, "{m:?}");
         assert!((m.energy_ratio - 1.1).abs() < 1e-6);
@@ -143,11 +148,11 @@ mod tests {
 
     #[test]
     fn the_percentile_sees_a_speckle_the_rmse_averages_away() {
-        let truth = vec![1.0f32; 2000];
+        let truth = vec![0.02f32; 2000];
         let mut x = truth.clone();
-        x[7] = 50.0;
-        x[1000] = 40.0;
-        x[1500] = 45.0;
+        x[7] = 0.9;
+        x[1000] = 0.8;
+        x[1500] = 0.85;
         let m = noise_free(&image(&x), &image(&truth), &image(&truth), None).expect("metrics");
         assert!(m.error_percentile > 30.0, "{m:?}");
         let few = [0usize, 1, 2, 3];
