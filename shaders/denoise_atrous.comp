@@ -75,9 +75,11 @@ void main() {
                     imageLoad(gb_position, c).xyz, normalize(imageLoad(gb_normal, c).xyz),
                     imageLoad(gb_material, c).r)
                 * denoise_luminance_weight(l_p, luminance(q.rgb), centre.a);
-            sum += w * q.rgb;
-            variance += w * w * q.a;
-            weight_sum += w;
+            if (w > 0.0) {
+                sum += w * q.rgb;
+                variance += w * w * q.a;
+                weight_sum += w;
+            }
         }
     }
     vec3 value = sum / weight_sum;
@@ -90,6 +92,6 @@ void main() {
         float share = specular_trace_weight(material_p.x, push.camera.w);
         imageStore(denoise_out, p, vec4(value * max(share * ks, vec3(DENOISE_MIN_WEIGHT)), 0.0));
     } else {
-        imageStore(denoise_out, p, vec4(value, variance));
+        imageStore(denoise_out, p, denoise_storable(vec4(value, variance)));
     }
 }

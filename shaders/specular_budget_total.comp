@@ -14,7 +14,7 @@ layout(set = 0, binding = 1, std430) buffer Budget {
     vec2 total;
 } budget;
 
-// shine::passes::specular::BudgetTotalPush
+// A bare u32 from shine::passes::specular (the tile count).
 layout(push_constant) uniform Push {
     // tiles of specular_budget
     uint tiles;

@@ -129,6 +129,6 @@ void main() {
     float variance = max(sum2 / count - mean * mean, 0.0);
     float radius = denoise_radius(brdf_alpha(centre.roughness), parallax / count,
         push.pixel_angle);
-    imageStore(denoise_signal, p, vec4(value, variance));
+    imageStore(denoise_signal, p, denoise_storable(vec4(value, variance)));
     imageStore(denoise_footprint, p, vec4(radius, 0.0, 0.0, 0.0));
 }

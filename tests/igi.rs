@@ -431,7 +431,8 @@ fn cpu_filter(g: &GBufferData, field: &[Vec<Vec3>], p: &IgiParams) -> Vec<Vec3> 
 // ---------------------------------------------------------------------------------------------
 
 /// Every pixel's SH projection of its set's VPLs (shadowed) equals shine-sh's, for SH orders
-/// 2–4 and interleaved patterns; the irradiance variant likewise.
+/// 2–4 and interleaved patterns up to the largest, 8×8 (64 sets: igi_sets' last slot); the
+/// irradiance variant likewise.
 #[test]
 fn vpl_sh_projection_matches_shine_sh() {
     let device = device();
@@ -441,6 +442,7 @@ fn vpl_sh_projection_matches_shine_sh() {
         ([4, 4], 3, FilterMode::Sh),
         ([3, 2], 4, FilterMode::Sh),
         ([1, 1], 3, FilterMode::Sh),
+        ([8, 8], 2, FilterMode::Sh),
         ([2, 3], 3, FilterMode::Irradiance),
     ] {
         let p = params(pattern, order, 1, mode);

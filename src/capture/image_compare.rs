@@ -47,6 +47,9 @@ pub enum CompareError {
     /// An image holds fewer texels than its size says.
     #[error("an image holds {0} texels, its size needs {1}")]
     Truncated(usize, usize),
+    /// A pixel index past the image's pixels.
+    #[error("pixel {0} lies outside the {1} pixels of the image")]
+    PixelOutOfRange(usize, usize),
     /// A mask that selects no pixel (none has a channel above 0.5).
     #[error("the mask selects no pixel (none has a channel above 0.5)")]
     EmptyMask,

@@ -63,6 +63,10 @@ pub fn noise_free(
 ) -> Result<NoiseFree, CompareError> {
     check(image, a)?;
     check(a, b)?;
+    let n = image.width as usize * image.height as usize;
+    if let Some(&i) = pixels.and_then(|p| p.iter().find(|&&i| i >= n)) {
+        return Err(CompareError::PixelOutOfRange(i, n));
+    }
     let all: Vec<usize>;
     let pixels = match pixels {
         Some(p) => p,
@@ -110,14 +114,6 @@ pub fn noise_free(
     })
 }
 
-/// The pixels where `mask` is lit (any channel above 0.5), as `shine compare --mask` takes
-/// them.
-pub fn mask_pixels(mask: &HdrImage) -> Vec<usize> {
-    (0..mask.texels.len())
-        .filter(|&i| mask.texels[i][..3].iter().any(|&v| v > 0.5))
-        .collect()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -159,5 +155,7 @@ mod tests {
         let clean = noise_free(&image(&x), &image(&truth), &image(&truth), Some(&few));
         assert_eq!(clean.expect("metrics").error_percentile, 0.0);
         assert!(noise_free(&image(&x), &image(&truth), &image(&truth), Some(&[])).is_err());
+        let outside = noise_free(&image(&x), &image(&truth), &image(&truth), Some(&[2000]));
+        assert_eq!(outside, Err(CompareError::PixelOutOfRange(2000, 2000)));
     }
 }

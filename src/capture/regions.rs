@@ -57,6 +57,20 @@ pub fn region_grid(
     Ok(regions)
 }
 
+/// The pixels where `mask` (of `reference`'s size) is lit: any channel above 0.5. A mask of
+/// another size is an error, and so is one that lights no pixel.
+pub fn mask_pixels(mask: &HdrImage, reference: &HdrImage) -> Result<Vec<usize>, CompareError> {
+    check(mask, reference)?;
+    let n = reference.width as usize * reference.height as usize;
+    let pixels: Vec<usize> = (0..n)
+        .filter(|&i| mask.texels[i][..3].iter().any(|&v| v > 0.5))
+        .collect();
+    if pixels.is_empty() {
+        return Err(CompareError::EmptyMask);
+    }
+    Ok(pixels)
+}
+
 /// The metrics over the pixels where `mask` is lit (any channel above 0.5), e.g. the
 /// receivers of one technique (`cubes.mask`): `(pixels, reference mean, energy ratio, relative
 /// RMSE)`. A mask that lights no pixel is an error.
@@ -66,13 +80,7 @@ pub fn masked_metrics(
     mask: &HdrImage,
 ) -> Result<(usize, f64, f64, f64), CompareError> {
     check(image, reference)?;
-    check(mask, reference)?;
-    let pixels: Vec<usize> = (0..mask.texels.len())
-        .filter(|&i| mask.texels[i][..3].iter().any(|&v| v > 0.5))
-        .collect();
-    if pixels.is_empty() {
-        return Err(CompareError::EmptyMask);
-    }
+    let pixels = mask_pixels(mask, reference)?;
     let (mean, energy, relative) = pixel_metrics(image, reference, pixels.iter().copied());
     Ok((pixels.len(), mean, energy, relative))
 }

@@ -8,7 +8,7 @@ use shine::capture::image_compare::{compare, flip_map};
 use shine::capture::image_io::{HdrImage, read_exr, read_png_linear, write_png};
 use shine::capture::noise_free as nf;
 use shine::capture::regions::{
-    Region, Surface, error_heatmap, masked_metrics, region_grid, surface_metrics,
+    Region, Surface, error_heatmap, mask_pixels, masked_metrics, region_grid, surface_metrics,
 };
 use std::path::{Path, PathBuf};
 
@@ -94,7 +94,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                 nf::noise_free(&image, &reference, &second, None)?,
             )];
             if let Some(mask) = &mask {
-                let pixels = nf::mask_pixels(mask);
+                let pixels = mask_pixels(mask, &reference)?;
                 reports.push((
                     "mask",
                     nf::noise_free(&image, &reference, &second, Some(&pixels))?,

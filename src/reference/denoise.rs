@@ -28,6 +28,10 @@ pub const LUMINANCE_SIGMA: f32 = 8.0;
 /// `DENOISE_FIREFLY_RATIO`: a pixel's luminance at most this many times its largest matching
 /// neighbour's.
 pub const FIREFLY_RATIO: f32 = 2.0;
+/// `DENOISE_LUMINANCE_EPSILON`: ε of the luminance weight.
+pub const LUMINANCE_EPSILON: f32 = 1e-6;
+/// `DENOISE_HALF_MAX`: the largest finite half float, what the filter's images hold at most.
+pub const HALF_MAX: f32 = 65504.0;
 /// `DENOISE_MATCH`: least geometry weight of a neighbour in the clamp and the variance.
 pub const MATCH: f32 = 0.25;
 /// `DENOISE_MIN_WEIGHT`: smallest demodulation weight share · ks.
@@ -113,7 +117,12 @@ pub fn geometry_weight(p: &Surface, q: &Surface) -> f32 {
 
 /// `denoise_luminance_weight`: SVGF's exp(−|l_p − l_q| / (σ_l √var_p + ε)).
 pub fn luminance_weight(l_p: f32, l_q: f32, variance: f32) -> f32 {
-    (-(l_p - l_q).abs() / (LUMINANCE_SIGMA * variance.max(0.0).sqrt() + 1e-6)).exp()
+    (-(l_p - l_q).abs() / (LUMINANCE_SIGMA * variance.max(0.0).sqrt() + LUMINANCE_EPSILON)).exp()
+}
+
+/// `denoise_storable`: each channel at most [`HALF_MAX`].
+pub fn storable(v: Vec4) -> Vec4 {
+    v.min(Vec4::splat(HALF_MAX))
 }
 
 /// `denoise_lobe_weight`: the footprint's gaussian at squared offset `offset2`.
@@ -227,7 +236,7 @@ pub fn specular_prep(
             sum2 += l_p * l_p;
             let mean = sum / n;
             let variance = (sum2 / n - mean * mean).max(0.0);
-            signal[i] = value.extend(variance);
+            signal[i] = storable(value.extend(variance));
             radii[i] = radius(alpha(centre.roughness), parallax / n, pixel_angle);
         }
     }
@@ -276,16 +285,18 @@ pub fn atrous(
                         * lobe
                         * geometry_weight(&p, &surface)
                         * luminance_weight(l_p, luminance(q.truncate()), centre.w);
-                    sum += w * q.truncate();
-                    variance += w * w * q.w;
-                    weight_sum += w;
+                    if w > 0.0 {
+                        sum += w * q.truncate();
+                        variance += w * w * q.w;
+                        weight_sum += w;
+                    }
                 }
             }
             let value = sum / weight_sum;
             out[i] = if remodulate {
                 (value * weight).extend(0.0)
             } else {
-                value.extend(variance / (weight_sum * weight_sum))
+                storable(value.extend(variance / (weight_sum * weight_sum)))
             };
         }
     }

@@ -88,6 +88,10 @@ use crate::passes::hvl::{self, HvlError, HvlParams};
 use crate::passes::rsm::Rsm;
 use crate::shaders;
 
+mod vpl_sets;
+
+pub use vpl_sets::{SETS_MAX, SetsPush, VplSets, sets, sets_bytes};
+
 /// Largest storage buffer every Vulkan device allows (`maxStorageBufferRange` ≥ 2²⁷ bytes):
 /// [`IgiParams::storage_limit`]'s default, which the frame replaces with its device's limit.
 pub const MAX_STORAGE_BUFFER: u64 = 1 << 27;
@@ -99,8 +103,7 @@ pub const COEFFICIENT_WORDS: u32 = (COEFFICIENT_BYTES / 4) as u32;
 
 /// Interleaving pattern sides n and m (paper 000 §2.2 uses 4×4 and 8×8 patterns).
 pub const PATTERN: RangeInclusive<u32> = 1..=8;
-/// Most sets n m of a pattern (`IGI_SETS_MAX` of shaders/igi_sets.comp, one thread each).
-pub const SETS_MAX: u32 = *PATTERN.end() * *PATTERN.end();
+
 /// VPL counts: the RSM is cut into cells by the HVL cache pass, one VPL each.
 pub const VPL_COUNT: RangeInclusive<u32> = hvl::CACHE_COUNT;
 /// SH orders of the per-pixel incident radiance (paper 000 §3.1 uses 3).
@@ -244,16 +247,6 @@ pub struct VplShPush {
     pub pad: u32,
 }
 
-/// Push constants of `shaders/igi_sets.comp` (8 bytes).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct SetsPush {
-    /// VPL count M.
-    pub vpl_count: u32,
-    /// Sets n m of the pattern.
-    pub sets: u32,
-}
-
 /// Push constants of `shaders/sh_filter.comp` (64 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
@@ -395,46 +388,8 @@ pub fn vpls(
     Ok(hvl::hvl_cache(rg, rsm, &cache)?)
 }
 
-/// Bytes of the `igi_sets` buffer for `vpl_count` records: [`SETS_MAX`] + 1 first slots, then
-/// one index per record.
-pub fn sets_bytes(vpl_count: u32) -> u64 {
-    4 * (u64::from(SETS_MAX) + 1 + u64::from(vpl_count))
-}
-
-/// The VPLs `vpls` (of [`vpls`]) and their grouping by interleaved set (of [`sets`]): what
-/// [`vpl_sh`] reads.
-#[derive(Debug, Clone, Copy)]
-pub struct VplSets {
-    /// The VPL records (layout of [`hvl::Hvl`]).
-    pub vpls: Handle<Buffer>,
-    /// `igi_sets`: first[s] of each set, then the record indices grouped by set.
-    pub sets: Handle<Buffer>,
-}
-
-/// Adds `igi_sets`: the valid records of `vpls` grouped by interleaved set (the set of their
-/// sample identity), in record order within a set; returns both for [`vpl_sh`].
-pub fn sets(
-    rg: &mut RenderGraph,
-    vpls: Handle<Buffer>,
-    params: &IgiParams,
-) -> Result<VplSets, IgiError> {
-    params.validate()?;
-    check_vpls(&vpls, params)?;
-    let mut sets = rg.create_buffer("igi_sets", BufferDesc::new(sets_bytes(params.vpl_count)));
-    let push = SetsPush {
-        vpl_count: params.vpl_count,
-        sets: params.n * params.m,
-    };
-    rg.compute("igi_sets", &shaders::IGI_SETS_COMP)
-        .read("vpls", &vpls)
-        .write("sets", &mut sets)
-        .push(&push)
-        .dispatch([1, 1, 1]);
-    Ok(VplSets { vpls, sets })
-}
-
 /// [`IgiError::OutOfRange`] unless `vpls` holds `params.vpl_count` records.
-fn check_vpls(vpls: &Handle<Buffer>, params: &IgiParams) -> Result<(), IgiError> {
+pub(crate) fn check_vpls(vpls: &Handle<Buffer>, params: &IgiParams) -> Result<(), IgiError> {
     if vpls.desc().size < hvl::cache_bytes(params.vpl_count) {
         return Err(IgiError::OutOfRange(super::OutOfRange {
             name: "vpls buffer bytes",
@@ -467,7 +422,7 @@ pub fn vpl_sh(
         return Err(IgiError::OutOfRange(super::OutOfRange {
             name: "igi_sets buffer bytes",
             value: vpls.sets.desc().size as f64,
-            expected: "(65 + vpl_count) × 4 bytes (igi::sets)".to_owned(),
+            expected: format!("({} + vpl_count) × 4 bytes (igi::sets)", SETS_MAX + 1),
         }));
     }
     let shader = shader("vpl_sh.comp", params, false)?;
