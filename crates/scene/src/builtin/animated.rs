@@ -54,16 +54,7 @@ pub fn sky() -> Environment {
 fn room() -> [MeshData; 4] {
     let (x, z) = (W * 0.5, D * 0.5);
     let c = Vec3::new;
-    let mut floor = MeshData::default();
-    floor.quad(
-        [c(-x, 0., z), c(x, 0., z), c(x, 0., -z), c(-x, 0., -z)],
-        Vec2::new(W, D),
-    );
-    let mut ceiling = MeshData::default();
-    ceiling.quad(
-        [c(-x, H, -z), c(x, H, -z), c(x, H, z), c(-x, H, z)],
-        Vec2::ONE,
-    );
+    let (floor, ceiling) = shapes::floor_and_ceiling(W, D, H, Vec2::ONE);
     let mut back = MeshData::default();
     back.quad(
         [c(-x, 0., -z), c(x, 0., -z), c(x, H, -z), c(-x, H, -z)],

@@ -71,18 +71,12 @@ fn swing(t: f32) -> f32 {
 fn room(roofless: bool) -> [MeshData; 5] {
     let (x, z) = (W * 0.5, D * 0.5);
     let c = Vec3::new;
-    let mut floor = MeshData::default();
-    floor.quad(
-        [c(-x, 0., z), c(x, 0., z), c(x, 0., -z), c(-x, 0., -z)],
-        Vec2::new(W, D),
-    );
-    let mut ceiling = MeshData::default();
-    if !roofless {
-        ceiling.quad(
-            [c(-x, H, -z), c(x, H, -z), c(x, H, z), c(-x, H, z)],
-            Vec2::ONE,
-        );
-    }
+    let (floor, ceiling) = shapes::floor_and_ceiling(W, D, H, Vec2::ONE);
+    let ceiling = if roofless {
+        MeshData::default()
+    } else {
+        ceiling
+    };
     let mut left = MeshData::default();
     left.quad(
         [c(-x, 0., z), c(-x, 0., -z), c(-x, H, -z), c(-x, H, z)],

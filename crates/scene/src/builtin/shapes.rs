@@ -180,6 +180,25 @@ pub fn cuboid(size: Vec3) -> MeshData {
     m
 }
 
+/// The floor (y = 0, texture repeats `w` × `d`) and ceiling (y = `h`, texture repeats
+/// `ceiling_uv`) of a `w` × `d` room centred on the origin, both facing into the room (the
+/// built-in rooms share them).
+pub fn floor_and_ceiling(w: f32, d: f32, h: f32, ceiling_uv: Vec2) -> (MeshData, MeshData) {
+    let (x, z) = (w * 0.5, d * 0.5);
+    let c = Vec3::new;
+    let mut floor = MeshData::default();
+    floor.quad(
+        [c(-x, 0., z), c(x, 0., z), c(x, 0., -z), c(-x, 0., -z)],
+        Vec2::new(w, d),
+    );
+    let mut ceiling = MeshData::default();
+    ceiling.quad(
+        [c(-x, h, -z), c(x, h, -z), c(x, h, z), c(-x, h, z)],
+        ceiling_uv,
+    );
+    (floor, ceiling)
+}
+
 /// A horizontal square of side `size` at y = 0 facing +Y, UVs repeating every `tile` metres.
 pub fn ground(size: f32, tile: f32) -> MeshData {
     let h = size * 0.5;
