@@ -7,6 +7,8 @@ mod common;
 mod gi_context;
 #[path = "../examples/host_gbuffer/host/mod.rs"]
 mod host;
+#[path = "embedding/warm_up.rs"]
+mod warm_up;
 
 use host::HostDevice;
 use shine::gpu::{Device, vk};

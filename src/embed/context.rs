@@ -1,6 +1,7 @@
 //! [`GiContext`]: shine as a GI pass inside a host engine's frame.
 
 use super::inputs::GiDispatch;
+use super::warm_up::{DispatchShape, Placeholders, warm_up_frames};
 use crate::farm::identity::fnv1a;
 use crate::frame::RenderError;
 use crate::frame::memory::MemoryReport;
@@ -105,6 +106,10 @@ pub struct GiContext {
     last_frame: Option<u64>,
     /// The frame budget of the description, and what it chose (`None` until chosen).
     budget: Option<(f64, Option<BudgetChoice>)>,
+    /// Frames the host records ahead of the GPU.
+    frames_in_flight: usize,
+    /// The warm-up's inputs, made on its first call.
+    placeholders: Option<Placeholders>,
 }
 
 impl GiContext {
@@ -151,6 +156,8 @@ impl GiContext {
             )?,
             last_frame: None,
             budget,
+            frames_in_flight: desc.frames_in_flight,
+            placeholders: None,
         })
     }
 
@@ -240,6 +247,19 @@ impl GiContext {
                 self.last_frame.unwrap_or_default()
             )));
         }
+        self.record(cb, dispatch, Some(dispatch.frame_index))?;
+        self.last_frame = Some(dispatch.frame_index);
+        Ok(())
+    }
+
+    /// Records `dispatch` into `cb` as the host's frame `host_frame` (`None`: a warm-up frame
+    /// shine submits and waits for itself).
+    fn record(
+        &mut self,
+        cb: vk::CommandBuffer,
+        dispatch: &GiDispatch,
+        host_frame: Option<u64>,
+    ) -> Result<(), RenderError> {
         let display = self.display;
         let constants = dispatch.host_frame(display);
         let camera = dispatch.camera.view_for(display);
@@ -248,7 +268,7 @@ impl GiContext {
             (&self.frame_constants, &mut self.ring, self.nearest.raw());
         self.renderer.record_indirect(
             cb,
-            dispatch.frame_index,
+            host_frame,
             &self.params,
             &camera,
             &mut |rg: &mut RenderGraph| {
@@ -289,9 +309,72 @@ impl GiContext {
                     environment,
                 })
             },
-        )?;
-        self.last_frame = Some(dispatch.frame_index);
+        )
+    }
+
+    /// Builds, ahead of the host's first frame, everything a frame needs: every pipeline
+    /// (through the device's pipeline cache), the graph's plans, transient memory and
+    /// descriptor pools. It records [`warm_up_frames`] frames of placeholder inputs at the
+    /// display size, submits them to shine's queue and waits, then starts the histories over,
+    /// so the host's first dispatch costs about what a steady one does. `shape`: what the
+    /// host's dispatches will bring (motion vectors, an environment map), which decides the
+    /// graph that is built. A load-time call, after [`GiContext::set_scene`]; call it again after a
+    /// [`GiContext::resize`] to warm the new size. The host must have no frame of this
+    /// context in flight.
+    pub fn warm_up(&mut self, shape: DispatchShape) -> Result<(), RenderError> {
+        if !self
+            .placeholders
+            .as_ref()
+            .is_some_and(|p| p.fit(self.display))
+        {
+            self.placeholders = Some(Placeholders::new(&self.device, self.display)?);
+        }
+        let placeholders = self.placeholders.take();
+        let mut result = Ok(());
+        if let Some(p) = &placeholders {
+            for _ in 0..warm_up_frames(self.frames_in_flight) {
+                result = self.warm_up_frame(p, shape);
+                if result.is_err() {
+                    break;
+                }
+            }
+        }
+        self.placeholders = placeholders;
+        result?;
+        // The warm-up's pass times are not the host's.
+        self.renderer.timings()?;
+        self.reset_history();
         Ok(())
+    }
+
+    /// One warm-up frame of `placeholders`, submitted and waited for (not submitted when it
+    /// could not be recorded).
+    fn warm_up_frame(
+        &mut self,
+        placeholders: &Placeholders,
+        shape: DispatchShape,
+    ) -> Result<(), RenderError> {
+        let device = self.device.clone();
+        let mut recorded = Ok(());
+        let submitted = device.run_once(|cmd| {
+            placeholders.clear(cmd);
+            recorded = self.record(cmd.raw(), &placeholders.dispatch(0, shape), None);
+            match recorded {
+                Ok(()) => Ok(()),
+                Err(_) => Err(shine_gpu::Error::InvalidUsage(
+                    "warm-up frame abandoned".into(),
+                )),
+            }
+        });
+        recorded?;
+        Ok(submitted.map(drop)?)
+    }
+
+    /// Starts every history over, for a camera cut or a teleport: the next dispatch computes
+    /// its indirect light as a first frame does, with nothing carried from earlier frames
+    /// (accumulation, reprojection, amortised caches, the previous frame's transforms).
+    pub fn reset_history(&mut self) {
+        self.renderer.reset_history();
     }
 
     /// The device memory the context holds, by category: the scene, the technique's caches,

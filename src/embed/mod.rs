@@ -4,6 +4,7 @@
 
 mod context;
 mod inputs;
+mod warm_up;
 
 pub use crate::frame::memory::MemoryReport;
 pub use context::{GiBudgets, GiContext, GiContextDesc};
@@ -11,3 +12,4 @@ pub use inputs::{
     DepthConvention, GiCamera, GiDispatch, HostEnvironment, HostMotion, MaterialChannels,
     NormalEncoding,
 };
+pub use warm_up::DispatchShape;

@@ -128,6 +128,11 @@ impl ProxyTechnique {
         (caches + brdf, self.ring.allocated_bytes() + brdf_staging)
     }
 
+    /// Forgets the history (the amortised schedule); the uploaded tables stay.
+    pub fn reset(&mut self) {
+        self.schedule.reset();
+    }
+
     /// Forgets the uploaded tables: a frame that may have uploaded them was dropped unrun.
     pub fn forget_uploads(&mut self) {
         self.schedule.reset();

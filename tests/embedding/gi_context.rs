@@ -15,13 +15,13 @@ use shine_scene::Scene;
 use std::sync::atomic::Ordering;
 
 /// Test image size.
-const EXTENT: [u32; 2] = [64, 64];
+pub const EXTENT: [u32; 2] = [64, 64];
 /// Radians the camera turns per frame in the moving-camera tests.
 const ORBIT: f32 = 0.04;
 
 /// A host with the cornell box, its G-buffer pipeline and targets, and shine's device on it.
-struct Bench {
-    scene: Scene,
+pub struct Bench {
+    pub scene: Scene,
     host_scene: Option<HostScene>,
     raster: Option<Raster>,
     targets: Option<Targets>,
@@ -31,7 +31,7 @@ struct Bench {
 }
 
 impl Bench {
-    fn new(share_allocator: bool) -> Self {
+    pub fn new(share_allocator: bool) -> Self {
         Self::with_device(share_allocator, |raw| raw)
     }
 
@@ -57,7 +57,7 @@ impl Bench {
         }
     }
 
-    fn device(&self) -> &Device {
+    pub fn device(&self) -> &Device {
         self.device.as_ref().expect("device")
     }
 
@@ -66,7 +66,7 @@ impl Bench {
     }
 
     /// A context for `technique` with the scene set.
-    fn context(&self, technique: &str) -> GiContext {
+    pub fn context(&self, technique: &str) -> GiContext {
         let mut gi =
             GiContext::new(self.device(), &exact_desc(EXTENT, technique)).expect("context");
         gi.set_scene(&self.scene, 0.0).expect("scene");
@@ -116,7 +116,7 @@ impl Bench {
     }
 
     /// Frames `frames` through `gi`, each in one host submission; the GI image of the last.
-    fn run(&self, gi: &mut GiContext, frames: std::ops::Range<u32>) -> Vec<[f32; 3]> {
+    pub fn run(&self, gi: &mut GiContext, frames: std::ops::Range<u32>) -> Vec<[f32; 3]> {
         for k in frames {
             let cb = self.host.begin().expect("begin");
             let dispatch = self.record_gbuffer(cb, k);
@@ -159,7 +159,7 @@ impl Bench {
     }
 
     /// Zero validation messages so far (the host's messenger sees shine's calls too).
-    fn assert_clean(&self) {
+    pub fn assert_clean(&self) {
         assert_eq!(host::VALIDATION_MESSAGES.load(Ordering::Relaxed), 0);
     }
 }
@@ -615,7 +615,7 @@ fn contexts_are_send_and_devices_send_and_sync() {
 /// per HVL and no traced near field: their noise follows the frame index and the G-buffer's
 /// last bits, which these comparisons of two G-buffer paths and of resized contexts are not
 /// about.
-fn exact_desc(display: [u32; 2], technique: &str) -> GiContextDesc {
+pub fn exact_desc(display: [u32; 2], technique: &str) -> GiContextDesc {
     let mut desc = GiContextDesc::new(display, technique).expect("desc");
     desc.settings.hvl.shadow_rays = 0;
     desc.settings.hvl.near_range = 0.0;

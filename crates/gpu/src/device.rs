@@ -9,6 +9,7 @@ use crate::instance::{
     Adapter, InstanceGuard, Owned, OwnedGuard, VALIDATION_LAYER, choose, create_instance,
     destroy_owned, list_adapters, messenger_info, physical_name,
 };
+use crate::pipeline_cache::PipelineCache;
 use crate::retire::Tracker;
 use crate::validation::{MessageCounts, MessageLog, Validation};
 use ash::vk;
@@ -24,6 +25,9 @@ pub struct DeviceDesc {
     /// Index (from `shine info`) or case-insensitive name substring; `None` picks by type
     /// (discrete > integrated > virtual > CPU).
     pub selector: Option<String>,
+    /// A previous run's [`Device::pipeline_cache_data`] to seed the pipeline cache with
+    /// (empty: start cold; data from another driver or device is ignored by the driver).
+    pub pipeline_cache_data: Vec<u8>,
 }
 
 impl DeviceDesc {
@@ -32,6 +36,7 @@ impl DeviceDesc {
         Self {
             validation: Validation::from_env(),
             selector: std::env::var("SHINE_DEVICE").ok().filter(|s| !s.is_empty()),
+            pipeline_cache_data: Vec::new(),
         }
     }
 }
@@ -61,6 +66,10 @@ pub struct RawDevice {
     /// `None`: shine makes its own. Shine frees all of its allocations before it drops its
     /// reference.
     pub allocator: Option<Arc<Mutex<Allocator>>>,
+    /// The host's pipeline cache, which every pipeline shine creates goes through (the host
+    /// saves it with `vkGetPipelineCacheData` and destroys it after shine's device is gone);
+    /// `vk::PipelineCache::null()`: shine makes its own.
+    pub pipeline_cache: vk::PipelineCache,
 }
 
 /// Facts about the device, for `shine info` and for sizing work.
@@ -108,6 +117,7 @@ pub(crate) struct Inner {
     pub(crate) tracker: Mutex<Tracker>,
     pub(crate) info: DeviceInfo,
     pub(crate) limits: vk::PhysicalDeviceLimits,
+    pub(crate) pipeline_cache: PipelineCache,
     owned: Option<Owned>,
     log: Arc<MessageLog>,
 }
@@ -244,6 +254,8 @@ impl Device {
                 validation: use_layer,
                 allocator: None,
                 anisotropy: false,
+                pipeline_cache: vk::PipelineCache::null(),
+                pipeline_cache_data: &desc.pipeline_cache_data,
             },
             owned,
             log,
@@ -292,15 +304,17 @@ impl Device {
                 validation: false,
                 allocator: raw.allocator,
                 anisotropy: raw.enabled.features.sampler_anisotropy == vk::TRUE,
+                pipeline_cache: raw.pipeline_cache,
+                pipeline_cache_data: &[],
             },
             None,
             Arc::new(MessageLog::default()),
         )
     }
 
-    fn assemble(parts: Parts, owned: Option<Owned>, log: Arc<MessageLog>) -> Result<Self> {
+    fn assemble(parts: Parts<'_>, owned: Option<Owned>, log: Arc<MessageLog>) -> Result<Self> {
         let is_owned = owned.is_some();
-        let cleanup = |parts: &Parts| {
+        let cleanup = |parts: &Parts<'_>| {
             if is_owned {
                 // SAFETY: created above by shine, no child objects exist yet.
                 unsafe { parts.raw.destroy_device(None) };
@@ -332,6 +346,18 @@ impl Device {
                 });
             }
         };
+        let pipeline_cache =
+            match PipelineCache::new(&parts.raw, parts.pipeline_cache, parts.pipeline_cache_data) {
+                Ok(cache) => cache,
+                Err(e) => {
+                    drop(allocator);
+                    cleanup(&parts);
+                    if let Some(owned) = owned {
+                        destroy_owned(&parts.instance, owned);
+                    }
+                    return Err(e);
+                }
+            };
         let support = Support::query(&parts.instance, parts.physical);
         // SAFETY: the physical device belongs to the instance.
         let families = unsafe {
@@ -411,6 +437,7 @@ impl Device {
                 tracker: Mutex::new(Tracker::default()),
                 info,
                 limits: properties.limits,
+                pipeline_cache,
                 owned,
                 log,
             }),
@@ -530,7 +557,7 @@ pub struct MemoryUsage {
     pub allocations: usize,
 }
 
-struct Parts {
+struct Parts<'a> {
     entry: ash::Entry,
     instance: ash::Instance,
     physical: vk::PhysicalDevice,
@@ -543,6 +570,10 @@ struct Parts {
     allocator: Option<Arc<Mutex<Allocator>>>,
     /// Whether the host enabled samplerAnisotropy.
     anisotropy: bool,
+    /// The host's pipeline cache, or null.
+    pipeline_cache: vk::PipelineCache,
+    /// What to seed shine's own pipeline cache with.
+    pipeline_cache_data: &'a [u8],
 }
 
 /// Locks a mutex, recovering the data if a panicking thread poisoned it.
@@ -575,6 +606,7 @@ impl Drop for Inner {
             let mut allocator = lock(&self.allocator);
             tracker.destroy_all(&self.raw, &mut allocator);
         }
+        self.pipeline_cache.destroy(&self.raw);
         // SAFETY: dropped exactly once, before the device it allocates from (the last
         // reference frees shine's own allocator; a host's lives on in the host).
         unsafe { ManuallyDrop::drop(&mut self.allocator) };

@@ -16,6 +16,7 @@ mod features;
 mod instance;
 mod memory;
 mod pipeline;
+mod pipeline_cache;
 mod retire;
 mod shader;
 mod timestamps;

@@ -193,7 +193,7 @@ impl ComputePipeline {
         let result = unsafe {
             device
                 .raw()
-                .create_compute_pipelines(vk::PipelineCache::null(), &info, None)
+                .create_compute_pipelines(device.pipeline_cache(), &info, None)
         };
         let raw = match result {
             Ok(p) => p.first().copied().unwrap_or_default(),
@@ -454,7 +454,7 @@ impl GraphicsPipeline {
         let result = unsafe {
             device
                 .raw()
-                .create_graphics_pipelines(vk::PipelineCache::null(), &info, None)
+                .create_graphics_pipelines(device.pipeline_cache(), &info, None)
         };
         let raw = match result {
             Ok(p) => p.first().copied().unwrap_or_default(),

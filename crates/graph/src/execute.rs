@@ -103,7 +103,7 @@ impl Executor {
     }
 
     /// Device memory the executor holds: `(transients, temporal)` bytes: the aliased heaps of
-    /// every kept transient set (one per plan and frame slot) and the temporal and history
+    /// every kept transient set (one per frame slot and transient layout) and the temporal and history
     /// resources kept across frames.
     pub fn memory(&self) -> (u64, u64) {
         self.objects.memory()

@@ -1,5 +1,6 @@
-//! The Vulkan objects the executor keeps across frames: a set of transients per plan and frame
-//! slot (bound into the plan's aliased memory, least recently used evicted) and the temporal
+//! The Vulkan objects the executor keeps across frames: a set of transients per frame slot and
+//! transient layout (bound into the plan's aliased memory, least recently used evicted; plans
+//! that differ only in their imports share one) and the temporal
 //! resources by key; and the table mapping one frame's resource ids to the objects behind them.
 
 use std::collections::HashMap;
@@ -23,7 +24,7 @@ const KEPT_TRANSIENT_SETS: usize = 8;
 /// Frames in flight use different slots, so they never share transient memory; a slot is reused
 /// only once its previous frame has completed (the [`crate::Executor`] contract).
 struct TransientSet {
-    /// The plan whose placements the set follows (the same `Arc` while the plan is cached).
+    /// The plan whose placements the set follows (or one with the same transients).
     plan: Arc<Plan>,
     /// The frame slot using the set.
     slot: usize,
@@ -31,6 +32,25 @@ struct TransientSet {
     _heaps: Vec<MemoryBlock>,
     /// The transient resources of the plan, each bound at its placement.
     objects: Vec<(ResourceId, RawObject)>,
+}
+
+/// Whether a transient set made for `kept` serves `plan`: the same plan, or one with the same
+/// heaps and, at each placement, a resource of the same id, description and usage. Plans that
+/// differ only in what they import (a host's image formats, a warm-up's placeholders) then
+/// share their transient memory instead of allocating a set each.
+fn same_transients(kept: &Plan, plan: &Plan) -> bool {
+    if std::ptr::eq(kept, plan) {
+        return true;
+    }
+    let (a, b) = (&kept.memory, &plan.memory);
+    a.heaps == b.heaps
+        && a.placements == b.placements
+        && a.placements.iter().all(|p| {
+            match (kept.resource(p.resource), plan.resource(p.resource)) {
+                (Some(x), Some(y)) => x.desc == y.desc && x.usage == y.usage,
+                _ => false,
+            }
+        })
 }
 
 /// A temporal resource on the GPU.
@@ -70,7 +90,7 @@ impl GraphObjects {
         if let Some(i) = self
             .transients
             .iter()
-            .position(|t| t.slot == slot && Arc::ptr_eq(&t.plan, plan))
+            .position(|t| t.slot == slot && same_transients(&t.plan, plan))
         {
             // Most recently used last, so eviction takes the least recently used.
             let set = self.transients.remove(i);

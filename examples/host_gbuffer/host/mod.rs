@@ -61,6 +61,8 @@ pub struct HostDevice {
     pub family: u32,
     pub queue: vk::Queue,
     pub pool: vk::CommandPool,
+    /// The host's pipeline cache, lent to shine (a real engine saves it between runs).
+    pub pipeline_cache: vk::PipelineCache,
     /// The host's allocator (shine may be handed it); `None` only while dropping.
     allocator: Option<Arc<Mutex<Allocator>>>,
     /// Whether the validation layer is on.
@@ -146,6 +148,8 @@ impl HostDevice {
                     .flags(vk::CommandPoolCreateFlags::RESET_COMMAND_BUFFER),
                 None,
             )?;
+            let pipeline_cache =
+                device.create_pipeline_cache(&vk::PipelineCacheCreateInfo::default(), None)?;
             let allocator = Allocator::new(&AllocatorCreateDesc {
                 instance: instance.clone(),
                 device: device.clone(),
@@ -163,6 +167,7 @@ impl HostDevice {
                 family,
                 queue,
                 pool,
+                pipeline_cache,
                 allocator: Some(Arc::new(Mutex::new(allocator))),
                 validation,
             })
@@ -227,6 +232,7 @@ impl HostDevice {
             debug_utils: true,
             enabled: shine::gpu::EnabledFeatures::required(),
             allocator: share_allocator.then(|| self.allocator()),
+            pipeline_cache: self.pipeline_cache,
         }
     }
 }
@@ -239,6 +245,8 @@ impl Drop for HostDevice {
         unsafe {
             let _ = self.device.device_wait_idle();
             self.device.destroy_command_pool(self.pool, None);
+            self.device
+                .destroy_pipeline_cache(self.pipeline_cache, None);
             drop(self.allocator.take());
             self.device.destroy_device(None);
             if let Some((debug, messenger)) = self.messenger.take() {

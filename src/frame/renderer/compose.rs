@@ -38,22 +38,32 @@ impl Renderer {
         declared
     }
 
-    /// After a graph that is dropped unrun: what that frame meant to leave for the next one
-    /// (previous vertices, camera, HVL history) or upload once (tables) was never written.
-    pub(super) fn forget_history(&mut self) {
+    /// Starts every history over (a camera cut): the next frame carries nothing from earlier
+    /// ones (previous vertices and camera, accumulation, amortised schedules, AAF's and the
+    /// cube maps' histories). What was uploaded once (tables) stays.
+    pub(crate) fn reset_history(&mut self) {
         if let Some(scene) = self.scene.as_mut() {
             scene.gpu.forget_previous();
+            scene.proxy.reset();
+            scene.cubes.reset();
         }
         self.motion.reset();
         self.accumulate.reset();
         self.taa.reset();
         self.exposure.reset();
+        self.hvl.reset();
+        self.igi.reset();
+        self.aaf.reset();
+    }
+
+    /// After a graph that is dropped unrun: what that frame meant to leave for the next one
+    /// (previous vertices, camera, HVL history) or upload once (tables) was never written.
+    pub(super) fn forget_history(&mut self) {
+        self.reset_history();
         self.hvl.forget_uploads();
         self.igi.forget_uploads();
-        self.aaf.reset();
         if let Some(scene) = self.scene.as_mut() {
             scene.proxy.forget_uploads();
-            scene.cubes.reset();
         }
     }
 

@@ -23,7 +23,8 @@ pub(crate) struct HostSide {
 pub(crate) type DeclareHost<'a> = dyn FnMut(&mut RenderGraph) -> Result<HostSide, RenderError> + 'a;
 
 impl Renderer {
-    /// Records into `cb`, as the host's frame `frame_index`, the scene's updates, `host`'s G-buffer conversion, the techniques of
+    /// Records into `cb`, as the host's frame `frame_index` (`None`: a frame of shine's own
+    /// that is waited for, which leaves the host's frame clock alone), the scene's updates, `host`'s G-buffer conversion, the techniques of
     /// `p` seen from `camera`, and their indirect light written into the host's output image
     /// (cleared to 0 when the frame has no indirect light, e.g. no primary light for HVL).
     /// Neither submits nor waits. After an error nothing usable was recorded, and what this
@@ -31,12 +32,14 @@ impl Renderer {
     pub(crate) fn record_indirect(
         &mut self,
         cb: vk::CommandBuffer,
-        frame_index: u64,
+        frame_index: Option<u64>,
         p: &FrameParams,
         camera: &View,
         host: &mut DeclareHost<'_>,
     ) -> Result<(), RenderError> {
-        self.begin_host_frame(frame_index);
+        if let Some(frame_index) = frame_index {
+            self.begin_host_frame(frame_index);
+        }
         let mut rg = self.executor.begin_frame();
         let recorded = match self.declare_host_frame(&mut rg, p, camera, host) {
             Ok(()) => self
