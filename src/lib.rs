@@ -7,6 +7,8 @@
 
 pub use shine_gpu as gpu;
 pub use shine_graph as graph;
+/// The scene format (`shine_scene`): what `GiContext::set_scene` and `Renderer::set_scene` take.
+pub use shine_scene as scene;
 
 pub mod capture;
 pub mod choice;

@@ -1,28 +1,35 @@
 //! A host engine using shine as a GI pass (docs/embedding.md): the host rasterises its own
 //! G-buffer and direct light with its own pipeline into its own images, hands them to a
 //! `GiContext` recorded into its own command buffer, composites direct + GI itself, and
-//! writes a PNG after 3 frames of a moving camera.
+//! writes a PNG after 6 frames of a moving camera. It prints how long the context took to make
+//! and warm up, and each frame's wall time (recording, submission and wait): with the warm-up
+//! the first frame costs what the others do; `--cold` skips it to show the hitch.
 //!
-//! `cargo run --release --example host_gbuffer -- out.png`
+//! `cargo run --release --example host_gbuffer -- out.png [--cold]`
 
 mod host;
 
 use host::{HostDevice, HostScene, Raster, Targets};
 use shine::embed::{
-    GiCamera, GiContext, GiContextDesc, GiDispatch, MaterialChannels, NormalEncoding,
+    DispatchShape, GiCamera, GiContext, GiContextDesc, GiDispatch, MaterialChannels, NormalEncoding,
 };
 use shine::graph::ExternalState;
 use std::error::Error;
 use std::sync::atomic::Ordering;
+use std::time::Instant;
 
 /// Frames rendered; the camera turns a little each frame.
-const FRAMES: u32 = 3;
+const FRAMES: u32 = 6;
 /// Radians the camera turns per frame about the scene's vertical axis.
 const ORBIT_PER_FRAME: f32 = 0.05;
 
 fn main() -> Result<(), Box<dyn Error>> {
-    let output = std::env::args()
-        .nth(1)
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let cold = args.iter().any(|a| a == "--cold");
+    let output = args
+        .iter()
+        .find(|a| !a.starts_with("--"))
+        .cloned()
         .unwrap_or_else(|| "host_gbuffer.png".into());
     let extent = [256, 256];
     let scene = shine_scene::Scene::builtin("cornell-box")?;
@@ -34,13 +41,24 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (direct, gi) = {
         // shine on the host's device, allocating from the host's allocator.
         let device = shine::gpu::Device::from_raw(host.lend(true))?;
+        let ms = |start: Instant| start.elapsed().as_secs_f64() * 1e3;
+        let start = Instant::now();
         let mut gi = GiContext::new(&device, &GiContextDesc::new(extent, "hvl")?)?;
+        println!("GiContext::new {:.1} ms", ms(start));
+        let start = Instant::now();
         gi.set_scene(&scene, 0.0)?;
+        println!("set_scene {:.1} ms", ms(start));
+        if !cold {
+            let start = Instant::now();
+            gi.warm_up(DispatchShape::default())?;
+            println!("warm_up {:.1} ms", ms(start));
+        }
         let mut previous = None;
         for frame in 0..FRAMES {
             let (view, projection) = host::camera(&scene, extent, frame as f32 * ORBIT_PER_FRAME);
             let (previous_view, previous_projection) = previous.unwrap_or((view, projection));
             previous = Some((view, projection));
+            let start = Instant::now();
             let cb = host.begin()?;
             raster.record(&host, cb, &targets, &host_scene, projection * view);
             let color =
@@ -73,7 +91,7 @@ fn main() -> Result<(), Box<dyn Error>> {
                 },
             )?;
             host.submit_and_wait(cb)?;
-            println!("frame {}/{FRAMES}", frame + 1);
+            println!("frame {}/{FRAMES} {:.1} ms", frame + 1, ms(start));
         }
         let direct = host::read_rgba16f(&host, &targets.direct, host::color_written())?;
         let gi_texels = host::read_rgba16f(&host, &targets.gi, host::copy_source())?;

@@ -3,10 +3,11 @@
 
 use crate::frame::RenderError;
 use crate::frame::renderer::HostTarget;
-use crate::passes::gbuffer::{View, flip_y};
+use crate::passes::gbuffer::{View, flip_y, projection_matrix};
 use crate::passes::host_gbuffer::{HostFrame, NO_CHANNEL};
 use glam::{Mat4, Vec3};
 use shine_gpu::vk;
+use shine_scene::Scene;
 
 /// The host's camera this frame and the previous one. Projections follow Vulkan clip
 /// conventions (y down, depth 0..1, standard or reversed Z as [`DepthConvention`] says) and
@@ -45,6 +46,33 @@ impl GiCamera {
             Mat4::look_at_rh(eye, target, Vec3::Y),
             flip_y(Mat4::perspective_rh(yfov, aspect, near, far)),
         )
+    }
+
+    /// Camera `index` of `scene` at time `t`, and at `previous_t` as the previous frame's, for
+    /// an image of `extent`: the matrices shine's own renderer uses for that camera. `None`
+    /// when the scene has no such camera.
+    pub fn from_scene(
+        scene: &Scene,
+        index: usize,
+        t: f32,
+        previous_t: f32,
+        extent: [u32; 2],
+    ) -> Option<Self> {
+        let camera = scene.cameras.get(index)?;
+        let aspect = extent[0] as f32 / extent[1].max(1) as f32;
+        let projection = projection_matrix(&camera.projection, aspect);
+        let view_at = |t: f32| {
+            scene
+                .camera_world(index, &scene.pose_at(t).world)
+                .map(|world| world.inverse())
+        };
+        Some(Self {
+            view: view_at(t)?,
+            projection,
+            jitter: [0.0; 2],
+            previous_view: view_at(previous_t)?,
+            previous_projection: projection,
+        })
     }
 
     /// The camera position (the view matrix's origin).

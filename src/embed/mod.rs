@@ -7,9 +7,15 @@ mod inputs;
 mod warm_up;
 
 pub use crate::frame::memory::MemoryReport;
+/// What a host also needs, in one place: the image type of every input and output, the
+/// per-frame scene update, the device wrapper and what it checks, and the image states.
+pub use crate::frame::renderer::HostTarget;
+pub use crate::gpu_scene::FrameUpdate;
 pub use context::{GiBudgets, GiContext, GiContextDesc};
 pub use inputs::{
     DepthConvention, GiCamera, GiDispatch, HostEnvironment, HostMotion, MaterialChannels,
     NormalEncoding,
 };
+pub use shine_gpu::{Device, EnabledFeatures, RawDevice};
+pub use shine_graph::ExternalState;
 pub use warm_up::DispatchShape;

@@ -116,38 +116,36 @@ pub fn jittered_camera_view(
         2.0 * jy / height.max(1) as f32,
         0.0,
     ));
-    let mut view = match frame.projection {
-        shine_scene::Projection::Perspective {
-            yfov, znear, zfar, ..
-        } => View {
-            view,
-            proj: flip_y(match zfar {
-                Some(far) => Mat4::perspective_rh(yfov, aspect, znear, far),
-                None => Mat4::perspective_infinite_rh(yfov, aspect, znear),
-            }),
-            eye,
-            orthographic: false,
-            extent: yfov,
-        },
-        shine_scene::Projection::Orthographic {
-            ymag, znear, zfar, ..
-        } => View {
-            view,
-            proj: flip_y(Mat4::orthographic_rh(
-                -ymag * aspect,
-                ymag * aspect,
-                -ymag,
-                ymag,
-                znear,
-                zfar,
-            )),
-            eye,
-            orthographic: true,
-            extent: 2.0 * ymag,
-        },
+    let (orthographic, extent) = match frame.projection {
+        shine_scene::Projection::Perspective { yfov, .. } => (false, yfov),
+        shine_scene::Projection::Orthographic { ymag, .. } => (true, 2.0 * ymag),
+    };
+    let mut view = View {
+        view,
+        proj: projection_matrix(&frame.projection, aspect),
+        eye,
+        orthographic,
+        extent,
     };
     view.proj = jitter * view.proj;
     view
+}
+
+/// The view-to-clip matrix of a scene camera's `projection` for an image of `aspect` (width
+/// over height), in Vulkan's clip conventions (y down, depth 0..1): the renderer's cameras
+/// and the GI context's [`crate::embed::GiCamera::from_scene`] both use it.
+pub(crate) fn projection_matrix(projection: &shine_scene::Projection, aspect: f32) -> Mat4 {
+    flip_y(match *projection {
+        shine_scene::Projection::Perspective {
+            yfov, znear, zfar, ..
+        } => match zfar {
+            Some(far) => Mat4::perspective_rh(yfov, aspect, znear, far),
+            None => Mat4::perspective_infinite_rh(yfov, aspect, znear),
+        },
+        shine_scene::Projection::Orthographic {
+            ymag, znear, zfar, ..
+        } => Mat4::orthographic_rh(-ymag * aspect, ymag * aspect, -ymag, ymag, znear, zfar),
+    })
 }
 
 /// Steps per octave of a directional light's box radius: the radius is rounded up to a

@@ -704,3 +704,20 @@ fn a_host_environment_map_lights_the_proxies() {
     assert!((energy - 1.0).abs() <= 0.01, "energy {energy}");
     bench.assert_clean();
 }
+
+/// `GiCamera::from_scene` gives the matrices of the scene's camera that the host bench
+/// computes by hand (`host::camera` without a turn), and a still camera when both times are
+/// the same; a missing camera is `None`.
+#[test]
+fn a_scene_camera_becomes_a_gi_camera() {
+    let scene = Scene::builtin("cornell-box").expect("scene");
+    let camera = GiCamera::from_scene(&scene, 0, 0.0, 0.0, EXTENT).expect("camera 0");
+    let (view, projection) = host::camera(&scene, EXTENT, 0.0);
+    assert!(camera.view.abs_diff_eq(view, 1e-5), "{camera:?}");
+    assert!(
+        camera.projection.abs_diff_eq(projection, 1e-5),
+        "{camera:?}"
+    );
+    assert_eq!(camera, GiCamera::still(camera.view, camera.projection));
+    assert!(GiCamera::from_scene(&scene, scene.cameras.len(), 0.0, 0.0, EXTENT).is_none());
+}

@@ -95,18 +95,24 @@ pub struct FrameImage {
     pub timings: Vec<PassTiming>,
 }
 
-/// A host engine's image that a frame is recorded into (see [`Renderer::record`]).
+/// A host engine's image that shine reads or writes in a frame: the target of a whole frame
+/// ([`Renderer::record`]: needs `TRANSFER_DST`; a blit converts the frame's HDR radiance to its
+/// format), or an input or the output of a GI dispatch (`crate::embed::GiDispatch`: inputs
+/// need `SAMPLED`, the output `TRANSFER_DST`).
 #[derive(Clone, Copy, Debug)]
 pub struct HostTarget {
-    /// The image (2D, one mip, one layer); needs `TRANSFER_DST`.
+    /// The image (2D, one mip, one layer).
     pub image: vk::Image,
-    /// A view of it (kept for the graph's bookkeeping; not sampled).
+    /// A view of the whole image: inputs are sampled through it. An image that is only
+    /// written by a blit may pass `vk::ImageView::null()` (a transfer-only image cannot have a
+    /// view, VUID-VkImageViewCreateInfo-image-04441).
     pub view: vk::ImageView,
-    /// Its format (a blit converts the frame's HDR radiance to it).
+    /// Its format.
     pub format: vk::Format,
-    /// Width and height; the frame is rendered at this size.
+    /// Width and height, exactly the image's: Vulkan cannot tell shine a `VkImage`'s size, so
+    /// a larger extent than the image's reads and writes outside it (garbage, not an error).
     pub extent: [u32; 2],
-    /// Its usage flags.
+    /// Its usage flags, as created: an access needing more is refused.
     pub usage: vk::ImageUsageFlags,
     /// Layout, stage and access of the host's last use before the frame.
     pub before: ExternalState,
