@@ -21,6 +21,7 @@ pub mod builtin;
 pub mod bvh;
 pub mod environment;
 mod error;
+mod flat;
 pub mod glb_writer;
 mod load;
 mod pose;
@@ -29,6 +30,7 @@ mod scene;
 mod types;
 
 pub use error::{Error, Result};
+pub use flat::{FlatDraw, FlatScene};
 pub use load::{
     DEFAULT_SUN_DIRECTION, DEFAULT_SUN_LUX, DEFAULT_YFOV, SUPPORTED_EXTENSIONS, load, load_slice,
 };

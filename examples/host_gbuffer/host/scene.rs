@@ -1,4 +1,5 @@
-//! The host's copy of a scene's geometry and its camera code.
+//! The host's copy of a scene's geometry (flattened by `Scene::flatten_at`) and its camera
+//! code.
 
 use super::HostDevice;
 use super::resources::HostBuffer;
@@ -13,53 +14,15 @@ use std::error::Error;
 pub struct HostScene {
     pub vertices: HostBuffer,
     pub indices: HostBuffer,
-    pub draws: Vec<Draw>,
+    pub draws: Vec<shine_scene::FlatDraw>,
     /// The first light (the host lights with it directly).
     pub light: Option<shine_scene::Light>,
 }
 
-/// One primitive: its index range and material.
-pub struct Draw {
-    pub first_index: u32,
-    pub index_count: u32,
-    pub base_color: [f32; 3],
-    pub roughness: f32,
-    pub metallic: f32,
-}
-
 impl HostScene {
-    /// Flattens `scene` at rest into host-visible vertex and index buffers.
+    /// `scene` at time 0 in host-visible vertex and index buffers.
     pub fn new(host: &HostDevice, scene: &Scene) -> Result<Self, Box<dyn Error>> {
-        let world = scene.rest_world_transforms();
-        let mut vertices: Vec<[f32; 6]> = Vec::new();
-        let mut indices: Vec<u32> = Vec::new();
-        let mut draws = Vec::new();
-        for (node, m) in scene.nodes.iter().zip(&world) {
-            let Some(mesh) = node.mesh.and_then(|i| scene.meshes.get(i)) else {
-                continue;
-            };
-            let normal_matrix = m.inverse().transpose();
-            for p in &mesh.primitives {
-                let base = vertices.len() as u32;
-                for (i, pos) in p.positions.iter().enumerate() {
-                    let wp = m.transform_point3(*pos);
-                    let n = p.normals.get(i).copied().unwrap_or(Vec3::Y);
-                    let wn = normal_matrix.transform_vector3(n).normalize_or(Vec3::Y);
-                    vertices.push([wp.x, wp.y, wp.z, wn.x, wn.y, wn.z]);
-                }
-                let material = scene.materials.get(p.material as usize);
-                draws.push(Draw {
-                    first_index: indices.len() as u32,
-                    index_count: p.indices.len() as u32,
-                    base_color: material.map_or([0.8; 3], |m| {
-                        [m.base_color[0], m.base_color[1], m.base_color[2]]
-                    }),
-                    roughness: material.map_or(1.0, |m| m.roughness),
-                    metallic: material.map_or(0.0, |m| m.metallic),
-                });
-                indices.extend(p.indices.iter().map(|i| i + base));
-            }
-        }
+        let flat = scene.flatten_at(0.0);
         let upload = |name, bytes: &[u8], usage| -> Result<HostBuffer, Box<dyn Error>> {
             let mut buffer = HostBuffer::new(
                 host,
@@ -74,16 +37,19 @@ impl HostScene {
         Ok(Self {
             vertices: upload(
                 "host vertices",
-                bytemuck::cast_slice(&vertices),
+                bytemuck::cast_slice(&flat.vertices),
                 vk::BufferUsageFlags::VERTEX_BUFFER,
             )?,
             indices: upload(
                 "host indices",
-                bytemuck::cast_slice(&indices),
+                bytemuck::cast_slice(&flat.indices),
                 vk::BufferUsageFlags::INDEX_BUFFER,
             )?,
-            draws,
-            light: scene.lights_at(&world).into_iter().next(),
+            draws: flat.draws,
+            light: scene
+                .lights_at(&scene.world_transforms_at(0.0))
+                .into_iter()
+                .next(),
         })
     }
 
