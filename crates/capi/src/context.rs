@@ -1,0 +1,248 @@
+//! `shine_context_*`: the GI context's life and frames, each a thin wrapper of the Rust
+//! [`GiContext`] call of the same name.
+
+use crate::device;
+use crate::error::{Failure, ShineResult, call};
+use crate::handles::{self, ShineContext_T, ShineDevice_T, ShineScene_T, lock};
+use crate::scene::string;
+use crate::types::{
+    SHINE_CONTEXT_DESC_VERSION, SHINE_DISPATCH_DESC_VERSION, ShineCamera, ShineContextDesc,
+    ShineDispatchDesc, ShineDispatchShape, ShineImage, ShineImageState, ShineVkCommandBuffer,
+};
+use glam::Mat4;
+use shine::embed::{
+    DepthConvention, DispatchShape, ExternalState, GiCamera, GiContext, GiContextDesc, GiDispatch,
+    HostEnvironment, HostMotion, HostTarget, MaterialChannels, NormalEncoding,
+};
+use shine::gpu::vk::{self, Handle};
+
+/// Makes a context on `device` and writes its handle to `out` (null on failure).
+///
+/// # Safety
+/// `desc` is null or a valid `ShineContextDesc` (its strings NUL-terminated); `out` is null or
+/// writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_create(
+    device: *mut ShineDevice_T,
+    desc: *const ShineContextDesc,
+    out: *mut *mut ShineContext_T,
+) -> ShineResult {
+    call(|| {
+        let device = device::lookup(device)?;
+        // SAFETY: the caller's promise.
+        let (desc, out) = unsafe { (desc.as_ref(), out.as_mut()) };
+        let (desc, out) = desc
+            .zip(out)
+            .ok_or_else(|| Failure::invalid("desc and out must not be null"))?;
+        *out = std::ptr::null_mut();
+        if desc.version != SHINE_CONTEXT_DESC_VERSION {
+            return Err(Failure::new(
+                ShineResult::ErrorVersionMismatch,
+                format!(
+                    "ShineContextDesc version {} (this library reads version \
+                     {SHINE_CONTEXT_DESC_VERSION})",
+                    desc.version
+                ),
+            ));
+        }
+        // SAFETY: the caller's promise.
+        let technique = unsafe { string(desc.technique, "technique") }?;
+        let mut rust = GiContextDesc::new([desc.width, desc.height], &technique)?;
+        rust.frames_in_flight = desc.frames_in_flight.max(1) as usize;
+        if desc.settings_count > 0 && desc.settings.is_null() {
+            return Err(Failure::invalid(
+                "settings is null with a nonzero settings_count",
+            ));
+        }
+        for i in 0..desc.settings_count as usize {
+            // SAFETY: `settings_count` strings (the caller's promise).
+            let setting = unsafe { string(*desc.settings.add(i), "a setting") }?;
+            let (key, value) = setting
+                .split_once('=')
+                .ok_or_else(|| Failure::invalid(format!("setting `{setting}` is not key=value")))?;
+            rust.settings
+                .set(key.trim(), value.trim())
+                .map_err(|e| Failure::invalid(format!("setting `{setting}`: {e}")))?;
+        }
+        *out = handles::add_context(GiContext::new(&device, &rust)?);
+        Ok(())
+    })
+}
+
+/// Hands the context `scene` posed at time `t` (uploads and waits: a load-time call).
+///
+/// # Safety
+/// Handles may be any value (null and stale ones are refused).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_set_scene(
+    context: *mut ShineContext_T,
+    scene: *mut ShineScene_T,
+    t: f32,
+) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        let scene = handles::scene(scene)?;
+        let scene = lock(&scene);
+        Ok(lock(&context).set_scene(&scene.scene, t)?)
+    })
+}
+
+/// Builds everything the host's frames need before the first (no first-dispatch hitch):
+/// submits placeholder frames on the device's queue and waits. `shape` null: neither motion
+/// nor an environment.
+///
+/// # Safety
+/// `shape` is null or valid.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_warm_up(
+    context: *mut ShineContext_T,
+    shape: *const ShineDispatchShape,
+) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        // SAFETY: the caller's promise.
+        let shape = unsafe { shape.as_ref() }.map_or(DispatchShape::default(), |s| DispatchShape {
+            motion: s.motion != 0,
+            environment: s.environment != 0,
+        });
+        Ok(lock(&context).warm_up(shape)?)
+    })
+}
+
+/// Starts every history over (a camera cut): the next dispatch is computed as a first frame.
+///
+/// # Safety
+/// `context` may be any value (null and stale handles are refused).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_reset_history(context: *mut ShineContext_T) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        lock(&context).reset_history();
+        Ok(())
+    })
+}
+
+/// Records one frame into `command_buffer` (recording, outside a render pass): never submits
+/// or waits. After an error nothing usable was recorded: do not submit the command buffer.
+///
+/// # Safety
+/// `command_buffer` is a command buffer of the context's device in the recording state;
+/// `desc` is null or valid, its images live until the submission completes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_dispatch(
+    context: *mut ShineContext_T,
+    command_buffer: ShineVkCommandBuffer,
+    desc: *const ShineDispatchDesc,
+) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        if command_buffer.is_null() {
+            return Err(Failure::invalid("command_buffer is null"));
+        }
+        // SAFETY: the caller's promise.
+        let desc = unsafe { desc.as_ref() }.ok_or_else(|| Failure::invalid("desc is null"))?;
+        // SAFETY: as above.
+        let dispatch = unsafe { dispatch(desc) }?;
+        let cb = vk::CommandBuffer::from_raw(command_buffer as u64);
+        Ok(lock(&context).dispatch(cb, &dispatch)?)
+    })
+}
+
+/// Destroys the context. The host's submissions that used it must have completed.
+///
+/// # Safety
+/// `context` may be any value (null and stale handles are refused).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_destroy(context: *mut ShineContext_T) -> ShineResult {
+    call(|| handles::remove(context, "context"))
+}
+
+/// The Rust dispatch of a C one.
+///
+/// # Safety
+/// `motion` and `environment` are null or valid.
+unsafe fn dispatch(d: &ShineDispatchDesc) -> Result<GiDispatch, Failure> {
+    if d.version != SHINE_DISPATCH_DESC_VERSION {
+        return Err(Failure::new(
+            ShineResult::ErrorVersionMismatch,
+            format!(
+                "ShineDispatchDesc version {} (this library reads version \
+                 {SHINE_DISPATCH_DESC_VERSION})",
+                d.version
+            ),
+        ));
+    }
+    let channel = |c: i32| u32::try_from(c).ok();
+    if d.metallic_channel < -1 {
+        return Err(Failure::invalid(format!(
+            "metallic_channel {} is neither −1 nor a channel",
+            d.metallic_channel
+        )));
+    }
+    // SAFETY: the caller's promise.
+    let (motion, environment) = unsafe { (d.motion.as_ref(), d.environment.as_ref()) };
+    Ok(GiDispatch {
+        frame_index: d.frame_index,
+        camera: camera(&d.camera),
+        depth: target(&d.depth),
+        depth_convention: if d.depth_reversed != 0 {
+            DepthConvention::Reversed
+        } else {
+            DepthConvention::Standard
+        },
+        normals: target(&d.normals),
+        normal_encoding: NormalEncoding {
+            mul: d.normal_mul,
+            add: d.normal_add,
+        },
+        albedo: target(&d.albedo),
+        material: target(&d.material),
+        material_channels: MaterialChannels {
+            roughness: d.roughness_channel,
+            metallic: channel(d.metallic_channel),
+            roughness_squared: d.roughness_squared != 0,
+        },
+        motion: motion.map(|m| HostMotion {
+            image: target(m),
+            scale: d.motion_scale,
+        }),
+        environment: environment.map(|e| HostEnvironment {
+            image: target(e),
+            intensity: d.environment_intensity,
+        }),
+        diffuse: target(&d.diffuse),
+    })
+}
+
+/// The Rust camera of a C one.
+fn camera(c: &ShineCamera) -> GiCamera {
+    GiCamera {
+        view: Mat4::from_cols_array(&c.view),
+        projection: Mat4::from_cols_array(&c.projection),
+        jitter: c.jitter,
+        previous_view: Mat4::from_cols_array(&c.previous_view),
+        previous_projection: Mat4::from_cols_array(&c.previous_projection),
+    }
+}
+
+/// The Rust image of a C one.
+fn target(i: &ShineImage) -> HostTarget {
+    HostTarget {
+        image: vk::Image::from_raw(i.image),
+        view: vk::ImageView::from_raw(i.view),
+        format: vk::Format::from_raw(i.format),
+        extent: [i.width, i.height],
+        usage: vk::ImageUsageFlags::from_raw(i.usage),
+        before: state(i.before),
+        after: state(i.after),
+    }
+}
+
+/// The Rust image state of a C one.
+fn state(s: ShineImageState) -> ExternalState {
+    ExternalState::new(
+        vk::PipelineStageFlags2::from_raw(s.stage),
+        vk::AccessFlags2::from_raw(s.access),
+        vk::ImageLayout::from_raw(s.layout),
+    )
+}
