@@ -10,6 +10,9 @@ packages+=(chromium)
 # A single-node Slurm cluster (scripts/slurm/local-cluster.sh): tests/slurm.rs runs the sbatch
 # templates on it.
 packages+=(slurm-wlm munge)
+# The C API's C++ host example (examples/capi_host, built and run by crates/capi/tests):
+# Vulkan headers, and glslangValidator for its G-buffer shaders.
+packages+=(libvulkan-dev glslang-tools g++ make)
 # Node.js runs the Khronos glTF validator over the built-in scenes (crates/scene/tests).
 if ! command -v npm >/dev/null 2>&1; then
     packages+=(nodejs npm)

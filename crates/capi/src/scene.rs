@@ -27,7 +27,7 @@ pub unsafe extern "C" fn shine_scene_load(
             Some(name) => shine::scene::Scene::builtin(name),
             None => shine::scene::load(std::path::Path::new(&path)),
         }
-        .map_err(|e| Failure::new(ShineResult::ErrorScene, format!("{path}: {e}")))?;
+        .map_err(|e| Failure::new(ShineResult::ErrorScene, e.to_string()))?;
         *out = handles::add_scene(SceneObject {
             scene,
             flat: Default::default(),
