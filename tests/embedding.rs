@@ -2,6 +2,8 @@
 //! `Device::requirements()`), lends them to shine with `Device::from_raw`, runs shine work, and
 //! still owns working handles after every shine object is gone.
 
+#[path = "embedding/animated_host.rs"]
+mod animated_host;
 mod common;
 #[path = "embedding/gi_context.rs"]
 mod gi_context;

@@ -61,6 +61,19 @@ impl Bench {
         self.device.as_ref().expect("device")
     }
 
+    /// Rebuilds the host's geometry with the scene posed by `update` (its node overrides),
+    /// as a host moving an instance does; the previous frame must have completed.
+    pub fn pose(&mut self, update: &FrameUpdate) {
+        let world = shine::gpu_scene::FrameState::evaluate(&self.scene, update)
+            .pose
+            .world;
+        if let Some(old) = self.host_scene.take() {
+            old.destroy(&self.host);
+        }
+        self.host_scene =
+            Some(HostScene::posed(&self.host, &self.scene, &world).expect("host scene"));
+    }
+
     fn targets(&self) -> &Targets {
         self.targets.as_ref().expect("targets")
     }
@@ -74,7 +87,7 @@ impl Bench {
     }
 
     /// The camera of frame `k` (turned by `k · ORBIT`) and the previous frame's.
-    fn camera(&self, k: u32) -> GiCamera {
+    pub fn camera(&self, k: u32) -> GiCamera {
         let (view, projection) = host::camera(&self.scene, EXTENT, k as f32 * ORBIT);
         let (previous_view, previous_projection) =
             host::camera(&self.scene, EXTENT, k.saturating_sub(1) as f32 * ORBIT);
@@ -89,7 +102,17 @@ impl Bench {
 
     /// Records the host's G-buffer of frame `k` into `cb` and returns the dispatch of it.
     fn record_gbuffer(&self, cb: vk::CommandBuffer, k: u32) -> GiDispatch {
-        let camera = self.camera(k);
+        self.record_gbuffer_from(cb, u64::from(k), self.camera(k))
+    }
+
+    /// Records the host's G-buffer seen from `camera` into `cb` and returns the dispatch of
+    /// it as frame `frame_index`.
+    fn record_gbuffer_from(
+        &self,
+        cb: vk::CommandBuffer,
+        frame_index: u64,
+        camera: GiCamera,
+    ) -> GiDispatch {
         let t = self.targets();
         self.raster.as_ref().expect("raster").record(
             &self.host,
@@ -100,7 +123,7 @@ impl Bench {
         );
         let color = |i: &host::HostImage| i.lend(host::color_written(), host::sampled_after());
         GiDispatch {
-            frame_index: u64::from(k),
+            frame_index,
             camera,
             depth: t.depth.lend(host::depth_written(), host::sampled_after()),
             depth_convention: Default::default(),
@@ -123,6 +146,16 @@ impl Bench {
             gi.dispatch(cb, &dispatch).expect("dispatch");
             self.host.submit_and_wait(cb).expect("submit");
         }
+        rgb(host::read_rgba16f(&self.host, &self.targets().gi, host::copy_source()).expect("read"))
+    }
+
+    /// Frame `k` through `gi` from the still camera of frame 0 (the scene's own), in one host
+    /// submission; the GI image.
+    pub fn run_still(&self, gi: &mut GiContext, k: u32) -> Vec<[f32; 3]> {
+        let cb = self.host.begin().expect("begin");
+        let dispatch = self.record_gbuffer_from(cb, u64::from(k), self.camera(0));
+        gi.dispatch(cb, &dispatch).expect("dispatch");
+        self.host.submit_and_wait(cb).expect("submit");
         rgb(host::read_rgba16f(&self.host, &self.targets().gi, host::copy_source()).expect("read"))
     }
 
@@ -186,7 +219,7 @@ fn rgb(texels: Vec<[f32; 4]>) -> Vec<[f32; 3]> {
 }
 
 /// Relative RMSE and energy ratio of `image` against `truth` over every pixel.
-fn error_of(image: &[[f32; 3]], truth: &[[f32; 3]]) -> (f64, f64) {
+pub fn error_of(image: &[[f32; 3]], truth: &[[f32; 3]]) -> (f64, f64) {
     let e = image_error(image, truth, &vec![true; truth.len()]).expect("signal");
     (e.relative_rmse, e.energy_ratio)
 }

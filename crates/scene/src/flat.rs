@@ -3,7 +3,7 @@
 //! draw their own G-buffers from it.
 
 use crate::Scene;
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 /// One primitive of a [`FlatScene`]: its range of indices and its material's factors.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -39,9 +39,14 @@ impl Scene {
     /// The nodes with a mesh, posed by the node animation at `t` (morph targets and skins at
     /// rest), flattened to world space.
     pub fn flatten_at(&self, t: f32) -> FlatScene {
-        let world = self.world_transforms_at(t);
+        self.flatten(&self.world_transforms_at(t))
+    }
+
+    /// The nodes with a mesh placed by `world` (one matrix per node, as
+    /// [`Scene::world_transforms_at`] or a host's own pose gives), flattened to world space.
+    pub fn flatten(&self, world: &[Mat4]) -> FlatScene {
         let mut flat = FlatScene::default();
-        for (node, m) in self.nodes.iter().zip(&world) {
+        for (node, m) in self.nodes.iter().zip(world) {
             let Some(mesh) = node.mesh.and_then(|i| self.meshes.get(i)) else {
                 continue;
             };

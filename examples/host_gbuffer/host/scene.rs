@@ -22,7 +22,12 @@ pub struct HostScene {
 impl HostScene {
     /// `scene` at time 0 in host-visible vertex and index buffers.
     pub fn new(host: &HostDevice, scene: &Scene) -> Result<Self, Box<dyn Error>> {
-        let flat = scene.flatten_at(0.0);
+        Self::posed(host, scene, &scene.world_transforms_at(0.0))
+    }
+
+    /// `scene` with its nodes placed by `world` (one matrix per node).
+    pub fn posed(host: &HostDevice, scene: &Scene, world: &[Mat4]) -> Result<Self, Box<dyn Error>> {
+        let flat = scene.flatten(world);
         let upload = |name, bytes: &[u8], usage| -> Result<HostBuffer, Box<dyn Error>> {
             let mut buffer = HostBuffer::new(
                 host,
@@ -46,10 +51,7 @@ impl HostScene {
                 vk::BufferUsageFlags::INDEX_BUFFER,
             )?,
             draws: flat.draws,
-            light: scene
-                .lights_at(&scene.world_transforms_at(0.0))
-                .into_iter()
-                .next(),
+            light: scene.lights_at(world).into_iter().next(),
         })
     }
 
