@@ -85,9 +85,12 @@ fn main() -> Result<(), Box<dyn Error>> {
                     material_channels: MaterialChannels::default(),
                     motion: None,
                     environment: None,
-                    diffuse: targets
-                        .gi
-                        .lend(ExternalState::UNDEFINED, host::copy_source()),
+                    diffuse: Some(
+                        targets
+                            .gi
+                            .lend(ExternalState::UNDEFINED, host::copy_source()),
+                    ),
+                    specular: None,
                 },
             )?;
             host.submit_and_wait(cb)?;

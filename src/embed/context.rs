@@ -305,7 +305,12 @@ impl GiContext {
                 };
                 Ok(HostSide {
                     g,
-                    output: dispatch.diffuse.import(rg, "host diffuse gi", false),
+                    diffuse: dispatch
+                        .diffuse
+                        .map(|d| d.import(rg, "host diffuse gi", false)),
+                    specular: dispatch
+                        .specular
+                        .map(|s| s.import(rg, "host specular gi", false)),
                     environment,
                 })
             },

@@ -237,9 +237,15 @@ pub struct GiDispatch {
     pub motion: Option<HostMotion>,
     /// The environment map; `None`: the scene's environment (if any).
     pub environment: Option<HostEnvironment>,
-    /// Output: the diffuse (and, for HVL, glossy) indirect radiance the host adds to its
-    /// direct light, RGBA16F (or another float format a blit can write), `TRANSFER_DST`.
-    pub diffuse: HostTarget,
+    /// Output: the indirect radiance the GI techniques carry (diffuse, and the glossy lobes
+    /// rougher than `specular.limit`), accumulated over frames; with no `specular` output,
+    /// the traced reflections too. RGBA16F (or another float format a blit can write),
+    /// `TRANSFER_DST`. `None`: not computed.
+    pub diffuse: Option<HostTarget>,
+    /// Output: the traced specular reflections of the lobes smoother than `specular.limit`
+    /// (faded in below it), denoised in space and not accumulated over frames; the same
+    /// formats as `diffuse`. `None`: they go into `diffuse` (when `specular.enabled`).
+    pub specular: Option<HostTarget>,
 }
 
 /// Depth formats a dispatch reads.
@@ -302,19 +308,24 @@ impl GiDispatch {
                 )));
             }
         }
-        check_extent("diffuse", &self.diffuse, display)?;
-        if !self
-            .diffuse
-            .usage
-            .contains(vk::ImageUsageFlags::TRANSFER_DST)
-        {
-            return Err(invalid("diffuse output needs TRANSFER_DST usage".into()));
+        let outputs = [("diffuse", &self.diffuse), ("specular", &self.specular)];
+        if outputs.iter().all(|(_, o)| o.is_none()) {
+            return Err(invalid(
+                "the dispatch has no output: give diffuse, specular or both".into(),
+            ));
         }
-        if shine_gpu::format_aspect(self.diffuse.format) != vk::ImageAspectFlags::COLOR {
-            return Err(invalid(format!(
-                "diffuse output format {:?} is not a colour format",
-                self.diffuse.format
-            )));
+        for (name, output) in outputs {
+            let Some(output) = output else { continue };
+            check_extent(name, output, display)?;
+            if !output.usage.contains(vk::ImageUsageFlags::TRANSFER_DST) {
+                return Err(invalid(format!("{name} output needs TRANSFER_DST usage")));
+            }
+            if shine_gpu::format_aspect(output.format) != vk::ImageAspectFlags::COLOR {
+                return Err(invalid(format!(
+                    "{name} output format {:?} is not a colour format",
+                    output.format
+                )));
+            }
         }
         Ok(())
     }

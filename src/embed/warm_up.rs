@@ -21,6 +21,8 @@ pub struct DispatchShape {
     pub motion: bool,
     /// Dispatches bring an environment map ([`GiDispatch::environment`]).
     pub environment: bool,
+    /// Dispatches ask for a separate specular output ([`GiDispatch::specular`]).
+    pub specular: bool,
 }
 
 /// Frames a warm-up records: one per frame-in-flight slot, plus one so that every slot also
@@ -42,11 +44,12 @@ pub(super) struct Placeholders {
     motion: Image,
     environment: Image,
     output: Image,
+    specular: Image,
     display: [u32; 2],
 }
 
 /// What a cleared placeholder holds: a floor at mid depth facing the camera, grey, rough.
-const CLEARS: [(&str, vk::Format, [f32; 4]); 6] = [
+const CLEARS: [(&str, vk::Format, [f32; 4]); 7] = [
     (
         "warm-up normal",
         vk::Format::R8G8B8A8_UNORM,
@@ -69,6 +72,11 @@ const CLEARS: [(&str, vk::Format, [f32; 4]); 6] = [
         [0.1, 0.1, 0.1, 1.0],
     ),
     ("warm-up output", vk::Format::R16G16B16A16_SFLOAT, [0.0; 4]),
+    (
+        "warm-up specular",
+        vk::Format::R16G16B16A16_SFLOAT,
+        [0.0; 4],
+    ),
 ];
 
 /// The depth a placeholder pixel holds (standard convention: mid-way into the scene).
@@ -100,6 +108,7 @@ impl Placeholders {
             motion: image(3, display)?,
             environment: image(4, ENVIRONMENT_EXTENT)?,
             output: image(5, display)?,
+            specular: image(6, display)?,
             display,
         })
     }
@@ -118,6 +127,7 @@ impl Placeholders {
             &self.motion,
             &self.environment,
             &self.output,
+            &self.specular,
         ];
         for image in colours.iter().copied().chain([&self.depth]) {
             cmd.image_barrier(
@@ -207,7 +217,10 @@ impl Placeholders {
                 image: target(&self.environment, sampled),
                 intensity: 1.0,
             }),
-            diffuse: target(&self.output, ExternalState::UNDEFINED),
+            diffuse: Some(target(&self.output, ExternalState::UNDEFINED)),
+            specular: shape
+                .specular
+                .then(|| target(&self.specular, ExternalState::UNDEFINED)),
         }
     }
 }

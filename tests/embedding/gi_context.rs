@@ -27,7 +27,7 @@ pub struct Bench {
     targets: Option<Targets>,
     device: Option<Device>,
     /// Last: dropped after every object above (the documented teardown order).
-    host: HostDevice,
+    pub host: HostDevice,
 }
 
 impl Bench {
@@ -35,9 +35,24 @@ impl Bench {
         Self::with_device(share_allocator, |raw| raw)
     }
 
+    /// A bench whose host draws the built-in scene `name`.
+    pub fn for_scene(name: &str) -> Self {
+        Self::build(false, name, |raw| raw)
+    }
+
     /// A bench whose shine device is `wrap` of what the host lends.
     fn with_device(
         share_allocator: bool,
+        wrap: impl FnOnce(shine::gpu::RawDevice) -> shine::gpu::RawDevice,
+    ) -> Self {
+        Self::build(share_allocator, "cornell-box", wrap)
+    }
+
+    /// A bench drawing the built-in `scene_name`, whose shine device is `wrap` of what the
+    /// host lends.
+    fn build(
+        share_allocator: bool,
+        scene_name: &str,
         wrap: impl FnOnce(shine::gpu::RawDevice) -> shine::gpu::RawDevice,
     ) -> Self {
         let host = HostDevice::new(true).expect("host device");
@@ -45,7 +60,7 @@ impl Bench {
             host.validation || std::env::var_os("CI").is_none(),
             "CI needs the validation layer"
         );
-        let scene = Scene::builtin("cornell-box").expect("scene");
+        let scene = Scene::builtin(scene_name).expect("scene");
         let device = Device::from_raw(wrap(host.lend(share_allocator))).expect("shine device");
         Self {
             host_scene: Some(HostScene::new(&host, &scene).expect("host scene")),
@@ -74,7 +89,7 @@ impl Bench {
             Some(HostScene::posed(&self.host, &self.scene, &world).expect("host scene"));
     }
 
-    fn targets(&self) -> &Targets {
+    pub fn targets(&self) -> &Targets {
         self.targets.as_ref().expect("targets")
     }
 
@@ -107,7 +122,7 @@ impl Bench {
 
     /// Records the host's G-buffer seen from `camera` into `cb` and returns the dispatch of
     /// it as frame `frame_index`.
-    fn record_gbuffer_from(
+    pub fn record_gbuffer_from(
         &self,
         cb: vk::CommandBuffer,
         frame_index: u64,
@@ -134,7 +149,8 @@ impl Bench {
             material_channels: MaterialChannels::default(),
             motion: None,
             environment: None,
-            diffuse: t.gi.lend(ExternalState::UNDEFINED, host::copy_source()),
+            diffuse: Some(t.gi.lend(ExternalState::UNDEFINED, host::copy_source())),
+            specular: None,
         }
     }
 
@@ -214,7 +230,7 @@ impl Drop for Bench {
     }
 }
 
-fn rgb(texels: Vec<[f32; 4]>) -> Vec<[f32; 3]> {
+pub fn rgb(texels: Vec<[f32; 4]>) -> Vec<[f32; 3]> {
     texels.into_iter().map(|t| [t[0], t[1], t[2]]).collect()
 }
 
@@ -346,7 +362,8 @@ fn two_contexts_share_a_device() {
         normals: read(&t.normal),
         albedo: read(&t.albedo),
         material: read(&t.material),
-        diffuse: hvl_image.lend(ExternalState::UNDEFINED, host::copy_source()),
+        diffuse: Some(hvl_image.lend(ExternalState::UNDEFINED, host::copy_source())),
+        specular: None,
         ..d
     };
     igi.dispatch(cb, &second).expect("igi");
@@ -422,11 +439,16 @@ fn bad_dispatches_are_refused() {
             ..good
         },
         GiDispatch {
-            diffuse: host::HostImage::lend(
+            diffuse: Some(host::HostImage::lend(
                 &bench.targets().depth,
                 ExternalState::UNDEFINED,
                 ExternalState::UNDEFINED,
-            ),
+            )),
+            ..good
+        },
+        GiDispatch {
+            diffuse: None,
+            specular: None,
             ..good
         },
     ];

@@ -3,7 +3,7 @@
 
 use crate::device;
 use crate::error::{Failure, ShineResult, call};
-use crate::handles::{self, ShineContext_T, ShineDevice_T, ShineScene_T, lock};
+use crate::handles::{self, ShineContext, ShineDevice, ShineScene, lock};
 use crate::scene::string;
 use crate::types::{
     SHINE_CONTEXT_DESC_VERSION, SHINE_DISPATCH_DESC_VERSION, ShineCamera, ShineContextDesc,
@@ -23,9 +23,9 @@ use shine::gpu::vk::{self, Handle};
 /// writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_context_create(
-    device: *mut ShineDevice_T,
+    device: ShineDevice,
     desc: *const ShineContextDesc,
-    out: *mut *mut ShineContext_T,
+    out: *mut ShineContext,
 ) -> ShineResult {
     call(|| {
         let device = device::lookup(device)?;
@@ -48,7 +48,10 @@ pub unsafe extern "C" fn shine_context_create(
         // SAFETY: the caller's promise.
         let technique = unsafe { string(desc.technique, "technique") }?;
         let mut rust = GiContextDesc::new([desc.width, desc.height], &technique)?;
-        rust.frames_in_flight = desc.frames_in_flight.max(1) as usize;
+        if desc.frames_in_flight == 0 {
+            return Err(Failure::invalid("frames_in_flight must be at least 1"));
+        }
+        rust.frames_in_flight = desc.frames_in_flight as usize;
         if desc.settings_count > 0 && desc.settings.is_null() {
             return Err(Failure::invalid(
                 "settings is null with a nonzero settings_count",
@@ -75,8 +78,8 @@ pub unsafe extern "C" fn shine_context_create(
 /// Handles may be any value (null and stale ones are refused).
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_context_set_scene(
-    context: *mut ShineContext_T,
-    scene: *mut ShineScene_T,
+    context: ShineContext,
+    scene: ShineScene,
     t: f32,
 ) -> ShineResult {
     call(|| {
@@ -95,7 +98,7 @@ pub unsafe extern "C" fn shine_context_set_scene(
 /// `shape` is null or valid.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_context_warm_up(
-    context: *mut ShineContext_T,
+    context: ShineContext,
     shape: *const ShineDispatchShape,
 ) -> ShineResult {
     call(|| {
@@ -104,6 +107,7 @@ pub unsafe extern "C" fn shine_context_warm_up(
         let shape = unsafe { shape.as_ref() }.map_or(DispatchShape::default(), |s| DispatchShape {
             motion: s.motion != 0,
             environment: s.environment != 0,
+            specular: s.specular != 0,
         });
         Ok(lock(&context).warm_up(shape)?)
     })
@@ -114,7 +118,7 @@ pub unsafe extern "C" fn shine_context_warm_up(
 /// # Safety
 /// `context` may be any value (null and stale handles are refused).
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn shine_context_reset_history(context: *mut ShineContext_T) -> ShineResult {
+pub unsafe extern "C" fn shine_context_reset_history(context: ShineContext) -> ShineResult {
     call(|| {
         let context = handles::context(context)?;
         lock(&context).reset_history();
@@ -130,7 +134,7 @@ pub unsafe extern "C" fn shine_context_reset_history(context: *mut ShineContext_
 /// `desc` is null or valid, its images live until the submission completes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_context_dispatch(
-    context: *mut ShineContext_T,
+    context: ShineContext,
     command_buffer: ShineVkCommandBuffer,
     desc: *const ShineDispatchDesc,
 ) -> ShineResult {
@@ -153,14 +157,14 @@ pub unsafe extern "C" fn shine_context_dispatch(
 /// # Safety
 /// `context` may be any value (null and stale handles are refused).
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn shine_context_destroy(context: *mut ShineContext_T) -> ShineResult {
+pub unsafe extern "C" fn shine_context_destroy(context: ShineContext) -> ShineResult {
     call(|| handles::remove(context, "context"))
 }
 
 /// The Rust dispatch of a C one.
 ///
 /// # Safety
-/// `motion` and `environment` are null or valid.
+/// `motion`, `environment`, `diffuse` and `specular` are null or valid.
 unsafe fn dispatch(d: &ShineDispatchDesc) -> Result<GiDispatch, Failure> {
     if d.version != SHINE_DISPATCH_DESC_VERSION {
         return Err(Failure::new(
@@ -180,7 +184,14 @@ unsafe fn dispatch(d: &ShineDispatchDesc) -> Result<GiDispatch, Failure> {
         )));
     }
     // SAFETY: the caller's promise.
-    let (motion, environment) = unsafe { (d.motion.as_ref(), d.environment.as_ref()) };
+    let (motion, environment, diffuse, specular) = unsafe {
+        (
+            d.motion.as_ref(),
+            d.environment.as_ref(),
+            d.diffuse.as_ref(),
+            d.specular.as_ref(),
+        )
+    };
     Ok(GiDispatch {
         frame_index: d.frame_index,
         camera: camera(&d.camera),
@@ -210,7 +221,8 @@ unsafe fn dispatch(d: &ShineDispatchDesc) -> Result<GiDispatch, Failure> {
             image: target(e),
             intensity: d.environment_intensity,
         }),
-        diffuse: target(&d.diffuse),
+        diffuse: diffuse.map(target),
+        specular: specular.map(target),
     })
 }
 

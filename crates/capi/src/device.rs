@@ -3,7 +3,7 @@
 //! `VkDeviceCreateInfo` it used.
 
 use crate::error::{Failure, ShineResult, call};
-use crate::handles::{self, ShineDevice_T};
+use crate::handles::{self, ShineDevice};
 use crate::types::{SHINE_DEVICE_DESC_VERSION, ShineDeviceDesc};
 use shine::embed::{Device, EnabledFeatures, RawDevice};
 use shine::gpu::ash;
@@ -24,7 +24,7 @@ const MAX_CHAIN: usize = 64;
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_device_create(
     desc: *const ShineDeviceDesc,
-    out: *mut *mut ShineDevice_T,
+    out: *mut ShineDevice,
 ) -> ShineResult {
     call(|| {
         // SAFETY: the caller's promise.
@@ -181,11 +181,11 @@ unsafe fn enabled_features(
 /// # Safety
 /// `device` is any value (null and stale handles are refused).
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn shine_device_destroy(device: *mut ShineDevice_T) -> ShineResult {
+pub unsafe extern "C" fn shine_device_destroy(device: ShineDevice) -> ShineResult {
     call(|| handles::remove(device, "device"))
 }
 
 /// The device behind a handle, for the other entry points.
-pub(crate) fn lookup(device: *mut ShineDevice_T) -> Result<Device, Failure> {
+pub(crate) fn lookup(device: ShineDevice) -> Result<Device, Failure> {
     handles::device(device)
 }

@@ -10,20 +10,27 @@ use shine::embed::{Device, GiContext};
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex, MutexGuard};
 
-/// A device lent by the host (`ShineDevice` in C).
+/// What a `ShineDevice` points to (never dereferenced).
 pub struct ShineDevice_T {
     _opaque: [u8; 0],
 }
 
-/// A scene loaded from glTF (`ShineScene` in C).
+/// What a `ShineScene` points to (never dereferenced).
 pub struct ShineScene_T {
     _opaque: [u8; 0],
 }
 
-/// A GI context (`ShineContext` in C).
+/// What a `ShineContext` points to (never dereferenced).
 pub struct ShineContext_T {
     _opaque: [u8; 0],
 }
+
+/// A device lent by the host.
+pub type ShineDevice = *mut ShineDevice_T;
+/// A scene loaded from glTF or a built-in.
+pub type ShineScene = *mut ShineScene_T;
+/// A GI context.
+pub type ShineContext = *mut ShineContext_T;
 
 /// A loaded scene and the last flattening handed out (its arrays stay valid until the next).
 pub(crate) struct SceneObject {

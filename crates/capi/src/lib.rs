@@ -19,6 +19,8 @@ mod types;
 pub use context::*;
 pub use device::*;
 pub use error::{ShineResult, shine_last_error};
-pub use handles::{ShineContext_T, ShineDevice_T, ShineScene_T};
+pub use handles::{
+    ShineContext, ShineContext_T, ShineDevice, ShineDevice_T, ShineScene, ShineScene_T,
+};
 pub use scene::*;
 pub use types::*;

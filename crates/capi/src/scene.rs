@@ -2,7 +2,7 @@
 //! and their cameras, so a C host draws the same geometry the context lights.
 
 use crate::error::{Failure, ShineResult, call};
-use crate::handles::{self, SceneObject, ShineScene_T, lock};
+use crate::handles::{self, SceneObject, ShineScene, lock};
 use crate::types::{ShineDraw, ShineGeometry};
 use shine::embed::GiCamera;
 use std::ffi::{CStr, c_char};
@@ -15,7 +15,7 @@ use std::ffi::{CStr, c_char};
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_scene_load(
     path: *const c_char,
-    out: *mut *mut ShineScene_T,
+    out: *mut ShineScene,
 ) -> ShineResult {
     call(|| {
         // SAFETY: the caller's promise.
@@ -44,7 +44,7 @@ pub unsafe extern "C" fn shine_scene_load(
 /// `out` is null or writable.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_scene_flatten(
-    scene: *mut ShineScene_T,
+    scene: ShineScene,
     t: f32,
     out: *mut ShineGeometry,
 ) -> ShineResult {
@@ -92,7 +92,7 @@ pub unsafe extern "C" fn shine_scene_flatten(
 /// `view` and `projection` are null or point to 16 writable floats each.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn shine_scene_camera(
-    scene: *mut ShineScene_T,
+    scene: ShineScene,
     index: u32,
     t: f32,
     width: u32,
@@ -136,7 +136,7 @@ pub unsafe extern "C" fn shine_scene_camera(
 /// # Safety
 /// `scene` is any value (null and stale handles are refused).
 #[unsafe(no_mangle)]
-pub unsafe extern "C" fn shine_scene_destroy(scene: *mut ShineScene_T) -> ShineResult {
+pub unsafe extern "C" fn shine_scene_destroy(scene: ShineScene) -> ShineResult {
     call(|| handles::remove(scene, "scene"))
 }
 

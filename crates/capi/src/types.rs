@@ -25,18 +25,18 @@ pub type ShinePfnVoidFunction = Option<unsafe extern "system" fn()>;
 pub type ShinePfnGetInstanceProcAddr =
     Option<unsafe extern "system" fn(ShineVkInstance, *const c_char) -> ShinePfnVoidFunction>;
 
-/// [`ShineDeviceDesc::version`] of this header.
+/// `ShineDeviceDesc::version` of this header.
 pub const SHINE_DEVICE_DESC_VERSION: u32 = 1;
-/// [`ShineContextDesc::version`] of this header.
+/// `ShineContextDesc::version` of this header.
 pub const SHINE_CONTEXT_DESC_VERSION: u32 = 1;
-/// [`ShineDispatchDesc::version`] of this header.
+/// `ShineDispatchDesc::version` of this header.
 pub const SHINE_DISPATCH_DESC_VERSION: u32 = 1;
 
 /// The host's Vulkan objects, lent to shine (`shine_device_create`). The host keeps them
 /// alive until the device and every context made on it are destroyed.
 #[repr(C)]
 pub struct ShineDeviceDesc {
-    /// [`SHINE_DEVICE_DESC_VERSION`].
+    /// `SHINE_DEVICE_DESC_VERSION`.
     pub version: u32,
     /// The loader's `vkGetInstanceProcAddr`.
     pub get_instance_proc_addr: ShinePfnGetInstanceProcAddr,
@@ -53,7 +53,7 @@ pub struct ShineDeviceDesc {
     pub queue: ShineVkQueue,
     /// The `VkDeviceCreateInfo` `device` was created with: shine reads the features (core,
     /// `VkPhysicalDeviceFeatures2`, `VkPhysicalDeviceVulkan13Features`) and extensions it
-    /// enabled, and names what is missing.
+    /// enabled, and names what is missing. Read during `shine_device_create` only.
     pub device_create_info: *const c_void,
     /// `VkApplicationInfo::apiVersion` of the instance.
     pub api_version: u32,
@@ -67,13 +67,13 @@ pub struct ShineDeviceDesc {
 /// How a context is made (`shine_context_create`).
 #[repr(C)]
 pub struct ShineContextDesc {
-    /// [`SHINE_CONTEXT_DESC_VERSION`].
+    /// `SHINE_CONTEXT_DESC_VERSION`.
     pub version: u32,
     /// Width of the host's G-buffer and of the output.
     pub width: u32,
     /// Height of the host's G-buffer and of the output.
     pub height: u32,
-    /// How many frames the host records ahead of the GPU (at least 1).
+    /// How many frames the host records ahead of the GPU (at least 1; 0 is refused).
     pub frames_in_flight: u32,
     /// The technique(s): "hvl", "igi", "aaf", "hvl,proxy" …
     pub technique: *const c_char,
@@ -139,7 +139,7 @@ pub struct ShineCamera {
 /// field's formats and encodings.
 #[repr(C)]
 pub struct ShineDispatchDesc {
-    /// [`SHINE_DISPATCH_DESC_VERSION`].
+    /// `SHINE_DISPATCH_DESC_VERSION`.
     pub version: u32,
     /// Strictly increasing; frame `frame_index − frames_in_flight` has completed.
     pub frame_index: u64,
@@ -173,8 +173,14 @@ pub struct ShineDispatchDesc {
     pub environment: *const ShineImage,
     /// Multiplier on the environment's radiance.
     pub environment_intensity: f32,
-    /// Output: outgoing indirect radiance (RGBA16F, `TRANSFER_DST`).
-    pub diffuse: ShineImage,
+    /// Output, or null: the indirect light of the GI techniques (diffuse, and glossy lobes
+    /// rougher than `specular.limit`), accumulated over frames; with no `specular` output,
+    /// the traced reflections too. RGBA16F, `TRANSFER_DST`.
+    pub diffuse: *const ShineImage,
+    /// Output, or null: the traced reflections of the smoother lobes, denoised in space, not
+    /// accumulated. RGBA16F, `TRANSFER_DST`. At least one of `diffuse` and `specular` is
+    /// given.
+    pub specular: *const ShineImage,
 }
 
 /// What the host's dispatches will bring (`shine_context_warm_up`).
@@ -184,13 +190,15 @@ pub struct ShineDispatchShape {
     pub motion: u32,
     /// Nonzero: dispatches bring an environment map.
     pub environment: u32,
+    /// Nonzero: dispatches ask for a separate specular output.
+    pub specular: u32,
 }
 
 /// One primitive of a flattened scene.
 #[repr(C)]
 #[derive(Clone, Copy)]
 pub struct ShineDraw {
-    /// First index in [`ShineGeometry::indices`].
+    /// First index in `ShineGeometry::indices`.
     pub first_index: u32,
     /// Number of indices.
     pub index_count: u32,

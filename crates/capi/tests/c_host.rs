@@ -6,20 +6,11 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-/// `target/<profile>`, where cargo put `libshine_capi.so` and build.rs `include/shine.h`.
-pub fn profile_dir() -> PathBuf {
-    let test_exe = std::env::current_exe().expect("test executable");
-    // target/<profile>/deps/c_host-<hash>
-    test_exe
-        .parent()
-        .and_then(|deps| deps.parent())
-        .expect("target/<profile>")
-        .to_path_buf()
-}
+mod common;
 
 #[test]
 fn bad_handles_and_arguments_get_codes_and_messages() {
-    let lib = profile_dir();
+    let lib = common::profile_dir();
     assert!(
         lib.join("include/shine.h").is_file() && lib.join("libshine_capi.so").is_file(),
         "no header or library in {}",

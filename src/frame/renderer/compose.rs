@@ -124,7 +124,9 @@ impl Renderer {
             .taa
             .apply(rg, p.taa, p.extent, Some(direct), &g, |_| geometry_then)?
             .unwrap_or(direct);
-        let indirect = self.declare_indirect(rg, p, &handles, &g, &camera, None)?;
+        let indirect = self
+            .declare_indirect(rg, p, &handles, &g, &camera, None)?
+            .summed(rg)?;
         let indirect = self
             .accumulate
             .apply(rg, p.history, p.extent, indirect, &g, |_| geometry_then)?;
@@ -178,7 +180,7 @@ impl Renderer {
         g: &GBuffer,
         camera: &View,
         environment: Option<Handle<shine_graph::Buffer>>,
-    ) -> Result<Option<Handle<Image>>, RenderError> {
+    ) -> Result<Indirect, RenderError> {
         let textures = self.texture_sampler(p);
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
         let frame = &scene.gpu.state;
@@ -407,7 +409,26 @@ impl Renderer {
             }
             _ => None,
         };
-        sum(rg, "specular_add", techniques, reflections)
+        Ok(Indirect {
+            techniques,
+            reflections,
+        })
+    }
+}
+
+/// A frame's indirect light in its two parts.
+pub(super) struct Indirect {
+    /// The GI techniques' light: diffuse, and the glossy lobes the SH terms carry (those
+    /// rougher than `specular.limit`, faded in below it).
+    pub techniques: Option<Handle<Image>>,
+    /// The traced specular reflections of the smoother lobes (denoised), when they run.
+    pub reflections: Option<Handle<Image>>,
+}
+
+impl Indirect {
+    /// Both parts summed: the frame's whole indirect light.
+    pub(super) fn summed(self, rg: &mut RenderGraph) -> Result<Option<Handle<Image>>, RenderError> {
+        sum(rg, "specular_add", self.techniques, self.reflections)
     }
 }
 

@@ -13,8 +13,11 @@ use shine_graph::{Buffer, Handle, Image, RenderGraph};
 pub(crate) struct HostSide {
     /// The G-buffer converted from the host's images.
     pub g: GBuffer,
-    /// The host's output image, imported.
-    pub output: Handle<Image>,
+    /// The host's diffuse output image, imported, if it gave one.
+    pub diffuse: Option<Handle<Image>>,
+    /// The host's specular output image, imported, if it gave one: the traced reflections go
+    /// there instead of into `diffuse`.
+    pub specular: Option<Handle<Image>>,
     /// The host's environment map projected to SH, when it gave one.
     pub environment: Option<Handle<Buffer>>,
 }
@@ -67,25 +70,50 @@ impl Renderer {
         let handles = scene.gpu.declare(rg)?;
         let HostSide {
             g,
-            mut output,
+            diffuse,
+            specular,
             environment,
         } = host(rg)?;
         let indirect = self.declare_indirect(rg, p, &handles, &g, camera, environment)?;
-        // With a history (issue 23), the host's G-buffer is kept for the next frame's
-        // disocclusion test.
-        let indirect = self
-            .accumulate
-            .apply(rg, p.history, p.extent, indirect, &g, |rg| {
-                history::gbuffer_history(rg, &g)
-            })?;
-        match indirect {
-            Some(indirect) => {
-                rg.blit_image("gi to host", &indirect, &mut output, vk::Filter::NEAREST);
+        // With a specular output the reflections go there, unaccumulated (the denoiser has
+        // filtered them in space; reprojecting a reflection by its surface's motion smears it).
+        let (to_diffuse, to_specular) = match specular {
+            Some(_) => (indirect.techniques, indirect.reflections),
+            None => (indirect.summed(rg)?, None),
+        };
+        match diffuse {
+            Some(mut output) => {
+                // With a history (issue 23), the host's G-buffer is kept for the next frame's
+                // disocclusion test.
+                let light =
+                    self.accumulate
+                        .apply(rg, p.history, p.extent, to_diffuse, &g, |rg| {
+                            history::gbuffer_history(rg, &g)
+                        })?;
+                write_or_clear(rg, "gi to host", light, &mut output);
             }
-            None => {
-                rg.clear_image("gi to host", &mut output, [0.0; 4]);
-            }
+            None => self.accumulate.reset(),
+        }
+        if let Some(mut output) = specular {
+            write_or_clear(rg, "specular to host", to_specular, &mut output);
         }
         Ok(())
+    }
+}
+
+/// Blits `light` into the host's `output`, or clears it when the frame has none.
+fn write_or_clear(
+    rg: &mut RenderGraph,
+    name: &str,
+    light: Option<Handle<Image>>,
+    output: &mut Handle<Image>,
+) {
+    match light {
+        Some(light) => {
+            rg.blit_image(name, &light, output, vk::Filter::NEAREST);
+        }
+        None => {
+            rg.clear_image(name, output, [0.0; 4]);
+        }
     }
 }
