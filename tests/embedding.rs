@@ -9,6 +9,8 @@ mod common;
 mod gi_context;
 #[path = "../examples/host_gbuffer/host/mod.rs"]
 mod host;
+#[path = "embedding/host_geometry.rs"]
+mod host_geometry;
 #[path = "embedding/specular_out.rs"]
 mod specular_out;
 #[path = "embedding/warm_up.rs"]

@@ -1,5 +1,6 @@
 //! [`GiContext`]: shine as a GI pass inside a host engine's frame.
 
+use super::host_geometry::{self, HostInstance, HostMaterial, HostMesh, MeshId};
 use super::inputs::GiDispatch;
 use super::warm_up::{DispatchShape, Placeholders, warm_up_frames};
 use crate::farm::identity::fnv1a;
@@ -18,7 +19,7 @@ use crate::profile::roofline::cache_dir;
 use crate::settings::Settings;
 use shine_gpu::{Buffer, Device, Sampler, vk};
 use shine_graph::{PassTiming, RenderGraph};
-use shine_scene::Scene;
+use shine_scene::{Light, Scene};
 
 /// How a [`GiContext`] is made: fixed for its life (make a new context to change them).
 #[derive(Clone, Debug, PartialEq)]
@@ -108,6 +109,10 @@ pub struct GiContext {
     budget: Option<(f64, Option<BudgetChoice>)>,
     /// Frames the host records ahead of the GPU.
     frames_in_flight: usize,
+    /// Meshes registered from the host's buffers, by [`MeshId`].
+    host_meshes: Vec<(shine_scene::Primitive, HostMaterial)>,
+    /// The instances and the number of lights of the last [`GiContext::set_instances`].
+    host_world: Option<(Vec<HostInstance>, usize)>,
     /// The warm-up's inputs, made on its first call.
     placeholders: Option<Placeholders>,
 }
@@ -158,6 +163,8 @@ impl GiContext {
             budget,
             frames_in_flight: desc.frames_in_flight,
             placeholders: None,
+            host_meshes: Vec::new(),
+            host_world: None,
         })
     }
 
@@ -217,6 +224,71 @@ impl GiContext {
             self.budget = Some((ms, Some(choice)));
         }
         self.renderer.set_scene(scene, t)
+    }
+
+    /// Registers a triangle mesh from the host's own buffers: reads them back once (a
+    /// load-time call: submits a copy on shine's queue and waits), after checking that every
+    /// range fits its buffer, and refuses indices past the vertices and non-finite positions.
+    /// Place it with [`GiContext::set_instances`].
+    pub fn register_mesh(&mut self, mesh: &HostMesh) -> Result<MeshId, RenderError> {
+        let primitive = host_geometry::read_mesh(&self.device, mesh)?;
+        let id = u32::try_from(self.host_meshes.len())
+            .map_err(|_| RenderError::Invalid("host geometry: too many meshes".into()))?;
+        self.host_meshes.push((primitive, mesh.material));
+        Ok(MeshId(id))
+    }
+
+    /// The host's world: registered meshes placed by `instances` (3×4 transforms) and lit by
+    /// `lights` (world space). Builds the scene the GI is computed from (BVH, RSMs) and hands
+    /// it over as [`GiContext::set_scene`] does (uploads and waits): call it when instances
+    /// come or go or the number of lights changes; [`GiContext::move_instances`] moves them
+    /// per frame. A bad transform, mesh id or light is refused and the old world stays.
+    pub fn set_instances(
+        &mut self,
+        instances: &[HostInstance],
+        lights: &[Light],
+    ) -> Result<(), RenderError> {
+        let scene = host_geometry::scene(&self.host_meshes, instances, lights)?;
+        self.set_scene(&scene, 0.0)?;
+        self.host_world = Some((instances.to_vec(), lights.len()));
+        Ok(())
+    }
+
+    /// Moves the instances of the last [`GiContext::set_instances`] (the same meshes, in the
+    /// same order) and replaces its lights (as many) for the next dispatch: CPU work only, a
+    /// per-frame call. Anything else is refused: a new instance list goes through
+    /// `set_instances`.
+    pub fn move_instances(
+        &mut self,
+        instances: &[HostInstance],
+        lights: &[Light],
+    ) -> Result<(), RenderError> {
+        let Some((set, light_count)) = &self.host_world else {
+            return Err(RenderError::Invalid(
+                "host geometry: move_instances before set_instances".into(),
+            ));
+        };
+        if instances.len() != set.len()
+            || instances.iter().zip(set).any(|(a, b)| a.mesh != b.mesh)
+            || lights.len() != *light_count
+        {
+            return Err(RenderError::Invalid(format!(
+                "host geometry: move_instances takes the {} instances (same meshes, same                  order) and {light_count} lights of set_instances; {} instances and {} lights                  given",
+                set.len(),
+                instances.len(),
+                lights.len()
+            )));
+        }
+        let nodes = instances
+            .iter()
+            .enumerate()
+            .map(|(i, instance)| Ok((i, host_geometry::instance_transform(&instance.transform)?)))
+            .collect::<Result<Vec<_>, RenderError>>()?;
+        self.update(&FrameUpdate {
+            nodes,
+            lights: lights.iter().copied().enumerate().collect(),
+            ..FrameUpdate::default()
+        })
     }
 
     /// Sets the scene's time, node transforms, lights and morph weights for the next

@@ -3,6 +3,7 @@
 //! recording into the host's command buffer, the way FidelityFX's GI effects integrate.
 
 mod context;
+mod host_geometry;
 mod inputs;
 mod warm_up;
 
@@ -12,10 +13,14 @@ pub use crate::frame::memory::MemoryReport;
 pub use crate::frame::renderer::HostTarget;
 pub use crate::gpu_scene::FrameUpdate;
 pub use context::{GiBudgets, GiContext, GiContextDesc};
+pub use host_geometry::{
+    HostBuffer, HostInstance, HostMaterial, HostMesh, IndexFormat, MeshId, PositionFormat,
+};
 pub use inputs::{
     DepthConvention, GiCamera, GiDispatch, HostEnvironment, HostMotion, MaterialChannels,
     NormalEncoding,
 };
 pub use shine_gpu::{Device, EnabledFeatures, RawDevice};
 pub use shine_graph::ExternalState;
+pub use shine_scene::{Light, LightKind};
 pub use warm_up::DispatchShape;

@@ -89,6 +89,11 @@ impl Bench {
             Some(HostScene::posed(&self.host, &self.scene, &world).expect("host scene"));
     }
 
+    /// The host's copy of the scene's geometry.
+    pub fn host_scene(&self) -> &HostScene {
+        self.host_scene.as_ref().expect("host scene")
+    }
+
     pub fn targets(&self) -> &Targets {
         self.targets.as_ref().expect("targets")
     }

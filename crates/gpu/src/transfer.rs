@@ -107,20 +107,30 @@ impl Device {
 
     /// Reads a whole buffer back (it needs `TRANSFER_SRC`). Waits for the copy.
     pub fn read_buffer(&self, buffer: &Buffer) -> Result<Vec<u8>> {
+        self.read_raw_buffer(buffer.raw(), 0, buffer.size())
+    }
+
+    /// `size` bytes at `offset` of any buffer of this device with `TRANSFER_SRC` usage (a host
+    /// engine's, say), copied back after every earlier write on the device: submits and
+    /// waits.
+    pub fn read_raw_buffer(&self, buffer: vk::Buffer, offset: u64, size: u64) -> Result<Vec<u8>> {
+        if size == 0 {
+            return Ok(Vec::new());
+        }
         let staging = self.staging(
             "staging readback",
-            buffer.size(),
+            size,
             vk::BufferUsageFlags::TRANSFER_DST,
             MemoryLocation::GpuToCpu,
         )?;
         let region = [vk::BufferCopy {
-            src_offset: 0,
+            src_offset: offset,
             dst_offset: 0,
-            size: buffer.size(),
+            size,
         }];
         self.run_once(|cmd| {
             cmd.memory_barrier(ANY_ACCESS, COPY_READ);
-            cmd.copy_buffer(buffer.raw(), staging.raw(), &region);
+            cmd.copy_buffer(buffer, staging.raw(), &region);
             cmd.memory_barrier(COPY_WRITE, HOST_READ);
             Ok(())
         })?;

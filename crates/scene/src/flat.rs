@@ -18,6 +18,8 @@ pub struct FlatDraw {
     pub roughness: f32,
     /// Metalness.
     pub metallic: f32,
+    /// Index of the primitive's material in the scene (`None`: it has none).
+    pub material: Option<usize>,
 }
 
 /// Every mesh instance of a scene posed at one time, in world space, in one vertex and one
@@ -59,22 +61,21 @@ impl Scene {
                     let wn = normal_matrix.transform_vector3(n).normalize_or(Vec3::Y);
                     flat.vertices.push([wp.x, wp.y, wp.z, wn.x, wn.y, wn.z]);
                 }
-                let (base_color, roughness, metallic) = self
-                    .materials
-                    .get(p.material as usize)
-                    .map_or(DEFAULT_DRAW, |m| {
-                        (
-                            [m.base_color[0], m.base_color[1], m.base_color[2]],
-                            m.roughness,
-                            m.metallic,
-                        )
-                    });
+                let material = self.materials.get(p.material as usize);
+                let (base_color, roughness, metallic) = material.map_or(DEFAULT_DRAW, |m| {
+                    (
+                        [m.base_color[0], m.base_color[1], m.base_color[2]],
+                        m.roughness,
+                        m.metallic,
+                    )
+                });
                 flat.draws.push(FlatDraw {
                     first_index: flat.indices.len() as u32,
                     index_count: p.indices.len() as u32,
                     base_color,
                     roughness,
                     metallic,
+                    material: material.map(|_| p.material as usize),
                 });
                 flat.indices.extend(p.indices.iter().map(|i| i + base));
             }

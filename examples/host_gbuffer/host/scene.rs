@@ -43,12 +43,13 @@ impl HostScene {
             vertices: upload(
                 "host vertices",
                 bytemuck::cast_slice(&flat.vertices),
-                vk::BufferUsageFlags::VERTEX_BUFFER,
+                // TRANSFER_SRC: a host that registers them with shine (`GiContext::register_mesh`).
+                vk::BufferUsageFlags::VERTEX_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
             )?,
             indices: upload(
                 "host indices",
                 bytemuck::cast_slice(&flat.indices),
-                vk::BufferUsageFlags::INDEX_BUFFER,
+                vk::BufferUsageFlags::INDEX_BUFFER | vk::BufferUsageFlags::TRANSFER_SRC,
             )?,
             draws: flat.draws,
             light: scene.lights_at(world).into_iter().next(),
