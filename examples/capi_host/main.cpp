@@ -135,7 +135,9 @@ int main(int argc, char** argv) {
     ShineContext context = nullptr;
     check_shine(shine_context_create(shine_device, &context_desc, &context),
                 "shine_context_create");
-    check_shine(shine_context_set_scene(context, scene, 0.0f), "shine_context_set_scene");
+    // The host's own buffers and the scene's lights, not shine's copy of the scene: what an
+    // engine with its geometry already on the GPU does.
+    register_with_shine(context, scene, host_scene);
     check_shine(shine_context_warm_up(context, nullptr), "shine_context_warm_up");
 
     const ShineImage diffuse = lend(targets.gi, undefined_state(), copy_source());

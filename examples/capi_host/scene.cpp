@@ -15,9 +15,14 @@ HostScene upload_scene(const HostDevice& host, ShineScene scene) {
     const VkDeviceSize vertex_bytes = VkDeviceSize(geometry.vertex_count) * 6 * sizeof(float);
     const VkDeviceSize index_bytes = VkDeviceSize(geometry.index_count) * sizeof(uint32_t);
     HostScene s;
-    s.vertices = create_host_buffer(host, vertex_bytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT);
+    // TRANSFER_SRC: shine reads the buffers back once when they are registered.
+    s.vertices = create_host_buffer(
+        host, vertex_bytes, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
     std::memcpy(s.vertices.mapped, geometry.vertices, vertex_bytes);
-    s.indices = create_host_buffer(host, index_bytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT);
+    s.indices = create_host_buffer(
+        host, index_bytes, VK_BUFFER_USAGE_INDEX_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
+    s.vertex_count = geometry.vertex_count;
+    s.index_count = geometry.index_count;
     std::memcpy(s.indices.mapped, geometry.indices, index_bytes);
     // The arrays belong to the scene: copy the draws before anything else touches it.
     s.draws.assign(geometry.draws, geometry.draws + geometry.draw_count);
@@ -27,6 +32,44 @@ HostScene upload_scene(const HostDevice& host, ShineScene scene) {
 void destroy_scene(const HostDevice& host, HostScene& s) {
     destroy_buffer(host, s.vertices);
     destroy_buffer(host, s.indices);
+}
+
+void register_with_shine(ShineContext context, ShineScene scene, const HostScene& s) {
+    const uint32_t vertex_bytes = 6 * sizeof(float);
+    std::vector<ShineHostInstance> instances;
+    for (const ShineDraw& draw : s.draws) {
+        ShineHostMesh mesh{};
+        mesh.version = SHINE_HOST_MESH_VERSION;
+        mesh.vertices.buffer = reinterpret_cast<uint64_t>(s.vertices.buffer);
+        mesh.vertices.size = uint64_t(s.vertex_count) * vertex_bytes;
+        mesh.vertex_stride = vertex_bytes;
+        mesh.vertex_count = s.vertex_count;
+        mesh.position_format = SHINE_POSITION_FLOAT3;
+        mesh.normal_offset = 3 * sizeof(float);
+        mesh.indices.buffer = reinterpret_cast<uint64_t>(s.indices.buffer);
+        mesh.indices.size = uint64_t(s.index_count) * sizeof(uint32_t);
+        mesh.indices.offset = uint64_t(draw.first_index) * sizeof(uint32_t);
+        mesh.index_format = SHINE_INDEX_UINT32;
+        mesh.index_count = draw.index_count;
+        std::memcpy(mesh.material.base_color, draw.base_color, sizeof draw.base_color);
+        mesh.material.roughness = draw.roughness;
+        mesh.material.metallic = draw.metallic;
+        std::memcpy(mesh.material.emissive, draw.emissive, sizeof draw.emissive);
+        mesh.material.double_sided = draw.double_sided;
+        ShineHostInstance instance{};
+        check_shine(shine_context_register_mesh(context, &mesh, &instance.mesh),
+                    "shine_context_register_mesh");
+        for (int row = 0; row < 3; ++row) instance.transform[row][row] = 1.0f;
+        instances.push_back(instance);
+    }
+    uint32_t light_count = 0;
+    check_shine(shine_scene_lights(scene, 0.0f, nullptr, 0, &light_count), "shine_scene_lights");
+    std::vector<ShineLight> lights(light_count);
+    check_shine(shine_scene_lights(scene, 0.0f, lights.data(), light_count, &light_count),
+                "shine_scene_lights");
+    check_shine(shine_context_set_instances(context, instances.data(), uint32_t(instances.size()),
+                                            lights.data(), light_count),
+                "shine_context_set_instances");
 }
 
 Mat4 multiply(const Mat4& a, const Mat4& b) {

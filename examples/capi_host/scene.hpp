@@ -17,6 +17,8 @@ namespace capi_host {
 struct HostScene {
     HostBuffer vertices;  // 6 floats per vertex: position, normal.
     HostBuffer indices;   // uint32 triangle list.
+    uint32_t vertex_count = 0;
+    uint32_t index_count = 0;
     std::vector<ShineDraw> draws;
 };
 
@@ -24,6 +26,10 @@ struct HostScene {
 HostScene upload_scene(const HostDevice& host, ShineScene scene);
 
 void destroy_scene(const HostDevice& host, HostScene& s);
+
+// Hands shine the host's own geometry: one mesh per draw registered from the host's vertex and
+// index buffers, placed where they are (the identity), lit by the scene's lights at time 0.
+void register_with_shine(ShineContext context, ShineScene scene, const HostScene& s);
 
 // Column-major 4x4 matrices, as in shine.h and GLSL.
 using Mat4 = std::array<float, 16>;

@@ -12,6 +12,7 @@
 mod context;
 mod device;
 mod error;
+mod geometry;
 mod handles;
 mod scene;
 mod types;
@@ -19,6 +20,7 @@ mod types;
 pub use context::*;
 pub use device::*;
 pub use error::{ShineResult, shine_last_error};
+pub use geometry::*;
 pub use handles::{
     ShineContext, ShineContext_T, ShineDevice, ShineDevice_T, ShineScene, ShineScene_T,
 };

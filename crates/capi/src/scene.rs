@@ -2,6 +2,7 @@
 //! and their cameras, so a C host draws the same geometry the context lights.
 
 use crate::error::{Failure, ShineResult, call};
+use crate::geometry::ShineLight;
 use crate::handles::{self, SceneObject, ShineScene, lock};
 use crate::types::{ShineDraw, ShineGeometry};
 use shine::embed::GiCamera;
@@ -58,16 +59,22 @@ pub unsafe extern "C" fn shine_scene_flatten(
         let mut guard = lock(&object);
         let o = &mut *guard;
         o.flat = o.scene.flatten_at(t);
+        let materials = &o.scene.materials;
         o.draws = o
             .flat
             .draws
             .iter()
-            .map(|d| ShineDraw {
-                first_index: d.first_index,
-                index_count: d.index_count,
-                base_color: d.base_color,
-                roughness: d.roughness,
-                metallic: d.metallic,
+            .map(|d| {
+                let material = d.material.and_then(|m| materials.get(m));
+                ShineDraw {
+                    first_index: d.first_index,
+                    index_count: d.index_count,
+                    base_color: d.base_color,
+                    roughness: d.roughness,
+                    metallic: d.metallic,
+                    emissive: material.map_or([0.0; 3], |m| m.emissive),
+                    double_sided: material.map_or(0, |m| m.double_sided),
+                }
             })
             .collect();
         let count = |n: usize, what: &str| {
@@ -126,6 +133,51 @@ pub unsafe extern "C" fn shine_scene_camera(
                 projection,
                 16,
             );
+        }
+        Ok(())
+    })
+}
+
+/// The scene's lights at time `t`, in world space: writes up to `capacity` of them to `out`
+/// (which may be null when `capacity` is 0) and their total number to `count`, as Vulkan's
+/// enumerations do.
+///
+/// # Safety
+/// `out` holds `capacity` writable lights; `count` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_scene_lights(
+    scene: ShineScene,
+    t: f32,
+    out: *mut ShineLight,
+    capacity: u32,
+    count: *mut u32,
+) -> ShineResult {
+    call(|| {
+        let object = handles::scene(scene)?;
+        // SAFETY: the caller's promise.
+        let count = unsafe { count.as_mut() }.ok_or_else(|| Failure::invalid("count is null"))?;
+        if !t.is_finite() {
+            return Err(Failure::invalid(format!("time {t} is not finite")));
+        }
+        if capacity > 0 && out.is_null() {
+            return Err(Failure::invalid("out is null with a nonzero capacity"));
+        }
+        let o = lock(&object);
+        let lights = o.scene.lights_at(&o.scene.world_transforms_at(t));
+        *count = u32::try_from(lights.len()).map_err(|_| Failure::invalid("too many lights"))?;
+        for (i, l) in lights.iter().take(capacity as usize).enumerate() {
+            let light = ShineLight {
+                kind: l.kind,
+                position: l.position,
+                direction: l.direction,
+                color: l.color,
+                intensity: l.intensity,
+                range: l.range,
+                inner_cone_angle: l.inner_cone_angle,
+                outer_cone_angle: l.outer_cone_angle,
+            };
+            // SAFETY: `i` < `capacity` (the caller's promise).
+            unsafe { out.add(i).write(light) };
         }
         Ok(())
     })

@@ -208,6 +208,10 @@ pub struct ShineDraw {
     pub roughness: f32,
     /// Metalness.
     pub metallic: f32,
+    /// Emitted radiance.
+    pub emissive: [f32; 3],
+    /// Nonzero: both faces reflect.
+    pub double_sided: u32,
 }
 
 /// A scene's meshes in world space (`shine_scene_flatten`); the arrays belong to the scene
