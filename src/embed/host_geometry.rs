@@ -105,6 +105,19 @@ pub struct HostMesh {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct MeshId(pub(crate) u32);
 
+impl MeshId {
+    /// The registration's number: 0 for a context's first mesh, then 1, 2 … (what the C
+    /// API hands out).
+    pub fn index(self) -> u32 {
+        self.0
+    }
+
+    /// The id of registration number `index` (an unknown one is refused where it is used).
+    pub fn from_index(index: u32) -> Self {
+        Self(index)
+    }
+}
+
 /// A mesh placed in the world: `transform` is the top three rows of the object-to-world
 /// matrix (row-major, translation in the last column), as `VkTransformMatrixKHR`.
 #[derive(Clone, Copy, Debug, PartialEq)]
