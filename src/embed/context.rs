@@ -335,7 +335,13 @@ impl GiContext {
         let display = self.display;
         let constants = dispatch.host_frame(display);
         let camera = dispatch.camera.view_for(display);
-        let proxy_bands = self.params.proxy.map(|p| p.sh_order);
+        // The proxies read the environment's SH at their order, the sky (frames without
+        // proxies) at its own.
+        let proxy_bands = self
+            .params
+            .proxy
+            .map(|p| p.sh_order)
+            .or(self.params.sky.map(|_| crate::passes::sky::BANDS));
         let (frame_constants, ring, sampler) =
             (&self.frame_constants, &mut self.ring, self.nearest.raw());
         self.renderer.record_indirect(
@@ -360,7 +366,7 @@ impl GiContext {
                         .map(|m| m.image.import(rg, "host motion", true)),
                 };
                 let g = host_gbuffer::host_gbuffer(rg, &host, &frame, display, sampler);
-                // Only the proxies read an environment.
+                // Only the proxies and the sky read an environment.
                 let environment = match (dispatch.environment, proxy_bands) {
                     (Some(env), Some(bands)) => {
                         let map = env.image.import(rg, "host environment", true);

@@ -699,11 +699,11 @@ fn test_map(w: u32, h: u32) -> Vec<[f32; 3]> {
         .collect()
 }
 
-/// The proxy technique lit by a host's environment map (projected to SH on the GPU) gives
-/// what the full renderer gives with the same map as the scene's environment (projected on
-/// the CPU): relative RMSE ≤ 2 %, energy within 1 %.
-#[test]
-fn a_host_environment_map_lights_the_proxies() {
+/// `technique`'s frame 0 lit by a host's environment map (the test map × 1.5, projected to
+/// SH on the GPU), and the full renderer's with the same map as the scene's environment
+/// (projected on the CPU): `(host, truth)`. For the proxies, a dispatch without any
+/// environment is refused (they have nothing to shade with).
+fn host_environment_frame(technique: &str) -> (Vec<[f32; 3]>, Vec<[f32; 3]>) {
     let (w, h) = (64, 32);
     let texels = test_map(w, h);
     let mut bench = Bench::new(false);
@@ -731,7 +731,7 @@ fn a_host_environment_map_lights_the_proxies() {
     .expect("map");
     let rgba: Vec<[f32; 4]> = texels.iter().map(|t| [t[0], t[1], t[2], 1.0]).collect();
     map.upload_rgba32f(&bench.host, &rgba).expect("upload");
-    let mut gi = bench.context("proxy");
+    let mut gi = bench.context(technique);
     let cb = bench.host.begin().expect("begin");
     let mut d = bench.record_gbuffer(cb, 0);
     d.environment = Some(shine::embed::HostEnvironment {
@@ -744,25 +744,60 @@ fn a_host_environment_map_lights_the_proxies() {
         host::read_rgba16f(&bench.host, &bench.targets().gi, host::copy_source()).expect("read"),
     );
     map.destroy(&bench.host);
-    // Without any environment the proxies have nothing to shade with: refused.
-    let cb = bench.host.begin().expect("begin");
-    let mut d = bench.record_gbuffer(cb, 1);
-    d.environment = None;
-    let error = gi.dispatch(cb, &d).expect_err("no environment").to_string();
-    assert!(error.contains("environment"), "{error}");
-    bench.host.submit_and_wait(cb).expect("submit");
-
+    if technique == "proxy" {
+        let cb = bench.host.begin().expect("begin");
+        let mut d = bench.record_gbuffer(cb, 1);
+        d.environment = None;
+        let error = gi.dispatch(cb, &d).expect_err("no environment").to_string();
+        assert!(error.contains("environment"), "{error}");
+        bench.host.submit_and_wait(cb).expect("submit");
+    }
     let truth = {
         let scene = std::mem::replace(&mut bench.scene, lit);
-        let truth = bench.full_renderer("proxy", 0);
+        let truth = bench.full_renderer(technique, 0);
         bench.scene = scene;
         truth
     };
+    bench.assert_clean();
+    (output, truth)
+}
+
+/// The proxy technique lit by a host's environment map gives what the full renderer gives
+/// with the same map as the scene's environment: relative RMSE ≤ 2 %, energy within 1 %.
+#[test]
+fn a_host_environment_map_lights_the_proxies() {
+    let (output, truth) = host_environment_frame("proxy");
     let (relative_rmse, energy) = error_of(&output, &truth);
     println!("host environment: relative RMSE {relative_rmse:.4}, energy {energy:.4}");
     assert!(relative_rmse <= 0.02, "relative RMSE {relative_rmse}");
     assert!((energy - 1.0).abs() <= 0.01, "energy {energy}");
-    bench.assert_clean();
+}
+
+/// HVL and IGI frames take a host's environment map as their sky light (the `[sky]` pass, as
+/// the full renderer lights them with the scene's environment): within 3 % relative RMSE and
+/// 1 % of the energy of the full renderer's, whose sky adds light to the frame without it.
+#[test]
+fn a_host_environment_map_lights_the_sky_of_hvl_and_igi() {
+    for technique in ["hvl", "igi"] {
+        let (output, truth) = host_environment_frame(technique);
+        let (relative_rmse, energy) = error_of(&output, &truth);
+        let without_sky = Bench::new(false).full_renderer(technique, 0);
+        let (_, sky_share) = error_of(&truth, &without_sky);
+        println!(
+            "{technique}: host environment relative RMSE {relative_rmse:.4}, energy {energy:.4}; \
+             the sky adds {:.1} %",
+            (sky_share - 1.0) * 100.0
+        );
+        assert!(
+            sky_share > 1.02,
+            "{technique}: the sky added nothing ({sky_share})"
+        );
+        assert!(
+            relative_rmse <= 0.03,
+            "{technique}: relative RMSE {relative_rmse}"
+        );
+        assert!((energy - 1.0).abs() <= 0.01, "{technique}: energy {energy}");
+    }
 }
 
 /// `GiCamera::from_scene` gives the matrices of the scene's camera that the host bench

@@ -168,8 +168,9 @@ impl Renderer {
     /// The indirect light of the surfaces in `g`, seen from `camera`: each technique of `p`
     /// prepares its persistent state, then the primary light's RSM, the receiver-resolution
     /// techniques (HVL, proxies) and their upsample, and the full-resolution ones (IGI, AAF)
-    /// are declared and summed. The proxies are lit by `environment` (an SH buffer, laid out
-    /// as `EnvironmentSh::gpu_data`) when given, else by the scene's environment. Returns
+    /// are declared and summed. The proxies and the sky are lit by `host_sh` (an SH buffer,
+    /// laid out as `EnvironmentSh::gpu_data`, at the proxies' order or the sky's
+    /// `sky::BANDS`) when given, else by the scene's environment. Returns
     /// full-resolution outgoing indirect radiance (RGBA16F), or `None` when `p` has no
     /// technique.
     pub(super) fn declare_indirect(
@@ -179,7 +180,7 @@ impl Renderer {
         handles: &SceneHandles,
         g: &GBuffer,
         camera: &View,
-        environment: Option<Handle<shine_graph::Buffer>>,
+        host_sh: Option<Handle<shine_graph::Buffer>>,
     ) -> Result<Indirect, RenderError> {
         let textures = self.texture_sampler(p);
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
@@ -203,7 +204,7 @@ impl Renderer {
             .map(|setup| {
                 scene
                     .proxy
-                    .prepare(rg, setup, &frame.pose.world, environment, receiver_extent)
+                    .prepare(rg, setup, &frame.pose.world, host_sh, receiver_extent)
             })
             .transpose()?;
         let cubes = match p.cubes {
@@ -263,7 +264,8 @@ impl Renderer {
         // Receiver-resolution terms (HVL, proxies, the sky) share one receiver buffer and one
         // upsample; they are summed at receiver resolution first. The sky light is for frames
         // without proxies, in scenes with an environment.
-        let sky = p.sky.filter(|_| scene.has_environment);
+        // A host's environment map (its SH in `host_sh`) lights the sky as the scene's does.
+        let sky = p.sky.filter(|_| scene.has_environment || host_sh.is_some());
         let recv = if hvl.is_some() || proxy.is_some() || sky.is_some() || cubes.is_some() {
             Some(receivers::receivers(rg, g, p.receiver_scale)?)
         } else {
@@ -328,7 +330,10 @@ impl Renderer {
                 rg,
                 p,
                 &params,
-                &mut scene.proxy,
+                sky_light::SkySh {
+                    host: host_sh,
+                    scene: &mut scene.proxy,
+                },
                 &handles.trace,
                 receivers,
                 camera.eye,

@@ -3,7 +3,7 @@
 //! Monte-Carlo passes (these and the specular reflections).
 
 use glam::Vec3;
-use shine_graph::{Handle, Image, RenderGraph};
+use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 use crate::frame::error::RenderError;
 use crate::frame::params::FrameParams;
@@ -48,18 +48,30 @@ pub(super) fn cavity_shaded(
     )?))
 }
 
-/// The sky's diffuse light at `receivers` seen from `camera`, from the scene environment's SH
-/// (the proxies' projection, at [`sky::BANDS`] bands).
+/// Where the sky's SH comes from: a host's environment map, projected at [`sky::BANDS`] bands
+/// this frame, or else the scene's environment (the proxies' projection).
+pub(super) struct SkySh<'a> {
+    /// The host's projection, when the host gave a map.
+    pub host: Option<Handle<Buffer>>,
+    /// The technique that projects the scene's environment.
+    pub scene: &'a mut ProxyTechnique,
+}
+
+/// The sky's diffuse light at `receivers` seen from `camera`, from the environment's SH at
+/// [`sky::BANDS`] bands.
 pub(super) fn sky_light(
     rg: &mut RenderGraph,
     p: &FrameParams,
     params: &SkyParams,
-    proxy: &mut ProxyTechnique,
+    sh: SkySh<'_>,
     bvh: &TraceImages,
     receivers: &Receivers,
     camera: Vec3,
 ) -> Result<Handle<Image>, RenderError> {
-    let environment = proxy.environment_sh(rg, sky::BANDS)?;
+    let environment = match sh.host {
+        Some(host) => host,
+        None => sh.scene.environment_sh(rg, sky::BANDS)?,
+    };
     let seed = history_seed(rg, p);
     Ok(sky::sky(
         rg,
