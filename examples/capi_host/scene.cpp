@@ -5,6 +5,8 @@
 #include "errors.hpp"
 
 #include <cstring>
+#include <iostream>
+#include <string>
 
 namespace capi_host {
 
@@ -34,28 +36,55 @@ void destroy_scene(const HostDevice& host, HostScene& s) {
     destroy_buffer(host, s.indices);
 }
 
-void register_with_shine(ShineContext context, ShineScene scene, const HostScene& s) {
+namespace {
+
+// The mesh of one draw of the host's buffers (all vertices, the draw's indices).
+ShineHostMesh mesh_of(const HostScene& s, const ShineDraw& draw) {
     const uint32_t vertex_bytes = 6 * sizeof(float);
+    ShineHostMesh mesh{};
+    mesh.version = SHINE_HOST_MESH_VERSION;
+    mesh.vertices.buffer = reinterpret_cast<uint64_t>(s.vertices.buffer);
+    mesh.vertices.size = uint64_t(s.vertex_count) * vertex_bytes;
+    mesh.vertex_stride = vertex_bytes;
+    mesh.vertex_count = s.vertex_count;
+    mesh.position_format = SHINE_POSITION_FLOAT3;
+    mesh.normal_offset = 3 * sizeof(float);
+    mesh.indices.buffer = reinterpret_cast<uint64_t>(s.indices.buffer);
+    mesh.indices.size = uint64_t(s.index_count) * sizeof(uint32_t);
+    mesh.indices.offset = uint64_t(draw.first_index) * sizeof(uint32_t);
+    mesh.index_format = SHINE_INDEX_UINT32;
+    mesh.index_count = draw.index_count;
+    std::memcpy(mesh.material.base_color, draw.base_color, sizeof draw.base_color);
+    mesh.material.roughness = draw.roughness;
+    mesh.material.metallic = draw.metallic;
+    std::memcpy(mesh.material.emissive, draw.emissive, sizeof draw.emissive);
+    mesh.material.double_sided = draw.double_sided;
+    return mesh;
+}
+
+// A vertex buffer stated one byte too small for its vertices is refused with
+// SHINE_RESULT_ERROR_INVALID_ARGUMENT and a message, and registers nothing.
+void check_bad_mesh_is_refused(ShineContext context, const HostScene& s) {
+    ShineHostMesh mesh = mesh_of(s, s.draws.front());
+    mesh.vertices.size -= 1;
+    uint32_t id = 0;
+    const ShineResult result = shine_context_register_mesh(context, &mesh, &id);
+    const std::string message = shine_last_error();
+    if (result != SHINE_RESULT_ERROR_INVALID_ARGUMENT || message.empty()) {
+        fail(std::string("a too-small vertex buffer was not refused as it should be: got ") +
+             shine_result_name(result) + " with message \"" + message + "\"");
+    }
+    std::cout << "too-small buffer refused: " << shine_result_name(result) << ": " << message
+              << "\n";
+}
+
+}  // namespace
+
+void register_with_shine(ShineContext context, ShineScene scene, const HostScene& s) {
+    check_bad_mesh_is_refused(context, s);
     std::vector<ShineHostInstance> instances;
     for (const ShineDraw& draw : s.draws) {
-        ShineHostMesh mesh{};
-        mesh.version = SHINE_HOST_MESH_VERSION;
-        mesh.vertices.buffer = reinterpret_cast<uint64_t>(s.vertices.buffer);
-        mesh.vertices.size = uint64_t(s.vertex_count) * vertex_bytes;
-        mesh.vertex_stride = vertex_bytes;
-        mesh.vertex_count = s.vertex_count;
-        mesh.position_format = SHINE_POSITION_FLOAT3;
-        mesh.normal_offset = 3 * sizeof(float);
-        mesh.indices.buffer = reinterpret_cast<uint64_t>(s.indices.buffer);
-        mesh.indices.size = uint64_t(s.index_count) * sizeof(uint32_t);
-        mesh.indices.offset = uint64_t(draw.first_index) * sizeof(uint32_t);
-        mesh.index_format = SHINE_INDEX_UINT32;
-        mesh.index_count = draw.index_count;
-        std::memcpy(mesh.material.base_color, draw.base_color, sizeof draw.base_color);
-        mesh.material.roughness = draw.roughness;
-        mesh.material.metallic = draw.metallic;
-        std::memcpy(mesh.material.emissive, draw.emissive, sizeof draw.emissive);
-        mesh.material.double_sided = draw.double_sided;
+        const ShineHostMesh mesh = mesh_of(s, draw);
         ShineHostInstance instance{};
         check_shine(shine_context_register_mesh(context, &mesh, &instance.mesh),
                     "shine_context_register_mesh");

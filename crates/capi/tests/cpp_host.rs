@@ -1,7 +1,9 @@
 //! A C++ host through the C API (examples/capi_host: its own instance, device, raster
 //! G-buffer pipeline and images; built by its Makefile with the system compiler) against the
 //! Rust host of examples/host_gbuffer through the Rust API: the same scene, camera, G-buffer
-//! shaders and technique give the same indirect light, within 1e-3 relative RMSE.
+//! shaders and technique give the same indirect light, within 1e-3 relative RMSE (the C++
+//! host registers its own vertex and index buffers; the Rust one hands over the built-in).
+//! The C++ host also checks that a NaN camera and a too-small vertex buffer are refused.
 
 mod common;
 #[path = "../../../examples/host_gbuffer/host/mod.rs"]
@@ -111,12 +113,16 @@ fn cpp_host(scene_name: &str) -> Vec<[f32; 4]> {
         .arg(&build)
         .output()
         .expect("run the C++ host");
-    println!("{}", String::from_utf8_lossy(&run.stdout));
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    println!("{stdout}");
     assert!(
         run.status.success(),
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+    // The host's own bad-input checks ran (it exits 1 when one is not refused).
+    assert!(stdout.contains("NaN camera refused"), "{stdout}");
+    assert!(stdout.contains("too-small buffer refused"), "{stdout}");
     let bytes = std::fs::read(&raw).expect("the C++ host's output");
     let _ = std::fs::remove_dir_all(&build);
     assert_eq!(bytes.len(), (EXTENT[0] * EXTENT[1] * 16) as usize);
