@@ -147,6 +147,10 @@ int main(int argc, char** argv) {
                      dispatch_desc(k, camera, targets, &diffuse), view_proj);
         std::cout << "frame " << k + 1 << "/" << options.frames << "\n";
     }
+    ShineMemoryReport memory{};
+    check_shine(shine_context_memory_report(context, &memory), "shine_context_memory_report");
+    std::cout << "shine holds " << memory.scene << " B of scene, " << memory.transients
+              << " B of transients, " << memory.history << " B of history\n";
     const std::vector<float> gi = read_rgba16f(host, submitter, targets.gi);
     write_raw(options.output, gi);
     std::cout << "wrote " << options.output << " (" << options.width << "x" << options.height

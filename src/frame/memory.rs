@@ -15,7 +15,8 @@ pub struct MemoryReport {
     pub frame_data: u64,
     /// Host-visible staging rings of the per-frame uploads.
     pub staging: u64,
-    /// The render graph's aliased transient heaps (one set per plan and frame slot).
+    /// The render graph's aliased transient heaps (one set per transient layout and frame
+    /// slot).
     pub transients: u64,
     /// Resources kept across frames by the graph: histories and temporal images.
     pub history: u64,

@@ -258,3 +258,67 @@ fn state(s: ShineImageState) -> ExternalState {
         vk::ImageLayout::from_raw(s.layout),
     )
 }
+
+/// Device memory a context holds, by category, in bytes (`shine_context_memory_report`).
+#[repr(C)]
+pub struct ShineMemoryReport {
+    /// Geometry, materials, textures, lights, the BVH.
+    pub scene: u64,
+    /// The techniques' persistent tables and caches.
+    pub gi_caches: u64,
+    /// Per-frame records kept on the device.
+    pub frame_data: u64,
+    /// Host-visible staging rings.
+    pub staging: u64,
+    /// The render graph's aliased transient heaps.
+    pub transients: u64,
+    /// Histories and temporal images kept across frames.
+    pub history: u64,
+    /// Objects waiting for the GPU to finish with them.
+    pub pending_release: u64,
+}
+
+/// Changes the display size after a swapchain resize: the next dispatch takes images of
+/// `width`×`height`; histories start over. Nothing waits (warm up again to avoid the next
+/// frame building its plan and memory).
+///
+/// # Safety
+/// `context` may be any value (null and stale handles are refused).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_resize(
+    context: ShineContext,
+    width: u32,
+    height: u32,
+) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        Ok(lock(&context).resize([width, height])?)
+    })
+}
+
+/// Writes the device memory the context holds, by category, to `out`.
+///
+/// # Safety
+/// `out` is null or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_memory_report(
+    context: ShineContext,
+    out: *mut ShineMemoryReport,
+) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        // SAFETY: the caller's promise.
+        let out = unsafe { out.as_mut() }.ok_or_else(|| Failure::invalid("out is null"))?;
+        let r = lock(&context).memory_report();
+        *out = ShineMemoryReport {
+            scene: r.scene,
+            gi_caches: r.gi_caches,
+            frame_data: r.frame_data,
+            staging: r.staging,
+            transients: r.transients,
+            history: r.history,
+            pending_release: r.pending_release,
+        };
+        Ok(())
+    })
+}

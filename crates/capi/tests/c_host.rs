@@ -10,17 +10,18 @@ mod common;
 
 #[test]
 fn bad_handles_and_arguments_get_codes_and_messages() {
-    let lib = common::profile_dir();
+    let (include, lib) = (common::include_dir(), common::library_dir());
     assert!(
-        lib.join("include/shine.h").is_file() && lib.join("libshine_capi.so").is_file(),
-        "no header or library in {}",
+        include.join("shine.h").is_file() && lib.join("libshine_capi.so").is_file(),
+        "no shine.h in {} or no libshine_capi.so in {}",
+        include.display(),
         lib.display()
     );
     let out = std::env::temp_dir().join(format!("shine-capi-handles-{}", std::process::id()));
     let source = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/handles.c");
     let compiled = Command::new("cc")
         .args(["-std=c99", "-pedantic", "-Wall", "-Wextra", "-Werror"])
-        .arg(format!("-I{}", lib.join("include").display()))
+        .arg(format!("-I{}", include.display()))
         .arg(&source)
         .arg("-o")
         .arg(&out)

@@ -85,13 +85,14 @@ fn rust_host(scene_name: &str) -> Vec<[f32; 4]> {
 
 /// The C++ host's indirect light: built with `make`, run, its raw RGBA32F file read.
 fn cpp_host(scene_name: &str) -> Vec<[f32; 4]> {
-    let lib = common::profile_dir();
+    let (include, lib) = (common::include_dir(), common::library_dir());
     let build = std::env::temp_dir().join(format!("shine-capi-host-{}", std::process::id()));
     let example = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../examples/capi_host");
     let made = Command::new("make")
         .arg("-C")
         .arg(&example)
         .arg(format!("SHINE_LIB={}", lib.display()))
+        .arg(format!("SHINE_INCLUDE={}", include.display()))
         .arg(format!("OUT={}", build.display()))
         .output()
         .expect("run make");

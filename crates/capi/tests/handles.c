@@ -77,6 +77,10 @@ int main(void) {
            "null");
     expect("null context", shine_context_dispatch(NULL, NULL, NULL), SHINE_RESULT_ERROR_NULL_HANDLE,
            "null");
+    expect("resize a null context", shine_context_resize(NULL, 64, 64),
+           SHINE_RESULT_ERROR_NULL_HANDLE, "null");
+    expect("memory of a destroyed scene", shine_context_memory_report((ShineContext)gone, NULL),
+           SHINE_RESULT_ERROR_STALE_HANDLE, "destroyed");
 
     printf("%d failure(s)\n", failures);
     return failures == 0 ? 0 : 1;
