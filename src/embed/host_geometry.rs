@@ -339,13 +339,18 @@ pub(crate) fn scene(
         });
     }
     for (i, light) in lights.iter().enumerate() {
+        let scalars = [
+            light.intensity,
+            light.range,
+            light.inner_cone_angle,
+            light.outer_cone_angle,
+        ];
         let numbers = light
             .position
             .iter()
             .chain(&light.direction)
             .chain(&light.color);
-        if !numbers.chain([&light.intensity]).all(|v| v.is_finite()) || light.light_kind().is_none()
-        {
+        if !numbers.chain(&scalars).all(|v| v.is_finite()) || light.light_kind().is_none() {
             return Err(invalid(format!(
                 "light {i} is not finite or of no known kind"
             )));
