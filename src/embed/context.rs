@@ -113,8 +113,6 @@ pub struct GiContext {
     host_meshes: Vec<(shine_scene::Primitive, HostMaterial)>,
     /// The instances and the number of lights of the last [`GiContext::set_instances`].
     host_world: Option<(Vec<HostInstance>, usize)>,
-    /// The warm-up's inputs, made on its first call.
-    placeholders: Option<Placeholders>,
 }
 
 impl GiContext {
@@ -162,7 +160,6 @@ impl GiContext {
             last_frame: None,
             budget,
             frames_in_flight: desc.frames_in_flight,
-            placeholders: None,
             host_meshes: Vec::new(),
             host_world: None,
         })
@@ -397,33 +394,20 @@ impl GiContext {
 
     /// Builds, ahead of the host's first frame, everything a frame needs: every pipeline
     /// (through the device's pipeline cache), the graph's plans, transient memory and
-    /// descriptor pools. It records [`warm_up_frames`] frames of placeholder inputs at the
+    /// descriptor pools. It records `frames_in_flight + 1` frames of placeholder inputs at the
     /// display size, submits them to shine's queue and waits, then starts the histories over,
     /// so the host's first dispatch costs about what a steady one does. `shape`: what the
-    /// host's dispatches will bring (motion vectors, an environment map), which decides the
-    /// graph that is built. A load-time call, after [`GiContext::set_scene`]; call it again after a
+    /// host's dispatches will bring (motion vectors, an environment map, a specular output),
+    /// which decides the graph that is built. The placeholders are released afterwards. A
+    /// load-time call, after [`GiContext::set_scene`]; call it again after a
     /// [`GiContext::resize`] to warm the new size. The host must have no frame of this
     /// context in flight.
     pub fn warm_up(&mut self, shape: DispatchShape) -> Result<(), RenderError> {
-        if !self
-            .placeholders
-            .as_ref()
-            .is_some_and(|p| p.fit(self.display))
-        {
-            self.placeholders = Some(Placeholders::new(&self.device, self.display)?);
+        // Made for the warm-up and released after it (at 1080p they would hold ~75 MB).
+        let placeholders = Placeholders::new(&self.device, self.display)?;
+        for _ in 0..warm_up_frames(self.frames_in_flight) {
+            self.warm_up_frame(&placeholders, shape)?;
         }
-        let placeholders = self.placeholders.take();
-        let mut result = Ok(());
-        if let Some(p) = &placeholders {
-            for _ in 0..warm_up_frames(self.frames_in_flight) {
-                result = self.warm_up_frame(p, shape);
-                if result.is_err() {
-                    break;
-                }
-            }
-        }
-        self.placeholders = placeholders;
-        result?;
         // The warm-up's pass times are not the host's.
         self.renderer.timings()?;
         self.reset_history();

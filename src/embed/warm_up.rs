@@ -113,11 +113,6 @@ impl Placeholders {
         })
     }
 
-    /// Whether these placeholders fit a `display`-sized context.
-    pub(super) fn fit(&self, display: [u32; 2]) -> bool {
-        self.display == display
-    }
-
     /// Records the clears of every placeholder, leaving each in [`CLEARED`].
     pub(super) fn clear(&self, cmd: &mut Commands) {
         let colours = [
