@@ -21,6 +21,7 @@ mod retire;
 mod shader;
 mod timestamps;
 mod transfer;
+mod usage;
 mod validation;
 
 /// The ash version shine is built on: a host engine must use the same one to lend its handles.
@@ -28,7 +29,7 @@ pub use ash;
 pub use ash::vk;
 pub use commands::{Commands, SCOPES_PER_RECORDING, Submission};
 pub use descriptors::{Descriptor, DescriptorArena};
-pub use device::{Device, DeviceDesc, DeviceInfo, MemoryUsage, RawDevice};
+pub use device::{Device, DeviceDesc, DeviceInfo, RawDevice};
 pub use error::{Error, Result};
 pub use features::{EnabledFeatures, FeatureStatus, REQUIREMENTS, Requirements};
 pub use instance::Adapter;
@@ -42,4 +43,5 @@ pub use pipeline::{
 };
 pub use shader::{BindingDesc, DescriptorKind, ShaderDesc, ShaderStage, VertexInputDesc};
 pub use timestamps::{ScopeTiming, TimestampPool, ticks_to_ns};
+pub use usage::MemoryUsage;
 pub use validation::{KEPT_MESSAGES, MessageCounts, Validation};
