@@ -10,10 +10,7 @@
 mod host;
 
 use host::{HostDevice, HostScene, Raster, Targets};
-use shine::embed::{
-    DispatchShape, GiCamera, GiContext, GiContextDesc, GiDispatch, MaterialChannels, NormalEncoding,
-};
-use shine::graph::ExternalState;
+use shine::embed::{DispatchShape, GiCamera, GiContext, GiContextDesc};
 use std::error::Error;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -61,38 +58,15 @@ fn main() -> Result<(), Box<dyn Error>> {
             let start = Instant::now();
             let cb = host.begin()?;
             raster.record(&host, cb, &targets, &host_scene, projection * view);
-            let color =
-                |image: &host::HostImage| image.lend(host::color_written(), host::sampled_after());
-            gi.dispatch(
-                cb,
-                &GiDispatch {
-                    frame_index: u64::from(frame),
-                    camera: GiCamera {
-                        view,
-                        projection,
-                        jitter: [0.0; 2],
-                        previous_view,
-                        previous_projection,
-                    },
-                    depth: targets
-                        .depth
-                        .lend(host::depth_written(), host::sampled_after()),
-                    depth_convention: Default::default(),
-                    normals: color(&targets.normal),
-                    normal_encoding: NormalEncoding::UNORM,
-                    albedo: color(&targets.albedo),
-                    material: color(&targets.material),
-                    material_channels: MaterialChannels::default(),
-                    motion: None,
-                    environment: None,
-                    diffuse: Some(
-                        targets
-                            .gi
-                            .lend(ExternalState::UNDEFINED, host::copy_source()),
-                    ),
-                    specular: None,
-                },
-            )?;
+            let camera = GiCamera {
+                view,
+                projection,
+                jitter: [0.0; 2],
+                previous_view,
+                previous_projection,
+            };
+            // Every image in the state the raster left it (host/raster.rs `Targets::dispatch`).
+            gi.dispatch(cb, &targets.dispatch(u64::from(frame), camera))?;
             host.submit_and_wait(cb)?;
             println!("frame {}/{FRAMES} {:.1} ms", frame + 1, ms(start));
         }

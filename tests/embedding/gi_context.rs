@@ -3,9 +3,7 @@
 
 use super::host::{self, HostDevice, HostScene, Raster, Targets};
 use glam::Mat4;
-use shine::embed::{
-    GiCamera, GiContext, GiContextDesc, GiDispatch, MaterialChannels, NormalEncoding,
-};
+use shine::embed::{GiCamera, GiContext, GiContextDesc, GiDispatch, MaterialChannels};
 use shine::gpu::{Device, vk};
 use shine::graph::ExternalState;
 use shine::passes::composite::Component;
@@ -141,22 +139,7 @@ impl Bench {
             self.host_scene.as_ref().expect("scene"),
             camera.projection * camera.view,
         );
-        let color = |i: &host::HostImage| i.lend(host::color_written(), host::sampled_after());
-        GiDispatch {
-            frame_index,
-            camera,
-            depth: t.depth.lend(host::depth_written(), host::sampled_after()),
-            depth_convention: Default::default(),
-            normals: color(&t.normal),
-            normal_encoding: NormalEncoding::UNORM,
-            albedo: color(&t.albedo),
-            material: color(&t.material),
-            material_channels: MaterialChannels::default(),
-            motion: None,
-            environment: None,
-            diffuse: Some(t.gi.lend(ExternalState::UNDEFINED, host::copy_source())),
-            specular: None,
-        }
+        t.dispatch(frame_index, camera)
     }
 
     /// Frames `frames` through `gi`, each in one host submission; the GI image of the last.

@@ -19,33 +19,55 @@ const IDENTITY: [[f32; 4]; 3] = [
 /// Bytes of one of the host's vertices: world position and normal, 6 floats.
 const VERTEX_BYTES: u32 = 24;
 
+/// The bench's whole flattened scene as one mesh of the host's buffers: every vertex (normals
+/// at byte 12), every index, a default material.
+fn whole_mesh(bench: &Bench) -> HostMesh {
+    let flat = bench.scene.flatten_at(0.0);
+    let host = bench.host_scene();
+    HostMesh {
+        vertices: HostBuffer {
+            buffer: host.vertices.buffer,
+            size: flat.vertices.len() as u64 * u64::from(VERTEX_BYTES),
+            offset: 0,
+        },
+        vertex_stride: VERTEX_BYTES,
+        vertex_count: flat.vertices.len() as u32,
+        position_format: PositionFormat::Float3,
+        normal_offset: Some(12),
+        indices: HostBuffer {
+            buffer: host.indices.buffer,
+            size: flat.indices.len() as u64 * 4,
+            offset: 0,
+        },
+        index_format: IndexFormat::U32,
+        index_count: flat.indices.len() as u32,
+        material: HostMaterial::default(),
+    }
+}
+
+/// Every mesh of `ids` placed at `transform`.
+fn placed(ids: &[MeshId], transform: [[f32; 4]; 3]) -> Vec<HostInstance> {
+    ids.iter()
+        .map(|&mesh| HostInstance { mesh, transform })
+        .collect()
+}
+
 /// A context for the bench with the host's meshes registered (one per draw of its
 /// flattened scene) and placed at the identity, lit by the scene's lights.
 fn registered(bench: &Bench, desc: &shine::embed::GiContextDesc) -> (GiContext, Vec<MeshId>) {
     let flat = bench.scene.flatten_at(0.0);
     let mut gi = GiContext::new(bench.device(), desc).expect("context");
-    let host = bench.host_scene();
+    let whole = whole_mesh(bench);
     let ids: Vec<MeshId> = flat
         .draws
         .iter()
         .map(|d| {
             let material = d.material.map(|m| bench.scene.materials[m]);
             gi.register_mesh(&HostMesh {
-                vertices: HostBuffer {
-                    buffer: host.vertices.buffer,
-                    size: flat.vertices.len() as u64 * u64::from(VERTEX_BYTES),
-                    offset: 0,
-                },
-                vertex_stride: VERTEX_BYTES,
-                vertex_count: flat.vertices.len() as u32,
-                position_format: PositionFormat::Float3,
-                normal_offset: Some(12),
                 indices: HostBuffer {
-                    buffer: host.indices.buffer,
-                    size: flat.indices.len() as u64 * 4,
                     offset: u64::from(d.first_index) * 4,
+                    ..whole.indices
                 },
-                index_format: IndexFormat::U32,
                 index_count: d.index_count,
                 material: HostMaterial {
                     base_color: d.base_color,
@@ -54,17 +76,12 @@ fn registered(bench: &Bench, desc: &shine::embed::GiContextDesc) -> (GiContext, 
                     emissive: material.map_or([0.0; 3], |m| m.emissive),
                     double_sided: material.is_some_and(|m| m.double_sided != 0),
                 },
+                ..whole
             })
             .expect("register")
         })
         .collect();
-    let instances: Vec<HostInstance> = ids
-        .iter()
-        .map(|&mesh| HostInstance {
-            mesh,
-            transform: IDENTITY,
-        })
-        .collect();
+    let instances = placed(&ids, IDENTITY);
     let lights = bench.scene.lights_at(&bench.scene.world_transforms_at(0.0));
     gi.set_instances(&instances, &lights).expect("instances");
     (gi, ids)
@@ -103,13 +120,7 @@ fn registered_lights_move_per_frame_and_lists_are_checked() {
     let mut lights = bench.scene.lights_at(&bench.scene.world_transforms_at(0.0));
     let still = bench.run_still(&mut gi, 0);
     lights[0].position[0] -= 0.1;
-    let instances: Vec<HostInstance> = ids
-        .iter()
-        .map(|&mesh| HostInstance {
-            mesh,
-            transform: IDENTITY,
-        })
-        .collect();
+    let instances = placed(&ids, IDENTITY);
     gi.move_instances(&instances, &lights).expect("move");
     let moved = bench.run_still(&mut gi, 1);
     let (change, _) = error_of(&moved, &still);
@@ -127,27 +138,12 @@ fn registered_lights_move_per_frame_and_lists_are_checked() {
 fn a_buffer_too_small_for_its_count_is_refused() {
     let bench = Bench::new(false);
     let mut gi = GiContext::new(bench.device(), &exact_desc(EXTENT, "hvl")).expect("context");
-    let host = bench.host_scene();
-    let flat = bench.scene.flatten_at(0.0);
     let error = gi
         .register_mesh(&HostMesh {
-            vertices: HostBuffer {
-                buffer: host.vertices.buffer,
-                size: flat.vertices.len() as u64 * u64::from(VERTEX_BYTES),
-                offset: 0,
-            },
-            vertex_stride: VERTEX_BYTES,
-            vertex_count: flat.vertices.len() as u32 + 1,
-            position_format: PositionFormat::Float3,
+            vertex_count: whole_mesh(&bench).vertex_count + 1,
             normal_offset: None,
-            indices: HostBuffer {
-                buffer: host.indices.buffer,
-                size: flat.indices.len() as u64 * 4,
-                offset: 0,
-            },
-            index_format: IndexFormat::U32,
             index_count: 3,
-            material: HostMaterial::default(),
+            ..whole_mesh(&bench)
         })
         .expect_err("overrun")
         .to_string();
@@ -161,28 +157,11 @@ fn a_buffer_too_small_for_its_count_is_refused() {
 fn an_index_out_of_range_is_refused() {
     let bench = Bench::new(false);
     let mut gi = GiContext::new(bench.device(), &exact_desc(EXTENT, "hvl")).expect("context");
-    let host = bench.host_scene();
-    let flat = bench.scene.flatten_at(0.0);
     let error = gi
         .register_mesh(&HostMesh {
-            vertices: HostBuffer {
-                buffer: host.vertices.buffer,
-                size: flat.vertices.len() as u64 * u64::from(VERTEX_BYTES),
-                offset: 0,
-            },
-            vertex_stride: VERTEX_BYTES,
             // Fewer vertices than the indices reach.
             vertex_count: 3,
-            position_format: PositionFormat::Float3,
-            normal_offset: Some(12),
-            indices: HostBuffer {
-                buffer: host.indices.buffer,
-                size: flat.indices.len() as u64 * 4,
-                offset: 0,
-            },
-            index_format: IndexFormat::U32,
-            index_count: flat.indices.len() as u32,
-            material: HostMaterial::default(),
+            ..whole_mesh(&bench)
         })
         .expect_err("index out of range")
         .to_string();
@@ -203,10 +182,7 @@ fn nan_and_sheared_transforms_are_refused() {
     let mut shear = IDENTITY;
     shear[0][1] = 0.5;
     for (transform, expected) in [(nan, "not finite"), (shear, "shears")] {
-        let instances: Vec<HostInstance> = ids
-            .iter()
-            .map(|&mesh| HostInstance { mesh, transform })
-            .collect();
+        let instances = placed(&ids, transform);
         let error = gi
             .set_instances(&instances, &lights)
             .expect_err("refused")

@@ -5,8 +5,8 @@
 use crate::error::{Failure, ShineResult, call};
 use crate::handles::{self, ShineContext, lock};
 use shine::embed::{
-    HostBuffer, HostInstance, HostMaterial, HostMesh, IndexFormat, Light, LightKind, MeshId,
-    PositionFormat,
+    GiContext, HostBuffer, HostInstance, HostMaterial, HostMesh, IndexFormat, Light, LightKind,
+    MeshId, PositionFormat,
 };
 use shine::gpu::vk::{self, Handle};
 
@@ -185,12 +185,17 @@ pub unsafe extern "C" fn shine_context_set_instances(
     lights: *const ShineLight,
     light_count: u32,
 ) -> ShineResult {
-    call(|| {
-        let context = handles::context(context)?;
-        // SAFETY: the caller's promise.
-        let (instances, lights) = unsafe { world(instances, instance_count, lights, light_count) }?;
-        Ok(lock(&context).set_instances(&instances, &lights)?)
-    })
+    // SAFETY: the caller's promise.
+    unsafe {
+        with_world(
+            context,
+            instances,
+            instance_count,
+            lights,
+            light_count,
+            |gi, i, l| gi.set_instances(i, l),
+        )
+    }
 }
 
 /// Moves the instances of the last `shine_context_set_instances` (same meshes, same order)
@@ -206,11 +211,36 @@ pub unsafe extern "C" fn shine_context_move_instances(
     lights: *const ShineLight,
     light_count: u32,
 ) -> ShineResult {
+    // SAFETY: the caller's promise.
+    unsafe {
+        with_world(
+            context,
+            instances,
+            instance_count,
+            lights,
+            light_count,
+            |gi, i, l| gi.move_instances(i, l),
+        )
+    }
+}
+
+/// Runs `f` on the context with the C arrays as Rust instances and lights.
+///
+/// # Safety
+/// The arrays hold their counts (or are null with a count of 0).
+unsafe fn with_world(
+    context: ShineContext,
+    instances: *const ShineHostInstance,
+    instance_count: u32,
+    lights: *const ShineLight,
+    light_count: u32,
+    f: impl FnOnce(&mut GiContext, &[HostInstance], &[Light]) -> Result<(), shine::RenderError>,
+) -> ShineResult {
     call(|| {
         let context = handles::context(context)?;
         // SAFETY: the caller's promise.
         let (instances, lights) = unsafe { world(instances, instance_count, lights, light_count) }?;
-        Ok(lock(&context).move_instances(&instances, &lights)?)
+        Ok(f(&mut lock(&context), &instances, &lights)?)
     })
 }
 

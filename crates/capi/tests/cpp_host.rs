@@ -10,10 +10,7 @@ mod common;
 mod host;
 
 use host::{HostDevice, HostScene, Raster, Targets};
-use shine::embed::{
-    Device, DispatchShape, ExternalState, GiCamera, GiContext, GiContextDesc, GiDispatch,
-    MaterialChannels, NormalEncoding,
-};
+use shine::embed::{Device, DispatchShape, GiCamera, GiContext, GiContextDesc};
 use std::path::PathBuf;
 use std::process::Command;
 use std::sync::atomic::Ordering;
@@ -49,28 +46,7 @@ fn rust_host(scene_name: &str) -> Vec<[f32; 4]> {
                 &host_scene,
                 camera.projection * camera.view,
             );
-            let color = |i: &host::HostImage| i.lend(host::color_written(), host::sampled_after());
-            let dispatch = GiDispatch {
-                frame_index: u64::from(k),
-                camera,
-                depth: targets
-                    .depth
-                    .lend(host::depth_written(), host::sampled_after()),
-                depth_convention: Default::default(),
-                normals: color(&targets.normal),
-                normal_encoding: NormalEncoding::UNORM,
-                albedo: color(&targets.albedo),
-                material: color(&targets.material),
-                material_channels: MaterialChannels::default(),
-                motion: None,
-                environment: None,
-                diffuse: Some(
-                    targets
-                        .gi
-                        .lend(ExternalState::UNDEFINED, host::copy_source()),
-                ),
-                specular: None,
-            };
+            let dispatch = targets.dispatch(u64::from(k), camera);
             gi.dispatch(cb, &dispatch).expect("dispatch");
             host.submit_and_wait(cb).expect("submit");
         }

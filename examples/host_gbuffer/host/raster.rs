@@ -63,6 +63,35 @@ impl Targets {
     }
 
     /// Destroys every image.
+    /// The GI dispatch of the G-buffer rasterised into these targets from `camera`, as frame
+    /// `frame_index`: each image in the state the raster left it, UNORM normals, glTF material
+    /// channels, the indirect light into `gi` (left ready to copy from).
+    pub fn dispatch(
+        &self,
+        frame_index: u64,
+        camera: shine::embed::GiCamera,
+    ) -> shine::embed::GiDispatch {
+        let color = |i: &HostImage| i.lend(color_written(), sampled_after());
+        shine::embed::GiDispatch {
+            frame_index,
+            camera,
+            depth: self.depth.lend(depth_written(), sampled_after()),
+            depth_convention: Default::default(),
+            normals: color(&self.normal),
+            normal_encoding: shine::embed::NormalEncoding::UNORM,
+            albedo: color(&self.albedo),
+            material: color(&self.material),
+            material_channels: shine::embed::MaterialChannels::default(),
+            motion: None,
+            environment: None,
+            diffuse: Some(
+                self.gi
+                    .lend(shine::embed::ExternalState::UNDEFINED, copy_source()),
+            ),
+            specular: None,
+        }
+    }
+
     pub fn destroy(self, host: &HostDevice) {
         for image in [
             self.depth,
