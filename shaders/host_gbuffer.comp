@@ -1,7 +1,8 @@
 // `host gbuffer`: a host engine's G-buffer (depth, normals, albedo, roughness/metallic and
 // optional motion, in the host's own formats and encodings) turned into the G-buffer images
-// the GI techniques read (docs/frame.md), at display size. src/passes/host_gbuffer.rs;
-// encodings in docs/embedding.md.
+// the GI techniques read (docs/frame.md), at display size or, for a context's internal
+// resolution, smaller: each pixel then takes the host texel under its centre.
+// src/passes/host_gbuffer.rs; encodings in docs/embedding.md.
 #version 460
 
 layout(local_size_x = 8, local_size_y = 8) in;
@@ -34,8 +35,15 @@ layout(set = 0, binding = 6, std430) readonly buffer Frame {
     // x: roughness channel, y: metallic channel (4: none), z: 1 when host motion is bound,
     // w: unused.
     uvec4 channels;
+    // Display width and height (z, w unused).
     uvec4 extent;
 } frame;
+
+// shine::passes::host_gbuffer::HostGbufferPush
+layout(push_constant) uniform Push {
+    // Width and height of the G-buffer written (the display's, or the internal resolution's).
+    uvec2 extent;
+} push;
 
 layout(set = 0, binding = 7, rgba32f) writeonly uniform image2D gb_position;
 layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D gb_normal;
@@ -50,20 +58,24 @@ float channel(vec4 v, uint c) {
 }
 
 void main() {
-    uvec2 xy = gl_GlobalInvocationID.xy;
-    if (any(greaterThanEqual(xy, frame.extent.xy))) {
+    uvec2 q = gl_GlobalInvocationID.xy;
+    if (any(greaterThanEqual(q, push.extent))) {
         return;
     }
+    // The host texel under this pixel's centre (itself at the display size).
+    vec2 ratio = vec2(frame.extent.xy) / vec2(push.extent);
+    uvec2 xy = min(uvec2((vec2(q) + 0.5) * ratio), frame.extent.xy - 1u);
     ivec2 p = ivec2(xy);
+    ivec2 out_p = ivec2(q);
     float depth = texelFetch(sampler2D(host_depth, host_sampler), p, 0).r;
     if (abs(depth - frame.params.x) < 1e-7) {
         // Background: every G-buffer image holds 0 there (docs/frame.md).
-        imageStore(gb_position, p, vec4(0.0));
-        imageStore(gb_normal, p, vec4(0.0));
-        imageStore(gb_albedo, p, vec4(0.0));
-        imageStore(gb_material, p, vec4(0.0));
-        imageStore(gb_geometric_normal, p, vec4(0.0));
-        imageStore(gb_motion, p, vec4(0.0));
+        imageStore(gb_position, out_p, vec4(0.0));
+        imageStore(gb_normal, out_p, vec4(0.0));
+        imageStore(gb_albedo, out_p, vec4(0.0));
+        imageStore(gb_material, out_p, vec4(0.0));
+        imageStore(gb_geometric_normal, out_p, vec4(0.0));
+        imageStore(gb_motion, out_p, vec4(0.0));
         return;
     }
     vec2 ndc = (vec2(xy) + 0.5) / vec2(frame.extent.xy) * 2.0 - 1.0;
@@ -94,10 +106,10 @@ void main() {
         motion = 0.5 * (now.xy / now.w - then.xy / then.w);
     }
 
-    imageStore(gb_position, p, vec4(position, linear_depth));
-    imageStore(gb_normal, p, vec4(n, 0.0));
-    imageStore(gb_albedo, p, vec4(texelFetch(sampler2D(host_albedo, host_sampler), p, 0).rgb, 1.0));
-    imageStore(gb_material, p, vec4(roughness, metallic, 0.0, 0.0));
-    imageStore(gb_geometric_normal, p, vec4(facing, 0.0));
-    imageStore(gb_motion, p, vec4(motion, 0.0, 0.0));
+    imageStore(gb_position, out_p, vec4(position, linear_depth));
+    imageStore(gb_normal, out_p, vec4(n, 0.0));
+    imageStore(gb_albedo, out_p, vec4(texelFetch(sampler2D(host_albedo, host_sampler), p, 0).rgb, 1.0));
+    imageStore(gb_material, out_p, vec4(roughness, metallic, 0.0, 0.0));
+    imageStore(gb_geometric_normal, out_p, vec4(facing, 0.0));
+    imageStore(gb_motion, out_p, vec4(motion, 0.0, 0.0));
 }

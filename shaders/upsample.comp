@@ -28,10 +28,11 @@ layout(set = 0, binding = 5, rgba16f) uniform image2D upsampled;
 layout(push_constant) uniform Push {
     // Full-resolution extent W×H.
     uvec2 extent;
-    // Receiver extent ceil(W/s)×ceil(H/s).
+    // Coarse extent: ceil(W/s)×ceil(H/s) for receivers, the internal size for a GI context.
     uvec2 recv_extent;
-    // Block size s ∈ {1, 2, 4}.
-    uint scale;
+    // Full-resolution pixels per coarse sample (s for receivers; sample i's centre sits at
+    // (i + 0.5)·step).
+    vec2 step;
     // σ_z: relative depth difference that halves w^z.
     float depth_sigma;
     // n: exponent of the normal weight.
@@ -60,7 +61,7 @@ void main() {
         imageStore(upsampled, ivec2(p), vec4(0.0));
         return;
     }
-    if (push.scale == 1u) {
+    if (push.step == vec2(1.0)) {
         // s = 1: the receiver is the pixel itself, an exact copy.
         imageStore(upsampled, ivec2(p), imageLoad(radiance, ivec2(p)));
         return;
@@ -68,7 +69,8 @@ void main() {
     vec3 normal = imageLoad(gb_normal, ivec2(p)).xyz;
 
     // Position of p in receiver texel coordinates (sample centres at integers).
-    vec2 u = (vec2(p) + 0.5) / float(push.scale) - 0.5;
+    vec2 centre = vec2(p) + 0.5;
+    vec2 u = centre / push.step - 0.5;
     vec2 base = floor(u);
     vec2 f = u - base;
     ivec2 last = ivec2(push.recv_extent) - 1;
@@ -89,7 +91,7 @@ void main() {
         result = sum / weight_sum;
     } else {
         // Fallback: the best match among the 3×3 receivers around p's own (own on ties).
-        ivec2 own = min(ivec2(p) / int(push.scale), last);
+        ivec2 own = min(ivec2(floor(centre / push.step)), last);
         float best = match_weight(own, target.w, normal);
         result = best >= 0.0 ? imageLoad(radiance, own) : vec4(0.0);
         for (int dy = -1; dy <= 1; dy++) {

@@ -11,6 +11,8 @@ mod gi_context;
 mod host;
 #[path = "embedding/host_geometry.rs"]
 mod host_geometry;
+#[path = "embedding/internal_resolution.rs"]
+mod internal_resolution;
 #[path = "embedding/specular_out.rs"]
 mod specular_out;
 #[path = "embedding/warm_up.rs"]

@@ -20,7 +20,8 @@ use shine::passes::receivers::{
     Receivers, ReceiversPush, gather_texels, receiver_extent, receiver_samples, receivers,
 };
 use shine::passes::upsample::{
-    UpsampleInputs, UpsampleParams, UpsamplePush, upsample, upsample_cpu,
+    Coarse, CoarseGrid, UpsampleInputs, UpsampleParams, UpsamplePush, upsample, upsample_cpu,
+    upsample_grid,
 };
 use shine::shaders;
 
@@ -375,7 +376,7 @@ fn upsample_both(
         position: &g.position,
         normal: &g.normal,
         extent: g.extent,
-        scale,
+        grid: CoarseGrid::blocks(g.extent, scale).unwrap(),
     };
     let expected = upsample_cpu(&inputs, params).unwrap();
     (got, expected)
@@ -486,7 +487,7 @@ fn upsample_does_not_bleed_across_a_depth_edge() {
             position: &g.position,
             normal: &g.normal,
             extent: g.extent,
-            scale,
+            grid: CoarseGrid::blocks(g.extent, scale).unwrap(),
         };
         let naive = max_bleed(&g, &upsample_cpu(&inputs, &bilinear).unwrap());
         println!("s = {scale}: GPU vs CPU {error:.2e}, bleed {bleed:.4} (bilinear {naive:.4})");
@@ -532,6 +533,85 @@ fn upsample_matches_the_cpu_on_a_curved_surface() {
         let error = max_error(&got, &expected);
         println!("s = {scale}: GPU vs CPU {error:.2e}");
         assert!(error <= F16_TOLERANCE, "s = {scale}: GPU vs CPU {error}");
+    }
+    assert_clean(&device);
+}
+
+/// The coarse G-buffer of an internal grid: each sample the full-resolution pixel under its
+/// centre (`CoarseGrid::source_texel`, what the host G-buffer conversion fetches).
+fn cpu_decimate(g: &CpuGBuffer, grid: &CoarseGrid) -> CpuGBuffer {
+    let [w, h] = grid.extent;
+    let samples: Vec<usize> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| [x, y]))
+        .map(|i| {
+            let [x, y] = grid.source_texel(i, g.extent);
+            (y * g.extent[0] + x) as usize
+        })
+        .collect();
+    CpuGBuffer {
+        extent: grid.extent,
+        position: gather_texels(&g.position, 4, &samples),
+        normal: gather_texels(&g.normal, 4, &samples),
+        albedo: gather_texels(&g.albedo, 4, &samples),
+        material: gather_texels(&g.material, 4, &samples),
+    }
+}
+
+/// A GI context's internal grids (75 % and 50 % of 64, and an odd 23 of 64: steps of 4/3, 2
+/// and 2.78 pixels): the upsample from the decimated G-buffer matches its CPU twin and does
+/// not bleed across the depth edge, as with the receivers' integer blocks.
+#[test]
+fn internal_grids_match_the_cpu_and_do_not_bleed() {
+    let device = device();
+    let g = two_planes();
+    let gpu = GpuGBuffer::new(&device, &g);
+    let params = UpsampleParams::default();
+    for side in [48, 32, 23] {
+        let grid = CoarseGrid::internal(g.extent, [side, side]).unwrap();
+        let coarse = cpu_decimate(&g, &grid);
+        let radiance = f16_round(&plane_radiance(&coarse));
+        let radiance_image = storage_image_with(
+            &device,
+            "radiance",
+            vk::Format::R16G16B16A16_SFLOAT,
+            grid.extent,
+            &f16_bytes(&radiance),
+        );
+        let coarse_gpu = GpuGBuffer::new(&device, &coarse);
+        let mut executor = Executor::new(&device, 1).unwrap();
+        let mut rg = executor.begin_frame();
+        let gb = gpu.import(&mut rg);
+        let c = coarse_gpu.import(&mut rg);
+        let l = rg.import_gpu_image(&radiance_image, uploaded_state(), ExternalState::UNDEFINED);
+        let source = Coarse {
+            position: c.position,
+            normal: c.normal,
+            grid,
+        };
+        let out = upsample_grid(&mut rg, "upsample", &l, &source, &gb, &params);
+        let mut readback = Readback::new();
+        readback.copy(
+            &device,
+            &mut rg,
+            &out,
+            u64::from(g.extent[0] * g.extent[1]) * 8,
+        );
+        run(&device, &mut executor, rg);
+        let got = f16_floats(&readback.bytes(&device, 0));
+        let inputs = UpsampleInputs {
+            radiance: &radiance,
+            recv_position: &coarse.position,
+            recv_normal: &coarse.normal,
+            position: &g.position,
+            normal: &g.normal,
+            extent: g.extent,
+            grid,
+        };
+        let expected = upsample_cpu(&inputs, &params).unwrap();
+        let (error, bleed) = (max_error(&got, &expected), max_bleed(&g, &got));
+        println!("{side}²: GPU vs CPU {error:.2e}, bleed {bleed:.4}");
+        assert!(error <= F16_TOLERANCE, "{side}²: GPU vs CPU {error}");
+        assert!(bleed <= BLEED_TOLERANCE, "{side}²: bleeds {bleed}");
     }
     assert_clean(&device);
 }

@@ -37,6 +37,21 @@ using namespace capi_host;
 
 namespace {
 
+// An internal resolution that is not offered (60 %) must be refused with INVALID_ARGUMENT and
+// a message naming the ones there are, and no context made.
+void check_bad_percent_is_refused(ShineDevice device, ShineContextDesc desc) {
+    desc.internal_percent = 60;
+    ShineContext context = nullptr;
+    const ShineResult result = shine_context_create(device, &desc, &context);
+    const std::string message = shine_last_error();
+    if (result != SHINE_RESULT_ERROR_INVALID_ARGUMENT || context != nullptr ||
+        message.find("75") == std::string::npos) {
+        fail(std::string("a 60 % internal resolution was not refused as it should be: got ") +
+             shine_result_name(result) + " with message \"" + message + "\"");
+    }
+    std::cout << "60 % refused: " << shine_result_name(result) << ": " << message << "\n";
+}
+
 // A dispatch whose view matrix holds a NaN must be refused with INVALID_ARGUMENT and a
 // message; its command buffer is reset, never submitted.
 void check_bad_input_is_refused(ShineContext context, const Submitter& s,
@@ -133,6 +148,7 @@ int main(int argc, char** argv) {
     context_desc.settings = settings;
     context_desc.settings_count = 2;
     ShineContext context = nullptr;
+    check_bad_percent_is_refused(shine_device, context_desc);
     check_shine(shine_context_create(shine_device, &context_desc, &context),
                 "shine_context_create");
     // The host's own buffers and the scene's lights, not shine's copy of the scene: what an

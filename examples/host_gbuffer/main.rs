@@ -3,14 +3,16 @@
 //! `GiContext` recorded into its own command buffer, composites direct + GI itself, and
 //! writes a PNG after 6 frames of a moving camera. It prints how long the context took to make
 //! and warm up, and each frame's wall time (recording, submission and wait): with the warm-up
-//! the first frame costs what the others do; `--cold` skips it to show the hitch.
+//! the first frame costs what the others do; `--cold` skips it to show the hitch. `--gi T`
+//! picks the technique (default `hvl`), `--internal P` the internal resolution in per cent
+//! (100, 75, 50 or 25); the last frame's GPU time of shine's passes is printed.
 //!
-//! `cargo run --release --example host_gbuffer -- out.png [--cold]`
+//! `cargo run --release --example host_gbuffer -- out.png [--cold] [--gi igi] [--internal 50]`
 
 mod host;
 
 use host::{HostDevice, HostScene, Raster, Targets};
-use shine::embed::{DispatchShape, GiCamera, GiContext, GiContextDesc};
+use shine::embed::{DispatchShape, GiCamera, GiContext, GiContextDesc, InternalResolution};
 use std::error::Error;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
@@ -23,10 +25,30 @@ const ORBIT_PER_FRAME: f32 = 0.05;
 fn main() -> Result<(), Box<dyn Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let cold = args.iter().any(|a| a == "--cold");
+    let option = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .map(|i| {
+                args.get(i + 1)
+                    .cloned()
+                    .ok_or(format!("{name} needs a value"))
+            })
+            .transpose()
+    };
+    let technique = option("--gi")?.unwrap_or_else(|| "hvl".into());
+    let internal = match option("--internal")? {
+        Some(p) => InternalResolution::from_percent(p.parse()?)?,
+        None => InternalResolution::Full,
+    };
+    // The output path: the first argument that is neither an option nor an option's value.
     let output = args
         .iter()
-        .find(|a| !a.starts_with("--"))
-        .cloned()
+        .enumerate()
+        .find(|(i, a)| {
+            !a.starts_with("--")
+                && (*i == 0 || !["--gi", "--internal"].contains(&args[i - 1].as_str()))
+        })
+        .map(|(_, a)| a.clone())
         .unwrap_or_else(|| "host_gbuffer.png".into());
     let extent = [256, 256];
     let scene = shine_scene::Scene::builtin("cornell-box")?;
@@ -40,7 +62,9 @@ fn main() -> Result<(), Box<dyn Error>> {
         let device = shine::gpu::Device::from_raw(host.lend(true))?;
         let ms = |start: Instant| start.elapsed().as_secs_f64() * 1e3;
         let start = Instant::now();
-        let mut gi = GiContext::new(&device, &GiContextDesc::new(extent, "hvl")?)?;
+        let mut desc = GiContextDesc::new(extent, &technique)?;
+        desc.internal_resolution = internal;
+        let mut gi = GiContext::new(&device, &desc)?;
         println!("GiContext::new {:.1} ms", ms(start));
         let start = Instant::now();
         gi.set_scene(&scene, 0.0)?;
@@ -70,6 +94,20 @@ fn main() -> Result<(), Box<dyn Error>> {
             host.submit_and_wait(cb)?;
             println!("frame {}/{FRAMES} {:.1} ms", frame + 1, ms(start));
         }
+        let timings = gi.timings()?;
+        let last = timings.iter().map(|t| t.frame).max();
+        let gpu_ns: f64 = timings
+            .iter()
+            .filter(|t| Some(t.frame) == last)
+            .map(|t| t.end_ns - t.begin_ns)
+            .sum();
+        println!(
+            "{technique} at {} % ({}×{}): shine's passes {:.2} ms GPU in the last frame",
+            internal.percent(),
+            gi.internal_extent()[0],
+            gi.internal_extent()[1],
+            gpu_ns * 1e-6
+        );
         let direct = host::read_rgba16f(&host, &targets.direct, host::color_written())?;
         let gi_texels = host::read_rgba16f(&host, &targets.gi, host::copy_source())?;
         // Teardown order: shine's objects (context, then device), then the host's.

@@ -2,6 +2,7 @@
 
 use super::host_geometry::{self, HostInstance, HostMaterial, HostMesh, MeshId};
 use super::inputs::GiDispatch;
+use super::resolution::InternalResolution;
 use super::warm_up::{DispatchShape, Placeholders, warm_up_frames};
 use crate::farm::identity::fnv1a;
 use crate::frame::RenderError;
@@ -36,6 +37,9 @@ pub struct GiContextDesc {
     pub settings: Settings,
     /// The most lights and proxy spheres a scene may bring (a larger one is refused).
     pub budgets: GiBudgets,
+    /// The share of the display size the light is computed at, then upsampled to the display
+    /// ([`InternalResolution`]; default: the display size).
+    pub internal_resolution: InternalResolution,
     /// A frame budget in ms: the context picks the GI configuration with the least error whose
     /// cost fits, from `shine lab`'s results for this device at the display size (every
     /// scene's, at creation); without results, from a quick lab of a few candidates on the
@@ -76,6 +80,7 @@ impl GiContextDesc {
                 ..Settings::default()
             },
             budgets: GiBudgets::default(),
+            internal_resolution: InternalResolution::default(),
             budget_ms: None,
         })
     }
@@ -95,9 +100,11 @@ pub struct GiContext {
     device: Device,
     display: [u32; 2],
     budgets: GiBudgets,
+    /// The share of the display the light is computed at.
+    internal: InternalResolution,
     /// The options of the context's description.
     settings: Settings,
-    /// What each frame computes, at the display size.
+    /// What each frame computes, at the internal size.
     params: FrameParams,
     /// The device buffer of the frame's [`HostFrame`], rewritten every dispatch.
     frame_constants: Buffer,
@@ -140,7 +147,8 @@ impl GiContext {
             device: device.clone(),
             display: desc.display,
             budgets: desc.budgets,
-            params: frame_params(&settings, desc.display)?,
+            internal: desc.internal_resolution,
+            params: frame_params(&settings, desc.internal_resolution.extent(desc.display))?,
             settings,
             frame_constants: Buffer::storage_for_uploads(
                 device,
@@ -176,11 +184,17 @@ impl GiContext {
         self.display
     }
 
+    /// The size the light is computed at: the display size scaled by the description's
+    /// [`InternalResolution`].
+    pub fn internal_extent(&self) -> [u32; 2] {
+        self.internal.extent(self.display)
+    }
+
     /// Changes the display size (the host's swapchain was resized): the next dispatch takes
     /// images of `display` size; histories start over, and the transients of the old size
     /// are released once the frames that used them have completed. Nothing waits.
     pub fn resize(&mut self, display: [u32; 2]) -> Result<(), RenderError> {
-        self.params = frame_params(&self.settings, display)?;
+        self.params = frame_params(&self.settings, self.internal.extent(display))?;
         self.display = display;
         Ok(())
     }
@@ -217,7 +231,7 @@ impl GiContext {
                 RenderError::Invalid("GI context: no budget candidate could be measured".into())
             })?;
             apply(&mut self.settings, &choice)?;
-            self.params = frame_params(&self.settings, self.display)?;
+            self.params = frame_params(&self.settings, self.internal.extent(self.display))?;
             self.budget = Some((ms, Some(choice)));
         }
         self.renderer.set_scene(scene, t)
@@ -270,7 +284,9 @@ impl GiContext {
             || lights.len() != *light_count
         {
             return Err(RenderError::Invalid(format!(
-                "host geometry: move_instances takes the {} instances (same meshes, same                  order) and {light_count} lights of set_instances; {} instances and {} lights                  given",
+                "host geometry: move_instances takes the {} instances (same meshes, same \
+                 order) and {light_count} lights of set_instances; {} instances and {} lights \
+                 given",
                 set.len(),
                 instances.len(),
                 lights.len()
@@ -330,6 +346,7 @@ impl GiContext {
         host_frame: Option<u64>,
     ) -> Result<(), RenderError> {
         let display = self.display;
+        let internal = self.internal.extent(display);
         let constants = dispatch.host_frame(display);
         let camera = dispatch.camera.view_for(display);
         // The proxies read the environment's SH at their order, the sky (frames without
@@ -362,7 +379,18 @@ impl GiContext {
                         .motion
                         .map(|m| m.image.import(rg, "host motion", true)),
                 };
-                let g = host_gbuffer::host_gbuffer(rg, &host, &frame, display, sampler);
+                let g = host_gbuffer::host_gbuffer(
+                    rg,
+                    "host gbuffer",
+                    &host,
+                    &frame,
+                    internal,
+                    sampler,
+                );
+                // Below the display size, the display's depth and normals guide the upsample.
+                let guide = (internal != display).then(|| {
+                    host_gbuffer::host_gbuffer(rg, "host guide", &host, &frame, display, sampler)
+                });
                 // Only the proxies and the sky read an environment.
                 let environment = match (dispatch.environment, proxy_bands) {
                     (Some(env), Some(bands)) => {
@@ -380,6 +408,7 @@ impl GiContext {
                 };
                 Ok(HostSide {
                     g,
+                    guide,
                     diffuse: dispatch
                         .diffuse
                         .map(|d| d.import(rg, "host diffuse gi", false)),
@@ -461,10 +490,10 @@ impl GiContext {
     }
 }
 
-/// The frame parameters of `settings` at `display` size: indirect light only (direct light
-/// and the composite are the host's).
-fn frame_params(settings: &Settings, display: [u32; 2]) -> Result<FrameParams, RenderError> {
-    let [width, height] = display;
+/// The frame parameters of `settings` at the `internal` size: indirect light only (direct
+/// light and the composite are the host's).
+fn frame_params(settings: &Settings, internal: [u32; 2]) -> Result<FrameParams, RenderError> {
+    let [width, height] = internal;
     let settings = Settings {
         width,
         height,

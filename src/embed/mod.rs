@@ -5,6 +5,7 @@
 mod context;
 mod host_geometry;
 mod inputs;
+mod resolution;
 mod warm_up;
 
 pub use crate::frame::memory::MemoryReport;
@@ -20,6 +21,7 @@ pub use inputs::{
     DepthConvention, GiCamera, GiDispatch, HostEnvironment, HostMotion, MaterialChannels,
     NormalEncoding,
 };
+pub use resolution::{INTERNAL_PERCENTS, InternalResolution};
 pub use shine_gpu::{Device, EnabledFeatures, RawDevice};
 pub use shine_graph::ExternalState;
 pub use shine_scene::{Light, LightKind};

@@ -50,10 +50,23 @@ pub struct HostImages {
     pub motion: Option<Handle<Image>>,
 }
 
-/// Converts the host's images into a new G-buffer of `extent`; `frame` holds the frame's
-/// [`HostFrame`], `sampler` is a nearest sampler (the images are fetched texel by texel).
+/// Push constants of `shaders/host_gbuffer.comp` (8 bytes).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct HostGbufferPush {
+    /// Width and height of the G-buffer written.
+    pub extent: [u32; 2],
+}
+
+/// Converts the host's images into a new G-buffer of `extent` in a pass named `name`;
+/// `frame` holds the frame's [`HostFrame`], `sampler` is a nearest sampler (the images are
+/// fetched texel by texel). At the display size each pixel is its host texel; a smaller
+/// `extent` (a context's internal resolution) takes, for each pixel, the host texel under its
+/// centre `(x + 0.5)·display/extent`: one whole host sample, so position, normal and material
+/// stay consistent (as the receivers do, paper 002 §4.2).
 pub fn host_gbuffer(
     rg: &mut RenderGraph,
+    name: &str,
     host: &HostImages,
     frame: &Handle<Buffer>,
     extent: [u32; 2],
@@ -62,7 +75,7 @@ pub fn host_gbuffer(
     let [w, h] = extent;
     // Emission and hardware depth stay unwritten: no GI pass reads them.
     let mut g = GBuffer::create(rg, extent);
-    rg.compute("host gbuffer", &shaders::HOST_GBUFFER_COMP)
+    rg.compute(name, &shaders::HOST_GBUFFER_COMP)
         .read("host_depth", &host.depth)
         .read("host_normal", &host.normal)
         .read("host_albedo", &host.albedo)
@@ -77,6 +90,7 @@ pub fn host_gbuffer(
         .write("gb_material", &mut g.material)
         .write("gb_geometric_normal", &mut g.geometric_normal)
         .write("gb_motion", &mut g.motion)
+        .push(&HostGbufferPush { extent })
         .dispatch([w, h, 1]);
     g
 }

@@ -22,6 +22,11 @@
 //! other side of an edge that the 2×2 misses: with the foreground-biased receivers, a
 //! background pixel next to a silhouette can have only foreground receivers in its 2×2.
 //! Background pixels (`w == 0`) get 0. With s = 1 the output is an exact copy of the radiance.
+//!
+//! The same pass upsamples any coarse grid ([`CoarseGrid`]): with a step of `W/w` pixels per
+//! sample instead of s, `u = (x + 0.5) / step − 0.5` and p's own sample is
+//! `floor((x + 0.5) / step)` (for an integer s both are the formulas above). A GI context's
+//! internal resolution (75 %, a step of 4/3) uses it through [`upsample_grid`].
 
 use serde::{Deserialize, Serialize};
 
@@ -103,18 +108,74 @@ impl UpsampleParams {
     }
 }
 
-/// Push constants of `shaders/upsample.comp` (32 bytes).
+/// A coarse grid the upsample reads from: `extent` samples, sample i standing for the
+/// full-resolution pixels `[i·step, (i+1)·step)` with its centre at `(i + 0.5)·step`.
+/// Receivers are blocks of an integer s ([`CoarseGrid::blocks`]); a GI context's internal
+/// resolution is any smaller size ([`CoarseGrid::internal`], e.g. 75 %: a step of 4/3).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct CoarseGrid {
+    /// Width and height of the coarse images.
+    pub extent: [u32; 2],
+    /// Full-resolution pixels per coarse sample, along x and y.
+    pub step: [f32; 2],
+}
+
+impl CoarseGrid {
+    /// The receiver grid of a full-resolution `extent` at block size `scale`.
+    pub fn blocks(extent: [u32; 2], scale: u32) -> Result<Self, ReceiverError> {
+        Ok(Self {
+            extent: receiver_extent(extent, scale)?,
+            step: [scale as f32; 2],
+        })
+    }
+
+    /// A grid of `coarse` samples spread evenly over `full` pixels (each side of `coarse` at
+    /// least 1 and at most `full`'s).
+    pub fn internal(full: [u32; 2], coarse: [u32; 2]) -> Result<Self, ReceiverError> {
+        if coarse.contains(&0) {
+            return Err(ReceiverError::EmptyExtent(coarse));
+        }
+        if coarse[0] > full[0] || coarse[1] > full[1] {
+            return Err(ReceiverError::Extent {
+                name: "coarse grid",
+                found: coarse,
+                expected: full,
+            });
+        }
+        Ok(Self {
+            extent: coarse,
+            step: [0, 1].map(|i| full[i] as f32 / coarse[i] as f32),
+        })
+    }
+
+    /// The full-resolution pixel whose G-buffer sample coarse sample `i` of an internal grid
+    /// holds: the one under its centre, `floor((i + 0.5) · step)` (clamped to `full`). GLSL
+    /// twin: the host texel of `shaders/host_gbuffer.comp`.
+    pub fn source_texel(&self, i: [u32; 2], full: [u32; 2]) -> [u32; 2] {
+        [0, 1].map(|a| (((i[a] as f32 + 0.5) * self.step[a]) as u32).min(full[a] - 1))
+    }
+
+    /// True when each coarse sample is one full-resolution pixel (the upsample copies).
+    pub fn is_identity(&self) -> bool {
+        self.step == [1.0; 2]
+    }
+}
+
+/// Push constants of `shaders/upsample.comp` (40 bytes: std430 rounds the block up to its
+/// `vec2` alignment).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct UpsamplePush {
     /// Full-resolution extent.
     pub extent: [u32; 2],
-    /// Receiver extent.
+    /// Coarse (receiver) extent.
     pub recv_extent: [u32; 2],
-    /// Block size s.
-    pub scale: u32,
+    /// Full-resolution pixels per coarse sample ([`CoarseGrid::step`]).
+    pub step: [f32; 2],
     /// The weights' parameters.
     pub params: UpsampleParams,
+    /// Padding to the block's 8-byte alignment.
+    pub pad: u32,
 }
 
 /// Adds the `upsample` pass: `radiance` (RGBA16F at the receiver extent) to a new transient
@@ -150,6 +211,38 @@ pub fn upsample(
             expected,
         });
     }
+    let coarse = Coarse {
+        position: receivers.position,
+        normal: receivers.normal,
+        grid: CoarseGrid::blocks(gbuffer.extent, receivers.scale)?,
+    };
+    Ok(upsample_grid(
+        rg, "upsample", radiance, &coarse, gbuffer, params,
+    ))
+}
+
+/// The guide of a coarse image: the positions and normals of its samples, and its grid.
+#[derive(Debug, Clone, Copy)]
+pub struct Coarse {
+    /// Coarse `gb_position` (RGBA32F, linear depth in w; w = 0: background).
+    pub position: Handle<Image>,
+    /// Coarse `gb_normal` (RGBA16F).
+    pub normal: Handle<Image>,
+    /// How the coarse samples sit over the full-resolution pixels.
+    pub grid: CoarseGrid,
+}
+
+/// Adds an upsample pass named `name`: `radiance` (RGBA16F on `coarse`'s grid, checked by
+/// the caller) to a new transient RGBA16F image of `gbuffer`'s extent, with the weights of
+/// [`upsample`]. `params` must be valid ([`UpsampleParams::validate`]).
+pub fn upsample_grid(
+    rg: &mut RenderGraph,
+    name: &str,
+    radiance: &Handle<Image>,
+    coarse: &Coarse,
+    gbuffer: &GBuffer,
+    params: &UpsampleParams,
+) -> Handle<Image> {
     let [w, h] = gbuffer.extent;
     let mut out = rg.create_image(
         "upsampled",
@@ -157,20 +250,21 @@ pub fn upsample(
     );
     let push = UpsamplePush {
         extent: gbuffer.extent,
-        recv_extent: expected,
-        scale: receivers.scale,
+        recv_extent: coarse.grid.extent,
+        step: coarse.grid.step,
         params: *params,
+        pad: 0,
     };
-    rg.compute("upsample", &shaders::UPSAMPLE_COMP)
+    rg.compute(name, &shaders::UPSAMPLE_COMP)
         .read("radiance", radiance)
-        .read("recv_position", &receivers.position)
-        .read("recv_normal", &receivers.normal)
+        .read("recv_position", &coarse.position)
+        .read("recv_normal", &coarse.normal)
         .read("gb_position", &gbuffer.position)
         .read("gb_normal", &gbuffer.normal)
         .write("upsampled", &mut out)
         .push(&push)
         .dispatch([w, h, 1]);
-    Ok(out)
+    out
 }
 
 /// Inputs of [`upsample_cpu`]: RGBA floats, 4 per pixel, row-major.
@@ -188,8 +282,8 @@ pub struct UpsampleInputs<'a> {
     pub normal: &'a [f32],
     /// Full-resolution extent W×H.
     pub extent: [u32; 2],
-    /// Block size s.
-    pub scale: u32,
+    /// The coarse grid of `radiance`, `recv_position` and `recv_normal`.
+    pub grid: CoarseGrid,
 }
 
 /// The joint bilateral match of a receiver at depth `z_i` with normal `n_i` for a target at
@@ -215,7 +309,7 @@ pub fn upsample_cpu(
     params: &UpsampleParams,
 ) -> Result<Vec<f32>, ReceiverError> {
     params.validate()?;
-    let recv = receiver_extent(inputs.extent, inputs.scale)?;
+    let recv = inputs.grid.extent;
     let [w, h] = inputs.extent.map(|v| v as usize);
     let [rw, rh] = recv.map(|v| v as usize);
     for (name, data, len, expected) in [
@@ -241,8 +335,7 @@ pub fn upsample_cpu(
             data[i * 4 + 3],
         ]
     };
-    let scale = inputs.scale as f32;
-    let s = inputs.scale as usize;
+    let step = inputs.grid.step;
     // Receiver index of texel coordinates, clamped to the edge.
     let index = |cx: i64, cy: i64| -> usize {
         cy.clamp(0, rh as i64 - 1) as usize * rw + cx.clamp(0, rw as i64 - 1) as usize
@@ -255,7 +348,7 @@ pub fn upsample_cpu(
             if target[3] <= 0.0 {
                 continue;
             }
-            if inputs.scale == 1 {
+            if inputs.grid.is_identity() {
                 out[p * 4..p * 4 + 4].copy_from_slice(&texel(inputs.radiance, p));
                 continue;
             }
@@ -269,10 +362,8 @@ pub fn upsample_cpu(
                 let n = texel(inputs.recv_normal, c);
                 bilateral_match(target[3], normal, position[3], n, params)
             };
-            let u = [
-                (x as f32 + 0.5) / scale - 0.5,
-                (y as f32 + 0.5) / scale - 0.5,
-            ];
+            let centre = [x as f32 + 0.5, y as f32 + 0.5];
+            let u = [centre[0] / step[0] - 0.5, centre[1] / step[1] - 0.5];
             let base = u.map(f32::floor);
             let f = [u[0] - base[0], u[1] - base[1]];
             let mut sum = [0.0f32; 4];
@@ -297,7 +388,10 @@ pub fn upsample_cpu(
                 sum.map(|v| v / weight_sum)
             } else {
                 // Fallback: the best match among the 3×3 around p's own receiver (own on ties).
-                let own = [(x / s) as i64, (y / s) as i64];
+                let own = [
+                    (centre[0] / step[0]).floor() as i64,
+                    (centre[1] / step[1]).floor() as i64,
+                ];
                 let own_index = index(own[0], own[1]);
                 let mut best = match_weight(own_index);
                 let mut result = if best >= 0.0 {

@@ -12,7 +12,7 @@ use crate::types::{
 use glam::Mat4;
 use shine::embed::{
     DepthConvention, DispatchShape, ExternalState, GiCamera, GiContext, GiContextDesc, GiDispatch,
-    HostEnvironment, HostMotion, HostTarget, MaterialChannels, NormalEncoding,
+    HostEnvironment, HostMotion, HostTarget, InternalResolution, MaterialChannels, NormalEncoding,
 };
 use shine::gpu::vk::{self, Handle};
 
@@ -52,6 +52,10 @@ pub unsafe extern "C" fn shine_context_create(
             return Err(Failure::invalid("frames_in_flight must be at least 1"));
         }
         rust.frames_in_flight = desc.frames_in_flight as usize;
+        rust.internal_resolution = match desc.internal_percent {
+            0 => InternalResolution::Full,
+            percent => InternalResolution::from_percent(percent)?,
+        };
         if desc.settings_count > 0 && desc.settings.is_null() {
             return Err(Failure::invalid(
                 "settings is null with a nonzero settings_count",

@@ -28,7 +28,7 @@ pub type ShinePfnGetInstanceProcAddr =
 /// `ShineDeviceDesc::version` of this header.
 pub const SHINE_DEVICE_DESC_VERSION: u32 = 1;
 /// `ShineContextDesc::version` of this header.
-pub const SHINE_CONTEXT_DESC_VERSION: u32 = 1;
+pub const SHINE_CONTEXT_DESC_VERSION: u32 = 2;
 /// `ShineDispatchDesc::version` of this header.
 pub const SHINE_DISPATCH_DESC_VERSION: u32 = 1;
 
@@ -81,6 +81,9 @@ pub struct ShineContextDesc {
     pub settings: *const *const c_char,
     /// How many strings `settings` holds.
     pub settings_count: u32,
+    /// The share of each display side the light is computed at, in per cent: 100, 75, 50 or
+    /// 25 (0 means 100); the outputs are upsampled to the display (version 2).
+    pub internal_percent: u32,
 }
 
 /// Layout, stages and accesses of an image's use (Vulkan's `VkImageLayout`,

@@ -6,13 +6,18 @@ use crate::frame::error::RenderError;
 use crate::frame::params::FrameParams;
 use crate::passes::gbuffer::{GBuffer, View};
 use crate::passes::history;
+use crate::passes::upsample::{Coarse, CoarseGrid, upsample_grid};
 use shine_gpu::vk;
 use shine_graph::{Buffer, Handle, Image, RenderGraph};
 
 /// The host's side of a frame, declared into its graph.
 pub(crate) struct HostSide {
-    /// The G-buffer converted from the host's images.
+    /// The G-buffer converted from the host's images, at the frame's extent: the display
+    /// size, or a context's internal resolution.
     pub g: GBuffer,
+    /// Below the display size: the display-size G-buffer that guides the upsample of the
+    /// outputs (`None`: `g` is at the display size).
+    pub guide: Option<GBuffer>,
     /// The host's diffuse output image, imported, if it gave one.
     pub diffuse: Option<Handle<Image>>,
     /// The host's specular output image, imported, if it gave one: the traced reflections go
@@ -70,6 +75,7 @@ impl Renderer {
         let handles = scene.gpu.declare(rg)?;
         let HostSide {
             g,
+            guide,
             diffuse,
             specular,
             environment,
@@ -90,15 +96,45 @@ impl Renderer {
                         .apply(rg, p.history, p.extent, to_diffuse, &g, |rg| {
                             history::gbuffer_history(rg, &g)
                         })?;
+                let light = light
+                    .map(|l| to_display(rg, "gi upsample", l, &g, guide.as_ref(), p))
+                    .transpose()?;
                 write_or_clear(rg, "gi to host", light, &mut output);
             }
             None => self.accumulate.reset(),
         }
         if let Some(mut output) = specular {
-            write_or_clear(rg, "specular to host", to_specular, &mut output);
+            let light = to_specular
+                .map(|l| to_display(rg, "specular upsample", l, &g, guide.as_ref(), p))
+                .transpose()?;
+            write_or_clear(rg, "specular to host", light, &mut output);
         }
         Ok(())
     }
+}
+
+/// `light` (on `g`'s grid) at the display size: itself without a `guide`, else upsampled
+/// joint-bilaterally (paper 002 eq. 11, `p.upsample`'s weights) guided by the display-size
+/// G-buffer.
+fn to_display(
+    rg: &mut RenderGraph,
+    name: &str,
+    light: Handle<Image>,
+    g: &GBuffer,
+    guide: Option<&GBuffer>,
+    p: &FrameParams,
+) -> Result<Handle<Image>, RenderError> {
+    Ok(match guide {
+        Some(guide) => {
+            let coarse = Coarse {
+                position: g.position,
+                normal: g.normal,
+                grid: CoarseGrid::internal(guide.extent, g.extent)?,
+            };
+            upsample_grid(rg, name, &light, &coarse, guide, &p.upsample)
+        }
+        None => light,
+    })
 }
 
 /// Blits `light` into the host's `output`, or clears it when the frame has none.
