@@ -52,7 +52,8 @@ layout(push_constant) uniform Push {
     uvec4 frame;
     // x: bounces B, y: light count, z: flags (PT_*), w: seed.
     uvec4 config;
-    vec4 pad;
+    // x: the specular limit of PT_PRIMARY_SPECULAR; y, z, w: unused.
+    vec4 options;
 } push;
 
 // The push constants the loops read, read once per invocation in main: llvmpipe loads a push
@@ -100,6 +101,7 @@ void main() {
     path_light_count = config.y;
     path_flags = config.z;
     uint bounces = config.x;
+    float specular_limit = push.options.x;
     bool sample_lights = (path_flags & PT_LIGHT_SAMPLING) != 0u;
     bool sample_emitters = sample_lights && (path_flags & PT_EMISSIVE_LIGHTING) != 0u && light_emitter_count() > 0u;
 #if PT_ENVIRONMENT_SAMPLING
@@ -207,7 +209,15 @@ void main() {
                 float p_specular = brdf_specular_probability(x.s.base_color, x.s.metallic);
                 l = brdf_sample(n, v, p_specular, x.s.roughness, xi);
                 last_pdf = brdf_pdf(n, l, v, p_specular, x.s.roughness);
-                weight = last_pdf > 0.0 ? brdf(x, l, v) * max(dot(n, l), 0.0) / last_pdf : vec3(0.0);
+                vec3 f = brdf(x, l, v);
+                if (scatters == 0u && (path_flags & PT_PRIMARY_SPECULAR) != 0u) {
+                    // The truth of a GI context's specular output: the camera's surface reflects
+                    // through its GGX lobe alone, by the share the traced specular takes.
+                    vec3 f_diffuse;
+                    brdf_metallic_roughness_parts(n, l, v, x.s.base_color, x.s.metallic, x.s.roughness, f_diffuse, f);
+                    f *= specular_trace_weight(x.s.roughness, specular_limit);
+                }
+                weight = last_pdf > 0.0 ? f * max(dot(n, l), 0.0) / last_pdf : vec3(0.0);
             }
             if (dot(n, l) <= 0.0 || dot(x.geometric_normal, l) <= 0.0 || all(equal(weight, vec3(0.0)))) {
                 break;

@@ -15,6 +15,8 @@ mod host_geometry;
 mod internal_resolution;
 #[path = "embedding/specular_out.rs"]
 mod specular_out;
+#[path = "embedding/truth.rs"]
+mod truth;
 #[path = "embedding/warm_up.rs"]
 mod warm_up;
 

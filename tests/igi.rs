@@ -689,6 +689,7 @@ fn room_reference() -> &'static ReferenceImages {
             lambert_only: false,
             light_sampling: true,
             seed: 0,
+            primary_specular: None,
         };
         let images = render_reference(&device, &spot_room(), 0.0, &params, REFERENCE_SPP)
             .expect("reference");

@@ -57,6 +57,7 @@ fn params(size: u32, bounces: u32) -> ReferenceParams {
         lambert_only: true,
         light_sampling: false,
         seed: 0,
+        primary_specular: None,
     }
 }
 
@@ -360,6 +361,7 @@ fn emitter_sampling_keeps_the_mean_and_cuts_the_noise() {
             lambert_only: false,
             light_sampling,
             seed,
+            primary_specular: None,
         };
         render_reference(&device, &scene, 0.0, &p, spp).expect("reference")
     };
@@ -559,6 +561,7 @@ fn error_falls_as_inverse_square_root_of_samples() {
         lambert_only: false,
         light_sampling: true,
         seed: 1,
+        primary_specular: None,
     };
     let run = |seed: u32, spp: u32| -> ReferenceImages {
         let mut tracer = PathTracer::new(&device, &scene, 0.0, &ReferenceParams { seed, ..base })

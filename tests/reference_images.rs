@@ -55,6 +55,7 @@ fn reference(bounces: u32, spp: u32) -> shine::reference::ReferenceImages {
         lambert_only: false,
         light_sampling: true,
         seed: 0,
+        primary_specular: None,
     };
     let images = render_reference(&device, &scene, 0.0, &params, spp).expect("reference");
     common::assert_clean(&device);
@@ -178,6 +179,7 @@ fn spheres_proxy_frame_against_the_path_traced_reference() {
         lambert_only: false,
         light_sampling: true,
         seed: 0,
+        primary_specular: None,
     };
     let reference = render_reference(&device, &scene, 0.0, &params, 256).expect("reference");
     common::assert_clean(&device);

@@ -74,6 +74,7 @@ const uint PT_JITTER = 1u;
 const uint PT_EMISSIVE_LIGHTING = 2u;
 const uint PT_LAMBERT_ONLY = 4u;
 const uint PT_LIGHT_SAMPLING = 8u;
+const uint PT_PRIMARY_SPECULAR = 16u;
 const float PT_FAR = 1e30;
 
 #include "random.glsl"

@@ -179,6 +179,7 @@ pub fn run(args: &ReferenceArgs) -> Result<(), CliError> {
         lambert_only: false,
         light_sampling: !args.no_light_sampling,
         seed: args.seed,
+        primary_specular: None,
     };
     if !shard.is_whole() {
         // A re-queued task finds the temporary file its killed run left: it is no part.

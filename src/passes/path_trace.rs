@@ -26,8 +26,8 @@ pub struct PathTraceConstants {
     pub frame: [u32; 4],
     /// Bounces, light count, flags (`FLAG_*`), seed.
     pub config: [u32; 4],
-    /// Padding.
-    pub pad: [f32; 4],
+    /// x: the specular limit of [`FLAG_PRIMARY_SPECULAR`]; y, z, w: padding.
+    pub options: [f32; 4],
 }
 
 /// Jitter the camera ray within the pixel (anti-aliasing); off: through the pixel centre, as
@@ -41,6 +41,10 @@ pub const FLAG_LAMBERT_ONLY: u32 = 4;
 /// BRDF sampling by multiple importance sampling (`light_sampling.glsl`); off: their light is
 /// found only by BRDF-sampled rays.
 pub const FLAG_LIGHT_SAMPLING: u32 = 8;
+/// The camera's surface reflects through its GGX lobe alone, weighted by the share the traced
+/// specular takes (`specular_trace_weight` at [`PathTraceParams::specular_limit`]): the truth
+/// of a GI context's specular output. Later vertices scatter by the whole BRDF.
+pub const FLAG_PRIMARY_SPECULAR: u32 = 16;
 
 /// What one `path_trace` dispatch computes.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -55,6 +59,8 @@ pub struct PathTraceParams {
     pub light_count: u32,
     /// `FLAG_*` bits.
     pub flags: u32,
+    /// The `specular.limit` of [`FLAG_PRIMARY_SPECULAR`] (unused without it).
+    pub specular_limit: f32,
     /// Seed mixed into every pixel's random numbers.
     pub seed: u32,
     /// Index of this dispatch's first sample (progressive accumulation).
@@ -114,7 +120,7 @@ pub fn path_trace(
             params.flags,
             params.seed,
         ],
-        pad: [0.0; 4],
+        options: [params.specular_limit, 0.0, 0.0, 0.0],
     };
     let shader = match (params.environment_sampling, params.textures) {
         (true, true) => &shaders::PATH_TRACE_COMP_ENVIRONMENT,

@@ -70,6 +70,11 @@ pub struct ReferenceParams {
     pub light_sampling: bool,
     /// Seed of the random numbers (different seeds give independent estimates).
     pub seed: u32,
+    /// `Some(limit)`: the camera's surface reflects through its specular lobe alone, by the
+    /// share a GI context's traced specular takes at `specular.limit = limit`
+    /// ([`path_trace::FLAG_PRIMARY_SPECULAR`]): the truth of the context's specular output.
+    /// `None` (default): the whole BRDF.
+    pub primary_specular: Option<f32>,
 }
 
 impl Default for ReferenceParams {
@@ -83,6 +88,7 @@ impl Default for ReferenceParams {
             lambert_only: false,
             light_sampling: true,
             seed: 0,
+            primary_specular: None,
         }
     }
 }
@@ -97,6 +103,13 @@ impl ReferenceParams {
             return Err(RenderError::Invalid(format!(
                 "reference size {}×{} is out of range (1..={MAX_EXTENT} per side)",
                 self.width, self.height
+            )));
+        }
+        if let Some(limit) = self.primary_specular
+            && !(limit.is_finite() && limit > 0.0 && limit <= 1.0)
+        {
+            return Err(RenderError::Invalid(format!(
+                "primary specular limit {limit} is out of range (0, 1]"
             )));
         }
         if self.bounces > MAX_BOUNCES {
@@ -114,6 +127,10 @@ impl ReferenceParams {
             | bit(self.emissive_lighting, path_trace::FLAG_EMISSIVE_LIGHTING)
             | bit(self.lambert_only, path_trace::FLAG_LAMBERT_ONLY)
             | bit(self.light_sampling, path_trace::FLAG_LIGHT_SAMPLING)
+            | bit(
+                self.primary_specular.is_some(),
+                path_trace::FLAG_PRIMARY_SPECULAR,
+            )
     }
 }
 
@@ -308,6 +325,7 @@ impl PathTracer {
             bounces: self.params.bounces,
             light_count,
             flags: self.params.flags(),
+            specular_limit: self.params.primary_specular.unwrap_or(0.0),
             seed: self.params.seed,
             first_sample: self.first_sample.saturating_add(self.samples),
             samples,

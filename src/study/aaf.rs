@@ -338,6 +338,7 @@ pub fn run(
                 lambert_only: false,
                 light_sampling: true,
                 seed: config.seed,
+                primary_specular: None,
             },
             config.path_tracer_spp,
         )?;

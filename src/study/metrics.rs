@@ -51,6 +51,28 @@ impl TruthAccumulator {
         self.sum.iter().map(|s| s.map(|v| (v / k) as f32)).collect()
     }
 
+    /// Per pixel, the estimated variance of the mean image averaged over the three channels:
+    /// where it is large against the pixel's value the truth has not converged there (a
+    /// firefly); `None` with fewer than two chunks.
+    pub fn pixel_noise(&self) -> Option<Vec<f64>> {
+        if self.chunks < 2 {
+            return None;
+        }
+        let k = f64::from(self.chunks);
+        Some(
+            self.sum
+                .iter()
+                .zip(&self.sum_sq)
+                .map(|(s, q)| {
+                    (0..3)
+                        .map(|c| ((q[c] - s[c] * s[c] / k) / (k - 1.0)).max(0.0) / k)
+                        .sum::<f64>()
+                        / 3.0
+                })
+                .collect(),
+        )
+    }
+
     /// `τ²`: the mean over `mask` of the estimated variance of the mean image; `None` with
     /// fewer than two chunks.
     pub fn noise_mse(&self, mask: &[bool]) -> Option<f64> {

@@ -172,6 +172,7 @@ pub fn pixel_centre_reference(size: u32, seed: u32) -> shine::reference::Referen
         lambert_only: false,
         light_sampling: true,
         seed,
+        primary_specular: None,
     }
 }
 
