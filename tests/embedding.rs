@@ -5,6 +5,8 @@
 #[path = "embedding/animated_host.rs"]
 mod animated_host;
 mod common;
+#[path = "embedding/debug_view.rs"]
+mod debug_view;
 #[path = "embedding/gi_context.rs"]
 mod gi_context;
 #[path = "../examples/host_gbuffer/host/mod.rs"]

@@ -7,6 +7,7 @@
 #include <cstring>
 #include <iostream>
 #include <string>
+#include <vector>
 
 namespace capi_host {
 
@@ -78,6 +79,22 @@ void check_bad_mesh_is_refused(ShineContext context, const HostScene& s) {
               << "\n";
 }
 
+// A new shape for a mesh registered rigid (deformable = 0) is refused with
+// SHINE_RESULT_ERROR_INVALID_ARGUMENT and a message, and changes nothing.
+void check_rigid_mesh_is_not_deformed(ShineContext context, uint32_t mesh, uint32_t vertex_count) {
+    const std::vector<float> positions(size_t(vertex_count) * 3, 0.0f);
+    const ShineResult result =
+        shine_context_deform_mesh(context, mesh, positions.data(), nullptr, vertex_count);
+    const std::string message = shine_last_error();
+    if (result != SHINE_RESULT_ERROR_INVALID_ARGUMENT ||
+        message.find("rigid") == std::string::npos) {
+        fail(std::string("deforming a rigid mesh was not refused as it should be: got ") +
+             shine_result_name(result) + " with message \"" + message + "\"");
+    }
+    std::cout << "rigid mesh deformation refused: " << shine_result_name(result) << ": "
+              << message << "\n";
+}
+
 }  // namespace
 
 void register_with_shine(ShineContext context, ShineScene scene, const HostScene& s) {
@@ -99,6 +116,7 @@ void register_with_shine(ShineContext context, ShineScene scene, const HostScene
     check_shine(shine_context_set_instances(context, instances.data(), uint32_t(instances.size()),
                                             lights.data(), light_count),
                 "shine_context_set_instances");
+    check_rigid_mesh_is_not_deformed(context, instances.front().mesh, s.vertex_count);
 }
 
 Mat4 multiply(const Mat4& a, const Mat4& b) {

@@ -1,6 +1,6 @@
 //! [`GiContext`]: shine as a GI pass inside a host engine's frame.
 
-use super::host_geometry::{self, HostInstance, HostMaterial, HostMesh, MeshId};
+use super::host_geometry::{self, HostInstance, HostMesh, MeshId, Registered};
 use super::inputs::GiDispatch;
 use super::resolution::InternalResolution;
 use super::warm_up::{DispatchShape, Placeholders, warm_up_frames};
@@ -117,9 +117,11 @@ pub struct GiContext {
     /// Frames the host records ahead of the GPU.
     frames_in_flight: usize,
     /// Meshes registered from the host's buffers, by [`MeshId`].
-    host_meshes: Vec<(shine_scene::Primitive, HostMaterial)>,
-    /// The instances and the number of lights of the last [`GiContext::set_instances`].
-    host_world: Option<(Vec<HostInstance>, usize)>,
+    host_meshes: Vec<Registered>,
+    /// The instances, the number of lights and the number of meshes of the last
+    /// [`GiContext::set_instances`] (`None` after a [`GiContext::set_scene`] of the host's
+    /// own scene).
+    host_world: Option<(Vec<HostInstance>, usize, usize)>,
 }
 
 impl GiContext {
@@ -234,7 +236,11 @@ impl GiContext {
             self.params = frame_params(&self.settings, self.internal.extent(self.display))?;
             self.budget = Some((ms, Some(choice)));
         }
-        self.renderer.set_scene(scene, t)
+        self.renderer.set_scene(scene, t)?;
+        // A scene of the host's own is not the registered meshes' world (set_instances sets
+        // it again after this).
+        self.host_world = None;
+        Ok(())
     }
 
     /// Registers a triangle mesh from the host's own buffers: reads them back once (a
@@ -245,8 +251,41 @@ impl GiContext {
         let primitive = host_geometry::read_mesh(&self.device, mesh)?;
         let id = u32::try_from(self.host_meshes.len())
             .map_err(|_| RenderError::Invalid("host geometry: too many meshes".into()))?;
-        self.host_meshes.push((primitive, mesh.material));
+        self.host_meshes.push(Registered {
+            primitive,
+            material: mesh.material,
+            deformable: mesh.deformable,
+            deltas: None,
+        });
         Ok(MeshId(id))
+    }
+
+    /// Gives a deformable mesh's new shape (skinned, simulated) from host memory: one
+    /// position per registered vertex, in the mesh's own space, and optionally normals (else
+    /// area-weighted ones). A per-frame call: CPU work (the deltas from the registered
+    /// vertices), uploaded by the next dispatch, whose BVH refit follows the new triangles
+    /// (same topology). The shape holds until the next call, through `set_instances` too.
+    /// Refused: a rigid or unknown mesh, a wrong count, a non-finite number.
+    pub fn deform_mesh(
+        &mut self,
+        mesh: MeshId,
+        positions: &[[f32; 3]],
+        normals: Option<&[[f32; 3]]>,
+    ) -> Result<(), RenderError> {
+        let index = mesh.0 as usize;
+        let registered = self.host_meshes.get_mut(index).ok_or_else(|| {
+            RenderError::Invalid(format!("host geometry: no mesh {} is registered", mesh.0))
+        })?;
+        host_geometry::deform(registered, mesh.0, positions, normals)?;
+        // In the current world: rewrite the scene's target now (else at set_instances).
+        if let (Some((_, _, meshes)), Some((deltas, normals))) =
+            (&self.host_world, &registered.deltas)
+            && index < *meshes
+        {
+            self.renderer
+                .set_morph_target([index, 0, 0], deltas, normals)?;
+        }
+        Ok(())
     }
 
     /// The host's world: registered meshes placed by `instances` (3×4 transforms) and lit by
@@ -261,7 +300,7 @@ impl GiContext {
     ) -> Result<(), RenderError> {
         let scene = host_geometry::scene(&self.host_meshes, instances, lights)?;
         self.set_scene(&scene, 0.0)?;
-        self.host_world = Some((instances.to_vec(), lights.len()));
+        self.host_world = Some((instances.to_vec(), lights.len(), self.host_meshes.len()));
         Ok(())
     }
 
@@ -274,7 +313,7 @@ impl GiContext {
         instances: &[HostInstance],
         lights: &[Light],
     ) -> Result<(), RenderError> {
-        let Some((set, light_count)) = &self.host_world else {
+        let Some((set, light_count, _)) = &self.host_world else {
             return Err(RenderError::Invalid(
                 "host geometry: move_instances before set_instances".into(),
             ));
@@ -322,6 +361,9 @@ impl GiContext {
         dispatch: &GiDispatch,
     ) -> Result<(), RenderError> {
         dispatch.validate(self.display)?;
+        if dispatch.debug.is_some() {
+            dispatch.debug_view.check(&self.params)?;
+        }
         if self
             .last_frame
             .is_some_and(|last| dispatch.frame_index <= last)
@@ -416,6 +458,9 @@ impl GiContext {
                         .specular
                         .map(|s| s.import(rg, "host specular gi", false)),
                     environment,
+                    debug: dispatch
+                        .debug
+                        .map(|d| (d.import(rg, "host debug", false), dispatch.debug_view)),
                 })
             },
         )

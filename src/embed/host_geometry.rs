@@ -6,7 +6,7 @@
 use crate::frame::RenderError;
 use glam::{Mat4, Vec3, Vec4};
 use shine_gpu::{Device, vk};
-use shine_scene::{Aabb, Light, Material, Mesh, Node, Primitive, Scene, Transform};
+use shine_scene::{Aabb, Light, Material, Mesh, MorphTarget, Node, Primitive, Scene, Transform};
 
 /// How a host mesh stores vertex positions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,6 +99,10 @@ pub struct HostMesh {
     pub index_count: u32,
     /// The surface.
     pub material: HostMaterial,
+    /// Whether the host changes the vertices every frame (skinning, cloth) and gives the new
+    /// ones with `GiContext::deform_mesh`: its instances' hierarchies are then refitted every
+    /// frame. `false`: a rigid mesh, whose hierarchy is built once.
+    pub deformable: bool,
 }
 
 /// A registered mesh (`GiContext::register_mesh`).
@@ -126,6 +130,68 @@ pub struct HostInstance {
     pub mesh: MeshId,
     /// Object to world, 3 rows of 4.
     pub transform: [[f32; 4]; 3],
+}
+
+/// A mesh registered with a context: what was read, and the host's last shape of it.
+#[derive(Clone, Debug)]
+pub(crate) struct Registered {
+    /// The vertices and indices read at registration.
+    pub primitive: Primitive,
+    /// Its surface.
+    pub material: HostMaterial,
+    /// Whether it may be deformed ([`HostMesh::deformable`]).
+    pub deformable: bool,
+    /// The last shape given to [`deform`], as position and normal deltas from `primitive`'s
+    /// (`None`: as registered).
+    pub deltas: Option<(Vec<Vec3>, Vec<Vec3>)>,
+}
+
+/// Records `positions` (and `normals`, else area-weighted ones) as mesh `id`'s new shape:
+/// their deltas from the registered vertices. Refused: a rigid mesh, a count other than the
+/// registered one, a non-finite number.
+pub(crate) fn deform(
+    mesh: &mut Registered,
+    id: u32,
+    positions: &[[f32; 3]],
+    normals: Option<&[[f32; 3]]>,
+) -> Result<(), RenderError> {
+    let rest = &mesh.primitive;
+    if !mesh.deformable {
+        return Err(invalid(format!(
+            "mesh {id} was registered rigid (HostMesh::deformable is false)"
+        )));
+    }
+    let count = rest.positions.len();
+    if positions.len() != count || normals.is_some_and(|n| n.len() != count) {
+        return Err(invalid(format!(
+            "mesh {id} has {count} vertices; {} positions and {} normals given",
+            positions.len(),
+            normals.map_or(0, <[_]>::len)
+        )));
+    }
+    let positions: Vec<Vec3> = positions.iter().map(|p| Vec3::from_array(*p)).collect();
+    let normals: Vec<Vec3> = match normals {
+        Some(n) => n
+            .iter()
+            .map(|n| Vec3::from_array(*n).normalize_or(Vec3::Y))
+            .collect(),
+        None => area_weighted_normals(&positions, &rest.indices),
+    };
+    if let Some(v) = positions
+        .iter()
+        .zip(&normals)
+        .position(|(p, n)| !(p.is_finite() && n.is_finite()))
+    {
+        return Err(invalid(format!("mesh {id}: vertex {v} is not finite")));
+    }
+    let delta = |new: &[Vec3], old: &[Vec3]| -> Vec<Vec3> {
+        new.iter().zip(old).map(|(a, b)| *a - *b).collect()
+    };
+    mesh.deltas = Some((
+        delta(&positions, &rest.positions),
+        delta(&normals, &rest.normals),
+    ));
+    Ok(())
 }
 
 fn invalid(message: String) -> RenderError {
@@ -289,7 +355,7 @@ pub(crate) fn instance_transform(rows: &[[f32; 4]; 3]) -> Result<Transform, Rend
 /// The scene of `meshes` placed by `instances`, lit by `lights` (world space): one node per
 /// instance, in order, each a root.
 pub(crate) fn scene(
-    meshes: &[(Primitive, HostMaterial)],
+    meshes: &[Registered],
     instances: &[HostInstance],
     lights: &[Light],
 ) -> Result<Scene, RenderError> {
@@ -297,7 +363,8 @@ pub(crate) fn scene(
         source: "host geometry".into(),
         ..Scene::default()
     };
-    for (primitive, material) in meshes {
+    for mesh in meshes {
+        let material = &mesh.material;
         scene.materials.push(Material {
             base_color: [
                 material.base_color[0],
@@ -314,11 +381,39 @@ pub(crate) fn scene(
         scene
             .material_names
             .push(format!("host material {}", scene.meshes.len()));
+        // A deformable mesh is one morph target at weight 1, whose deltas are the host's
+        // last shape (GpuScene::set_morph_target rewrites them per frame).
+        let count = mesh.primitive.positions.len();
+        let targets = match (&mesh.deltas, mesh.deformable) {
+            (Some((positions, normals)), true) => vec![MorphTarget {
+                positions: positions.clone(),
+                normals: normals.clone(),
+            }],
+            (None, true) => vec![MorphTarget {
+                positions: vec![Vec3::ZERO; count],
+                normals: vec![Vec3::ZERO; count],
+            }],
+            (_, false) => Vec::new(),
+        };
+        let weights = if mesh.deformable {
+            vec![1.0]
+        } else {
+            Vec::new()
+        };
+        let mut bounds = mesh.primitive.bounds;
+        if let Some((deltas, _)) = mesh.deltas.as_ref().filter(|_| mesh.deformable) {
+            for (rest, delta) in mesh.primitive.positions.iter().zip(deltas) {
+                bounds.grow(*rest + *delta);
+            }
+        }
         scene.meshes.push(Mesh {
             primitives: vec![Primitive {
                 material: (scene.materials.len() - 1) as u32,
-                ..primitive.clone()
+                targets,
+                bounds,
+                ..mesh.primitive.clone()
             }],
+            weights,
             ..Mesh::default()
         });
     }

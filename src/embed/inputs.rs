@@ -3,6 +3,7 @@
 
 use crate::frame::RenderError;
 use crate::frame::renderer::HostTarget;
+use crate::passes::debug_view::DebugView;
 use crate::passes::gbuffer::{View, flip_y, projection_matrix};
 use crate::passes::host_gbuffer::{HostFrame, NO_CHANNEL};
 use glam::{Mat4, Vec3};
@@ -246,6 +247,15 @@ pub struct GiDispatch {
     /// (faded in below it), denoised in space and not accumulated over frames; the same
     /// formats as `diffuse`. `None`: they go into `diffuse` (when `specular.enabled`).
     pub specular: Option<HostTarget>,
+    /// Output for debugging: what the GI sees, as `debug_view` says, drawn at the display size
+    /// (docs/embedding.md "Debug view"); the same formats as `diffuse`. `None`: nothing of it
+    /// is declared, and the frame is the same without it.
+    pub debug: Option<HostTarget>,
+    /// What `debug` shows. A view the context's technique does not have is refused. Chosen per
+    /// dispatch, not on the context: a host flips between views (a debug menu) without a new
+    /// context, and a frame budget may change the technique at `set_scene`, so only a
+    /// dispatch knows what runs. Not used without `debug`.
+    pub debug_view: DebugView,
 }
 
 /// Depth formats a dispatch reads.
@@ -314,7 +324,7 @@ impl GiDispatch {
                 "the dispatch has no output: give diffuse, specular or both".into(),
             ));
         }
-        for (name, output) in outputs {
+        for (name, output) in outputs.into_iter().chain([("debug", &self.debug)]) {
             let Some(output) = output else { continue };
             check_extent(name, output, display)?;
             if !output.usage.contains(vk::ImageUsageFlags::TRANSFER_DST) {

@@ -13,6 +13,7 @@ pub use crate::frame::memory::MemoryReport;
 /// per-frame scene update, the device wrapper and what it checks, and the image states.
 pub use crate::frame::renderer::HostTarget;
 pub use crate::gpu_scene::FrameUpdate;
+pub use crate::passes::debug_view::DebugView;
 pub use context::{GiBudgets, GiContext, GiContextDesc};
 pub use host_geometry::{
     HostBuffer, HostInstance, HostMaterial, HostMesh, IndexFormat, MeshId, PositionFormat,

@@ -8,6 +8,7 @@ use super::inputs::{
     NormalEncoding,
 };
 use crate::frame::renderer::HostTarget;
+use crate::passes::debug_view::DebugView;
 use glam::Vec3;
 use shine_gpu::{Commands, Device, Image, ImageDesc, format_aspect, vk};
 use shine_graph::ExternalState;
@@ -216,6 +217,8 @@ impl Placeholders {
             specular: shape
                 .specular
                 .then(|| target(&self.specular, ExternalState::UNDEFINED)),
+            debug: None,
+            debug_view: DebugView::default(),
         }
     }
 }

@@ -15,6 +15,7 @@ use crate::gpu_scene::SceneHandles;
 use crate::gpu_scene::bvh::TraceImages;
 use crate::passes::aaf::{self, AafParams, AafRecords, AafScene, AafSlice};
 use crate::passes::amortise::{self, RecordHistory, RecordSignal, Schedule, Slice};
+use crate::passes::debug_view::AafSpp;
 use crate::passes::gbuffer::{GBuffer, View};
 
 /// The AAF technique: which frame last wrote its amortised samples' history, and how large a
@@ -84,12 +85,13 @@ impl AafTechnique {
 }
 
 impl PreparedAaf {
-    /// Adds the AAF passes; returns the full-resolution indirect light (RGBA16F).
+    /// Adds the AAF passes; returns the full-resolution indirect light (RGBA16F) and the
+    /// per-pixel sample counts (a context's debug view shows them).
     pub fn declare(
         self,
         rg: &mut RenderGraph,
         inputs: &AafInputs<'_>,
-    ) -> Result<Handle<Image>, RenderError> {
+    ) -> Result<(Handle<Image>, AafSpp), RenderError> {
         let scene = AafScene {
             handles: inputs.scene,
             bvh: inputs.bvh,
@@ -98,8 +100,13 @@ impl PreparedAaf {
             texture_sampler: inputs.texture_sampler,
         };
         let (g, camera, params) = (inputs.gbuffer, inputs.camera, &self.params);
+        let spp = |widths| AafSpp {
+            widths,
+            range: [params.spp_min as f32, params.spp_upper()],
+        };
         let Some(amortised) = self.amortised else {
-            return Ok(aaf::aaf(rg, g, &scene, camera, params)?.indirect);
+            let outputs = aaf::aaf(rg, g, &scene, camera, params)?;
+            return Ok((outputs.indirect, spp(outputs.widths)));
         };
         let sums_words = (aaf::SUMS_BYTES / 4) as u32;
         let widths_words = (aaf::WIDTHS_BYTES / 4) as u32;
@@ -135,13 +142,7 @@ impl PreparedAaf {
             };
             samples = aaf::aaf_sample(rg, g, &scene, camera, params, slice)?;
         }
-        Ok(aaf::aaf_filter(
-            rg,
-            g,
-            &samples.sums,
-            &samples.widths,
-            camera,
-            params,
-        )?)
+        let light = aaf::aaf_filter(rg, g, &samples.sums, &samples.widths, camera, params)?;
+        Ok((light, spp(samples.widths)))
     }
 }

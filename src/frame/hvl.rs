@@ -13,6 +13,7 @@ use super::error::RenderError;
 use crate::gpu_scene::bvh::TraceImages;
 use crate::passes::amortise::{self, ResolveHistory, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
+use crate::passes::debug_view::LightRecords;
 use crate::passes::hvl::{self, HvlParams};
 use crate::passes::receivers::Receivers;
 use crate::passes::rsm::Rsm;
@@ -103,16 +104,21 @@ impl HvlTechnique {
 
 impl PreparedHvl {
     /// Adds `hvl_cache` and `hvl_gather`; returns the indirect light at receiver resolution
-    /// (RGBA16F outgoing radiance towards the camera).
+    /// (RGBA16F outgoing radiance towards the camera) and the HVLs (a context's debug view
+    /// draws them).
     pub fn declare(
         self,
         rg: &mut RenderGraph,
         inputs: &HvlInputs<'_>,
-    ) -> Result<Handle<Image>, RenderError> {
+    ) -> Result<(Handle<Image>, LightRecords), RenderError> {
         let mut params = self.params;
         params.shadow_seed = inputs.seed;
         params.near_radius = inputs.near_radius;
         let hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
+        let lights = LightRecords {
+            records: hvls,
+            count: params.count,
+        };
         let records = hvl::hvl_gather_prep(rg, &hvls, &params)?;
         let bvh = params.visibility.then_some(inputs.bvh);
         let slice = self.amortised.map_or(0, |s| s.slice);
@@ -127,7 +133,7 @@ impl PreparedHvl {
             slice,
         )?;
         let Some(amortised) = self.amortised else {
-            return Ok(gathered);
+            return Ok((gathered, lights));
         };
         let surfaces = inputs.receivers.into();
         let mut history = ResolveHistory::declare(rg, "hvl", inputs.receivers.extent);
@@ -153,13 +159,14 @@ impl PreparedHvl {
                 &mut gathered,
             )?;
         }
-        Ok(amortise::resolve(
+        let resolved = amortise::resolve(
             rg,
             surfaces,
             &gathered,
             inputs.motion,
             &mut history,
             amortised,
-        )?)
+        )?;
+        Ok((resolved, lights))
     }
 }

@@ -16,6 +16,7 @@ use super::error::RenderError;
 use crate::gpu_scene::bvh::TraceImages;
 use crate::passes::amortise::{self, RecordHistory, RecordSignal, Schedule, Slice};
 use crate::passes::brdf_tables::BrdfTables;
+use crate::passes::debug_view::LightRecords;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::igi::{self, IgiParams, IgiSlice};
 use crate::passes::rsm::Rsm;
@@ -104,15 +105,20 @@ impl IgiTechnique {
 }
 
 impl PreparedIgi {
-    /// Adds the IGI passes; returns the full-resolution indirect light (RGBA16F).
+    /// Adds the IGI passes; returns the full-resolution indirect light (RGBA16F) and the VPLs
+    /// (a context's debug view draws them).
     pub fn declare(
         self,
         rg: &mut RenderGraph,
         inputs: &IgiInputs<'_>,
-    ) -> Result<Handle<Image>, RenderError> {
+    ) -> Result<(Handle<Image>, LightRecords), RenderError> {
         let (g, params, camera) = (inputs.gbuffer, &self.params, inputs.camera);
         let lights = igi::vpls(rg, inputs.rsm, params)?;
         let lights = igi::sets(rg, lights, params)?;
+        let records = LightRecords {
+            records: lights.vpls,
+            count: params.vpl_count,
+        };
         let Some(amortised) = self.amortised else {
             let sh = igi::vpl_sh(
                 rg,
@@ -123,14 +129,8 @@ impl PreparedIgi {
                 params,
                 IgiSlice::default(),
             )?;
-            return Ok(igi::sh_filter(
-                rg,
-                g,
-                &sh,
-                self.brdf.as_ref(),
-                camera,
-                params,
-            )?);
+            let light = igi::sh_filter(rg, g, &sh, self.brdf.as_ref(), camera, params)?;
+            return Ok((light, records));
         };
         let words = params.coefficients() * igi::COEFFICIENT_WORDS;
         let mut history =
@@ -154,13 +154,7 @@ impl PreparedIgi {
                 igi::vpl_sh(rg, g, &lights, inputs.bvh, camera, params, again)?;
         }
         let sh = history.records.current;
-        Ok(igi::sh_filter(
-            rg,
-            g,
-            &sh,
-            self.brdf.as_ref(),
-            camera,
-            params,
-        )?)
+        let light = igi::sh_filter(rg, g, &sh, self.brdf.as_ref(), camera, params)?;
+        Ok((light, records))
     }
 }

@@ -15,6 +15,7 @@ pub mod environment;
 pub mod environment_sh;
 pub mod frame_update;
 pub mod geometry;
+mod morph_edit;
 mod textures;
 pub mod upload_ring;
 
@@ -160,8 +161,12 @@ pub struct GpuScene {
     deform_instances: Buffer,
     /// Per vertex: skin influences ([`geometry::SkinVertex`]), static.
     skin_vertices: Buffer,
-    /// Morph deltas, static.
+    /// Morph deltas: static, unless a host rewrites a target ([`GpuScene::set_morph_target`]).
     morph_deltas: Buffer,
+    /// The CPU copy of `morph_deltas`, as the last set target left it.
+    deltas: Vec<[f32; 4]>,
+    /// `deltas` changed since `morph_deltas` was last written: the next frame uploads them.
+    deltas_pending: bool,
     /// The frame's joint matrices.
     joint_matrices: Buffer,
     /// The frame's morph weights.
@@ -283,11 +288,14 @@ impl GpuScene {
                 bytemuck::cast_slice(&geometry.skin),
                 vk::BufferUsageFlags::STORAGE_BUFFER,
             )?,
+            // TRANSFER_DST: a host's new shape is copied in (`set_morph_target`).
             morph_deltas: storage(
                 "scene morph deltas",
                 bytemuck::cast_slice(&geometry.deltas),
-                vk::BufferUsageFlags::STORAGE_BUFFER,
+                vk::BufferUsageFlags::STORAGE_BUFFER | vk::BufferUsageFlags::TRANSFER_DST,
             )?,
+            deltas: geometry.deltas.clone(),
+            deltas_pending: false,
             joint_matrices: dynamic(
                 "joint matrices",
                 joint_count * std::mem::size_of::<Mat4>(),
@@ -350,6 +358,8 @@ impl GpuScene {
     /// starts its motion from itself.
     pub fn forget_previous(&mut self) {
         self.has_previous = false;
+        // A set morph target's upload may have been in that frame.
+        self.deltas_pending |= !self.deltas.is_empty();
     }
 
     /// The scene's CPU data (without textures), as frames are evaluated from it.
@@ -463,7 +473,16 @@ impl GpuScene {
         let inputs = DeformInputs {
             source: rg.import_gpu_buffer(&self.source_vertices, BUFFER_READ, BUFFER_READ),
             skin: rg.import_gpu_buffer(&self.skin_vertices, BUFFER_READ, BUFFER_READ),
-            deltas: rg.import_gpu_buffer(&self.morph_deltas, BUFFER_READ, BUFFER_READ),
+            deltas: if std::mem::take(&mut self.deltas_pending) {
+                ring.upload(
+                    rg,
+                    "morph deltas",
+                    &self.morph_deltas,
+                    bytemuck::cast_slice(&self.deltas),
+                )?
+            } else {
+                rg.import_gpu_buffer(&self.morph_deltas, BUFFER_READ, BUFFER_READ)
+            },
             instances: deform,
             joints,
             weights,

@@ -8,6 +8,7 @@ pub mod amortise;
 pub mod brdf_tables;
 pub mod composite;
 pub mod cubes;
+pub mod debug_view;
 pub mod denoise;
 pub mod direct;
 pub mod environment_sh;

@@ -6,13 +6,16 @@ use crate::error::{Failure, ShineResult, call};
 use crate::handles::{self, ShineContext, ShineDevice, ShineScene, lock};
 use crate::scene::string;
 use crate::types::{
-    SHINE_CONTEXT_DESC_VERSION, SHINE_DISPATCH_DESC_VERSION, ShineCamera, ShineContextDesc,
-    ShineDispatchDesc, ShineDispatchShape, ShineImage, ShineImageState, ShineVkCommandBuffer,
+    SHINE_CONTEXT_DESC_VERSION, SHINE_DEBUG_AAF_SAMPLES, SHINE_DEBUG_LIGHT_POINTS,
+    SHINE_DEBUG_RECEIVER_ALBEDO, SHINE_DEBUG_RECEIVER_NORMALS, SHINE_DEBUG_RSM,
+    SHINE_DISPATCH_DESC_VERSION, ShineCamera, ShineContextDesc, ShineDispatchDesc,
+    ShineDispatchShape, ShineImage, ShineImageState, ShineVkCommandBuffer,
 };
 use glam::Mat4;
 use shine::embed::{
-    DepthConvention, DispatchShape, ExternalState, GiCamera, GiContext, GiContextDesc, GiDispatch,
-    HostEnvironment, HostMotion, HostTarget, InternalResolution, MaterialChannels, NormalEncoding,
+    DebugView, DepthConvention, DispatchShape, ExternalState, GiCamera, GiContext, GiContextDesc,
+    GiDispatch, HostEnvironment, HostMotion, HostTarget, InternalResolution, MaterialChannels,
+    NormalEncoding,
 };
 use shine::gpu::vk::{self, Handle};
 
@@ -188,13 +191,22 @@ unsafe fn dispatch(d: &ShineDispatchDesc) -> Result<GiDispatch, Failure> {
         )));
     }
     // SAFETY: the caller's promise.
-    let (motion, environment, diffuse, specular) = unsafe {
+    let (motion, environment, diffuse, specular, debug) = unsafe {
         (
             d.motion.as_ref(),
             d.environment.as_ref(),
             d.diffuse.as_ref(),
             d.specular.as_ref(),
+            d.debug.as_ref(),
         )
+    };
+    let debug_view = match d.debug_view {
+        SHINE_DEBUG_RECEIVER_NORMALS => DebugView::ReceiverNormals,
+        SHINE_DEBUG_RECEIVER_ALBEDO => DebugView::ReceiverAlbedo,
+        SHINE_DEBUG_RSM => DebugView::Rsm,
+        SHINE_DEBUG_LIGHT_POINTS => DebugView::LightPoints,
+        SHINE_DEBUG_AAF_SAMPLES => DebugView::AafSamples,
+        other => return Err(Failure::invalid(format!("debug_view {other}"))),
     };
     Ok(GiDispatch {
         frame_index: d.frame_index,
@@ -227,6 +239,8 @@ unsafe fn dispatch(d: &ShineDispatchDesc) -> Result<GiDispatch, Failure> {
         }),
         diffuse: diffuse.map(target),
         specular: specular.map(target),
+        debug: debug.map(target),
+        debug_view,
     })
 }
 

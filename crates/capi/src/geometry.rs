@@ -11,7 +11,7 @@ use shine::embed::{
 use shine::gpu::vk::{self, Handle};
 
 /// `ShineHostMesh::version` of this header.
-pub const SHINE_HOST_MESH_VERSION: u32 = 1;
+pub const SHINE_HOST_MESH_VERSION: u32 = 2;
 /// `ShineHostMesh::position_format`: three 32-bit floats.
 pub const SHINE_POSITION_FLOAT3: u32 = 0;
 /// `ShineHostMesh::position_format`: four 16-bit floats (w ignored).
@@ -79,6 +79,9 @@ pub struct ShineHostMesh {
     pub index_count: u32,
     /// The surface.
     pub material: ShineHostMaterial,
+    /// Nonzero: the host changes the vertices every frame and gives them with
+    /// `shine_context_deform_mesh` (version 2).
+    pub deformable: u32,
 }
 
 /// A registered mesh placed in the world: the top three rows of its object-to-world matrix,
@@ -166,9 +169,39 @@ pub unsafe extern "C" fn shine_context_register_mesh(
                 emissive: mesh.material.emissive,
                 double_sided: mesh.material.double_sided != 0,
             },
+            deformable: mesh.deformable != 0,
         };
         *out = lock(&context).register_mesh(&rust)?.index();
         Ok(())
+    })
+}
+
+/// Gives deformable mesh `mesh`'s new shape from host memory: `vertex_count` positions (3
+/// floats each, mesh space) and, unless null, as many normals. CPU only, per frame; the next
+/// dispatch uploads it.
+///
+/// # Safety
+/// `positions` holds `3 · vertex_count` floats; `normals` is null or holds as many.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_deform_mesh(
+    context: ShineContext,
+    mesh: u32,
+    positions: *const f32,
+    normals: *const f32,
+    vertex_count: u32,
+) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        if positions.is_null() {
+            return Err(Failure::invalid("positions must not be null"));
+        }
+        let len = vertex_count as usize;
+        // SAFETY: the caller's promise: 3 · vertex_count floats each.
+        let positions = unsafe { std::slice::from_raw_parts(positions.cast::<[f32; 3]>(), len) };
+        // SAFETY: as above.
+        let normals = (!normals.is_null())
+            .then(|| unsafe { std::slice::from_raw_parts(normals.cast::<[f32; 3]>(), len) });
+        Ok(lock(&context).deform_mesh(MeshId::from_index(mesh), positions, normals)?)
     })
 }
 

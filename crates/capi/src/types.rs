@@ -30,7 +30,18 @@ pub const SHINE_DEVICE_DESC_VERSION: u32 = 1;
 /// `ShineContextDesc::version` of this header.
 pub const SHINE_CONTEXT_DESC_VERSION: u32 = 2;
 /// `ShineDispatchDesc::version` of this header.
-pub const SHINE_DISPATCH_DESC_VERSION: u32 = 1;
+pub const SHINE_DISPATCH_DESC_VERSION: u32 = 2;
+
+/// `ShineDispatchDesc::debug_view`: the receivers' normals (needs hvl or proxy).
+pub const SHINE_DEBUG_RECEIVER_NORMALS: u32 = 0;
+/// The receivers' albedo (needs hvl or proxy).
+pub const SHINE_DEBUG_RECEIVER_ALBEDO: u32 = 1;
+/// The primary light's reflective shadow map (needs hvl or igi).
+pub const SHINE_DEBUG_RSM: u32 = 2;
+/// The virtual lights as dots over the dimmed indirect light (needs hvl or igi).
+pub const SHINE_DEBUG_LIGHT_POINTS: u32 = 3;
+/// AAF's samples per pixel as a heat map (needs aaf).
+pub const SHINE_DEBUG_AAF_SAMPLES: u32 = 4;
 
 /// The host's Vulkan objects, lent to shine (`shine_device_create`). The host keeps them
 /// alive until the device and every context made on it are destroyed.
@@ -184,6 +195,11 @@ pub struct ShineDispatchDesc {
     /// accumulated. RGBA16F, `TRANSFER_DST`. At least one of `diffuse` and `specular` is
     /// given.
     pub specular: *const ShineImage,
+    /// Output, or null: what the GI sees (`debug_view`), display size, the formats of
+    /// `diffuse` (version 2).
+    pub debug: *const ShineImage,
+    /// Which view `debug` shows: a `SHINE_DEBUG_*` (version 2).
+    pub debug_view: u32,
 }
 
 /// What the host's dispatches will bring (`shine_context_warm_up`).

@@ -3,8 +3,8 @@
 //! Rust host of examples/host_gbuffer through the Rust API: the same scene, camera, G-buffer
 //! shaders and technique give the same indirect light, within 1e-3 relative RMSE (the C++
 //! host registers its own vertex and index buffers; the Rust one hands over the built-in).
-//! The C++ host also checks that a NaN camera, a too-small vertex buffer and a 60 % internal
-//! resolution are refused.
+//! The C++ host also checks that a NaN camera, a too-small vertex buffer, a 60 % internal
+//! resolution and a new shape for a rigid mesh are refused.
 
 mod common;
 #[path = "../../../examples/host_gbuffer/host/mod.rs"]
@@ -102,6 +102,10 @@ fn cpp_host(scene_name: &str) -> Vec<[f32; 4]> {
     assert!(stdout.contains("NaN camera refused"), "{stdout}");
     assert!(stdout.contains("too-small buffer refused"), "{stdout}");
     assert!(stdout.contains("60 % refused"), "{stdout}");
+    assert!(
+        stdout.contains("rigid mesh deformation refused"),
+        "{stdout}"
+    );
     let bytes = std::fs::read(&raw).expect("the C++ host's output");
     let _ = std::fs::remove_dir_all(&build);
     assert_eq!(bytes.len(), (EXTENT[0] * EXTENT[1] * 16) as usize);

@@ -89,6 +89,8 @@ impl Targets {
                     .lend(shine::embed::ExternalState::UNDEFINED, copy_source()),
             ),
             specular: None,
+            debug: None,
+            debug_view: shine::embed::DebugView::default(),
         }
     }
 

@@ -14,6 +14,7 @@ use crate::gpu_scene::{SAMPLED_READ, SceneHandles};
 use crate::passes::aaf::scene_size;
 use crate::passes::composite::{self, Component, CompositeOutputs};
 use crate::passes::cubes;
+use crate::passes::debug_view::DebugSources;
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::{Distribution, near};
@@ -305,6 +306,7 @@ impl Renderer {
             }
             _ => None,
         };
+        let (hvl_low, hvl_lights) = hvl_low.unzip();
         let hvl_low =
             sky_light::cavity_shaded(rg, p, frame.bounds, &handles.trace, recv.as_ref(), hvl_low)?;
         // HVL's traced near field, where the gather left it out (after the cavity shading: its
@@ -388,6 +390,7 @@ impl Renderer {
             )?),
             None => None,
         };
+        let ((igi_full, igi_lights), (aaf_full, aaf_spp)) = (igi_full.unzip(), aaf_full.unzip());
         // `igi,proxy` and `aaf,proxy`: both full-resolution indirect terms summed (settings
         // allow at most one of hvl, igi and aaf).
         let full = igi_full.or(aaf_full);
@@ -417,6 +420,13 @@ impl Renderer {
         Ok(Indirect {
             techniques,
             reflections,
+            debug: DebugSources {
+                receivers: recv,
+                rsm_flux: rsm_faces.first().map(|face| face.flux),
+                lights: hvl_lights.or(igi_lights),
+                aaf: aaf_spp,
+                indirect: techniques,
+            },
         })
     }
 }
@@ -428,6 +438,8 @@ pub(super) struct Indirect {
     pub techniques: Option<Handle<Image>>,
     /// The traced specular reflections of the smoother lobes (denoised), when they run.
     pub reflections: Option<Handle<Image>>,
+    /// What the techniques declared that a GI context's debug view shows.
+    pub debug: DebugSources,
 }
 
 impl Indirect {

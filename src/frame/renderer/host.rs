@@ -4,6 +4,7 @@
 use super::Renderer;
 use crate::frame::error::RenderError;
 use crate::frame::params::FrameParams;
+use crate::passes::debug_view::{DebugView, debug_view};
 use crate::passes::gbuffer::{GBuffer, View};
 use crate::passes::history;
 use crate::passes::upsample::{Coarse, CoarseGrid, upsample_grid};
@@ -25,6 +26,8 @@ pub(crate) struct HostSide {
     pub specular: Option<Handle<Image>>,
     /// The host's environment map projected to SH, when it gave one.
     pub environment: Option<Handle<Buffer>>,
+    /// The host's debug output image, imported, and the view it shows, if it gave one.
+    pub debug: Option<(Handle<Image>, DebugView)>,
 }
 
 /// Declares the host's side of a frame into its graph.
@@ -79,8 +82,14 @@ impl Renderer {
             diffuse,
             specular,
             environment,
+            debug,
         } = host(rg)?;
         let indirect = self.declare_indirect(rg, p, &handles, &g, camera, environment)?;
+        if let Some((mut output, view)) = debug {
+            let display = guide.as_ref().map_or(g.extent, |guide| guide.extent);
+            let image = debug_view(rg, view, &indirect.debug, &g, display, camera.view_proj());
+            rg.blit_image("debug to host", &image, &mut output, vk::Filter::NEAREST);
+        }
         // With a specular output the reflections go there, unaccumulated (the denoiser has
         // filtered them in space; reprojecting a reflection by its surface's motion smears it).
         let (to_diffuse, to_specular) = match specular {

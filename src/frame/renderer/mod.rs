@@ -306,6 +306,21 @@ impl Renderer {
         Ok(())
     }
 
+    /// Replaces the deltas of morph target `[mesh, primitive, target]` for the next frame on
+    /// ([`GpuScene::set_morph_target`](crate::gpu_scene::GpuScene::set_morph_target)): how
+    /// a host's deformed vertices arrive. CPU work; the next frame uploads them.
+    pub fn set_morph_target(
+        &mut self,
+        [mesh, primitive, target]: [usize; 3],
+        positions: &[glam::Vec3],
+        normals: &[glam::Vec3],
+    ) -> Result<(), RenderError> {
+        let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        Ok(scene
+            .gpu
+            .set_morph_target(mesh, primitive, target, positions, normals)?)
+    }
+
     /// Numbers the next frame `frame` (forward only), as frame `frame` of a sequence whose
     /// earlier frames another process renders: what depends on the frame number (TAA's
     /// jitter, amortised slices, IGI's interleaving) then matches a one-process run. The
