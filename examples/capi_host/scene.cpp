@@ -6,6 +6,7 @@
 
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -95,6 +96,20 @@ void check_rigid_mesh_is_not_deformed(ShineContext context, uint32_t mesh, uint3
               << message << "\n";
 }
 
+// A NaN scene time is refused with SHINE_RESULT_ERROR_INVALID_ARGUMENT and a message; a
+// finite one is taken.
+void check_nan_time_is_refused(ShineContext context) {
+    const ShineResult result =
+        shine_context_set_time(context, std::numeric_limits<float>::quiet_NaN());
+    const std::string message = shine_last_error();
+    if (result != SHINE_RESULT_ERROR_INVALID_ARGUMENT || message.empty()) {
+        fail(std::string("a NaN scene time was not refused as it should be: got ") +
+             shine_result_name(result) + " with message \"" + message + "\"");
+    }
+    std::cout << "NaN time refused: " << shine_result_name(result) << ": " << message << "\n";
+    check_shine(shine_context_set_time(context, 0.0f), "shine_context_set_time");
+}
+
 }  // namespace
 
 void register_with_shine(ShineContext context, ShineScene scene, const HostScene& s) {
@@ -117,6 +132,7 @@ void register_with_shine(ShineContext context, ShineScene scene, const HostScene
                                             lights.data(), light_count),
                 "shine_context_set_instances");
     check_rigid_mesh_is_not_deformed(context, instances.front().mesh, s.vertex_count);
+    check_nan_time_is_refused(context);
 }
 
 Mat4 multiply(const Mat4& a, const Mat4& b) {

@@ -13,9 +13,9 @@ use crate::types::{
 };
 use glam::Mat4;
 use shine::embed::{
-    DebugView, DepthConvention, DispatchShape, ExternalState, GiCamera, GiContext, GiContextDesc,
-    GiDispatch, HostEnvironment, HostMotion, HostTarget, InternalResolution, MaterialChannels,
-    NormalEncoding,
+    DebugView, DepthConvention, DispatchShape, ExternalState, FrameUpdate, GiCamera, GiContext,
+    GiContextDesc, GiDispatch, HostEnvironment, HostMotion, HostTarget, InternalResolution,
+    MaterialChannels, NormalEncoding,
 };
 use shine::gpu::vk::{self, Handle};
 
@@ -130,6 +130,21 @@ pub unsafe extern "C" fn shine_context_reset_history(context: ShineContext) -> S
         let context = handles::context(context)?;
         lock(&context).reset_history();
         Ok(())
+    })
+}
+
+/// Sets the scene's clock for the next dispatch: every animation of a loaded scene (nodes,
+/// lights, morph weights, skins) is evaluated at `time` seconds (`GiContext::update` with
+/// `FrameUpdate::at(time)`; host-set instances and lights go through
+/// `shine_context_move_instances`). CPU only, per frame. A non-finite time is refused.
+///
+/// # Safety
+/// `context` may be any value (null and stale handles are refused).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn shine_context_set_time(context: ShineContext, time: f32) -> ShineResult {
+    call(|| {
+        let context = handles::context(context)?;
+        Ok(lock(&context).update(&FrameUpdate::at(time))?)
     })
 }
 

@@ -35,7 +35,11 @@ fn bad_handles_and_arguments_get_codes_and_messages() {
         "{}",
         String::from_utf8_lossy(&compiled.stderr)
     );
-    let run = Command::new(&out).output().expect("run the C test");
+    // The library just linked, first (cargo's LD_LIBRARY_PATH may name an older copy).
+    let run = Command::new(&out)
+        .env("LD_LIBRARY_PATH", &lib)
+        .output()
+        .expect("run the C test");
     let stdout = String::from_utf8_lossy(&run.stdout);
     println!("{stdout}");
     let _ = std::fs::remove_file(&out);

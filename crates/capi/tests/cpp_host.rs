@@ -4,7 +4,7 @@
 //! shaders and technique give the same indirect light, within 1e-3 relative RMSE (the C++
 //! host registers its own vertex and index buffers; the Rust one hands over the built-in).
 //! The C++ host also checks that a NaN camera, a too-small vertex buffer, a 60 % internal
-//! resolution and a new shape for a rigid mesh are refused.
+//! resolution, a new shape for a rigid mesh and a NaN scene time are refused.
 
 mod common;
 #[path = "../../../examples/host_gbuffer/host/mod.rs"]
@@ -80,7 +80,10 @@ fn cpp_host(scene_name: &str) -> Vec<[f32; 4]> {
         String::from_utf8_lossy(&made.stderr)
     );
     let raw = build.join("gi.raw");
+    // The library just linked, first: cargo's own LD_LIBRARY_PATH may name an older copy
+    // of it (target/<profile>, uplifted by an earlier `cargo build`) ahead of the rpath.
     let run = Command::new(build.join("capi_host"))
+        .env("LD_LIBRARY_PATH", &lib)
         .arg(scene_name)
         .args([
             EXTENT[0].to_string(),
