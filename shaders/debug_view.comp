@@ -25,6 +25,7 @@
 //! variant samples DEBUG_SAMPLES=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#include "grid.glsl"
 
 #ifdef DEBUG_POINTS
 #define SH_BANDS 5
@@ -81,13 +82,12 @@ layout(set = 0, binding = 2, std430) readonly buffer Filter {
 
 // The source texel under the centre of display pixel p.
 ivec2 source_texel(uvec2 p) {
-    return ivec2(((2u * p + 1u) * push.source) / (2u * push.extent));
+    return ivec2(texel_under_centre(p, push.extent, push.source));
 }
 
 // Blue, cyan, green, yellow, red as t goes from 0 to 1.
 vec3 heat(float t) {
-    vec3 c = clamp(vec3(4.0 * t - 2.0, 2.0 - abs(4.0 * t - 2.0), 2.0 - 4.0 * t), 0.0, 1.0);
-    return c;
+    return clamp(vec3(4.0 * t - 2.0, 2.0 - abs(4.0 * t - 2.0), 2.0 - 4.0 * t), 0.0, 1.0);
 }
 
 void main() {

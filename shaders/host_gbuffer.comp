@@ -4,6 +4,8 @@
 // resolution, smaller: each pixel then takes the host texel under its centre.
 // src/passes/host_gbuffer.rs; encodings in docs/embedding.md.
 #version 460
+#extension GL_GOOGLE_include_directive : require
+#include "grid.glsl"
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
@@ -63,8 +65,7 @@ void main() {
         return;
     }
     // The host texel under this pixel's centre (itself at the display size).
-    vec2 ratio = vec2(frame.extent.xy) / vec2(push.extent);
-    uvec2 xy = min(uvec2((vec2(q) + 0.5) * ratio), frame.extent.xy - 1u);
+    uvec2 xy = texel_under_centre(q, push.extent, frame.extent.xy);
     ivec2 p = ivec2(xy);
     ivec2 out_p = ivec2(q);
     float depth = texelFetch(sampler2D(host_depth, host_sampler), p, 0).r;

@@ -61,7 +61,7 @@ void main() {
         imageStore(upsampled, ivec2(p), vec4(0.0));
         return;
     }
-    if (push.step == vec2(1.0)) {
+    if (push.step == vec2(1.0) && push.recv_extent == push.extent) {
         // s = 1: the receiver is the pixel itself, an exact copy.
         imageStore(upsampled, ivec2(p), imageLoad(radiance, ivec2(p)));
         return;

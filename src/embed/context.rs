@@ -41,11 +41,12 @@ pub struct GiContextDesc {
     /// ([`InternalResolution`]; default: the display size).
     pub internal_resolution: InternalResolution,
     /// A frame budget in ms: the context picks the GI configuration with the least error whose
-    /// cost fits, from `shine lab`'s results for this device at the display size (every
+    /// cost fits, from `shine lab`'s results for this device at the internal size (every
     /// scene's, at creation); without results, from a quick lab of a few candidates on the
     /// first scene (`set_scene`, which then takes seconds). The pick replaces `settings`'
-    /// technique keys; [`GiContext::budget_choice`] tells what was chosen. `None`: `settings`
-    /// as given.
+    /// technique keys; [`GiContext::budget_choice`] tells what was chosen. Costed at the
+    /// internal size (`internal_resolution`; the upsample to the display is not counted).
+    /// `None`: `settings` as given.
     pub budget_ms: Option<f64>,
 }
 
@@ -136,7 +137,12 @@ impl GiContext {
             }
             Some(ms) => {
                 let table = budget_table(device)?;
-                let choice = budget::choose(&table, None, desc.display, ms);
+                let choice = budget::choose(
+                    &table,
+                    None,
+                    desc.internal_resolution.extent(desc.display),
+                    ms,
+                );
                 if let Some(c) = &choice {
                     apply(&mut settings, c)?;
                 }
@@ -226,8 +232,14 @@ impl GiContext {
                 scene.lights.len()
             );
             let key = format!("host-{:016x}", fnv1a(shape.as_bytes()));
-            let (entries, _) = budget::fill(device, scene, &key, self.display, path.as_deref())
-                .map_err(lab_error)?;
+            let (entries, _) = budget::fill(
+                device,
+                scene,
+                &key,
+                self.internal.extent(self.display),
+                path.as_deref(),
+            )
+            .map_err(lab_error)?;
             let refs: Vec<&budget::BudgetEntry> = entries.iter().collect();
             let choice = budget::pick(&refs, ms).ok_or_else(|| {
                 RenderError::Invalid("GI context: no budget candidate could be measured".into())
@@ -273,18 +285,19 @@ impl GiContext {
         normals: Option<&[[f32; 3]]>,
     ) -> Result<(), RenderError> {
         let index = mesh.0 as usize;
-        let registered = self.host_meshes.get_mut(index).ok_or_else(|| {
+        let registered = self.host_meshes.get(index).ok_or_else(|| {
             RenderError::Invalid(format!("host geometry: no mesh {} is registered", mesh.0))
         })?;
-        host_geometry::deform(registered, mesh.0, positions, normals)?;
+        let (deltas, normals) = host_geometry::deform(registered, mesh.0, positions, normals)?;
         // In the current world: rewrite the scene's target now (else at set_instances).
-        if let (Some((_, _, meshes)), Some((deltas, normals))) =
-            (&self.host_world, &registered.deltas)
+        if let Some((_, _, meshes)) = &self.host_world
             && index < *meshes
         {
             self.renderer
-                .set_morph_target([index, 0, 0], deltas, normals)?;
+                .set_morph_target([index, 0, 0], &deltas, &normals)?;
         }
+        // Kept only once taken: a refused shape leaves the last one.
+        self.host_meshes[index].deltas = Some((deltas, normals));
         Ok(())
     }
 

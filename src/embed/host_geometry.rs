@@ -146,15 +146,15 @@ pub(crate) struct Registered {
     pub deltas: Option<(Vec<Vec3>, Vec<Vec3>)>,
 }
 
-/// Records `positions` (and `normals`, else area-weighted ones) as mesh `id`'s new shape:
-/// their deltas from the registered vertices. Refused: a rigid mesh, a count other than the
-/// registered one, a non-finite number.
+/// The deltas of `positions` and `normals` (else area-weighted ones) from mesh `id`'s
+/// registered vertices: its new shape, for [`Registered::deltas`]. Refused: a rigid mesh, a
+/// count other than the registered one, a non-finite position, normal or delta.
 pub(crate) fn deform(
-    mesh: &mut Registered,
+    mesh: &Registered,
     id: u32,
     positions: &[[f32; 3]],
     normals: Option<&[[f32; 3]]>,
-) -> Result<(), RenderError> {
+) -> Result<(Vec<Vec3>, Vec<Vec3>), RenderError> {
     let rest = &mesh.primitive;
     if !mesh.deformable {
         return Err(invalid(format!(
@@ -169,6 +169,15 @@ pub(crate) fn deform(
             normals.map_or(0, <[_]>::len)
         )));
     }
+    let finite = |v: &[f32; 3]| v.iter().all(|c| c.is_finite());
+    let bad = positions
+        .iter()
+        .zip(0..)
+        .chain(normals.unwrap_or_default().iter().zip(0..))
+        .find(|(v, _)| !finite(v));
+    if let Some((_, v)) = bad {
+        return Err(invalid(format!("mesh {id}: vertex {v} is not finite")));
+    }
     let positions: Vec<Vec3> = positions.iter().map(|p| Vec3::from_array(*p)).collect();
     let normals: Vec<Vec3> = match normals {
         Some(n) => n
@@ -177,21 +186,19 @@ pub(crate) fn deform(
             .collect(),
         None => area_weighted_normals(&positions, &rest.indices),
     };
-    if let Some(v) = positions
-        .iter()
-        .zip(&normals)
-        .position(|(p, n)| !(p.is_finite() && n.is_finite()))
-    {
-        return Err(invalid(format!("mesh {id}: vertex {v} is not finite")));
-    }
     let delta = |new: &[Vec3], old: &[Vec3]| -> Vec<Vec3> {
         new.iter().zip(old).map(|(a, b)| *a - *b).collect()
     };
-    mesh.deltas = Some((
+    let deltas = (
         delta(&positions, &rest.positions),
         delta(&normals, &rest.normals),
-    ));
-    Ok(())
+    );
+    if !deltas.0.iter().all(|d| d.is_finite()) {
+        return Err(invalid(format!(
+            "mesh {id}: the new shape is too far from the registered one"
+        )));
+    }
+    Ok(deltas)
 }
 
 fn invalid(message: String) -> RenderError {

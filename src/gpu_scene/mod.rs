@@ -167,6 +167,8 @@ pub struct GpuScene {
     deltas: Vec<[f32; 4]>,
     /// `deltas` changed since `morph_deltas` was last written: the next frame uploads them.
     deltas_pending: bool,
+    /// A target was ever set ([`GpuScene::set_morph_target`]).
+    deltas_edited: bool,
     /// The frame's joint matrices.
     joint_matrices: Buffer,
     /// The frame's morph weights.
@@ -296,6 +298,7 @@ impl GpuScene {
             )?,
             deltas: geometry.deltas.clone(),
             deltas_pending: false,
+            deltas_edited: false,
             joint_matrices: dynamic(
                 "joint matrices",
                 joint_count * std::mem::size_of::<Mat4>(),
@@ -358,8 +361,6 @@ impl GpuScene {
     /// starts its motion from itself.
     pub fn forget_previous(&mut self) {
         self.has_previous = false;
-        // A set morph target's upload may have been in that frame.
-        self.deltas_pending |= !self.deltas.is_empty();
     }
 
     /// The scene's CPU data (without textures), as frames are evaluated from it.
@@ -386,6 +387,7 @@ impl GpuScene {
     /// copied from the staging ring; the world vertices rewritten) and imports everything the
     /// frame reads.
     pub fn declare(&mut self, rg: &mut RenderGraph) -> Result<SceneHandles, SceneUploadError> {
+        self.refresh_edited_bounds();
         let frame = DeformFrame::new(&self.instances, &self.state.pose);
         let (nodes, triangles, deformer_roots) = self.declare_bottom_levels(rg)?;
         let bottom = &self.bvh.bottom;

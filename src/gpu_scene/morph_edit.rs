@@ -63,10 +63,23 @@ impl GpuScene {
         for (rest, delta) in prim.positions.iter().zip(positions) {
             prim.bounds.grow(*rest + *delta);
         }
-        // The frame's world bounds (RSM fits, ray offsets) follow the new shape.
-        let bounds = self.rig.pose_bounds(&self.state.pose);
-        self.state.bounds = (bounds.min, bounds.max);
         self.deltas_pending = true;
+        self.deltas_edited = true;
         Ok(())
+    }
+
+    /// The frame's world bounds (RSM fits, ray offsets) after set targets: recomputed once
+    /// per declared frame that follows a [`GpuScene::set_morph_target`], not once per call.
+    pub(super) fn refresh_edited_bounds(&mut self) {
+        if self.deltas_pending {
+            let bounds = self.rig.pose_bounds(&self.state.pose);
+            self.state.bounds = (bounds.min, bounds.max);
+        }
+    }
+
+    /// A declared frame was dropped unrun: an upload of set targets it held never happened, so
+    /// the next frame uploads them again (only when a target was ever set).
+    pub fn forget_uploads(&mut self) {
+        self.deltas_pending |= self.deltas_edited;
     }
 }

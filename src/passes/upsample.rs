@@ -149,16 +149,26 @@ impl CoarseGrid {
     }
 
     /// The full-resolution pixel whose G-buffer sample coarse sample `i` of an internal grid
-    /// holds: the one under its centre, `floor((i + 0.5) · step)` (clamped to `full`). GLSL
-    /// twin: the host texel of `shaders/host_gbuffer.comp`.
+    /// of `full` pixels holds: the one under its centre ([`texel_under_centre`], what
+    /// `shaders/host_gbuffer.comp` fetches). Its centre lies up to half a pixel from
+    /// `(i + 0.5) · step`, where the upsample's bilinear weights place the sample (half a
+    /// pixel right and down at 50 % and 25 %): accepted, the light varies slowly.
     pub fn source_texel(&self, i: [u32; 2], full: [u32; 2]) -> [u32; 2] {
-        [0, 1].map(|a| (((i[a] as f32 + 0.5) * self.step[a]) as u32).min(full[a] - 1))
+        [0, 1].map(|a| texel_under_centre(i[a], self.extent[a], full[a]))
     }
 
     /// True when each coarse sample is one full-resolution pixel (the upsample copies).
-    pub fn is_identity(&self) -> bool {
-        self.step == [1.0; 2]
+    pub fn is_identity(&self, full: [u32; 2]) -> bool {
+        self.step == [1.0; 2] && self.extent == full
     }
+}
+
+/// The texel of a `to`-wide grid under the centre of texel `i` of a `from`-wide grid over the
+/// same image: `floor((i + 0.5) · to / from)`, in integers (a float ratio rounds the exact ties
+/// of a 2× or 4× step either way). GLSL twin: `texel_under_centre` in
+/// `shaders/include/grid.glsl`.
+pub fn texel_under_centre(i: u32, from: u32, to: u32) -> u32 {
+    ((2 * u64::from(i) + 1) * u64::from(to) / (2 * u64::from(from))) as u32
 }
 
 /// Push constants of `shaders/upsample.comp` (40 bytes: std430 rounds the block up to its
@@ -348,7 +358,7 @@ pub fn upsample_cpu(
             if target[3] <= 0.0 {
                 continue;
             }
-            if inputs.grid.is_identity() {
+            if inputs.grid.is_identity(inputs.extent) {
                 out[p * 4..p * 4 + 4].copy_from_slice(&texel(inputs.radiance, p));
                 continue;
             }

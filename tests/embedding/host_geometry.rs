@@ -258,7 +258,8 @@ fn a_deformed_mesh_matches_the_same_shape_placed_rigidly() {
     bench.assert_clean();
 }
 
-/// A rigid mesh, a wrong vertex count and a NaN position are refused by `deform_mesh`.
+/// A rigid mesh, a wrong vertex count, an infinite normal and a NaN position are refused by
+/// `deform_mesh`.
 #[test]
 fn bad_deformations_are_refused() {
     let bench = Bench::new(false);
@@ -272,6 +273,15 @@ fn bad_deformations_are_refused() {
         .deform_mesh(ids[0], &positions[1..], None)
         .expect_err("count");
     assert!(short.to_string().contains("vertices;"), "{short}");
+    let mut normals = vec![[0.0f32, 1.0, 0.0]; count];
+    normals[5][2] = f32::INFINITY;
+    let bad_normal = gi
+        .deform_mesh(ids[0], &positions, Some(&normals))
+        .expect_err("infinite normal");
+    assert!(
+        bad_normal.to_string().contains("vertex 5 is not finite"),
+        "{bad_normal}"
+    );
     positions[7][1] = f32::NAN;
     let nan = gi.deform_mesh(ids[0], &positions, None).expect_err("NaN");
     assert!(nan.to_string().contains("vertex 7 is not finite"), "{nan}");

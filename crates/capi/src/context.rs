@@ -135,8 +135,10 @@ pub unsafe extern "C" fn shine_context_reset_history(context: ShineContext) -> S
 
 /// Sets the scene's clock for the next dispatch: every animation of a loaded scene (nodes,
 /// lights, morph weights, skins) is evaluated at `time` seconds (`GiContext::update` with
-/// `FrameUpdate::at(time)`; host-set instances and lights go through
-/// `shine_context_move_instances`). CPU only, per frame. A non-finite time is refused.
+/// `FrameUpdate::at(time)`). It replaces the whole frame state: on a world of registered
+/// meshes it puts the instances and lights back where `shine_context_set_instances` put them,
+/// so such a host moves things with `shine_context_move_instances` instead. CPU only, per
+/// frame. A non-finite time is refused.
 ///
 /// # Safety
 /// `context` may be any value (null and stale handles are refused).

@@ -109,6 +109,7 @@ fn cpp_host(scene_name: &str) -> Vec<[f32; 4]> {
         stdout.contains("rigid mesh deformation refused"),
         "{stdout}"
     );
+    assert!(stdout.contains("NaN time refused"), "{stdout}");
     let bytes = std::fs::read(&raw).expect("the C++ host's output");
     let _ = std::fs::remove_dir_all(&build);
     assert_eq!(bytes.len(), (EXTENT[0] * EXTENT[1] * 16) as usize);

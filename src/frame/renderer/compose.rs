@@ -57,6 +57,20 @@ impl Renderer {
         self.aaf.reset();
     }
 
+    /// Starts the indirect light's histories over (a light cut): accumulation and the
+    /// techniques' amortised caches, not the camera's (motion, TAA, exposure, previous
+    /// vertices), which a change of light leaves valid.
+    pub(super) fn restart_indirect(&mut self) {
+        if let Some(scene) = self.scene.as_mut() {
+            scene.proxy.reset();
+            scene.cubes.reset();
+        }
+        self.accumulate.reset();
+        self.hvl.reset();
+        self.igi.reset();
+        self.aaf.reset();
+    }
+
     /// After a graph that is dropped unrun: what that frame meant to leave for the next one
     /// (previous vertices, camera, HVL history) or upload once (tables) was never written.
     pub(super) fn forget_history(&mut self) {
@@ -65,6 +79,7 @@ impl Renderer {
         self.igi.forget_uploads();
         if let Some(scene) = self.scene.as_mut() {
             scene.proxy.forget_uploads();
+            scene.gpu.forget_uploads();
         }
     }
 

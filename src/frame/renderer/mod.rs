@@ -6,6 +6,7 @@
 
 mod compose;
 mod host;
+mod light_cut;
 mod sky_light;
 
 pub(crate) use host::HostSide;
@@ -300,9 +301,16 @@ impl Renderer {
     /// lights, jitter. CPU work only; the next frame uploads the result through its own
     /// `update …` passes, without waiting for the GPU. A bad update is refused (nothing
     /// changes).
+    ///
+    /// A light cut ([`light_cut::LIGHT_CUT_RATIO`]: a light switched on or off, or its power
+    /// changed more than that) restarts the indirect light's histories.
     pub fn update(&mut self, update: &FrameUpdate) -> Result<(), RenderError> {
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
+        let before = scene.gpu.state.lights.clone();
         scene.gpu.update(update)?;
+        if light_cut::is_light_cut(&before, &scene.gpu.state.lights) {
+            self.restart_indirect();
+        }
         Ok(())
     }
 
