@@ -1,10 +1,10 @@
 //! [`GiContext`]: shine as a GI pass inside a host engine's frame.
 
+use super::budget_pick;
 use super::host_geometry::{self, HostInstance, HostMesh, MeshId, Registered};
 use super::inputs::GiDispatch;
 use super::resolution::InternalResolution;
 use super::warm_up::{DispatchShape, Placeholders, warm_up_frames};
-use crate::farm::identity::fnv1a;
 use crate::frame::RenderError;
 use crate::frame::memory::MemoryReport;
 use crate::frame::params::FrameParams;
@@ -12,11 +12,9 @@ use crate::frame::renderer::HostSide;
 use crate::frame::renderer::Renderer;
 use crate::gpu_scene::FrameUpdate;
 use crate::gpu_scene::upload_ring::UploadRing;
-use crate::lab::LabError;
-use crate::lab::budget::{self, BudgetChoice};
+use crate::lab::budget::BudgetChoice;
 use crate::passes::environment_sh;
 use crate::passes::host_gbuffer::{self, HostFrame, HostImages};
-use crate::profile::roofline::cache_dir;
 use crate::settings::Settings;
 use shine_gpu::{Buffer, Device, Sampler, vk};
 use shine_graph::{PassTiming, RenderGraph};
@@ -136,15 +134,10 @@ impl GiContext {
                 )));
             }
             Some(ms) => {
-                let table = budget_table(device)?;
-                let choice = budget::choose(
-                    &table,
-                    None,
-                    desc.internal_resolution.extent(desc.display),
-                    ms,
-                );
+                let internal = desc.internal_resolution.extent(desc.display);
+                let choice = budget_pick::from_results(device, internal, ms)?;
                 if let Some(c) = &choice {
-                    apply(&mut settings, c)?;
+                    budget_pick::apply(&mut settings, c)?;
                 }
                 Some((ms, choice))
             }
@@ -221,30 +214,9 @@ impl GiContext {
             )));
         }
         if let Some((ms, None)) = self.budget {
-            let device = &self.device;
-            let path = cache_dir()
-                .map(|dir| budget::table_path(&dir, &device.info().name, &device.info().driver));
-            let shape = format!(
-                "{:?} {} {} {}",
-                scene.pose_bounds(&scene.pose_at(t)),
-                scene.nodes.len(),
-                scene.meshes.len(),
-                scene.lights.len()
-            );
-            let key = format!("host-{:016x}", fnv1a(shape.as_bytes()));
-            let (entries, _) = budget::fill(
-                device,
-                scene,
-                &key,
-                self.internal.extent(self.display),
-                path.as_deref(),
-            )
-            .map_err(lab_error)?;
-            let refs: Vec<&budget::BudgetEntry> = entries.iter().collect();
-            let choice = budget::pick(&refs, ms).ok_or_else(|| {
-                RenderError::Invalid("GI context: no budget candidate could be measured".into())
-            })?;
-            apply(&mut self.settings, &choice)?;
+            let internal = self.internal.extent(self.display);
+            let choice = budget_pick::from_quick_lab(&self.device, scene, t, internal, ms)?;
+            budget_pick::apply(&mut self.settings, &choice)?;
             self.params = frame_params(&self.settings, self.internal.extent(self.display))?;
             self.budget = Some((ms, Some(choice)));
         }
@@ -568,33 +540,4 @@ fn frame_params(settings: &Settings, internal: [u32; 2]) -> Result<FrameParams, 
     // The technique shades the host's G-buffer at its size: nothing to supersample.
     params.composite.ssaa = 1;
     Ok(params)
-}
-
-/// The budget table of `device` under the cache directory (empty without one).
-fn budget_table(device: &Device) -> Result<budget::BudgetTable, RenderError> {
-    match cache_dir() {
-        Some(dir) => budget::load_table(&budget::table_path(
-            &dir,
-            &device.info().name,
-            &device.info().driver,
-        ))
-        .map_err(lab_error),
-        None => Ok(budget::BudgetTable::default()),
-    }
-}
-
-/// `choice`'s settings over `settings`, validated.
-fn apply(settings: &mut Settings, choice: &BudgetChoice) -> Result<(), RenderError> {
-    for (key, value) in &choice.config.set {
-        settings
-            .set(key, value)
-            .map_err(|e| RenderError::Invalid(format!("GI context budget: {e}")))?;
-    }
-    settings.validate()?;
-    Ok(())
-}
-
-/// A lab error as the context reports it.
-fn lab_error(e: LabError) -> RenderError {
-    RenderError::Invalid(format!("GI context budget: {e}"))
 }

@@ -2,6 +2,7 @@
 //! once on the host's device, fed the host's G-buffer every frame ([`GiDispatch`]) and
 //! recording into the host's command buffer, the way FidelityFX's GI effects integrate.
 
+mod budget_pick;
 mod context;
 mod host_geometry;
 mod inputs;
