@@ -32,14 +32,9 @@ fn frame(bench: &Bench, specular: Option<&HostImage>) -> (Vec<[f32; 3]>, Option<
     (read(&bench.targets().gi), specular.map(read))
 }
 
-/// Metals: the specular image carries the sharp reflections (a real share of the light: the
-/// chrome and silver spheres), the diffuse image the rest, and their sum is the
-/// single-output frame to RGBA16F rounding (relative RMSE ≤ 2e-3). The traced part is not
-/// accumulated either way here (`history.frames = 1`).
-#[test]
-fn diffuse_and_specular_outputs_add_up_to_the_whole_indirect_light() {
-    let bench = Bench::for_scene("metals");
-    let specular = HostImage::new(
+/// The host's specular output image (RGBA16F, display size).
+fn specular_image(bench: &Bench) -> HostImage {
+    HostImage::new(
         &bench.host,
         "host specular",
         vk::Format::R16G16B16A16_SFLOAT,
@@ -48,7 +43,17 @@ fn diffuse_and_specular_outputs_add_up_to_the_whole_indirect_light() {
             | vk::ImageUsageFlags::TRANSFER_SRC
             | vk::ImageUsageFlags::SAMPLED,
     )
-    .expect("specular image");
+    .expect("specular image")
+}
+
+/// Metals: the specular image carries the sharp reflections (a real share of the light: the
+/// chrome and silver spheres), the diffuse image the rest, and their sum is the
+/// single-output frame to RGBA16F rounding (relative RMSE ≤ 2e-3). The traced part is not
+/// accumulated either way here (`history.frames = 1`).
+#[test]
+fn diffuse_and_specular_outputs_add_up_to_the_whole_indirect_light() {
+    let bench = Bench::for_scene("metals");
+    let specular = specular_image(&bench);
     let (whole, _) = frame(&bench, None);
     let (diffuse, split) = frame(&bench, Some(&specular));
     let split = split.expect("specular read back");
@@ -88,16 +93,7 @@ const SPECULAR_ENERGY: f64 = 0.08;
 #[test]
 fn the_specular_output_matches_its_path_traced_truth() {
     let bench = Bench::for_scene("metals");
-    let specular = HostImage::new(
-        &bench.host,
-        "host specular",
-        vk::Format::R16G16B16A16_SFLOAT,
-        EXTENT,
-        vk::ImageUsageFlags::TRANSFER_DST
-            | vk::ImageUsageFlags::TRANSFER_SRC
-            | vk::ImageUsageFlags::SAMPLED,
-    )
-    .expect("specular image");
+    let specular = specular_image(&bench);
     let (_, output) = frame(&bench, Some(&specular));
     let output = output.expect("specular read back");
     let limit = exact_desc(EXTENT, "hvl").settings.specular.limit;

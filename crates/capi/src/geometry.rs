@@ -195,12 +195,12 @@ pub unsafe extern "C" fn shine_context_deform_mesh(
         if positions.is_null() {
             return Err(Failure::invalid("positions must not be null"));
         }
-        let len = vertex_count as usize;
         // SAFETY: the caller's promise: 3 · vertex_count floats each.
-        let positions = unsafe { std::slice::from_raw_parts(positions.cast::<[f32; 3]>(), len) };
+        let positions = unsafe { slice(positions.cast::<[f32; 3]>(), vertex_count, "positions") }?;
         // SAFETY: as above.
         let normals = (!normals.is_null())
-            .then(|| unsafe { std::slice::from_raw_parts(normals.cast::<[f32; 3]>(), len) });
+            .then(|| unsafe { slice(normals.cast::<[f32; 3]>(), vertex_count, "normals") })
+            .transpose()?;
         Ok(lock(&context).deform_mesh(MeshId::from_index(mesh), positions, normals)?)
     })
 }

@@ -43,18 +43,13 @@ impl Renderer {
     /// ones (previous vertices and camera, accumulation, amortised schedules, AAF's and the
     /// cube maps' histories). What was uploaded once (tables) stays.
     pub(crate) fn reset_history(&mut self) {
+        self.restart_indirect();
         if let Some(scene) = self.scene.as_mut() {
             scene.gpu.forget_previous();
-            scene.proxy.reset();
-            scene.cubes.reset();
         }
         self.motion.reset();
-        self.accumulate.reset();
         self.taa.reset();
         self.exposure.reset();
-        self.hvl.reset();
-        self.igi.reset();
-        self.aaf.reset();
     }
 
     /// Starts the indirect light's histories over (a light cut): accumulation and the
