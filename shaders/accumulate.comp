@@ -6,7 +6,11 @@
 // hold the pixel's own light, so a static image keeps its history), and blended with
 // weight 1/n, where n is the history's length (alpha), capped at `max_frames`: an exponential
 // history that converges where nothing changes, restarts where the surface was not visible
-// (n = 1) and follows at once where the light leaves the clip box. With `geometry` 0 it is
+// (n = 1) and follows at once where the light leaves the clip box. The indirect light's
+// history is Holt's linear exponential smoothing: the level plus its trend (push.trend, an EMA
+// of the level's change) is the forecast that is clipped and blended, and the clip box is at
+// least the pixel's temporal noise (push.temporal: the innovations' σ, state.a), so smooth
+// light that pops as a whole keeps its history. With `geometry` 0 it is
 // TAA: every pixel counts, the background too, a still pixel keeps history of any surface of
 // its 3×3 neighbourhood (jittered silhouettes) while a pixel near motion keeps only its own
 // surface's and at most TAA_MOVING_FRAMES, and the blend is in the space x / (1 + luma) so
@@ -34,6 +38,11 @@ layout(set = 0, binding = 4, rgba32f) readonly uniform image2D history_geometry;
 layout(set = 0, binding = 5, rgba16f) readonly uniform image2D history_light;
 // This frame's accumulated light (next frame's history).
 layout(set = 0, binding = 6, rgba16f) uniform image2D accumulated;
+// The previous frame's filter state: rgb Holt's trend (the level's change per frame), a the
+// variance of the innovations (luminance²). Zero under TAA.
+layout(set = 0, binding = 7, rgba16f) readonly uniform image2D history_state;
+// This frame's filter state (next frame's history_state).
+layout(set = 0, binding = 8, rgba16f) writeonly uniform image2D state;
 
 // shine::passes::accumulate::AccumulatePush
 layout(push_constant) uniform Push {
@@ -48,8 +57,10 @@ layout(push_constant) uniform Push {
     // direct light (blend space, the background accumulates, still pixels take any nearby
     // surface's history)
     uint geometry;
-    uint pad1;
-    uint pad2;
+    // β of Holt's trend (0: none; the indirect light's history only)
+    float trend;
+    // 1: the clip box widens to the pixel's own temporal noise (the indirect light's only)
+    uint temporal;
 } push;
 
 // Whether p is inside the image.
@@ -107,6 +118,7 @@ void main() {
     bool background = geometry && depth == 0.0;
     if (background || push.has_history == 0u) {
         imageStore(accumulated, p, vec4(radiance, background ? 0.0 : 1.0));
+        imageStore(state, p, vec4(0.0));
         return;
     }
     vec3 n = normalize(imageLoad(gb_geometric_normal, p).xyz);
@@ -130,6 +142,7 @@ void main() {
     ivec2 base = ivec2(floor(then_px));
     vec2 f = then_px - vec2(base);
     vec4 history = vec4(0.0);
+    vec4 filter_state = vec4(0.0);
     float weight = 0.0;
     for (int j = 0; j < 2; ++j) {
         for (int i = 0; i < 2; ++i) {
@@ -146,16 +159,32 @@ void main() {
             float w = (i == 0 ? 1.0 - f.x : f.x) * (j == 0 ? 1.0 - f.y : f.y);
             vec4 h = imageLoad(history_light, q);
             history += w * vec4(to_blend(h.rgb), h.a);
+            filter_state += w * imageLoad(history_state, q);
             weight += w;
         }
     }
     if (weight < ACCUMULATE_MIN_WEIGHT) {
         // Disoccluded: the history restarts here.
         imageStore(accumulated, p, vec4(radiance, 1.0));
+        imageStore(state, p, vec4(0.0));
         return;
     }
     history /= weight;
+    filter_state /= weight;
+    // Whether the view holds still here. A moving pixel's history is a reprojection, which the
+    // clip judges on its own: restarting it there would show the raw frame, and a trend or a
+    // temporal noise measured elsewhere would let the moving surface's history trail. There
+    // the history is the plain one and the filter's state starts again.
+    bool view_still = length(motion * vec2(push.extent)) < TAA_STILL_PIXELS;
+    bool still_indirect = geometry && view_still;
+    // Holt's forecast: the previous level moved on by its trend (never below black).
+    vec3 level = history.rgb;
+    vec3 trend = still_indirect && push.trend > 0.0 ? filter_state.rgb : vec3(0.0);
+    float noise = still_indirect ? filter_state.a : 0.0;
+    history.rgb = max(level + trend, vec3(0.0));
+    vec3 forecast = history.rgb;
 
+    bool restarted = false;
     if (push.clip > 0.0) {
         // Mean and standard deviation of the current light over the 3×3 neighbourhood's
         // foreground pixels.
@@ -176,16 +205,19 @@ void main() {
         }
         vec3 mean = sum / count;
         vec3 sigma = sqrt(max(sum2 / count - mean * mean, vec3(0.0)));
+        if (still_indirect && push.temporal != 0u) {
+            // The pixel's own noise from frame to frame, spread over the channels as the
+            // neighbourhood's colour: smooth light pops as a whole, which the 3×3 σ misses.
+            sigma = max(sigma, sqrt(noise) * mean / max(luminance(mean), ACCUMULATE_MIN_LUMINANCE));
+        }
         // The box always holds the pixel's own light: where nothing changes, history is kept.
         vec3 lo = min(light, mean - push.clip * sigma);
         vec3 hi = max(light, mean + push.clip * sigma);
         vec3 clipped = clamp(history.rgb, lo, hi);
         float moved = luminance(abs(history.rgb - clipped));
-        // Only where the view holds still: a moving pixel's history is a reprojection, which
-        // the clip already judges, and restarting it there shows the raw frame.
-        bool view_still = length(motion * vec2(push.extent)) < TAA_STILL_PIXELS;
-        if (geometry && view_still && moved > ACCUMULATE_CHANGE * max(luminance(clipped), luminance(light))) {
+        if (still_indirect && moved > ACCUMULATE_CHANGE * max(luminance(clipped), luminance(light))) {
             history.a = 0.0;
+            restarted = true;
         }
         history.rgb = clipped;
     }
@@ -193,5 +225,12 @@ void main() {
     // surfaces, and a long history would carry one surface's light onto the other.
     float longest = geometry || still ? push.max_frames : min(push.max_frames, TAA_MOVING_FRAMES);
     float frames = min(history.a + 1.0, longest);
-    imageStore(accumulated, p, vec4(from_blend(mix(history.rgb, light, 1.0 / frames)), frames));
+    vec3 blended = mix(history.rgb, light, 1.0 / frames);
+    imageStore(accumulated, p, vec4(from_blend(blended), frames));
+    // The next frame's state: the trend an EMA (β) of the level's change, the innovations'
+    // variance an EMA (1/n) of this frame's; both restart with the history and where the view
+    // moves.
+    float innovation = luminance(radiance) - luminance(forecast);
+    vec4 next = vec4(mix(trend, blended - level, push.trend), mix(noise, innovation * innovation, 1.0 / frames));
+    imageStore(state, p, still_indirect && !restarted ? accumulate_storable(next) : vec4(0.0));
 }

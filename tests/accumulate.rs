@@ -1,26 +1,28 @@
 //! Histories (src/passes/accumulate.rs): `accumulate` against its CPU twin (reprojection,
 //! disocclusion, variance clip, blend; the indirect light's geometry-tested mode and TAA's
 //! colour-only mode), history rejected on a disocclusion, and a static scene accumulated over
-//! frames against its single frame, and a switched-off light gone the next frame.
+//! frames against its single frame, and a switched-off light gone the next frame; the
+//! indirect light's trend and temporal clip (issue 43) against the spatial clip alone on a
+//! noisy ramp.
 
 mod common;
 
 use common::{Rng, bytes_f16, f16_to_f32, f32_to_f16, q16, storage_image_with, uploaded_state};
 use glam::{Vec2, Vec3, Vec4};
 use shine::graph::{Executor, ExternalState, History, RenderGraph, vk};
-use shine::passes::accumulate::{AccumulateParams, accumulate};
+use shine::passes::accumulate::{AccumulateHistory, AccumulateParams, accumulate};
 use shine::passes::gbuffer::GBuffer;
-use shine::reference::accumulate::{AccumulateInputs, accumulate_cpu};
+use shine::reference::accumulate::{AccumulateInputs, Accumulated, accumulate_cpu};
 use shine::{FrameUpdate, Renderer, Settings};
 use shine_scene::{Light, Scene};
 
 /// Runs `accumulate` on the GPU over `inp` (as uploaded: f16 values where the images are f16)
-/// and returns the accumulated light.
+/// and returns the accumulated light and the filter state.
 fn accumulate_gpu(
     device: &shine::gpu::Device,
     inp: &AccumulateInputs<'_>,
     params: &AccumulateParams,
-) -> Vec<Vec4> {
+) -> Accumulated {
     let [w, h] = inp.extent;
     let rgba16 = vk::Format::R16G16B16A16_SFLOAT;
     let rgba32 = vk::Format::R32G32B32A32_SFLOAT;
@@ -56,7 +58,15 @@ fn accumulate_gpu(
         inp.extent,
         &bytes_f16(inp.history_light),
     );
+    let state = storage_image_with(
+        device,
+        "history state",
+        rgba16,
+        inp.extent,
+        &bytes_f16(inp.history_state),
+    );
     let out = common::transfer_storage(device, "out", u64::from(w * h) * 8, None);
+    let out_state = common::transfer_storage(device, "out state", u64::from(w * h) * 8, None);
     let mut executor = Executor::new(device, 1).expect("executor");
     let mut rg = executor.begin_frame();
     let import = |rg: &mut RenderGraph, image| {
@@ -75,9 +85,15 @@ fn accumulate_gpu(
     };
     let current_handle = import(&mut rg, &current);
     let geometry_handle = import(&mut rg, &geometry);
-    let mut history = History {
-        previous: import(&mut rg, &light),
-        current: rg.create_image("accumulated", shine::graph::ImageDesc::new_2d(rgba16, w, h)),
+    let mut history = AccumulateHistory {
+        light: History {
+            previous: import(&mut rg, &light),
+            current: rg.create_image("accumulated", shine::graph::ImageDesc::new_2d(rgba16, w, h)),
+        },
+        state: History {
+            previous: import(&mut rg, &state),
+            current: rg.create_image("state", shine::graph::ImageDesc::new_2d(rgba16, w, h)),
+        },
     };
     let accumulated = accumulate(
         &mut rg,
@@ -93,8 +109,14 @@ fn accumulate_gpu(
     let mut out_handle =
         rg.import_gpu_buffer(&out, ExternalState::UNDEFINED, common::read_by_copy());
     rg.copy_image_to_buffer("read accumulated", &accumulated, &mut out_handle);
+    let mut state_handle =
+        rg.import_gpu_buffer(&out_state, ExternalState::UNDEFINED, common::read_by_copy());
+    rg.copy_image_to_buffer("read state", &history.state.current, &mut state_handle);
     common::run_graph(device, &mut executor, rg);
-    common::decode_rgba16f(&device.read_buffer(&out).expect("read"))
+    Accumulated {
+        light: common::decode_rgba16f(&device.read_buffer(&out).expect("read")),
+        state: common::decode_rgba16f(&device.read_buffer(&out_state).expect("read state")),
+    }
 }
 
 /// The GPU pass equals its CPU twin with history kept, moved between texels (bilinear), partly
@@ -137,6 +159,17 @@ fn accumulate_matches_the_cpu_twin() {
             ))
         })
         .collect();
+    // Filter state: a trend of either sign and an innovations' variance.
+    let history_state: Vec<Vec4> = (0..n)
+        .map(|_| {
+            q16(Vec4::new(
+                0.2 * (rng.next() - 0.5),
+                0.2 * (rng.next() - 0.5),
+                0.2 * (rng.next() - 0.5),
+                0.05 * rng.next(),
+            ))
+        })
+        .collect();
     // History geometry: mostly the pixel's own, sometimes another depth or normal.
     let history_geometry: Vec<Vec4> = (0..n)
         .map(|i| {
@@ -162,12 +195,14 @@ fn accumulate_matches_the_cpu_twin() {
         .collect();
     let mut restarted = 0;
     let still = vec![Vec2::ZERO; n];
-    for (has_history, max_frames, clip, geometry, moving) in [
-        (true, 8, 1.0, true, true),
-        (true, 4, 0.0, true, true),
-        (false, 8, 1.0, true, true),
-        (true, 16, 1.0, false, true),
-        (true, 16, 1.0, false, false),
+    for (has_history, max_frames, clip, geometry, moving, trend, temporal) in [
+        (true, 8, 1.0, true, true, 0.0, false),
+        (true, 8, 3.0, true, true, 0.1, true),
+        (true, 8, 1.0, true, false, 0.5, true),
+        (true, 4, 0.0, true, true, 0.1, false),
+        (false, 8, 1.0, true, true, 0.1, true),
+        (true, 16, 1.0, false, true, 0.0, false),
+        (true, 16, 1.0, false, false, 0.0, false),
     ] {
         let inputs = AccumulateInputs {
             extent,
@@ -177,6 +212,7 @@ fn accumulate_matches_the_cpu_twin() {
             motion: if moving { &motion } else { &still },
             history_geometry: &history_geometry,
             history_light: &history_light,
+            history_state: &history_state,
             has_history,
         };
         let params = AccumulateParams {
@@ -184,15 +220,32 @@ fn accumulate_matches_the_cpu_twin() {
             clip,
             geometry,
             reseed: false,
+            trend,
+            temporal,
         };
         let cpu = accumulate_cpu(&inputs, &params);
         let gpu = accumulate_gpu(&device, &inputs, &params);
-        for (i, (c, g)) in cpu.iter().zip(&gpu).enumerate() {
+        let case = format!(
+            "history {has_history}, n {max_frames}, clip {clip}, geometry {geometry}, trend {trend}, temporal {temporal}"
+        );
+        for (i, (c, g)) in cpu.light.iter().zip(&gpu.light).enumerate() {
             assert!(
                 (*c - *g).abs().max_element() <= 4e-3 * c.abs().max_element().max(1.0),
-                "history {has_history}, n {max_frames}, clip {clip}, geometry {geometry}, pixel {i}: cpu {c} gpu {g}"
+                "{case}, pixel {i}: cpu {c} gpu {g}"
             );
             restarted += usize::from(position[i].w > 0.0 && c.w == 1.0);
+        }
+        for (i, (c, g)) in cpu.state.iter().zip(&gpu.state).enumerate() {
+            assert!(
+                (*c - *g).abs().max_element() <= 4e-3 * c.abs().max_element().max(0.1),
+                "{case}, pixel {i}: state cpu {c} gpu {g}"
+            );
+        }
+        if geometry && has_history && trend > 0.0 {
+            assert!(
+                cpu.state.iter().any(|s| s.truncate() != Vec3::ZERO),
+                "{case}: no trend carried"
+            );
         }
     }
     assert!(restarted > n, "restarted {restarted}");
@@ -214,8 +267,9 @@ fn disocclusion_rejects_history() {
         max_frames: 8,
         clip: 0.0,
         geometry: true,
-        reseed: false,
+        ..AccumulateParams::default()
     };
+    let history_state = vec![Vec4::ZERO; 4];
     for (geometry, keeps) in [
         (Vec4::new(0.0, 0.0, 1.0, 2.0), true),
         (Vec4::new(0.0, 0.0, 1.0, 3.0), false),
@@ -230,9 +284,10 @@ fn disocclusion_rejects_history() {
             motion: &motion,
             history_geometry: &history_geometry,
             history_light: &history_light,
+            history_state: &history_state,
             has_history: true,
         };
-        let gpu = accumulate_gpu(&device, &inputs, &params);
+        let gpu = accumulate_gpu(&device, &inputs, &params).light;
         let expected = if keeps {
             // n = 5: a fifth of this frame's light into the history.
             Vec4::new(0.2, 0.1, 6.45, 5.0)
@@ -262,6 +317,7 @@ fn a_large_change_of_the_light_restarts_the_history() {
     let current = vec![Vec3::splat(1.0); 9];
     let history_geometry = vec![Vec4::new(0.0, 0.0, 1.0, 2.0); 9];
     let motion = vec![Vec2::ZERO; 9];
+    let history_state = vec![Vec4::ZERO; 9];
     // A flat neighbourhood: the clip box is the light itself, so the clip moves a history of
     // 1 + e by e.
     for (excess, geometry, restarts) in [
@@ -279,18 +335,19 @@ fn a_large_change_of_the_light_restarts_the_history() {
             motion: &motion,
             history_geometry: &history_geometry,
             history_light: &history_light,
+            history_state: &history_state,
             has_history: true,
         };
         let params = AccumulateParams {
             max_frames: 8,
             clip: 3.0,
             geometry,
-            reseed: false,
+            ..AccumulateParams::default()
         };
         let gpu = accumulate_gpu(&device, &inputs, &params);
         let cpu = accumulate_cpu(&inputs, &params);
         let count = if restarts { 1.0 } else { 5.0 };
-        for (g, c) in gpu.iter().zip(&cpu) {
+        for (g, c) in gpu.light.iter().zip(&cpu.light) {
             assert!((*g - *c).abs().max_element() <= 4e-3, "{g} against {c}");
             assert_eq!(g.w, count, "excess {excess}, geometry {geometry}: {g}");
         }
@@ -395,4 +452,80 @@ fn a_light_switched_off_is_gone_the_next_frame() {
         assert!(left.abs() < 0.05, "{gi}: {left} of the light left");
     }
     common::assert_clean(&device);
+}
+
+/// Smooth light that pops as a whole while it brightens steadily (issue 43): every pixel of a
+/// flat 8×8 wall is a ramp times one common factor per frame, plus a little noise of its own.
+/// The 3×3 clip alone sees only the small per-pixel σ and keeps the pops; the temporal clip
+/// keeps the history that averages them, and the trend follows the ramp that a plain history
+/// trails by n − 1 frames of its change. CPU twin (tied to the pass by
+/// `accumulate_matches_the_cpu_twin`), 48 frames, the last 32 measured.
+#[test]
+fn the_trend_and_temporal_clip_hold_a_popping_ramp_still_without_lag() {
+    let extent = [8u32, 8];
+    let n = 64;
+    let position = vec![Vec4::new(0.0, 0.0, 0.0, 2.0); n];
+    let normal = vec![Vec3::Z; n];
+    let history_geometry = vec![Vec4::new(0.0, 0.0, 1.0, 2.0); n];
+    let motion = vec![Vec2::ZERO; n];
+    let ramp = |k: usize| 1.0 + 0.02 * k as f32;
+    let mut rng = Rng(5);
+    let frames: Vec<Vec<Vec3>> = (0..48)
+        .map(|k| {
+            let pop = 1.0 + 0.1 * (rng.next() - 0.5);
+            (0..n)
+                .map(|_| Vec3::splat(ramp(k) * pop * (1.0 + 0.01 * (rng.next() - 0.5))))
+                .collect()
+        })
+        .collect();
+    // (flicker: RMS of the second difference over the mean, lag: mean |out − ramp| over the
+    // mean) of the centre pixel over the measured frames.
+    let run = |params: &AccumulateParams| {
+        let mut light = vec![Vec4::ZERO; n];
+        let mut state = vec![Vec4::ZERO; n];
+        let mut out = Vec::new();
+        for (k, current) in frames.iter().enumerate() {
+            let inputs = AccumulateInputs {
+                extent,
+                current,
+                position: &position,
+                normal: &normal,
+                motion: &motion,
+                history_geometry: &history_geometry,
+                history_light: &light,
+                history_state: &state,
+                has_history: k > 0,
+            };
+            let next = accumulate_cpu(&inputs, params);
+            out.push(next.light[27].x);
+            (light, state) = (next.light, next.state);
+        }
+        let measured = &out[16..];
+        let mean = measured.iter().sum::<f32>() / measured.len() as f32;
+        let d2: Vec<f32> = measured
+            .windows(3)
+            .map(|w| w[0] - 2.0 * w[1] + w[2])
+            .collect();
+        let flicker = (d2.iter().map(|d| d * d).sum::<f32>() / d2.len() as f32).sqrt() / mean;
+        let lag = (16..48).map(|k| (out[k] - ramp(k)).abs()).sum::<f32>() / 32.0 / mean;
+        (flicker, lag)
+    };
+    let base = AccumulateParams::default();
+    let spatial = run(&AccumulateParams {
+        trend: 0.0,
+        temporal: false,
+        ..base
+    });
+    let plain = run(&AccumulateParams { trend: 0.0, ..base });
+    let default = run(&base);
+    eprintln!("spatial clip {spatial:?}, temporal without trend {plain:?}, default {default:?}");
+    assert!(
+        default.0 < 0.5 * spatial.0,
+        "flicker {default:?} against the spatial clip's {spatial:?}"
+    );
+    assert!(
+        default.1 < 0.5 * plain.1,
+        "lag {default:?} against the plain history's {plain:?}"
+    );
+    assert!(default.1 < 0.02, "lag {default:?}");
 }

@@ -5,6 +5,10 @@
 
 use std::process::Command;
 
+/// Largest share of the FMA peak `hvl_gather` may read before its declared work counts as
+/// wrong (see the assertion).
+const ROOFLINE_SHARE_BOUND: f64 = 5.0;
+
 fn shine() -> Command {
     Command::new(env!("CARGO_BIN_EXE_shine"))
 }
@@ -65,7 +69,13 @@ fn profile_roofline_sets_hvl_gather_against_the_peaks() {
         gflops > 0.0 && (share - gflops / peak).abs() < 1e-9,
         "{gather}"
     );
-    // A count far above what was executed would show as a share beyond the peak.
-    assert!(share < 1.0, "hvl_gather at {share} of the peak: {gather}");
+    // A count far above what was executed would show as a share far beyond the peak. Not
+    // merely beyond it: the peak and the pass are timed seconds apart on the CPU that runs
+    // lavapipe, and another process loading it while the peak is timed read 2.3× once (a
+    // fresh-clone `make test` beside two studies); an order of magnitude is a wrong count.
+    assert!(
+        share < ROOFLINE_SHARE_BOUND,
+        "hvl_gather at {share} of the peak: {gather}"
+    );
     let _ = std::fs::remove_dir_all(&cache);
 }

@@ -163,11 +163,19 @@ fn agx_constants_match_the_shader() {
 #[test]
 fn accumulate_constant_matches_the_shader() {
     use shine::passes::accumulate::{
-        ACCUMULATE_CHANGE, ACCUMULATE_MIN_WEIGHT, TAA_MIN_INVERSE, TAA_MOVING_FRAMES,
-        TAA_STILL_PIXELS,
+        ACCUMULATE_CHANGE, ACCUMULATE_MIN_LUMINANCE, ACCUMULATE_MIN_WEIGHT, TAA_MIN_INVERSE,
+        TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
     };
     let file = "include/accumulate.glsl";
     assert_eq!(glsl_float(file, "ACCUMULATE_CHANGE"), ACCUMULATE_CHANGE);
+    assert_eq!(
+        glsl_float(file, "ACCUMULATE_MIN_LUMINANCE"),
+        ACCUMULATE_MIN_LUMINANCE
+    );
+    assert_eq!(
+        glsl_float("include/color.glsl", "HALF_MAX"),
+        shine::reference::denoise::HALF_MAX
+    );
     assert_eq!(
         glsl_float(file, "ACCUMULATE_MIN_WEIGHT"),
         ACCUMULATE_MIN_WEIGHT

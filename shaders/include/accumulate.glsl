@@ -15,6 +15,16 @@ const float ACCUMULATE_MIN_WEIGHT = 0.01;
 // it.
 const float ACCUMULATE_CHANGE = 0.5;
 
+// Least luminance the temporal σ is spread over (the neighbourhood's colour of a black
+// neighbourhood is undefined).
+const float ACCUMULATE_MIN_LUMINANCE = 1e-6;
+
+// What the filter state's RGBA16F texel holds: the trend within ±HALF_MAX, the variance at
+// most HALF_MAX (inf would turn into NaN in the next frame's blend).
+vec4 accumulate_storable(vec4 v) {
+    return clamp(v, vec4(-HALF_MAX), vec4(HALF_MAX));
+}
+
 // Motion (pixels) below which TAA counts a pixel as still: its history may show any surface
 // of its 3×3 neighbourhood.
 const float TAA_STILL_PIXELS = 0.01;

@@ -1,14 +1,16 @@
 //! CPU twin of `accumulate` (src/passes/accumulate.rs, shaders/accumulate.comp): the indirect
-//! light's reprojection, disocclusion test, variance clip and blend, pixel for pixel.
+//! light's reprojection, disocclusion test, variance clip, blend and filter state (Holt's trend,
+//! the innovations' variance), pixel for pixel.
 
 use glam::{Vec2, Vec3, Vec4};
 
 use crate::capture::tonemap::luminance;
 use crate::passes::accumulate::{
-    ACCUMULATE_CHANGE, ACCUMULATE_MIN_WEIGHT, AccumulateParams, TAA_MIN_INVERSE, TAA_MOVING_FRAMES,
-    TAA_STILL_PIXELS,
+    ACCUMULATE_CHANGE, ACCUMULATE_MIN_LUMINANCE, ACCUMULATE_MIN_WEIGHT, AccumulateParams,
+    TAA_MIN_INVERSE, TAA_MOVING_FRAMES, TAA_STILL_PIXELS,
 };
 use crate::passes::amortise::same_surface;
+use crate::reference::denoise::HALF_MAX;
 
 /// The images `accumulate` reads, row-major, all of one extent.
 pub struct AccumulateInputs<'a> {
@@ -26,6 +28,8 @@ pub struct AccumulateInputs<'a> {
     pub history_geometry: &'a [Vec4],
     /// The previous frame's accumulated light (alpha: history length).
     pub history_light: &'a [Vec4],
+    /// The previous frame's filter state (rgb: trend, alpha: the innovations' variance).
+    pub history_state: &'a [Vec4],
     /// Whether the history holds the previous frame.
     pub has_history: bool,
 }
@@ -73,12 +77,22 @@ fn taa_seen_nearby(inp: &AccumulateInputs<'_>, x: i32, y: i32, g: Vec4) -> bool 
         })
 }
 
-/// The accumulated light (alpha: history length), as the pass writes it.
-pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> Vec<Vec4> {
+/// What the pass writes, row-major: the accumulated light (alpha: history length) and the
+/// filter state (rgb: trend, alpha: the innovations' variance).
+pub struct Accumulated {
+    /// The accumulated light.
+    pub light: Vec<Vec4>,
+    /// The next frame's filter state.
+    pub state: Vec<Vec4>,
+}
+
+/// The accumulated light and filter state, as the pass writes them.
+pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> Accumulated {
     let [w, h] = inp.extent;
     let inside = |x: i32, y: i32| x >= 0 && y >= 0 && x < w as i32 && y < h as i32;
     let at = |x: i32, y: i32| (y * w as i32 + x) as usize;
     let mut out = vec![Vec4::ZERO; (w * h) as usize];
+    let mut state = vec![Vec4::ZERO; (w * h) as usize];
     for y in 0..h as i32 {
         for x in 0..w as i32 {
             let i = at(x, y);
@@ -101,7 +115,7 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                     .all(|(qx, qy)| (inp.motion[at(qx, qy)] * size).length() < TAA_STILL_PIXELS);
             let base = then.floor();
             let f = then - base;
-            let (mut history, mut weight) = (Vec4::ZERO, 0.0f32);
+            let (mut history, mut filter_state, mut weight) = (Vec4::ZERO, Vec4::ZERO, 0.0f32);
             for j in 0..2 {
                 for k in 0..2 {
                     let (qx, qy) = (base.x as i32 + k, base.y as i32 + j);
@@ -121,6 +135,7 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                     let wy = if j == 0 { 1.0 - f.y } else { f.y };
                     let h = inp.history_light[at(qx, qy)];
                     history += wx * wy * to_blend(h.truncate(), params).extend(h.w);
+                    filter_state += wx * wy * inp.history_state[at(qx, qy)];
                     weight += wx * wy;
                 }
             }
@@ -129,7 +144,21 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                 continue;
             }
             history /= weight;
-            let mut past = history.truncate();
+            filter_state /= weight;
+            // Holt's filter where the view holds still; elsewhere the plain history.
+            let view_still = (inp.motion[i] * size).length() < TAA_STILL_PIXELS;
+            let still_indirect = params.geometry && view_still;
+            // Holt's forecast: the level moved on by its trend.
+            let level = history.truncate();
+            let trend = if still_indirect && params.trend > 0.0 {
+                filter_state.truncate()
+            } else {
+                Vec3::ZERO
+            };
+            let noise = if still_indirect { filter_state.w } else { 0.0 };
+            let forecast = (level + trend).max(Vec3::ZERO);
+            let mut past = forecast;
+            let mut restarted = false;
             if params.clip > 0.0 {
                 let (mut sum, mut sum2, mut count) = (Vec3::ZERO, Vec3::ZERO, 0.0f32);
                 for dy in -1..=1 {
@@ -147,17 +176,20 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                 }
                 let mean = sum / count;
                 let variance = (sum2 / count - mean * mean).max(Vec3::ZERO);
-                let sigma = Vec3::new(variance.x.sqrt(), variance.y.sqrt(), variance.z.sqrt());
+                let mut sigma = Vec3::new(variance.x.sqrt(), variance.y.sqrt(), variance.z.sqrt());
+                if still_indirect && params.temporal {
+                    let spread = mean / luminance(mean).max(ACCUMULATE_MIN_LUMINANCE);
+                    sigma = sigma.max(noise.max(0.0).sqrt() * spread);
+                }
                 let lo = light.min(mean - params.clip * sigma);
                 let hi = light.max(mean + params.clip * sigma);
                 let clipped = past.clamp(lo, hi);
                 let moved = luminance((past - clipped).abs());
-                let view_still = (inp.motion[i] * size).length() < TAA_STILL_PIXELS;
-                if params.geometry
-                    && view_still
+                if still_indirect
                     && moved > ACCUMULATE_CHANGE * luminance(clipped).max(luminance(light))
                 {
                     history.w = 0.0;
+                    restarted = true;
                 }
                 past = clipped;
             }
@@ -167,8 +199,16 @@ pub fn accumulate_cpu(inp: &AccumulateInputs<'_>, params: &AccumulateParams) -> 
                 params.max_frames.min(TAA_MOVING_FRAMES)
             };
             let frames = (history.w + 1.0).min(longest as f32);
-            out[i] = from_blend(past.lerp(light, 1.0 / frames), params).extend(frames);
+            let blended = past.lerp(light, 1.0 / frames);
+            out[i] = from_blend(blended, params).extend(frames);
+            if still_indirect && !restarted {
+                let innovation = luminance(radiance) - luminance(forecast);
+                let next = trend
+                    .lerp(blended - level, params.trend)
+                    .extend(noise + (innovation * innovation - noise) / frames);
+                state[i] = next.clamp(Vec4::splat(-HALF_MAX), Vec4::splat(HALF_MAX));
+            }
         }
     }
-    out
+    Accumulated { light: out, state }
 }
