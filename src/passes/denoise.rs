@@ -1,5 +1,5 @@
 //! The denoiser of the traced signals (issue 47): `specular_prep` and `denoise_atrous`
-//! (`shaders/specular_prep.comp`, `shaders/denoise_atrous.comp`, formulas in
+//! (`shaders/denoise_prep.comp`, `shaders/denoise_atrous.comp`, formulas in
 //! `shaders/include/denoise.glsl`; CPU twin [`crate::reference::denoise`]).
 //!
 //! At one sample per pixel (`--ssaa 1`, a host's real-time frame) the specular pass's two
@@ -48,19 +48,31 @@ use serde::{Deserialize, Serialize};
 use crate::declare::{Section, Settings};
 use crate::graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 use crate::passes::gbuffer::{GBuffer, View};
+use crate::passes::receivers::Receivers;
 use crate::shaders;
 
 /// Default à-trous iterations (tap spacing 1, 2, 4: a reach of 14 pixels).
 pub const ITERATIONS: u32 = 3;
 /// Iterations the settings take.
 pub const ITERATIONS_RANGE: RangeInclusive<u32> = 1..=5;
+/// The sky visibility's footprint radius (the gaussian's σ), in receivers: a stated radius,
+/// the sky pass keeps no hit distances (its open rays have none). `builtin:animated`'s room,
+/// against the same renderer at 1024 sky rays: radius 2, 3, 4 left 0.0625, 0.0576, 0.0575 of
+/// the orange wall (docs/quality.md).
+pub const SKY_RADIUS: f32 = 3.0;
+/// HVL's near field's footprint radius, in receivers: stated too (its rays reach only 2R, and
+/// the light they find changes within a few receivers; `builtin:motion-sun`, whose only
+/// traced diffuse signal it is: radius 2, 3, 4 left 0.0216, 0.0259, 0.0282 of the frame
+/// against the same renderer at 256 near rays).
+pub const NEAR_RADIUS: f32 = 2.0;
 
-/// `[denoise]`: the edge-stopping filter of the traced specular (issue 47): its parameters,
-/// each declared once.
+/// `[denoise]`: the edge-stopping filter of the traced signals (issue 47): the specular, the
+/// sky's visibility and HVL's near field; its parameters, each declared once.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Settings)]
 #[serde(default, deny_unknown_fields)]
 pub struct DenoiseParams {
-    /// Filter the traced specular (off: its samples as traced).
+    /// Filter the traced signals (off: the specular as traced, the sky and HVL's near field by
+    /// their joint bilateral).
     #[setting(default = true, affects = both)]
     pub enabled: bool,
     /// À-trous iterations; iteration i spaces its 5×5 taps 2^i pixels apart.
@@ -68,8 +80,14 @@ pub struct DenoiseParams {
     pub iterations: u32,
     /// Clamp fireflies: a pixel's luminance at most twice the largest of its 3×3 neighbours on
     /// the same surface.
+    /// (The specular's only: the diffuse signals' few rays leave neighbours at 0, and a lone
+    /// ray's real light would be cut.)
     #[setting(default = true, affects = quality)]
     pub clamp: bool,
+    /// Filter the sky's and HVL's near field's light too, with the diffuse footprint (off:
+    /// their joint bilateral, `sky.filter_radius`).
+    #[setting(default = true, affects = both)]
+    pub diffuse: bool,
 }
 
 /// What the denoiser refuses.
@@ -87,7 +105,7 @@ impl DenoiseParams {
     }
 }
 
-/// Push constants of `shaders/specular_prep.comp` (32 bytes).
+/// Push constants of `shaders/denoise_prep.comp` (32 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct PrepPush {
@@ -95,8 +113,9 @@ pub struct PrepPush {
     pub camera: [f32; 4],
     /// Image size.
     pub extent: [u32; 2],
-    /// Angle one pixel subtends at the eye ([`pixel_angle`]).
-    pub pixel_angle: f32,
+    /// The specular variant: the angle one pixel subtends at the eye ([`pixel_angle`]); the
+    /// diffuse one: the footprint radius in pixels ([`SKY_RADIUS`], [`NEAR_RADIUS`]).
+    pub footprint: f32,
     /// 1: the firefly clamp on.
     pub clamp: u32,
 }
@@ -137,61 +156,137 @@ pub fn specular(
     limit: f32,
     params: &DenoiseParams,
 ) -> Result<Handle<Image>, DenoiseError> {
+    let guide = Guide {
+        position: &g.position,
+        normal: &g.normal,
+        albedo: &g.albedo,
+        material: &g.material,
+        extent: g.extent,
+    };
+    let push = PrepPush {
+        camera: view.eye.extend(limit).to_array(),
+        extent: g.extent,
+        footprint: pixel_angle(view, g.extent[1]),
+        clamp: u32::from(params.clamp),
+    };
+    let signal = Signal {
+        names: ["specular_prep", "denoise_atrous", "specular_denoised"],
+        input: ("specular", specular),
+        prep: &shaders::DENOISE_PREP_COMP_SPECULAR,
+        atrous: &shaders::DENOISE_ATROUS_COMP_SPECULAR,
+    };
+    filter(rg, &guide, &signal, &push, params)
+}
+
+/// Adds a prep pass `names[0]` and à-trous iterations `names[1]_i` over `light` (the
+/// demodulated diffuse light, light / π, RGBA16F at receiver resolution: the sky's or HVL's
+/// near field's) guided by `receivers` seen from `camera`, in a footprint of `radius`
+/// receivers ([`SKY_RADIUS`], [`NEAR_RADIUS`]), without the firefly clamp: the filtered light times each receiver's `kd` (RGBA16F, a = 0), as
+/// [`crate::passes::sky::bilateral_filter`] does. Returns a new image `names[2]`.
+///
+/// At receiver resolution, where both signals are traced and summed before the upsample: each
+/// receiver holds its own rays, so neighbours' noise is independent there (at full resolution
+/// the upsample copies one receiver's noise into s × s pixels, which the 3×3 variance would
+/// read as signal), and the filter costs 1/s² of a full-resolution one.
+pub fn diffuse(
+    rg: &mut RenderGraph,
+    names: [&str; 3],
+    receivers: &Receivers,
+    light: &Handle<Image>,
+    camera: glam::Vec3,
+    radius: f32,
+    params: &DenoiseParams,
+) -> Result<Handle<Image>, DenoiseError> {
+    let guide = Guide {
+        position: &receivers.position,
+        normal: &receivers.normal,
+        albedo: &receivers.albedo,
+        material: &receivers.material,
+        extent: receivers.extent,
+    };
+    let push = PrepPush {
+        camera: camera.extend(0.0).to_array(),
+        extent: receivers.extent,
+        footprint: radius,
+        clamp: 0,
+    };
+    let signal = Signal {
+        names,
+        input: ("light", light),
+        prep: &shaders::DENOISE_PREP_COMP_DIFFUSE,
+        atrous: &shaders::DENOISE_ATROUS_COMP_DIFFUSE,
+    };
+    filter(rg, &guide, &signal, &push, params)
+}
+
+/// The guide images of a filter: a G-buffer's or the receivers' (same formats).
+struct Guide<'a> {
+    position: &'a Handle<Image>,
+    normal: &'a Handle<Image>,
+    albedo: &'a Handle<Image>,
+    material: &'a Handle<Image>,
+    extent: [u32; 2],
+}
+
+/// One traced signal through the filter: the prep pass's name, the iterations' (`_i` added),
+/// the output image's, the input's binding and image, and the two shaders' variants.
+struct Signal<'a> {
+    names: [&'a str; 3],
+    input: (&'a str, &'a Handle<Image>),
+    prep: &'static crate::gpu::ShaderDesc,
+    atrous: &'static crate::gpu::ShaderDesc,
+}
+
+/// Adds the prep pass and `params.iterations` à-trous iterations of `signal` over `guide`.
+fn filter(
+    rg: &mut RenderGraph,
+    guide: &Guide<'_>,
+    signal: &Signal<'_>,
+    push: &PrepPush,
+    params: &DenoiseParams,
+) -> Result<Handle<Image>, DenoiseError> {
     params.validate()?;
-    let [w, h] = g.extent;
-    let camera = view.eye.extend(limit).to_array();
+    let [w, h] = guide.extent;
     let image = |rg: &mut RenderGraph, name: &str| {
         rg.create_image(
             name,
             ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, w, h),
         )
     };
-    let mut signal = image(rg, "denoise_signal");
+    let mut filtered = image(rg, "denoise_signal");
     let mut radius = image(rg, "denoise_footprint");
-    rg.compute("specular_prep", &shaders::SPECULAR_PREP_COMP)
-        .read("specular", specular)
-        .read("gb_position", &g.position)
-        .read("gb_normal", &g.normal)
-        .read("gb_albedo", &g.albedo)
-        .read("gb_material", &g.material)
-        .write("denoise_signal", &mut signal)
+    let [prep_name, atrous_name, output] = signal.names;
+    let mut prep = rg.compute(prep_name, signal.prep);
+    prep.read(signal.input.0, signal.input.1)
+        .read("gb_position", guide.position)
+        .read("gb_normal", guide.normal);
+    if signal.prep.binding("gb_albedo").is_some() {
+        prep.read("gb_albedo", guide.albedo)
+            .read("gb_material", guide.material);
+    }
+    prep.write("denoise_signal", &mut filtered)
         .write("denoise_footprint", &mut radius)
-        .push(&PrepPush {
-            camera,
-            extent: g.extent,
-            pixel_angle: pixel_angle(view, h),
-            clamp: u32::from(params.clamp),
-        })
+        .push(push)
         .dispatch([w, h, 1]);
     for i in 0..params.iterations {
         let last = i + 1 == params.iterations;
-        let mut out = image(
-            rg,
-            if last {
-                "specular_denoised"
-            } else {
-                "denoise_signal"
-            },
-        );
-        rg.compute(
-            &format!("denoise_atrous_{i}"),
-            &shaders::DENOISE_ATROUS_COMP,
-        )
-        .read("denoise_in", &signal)
-        .read("denoise_footprint", &radius)
-        .read("gb_position", &g.position)
-        .read("gb_normal", &g.normal)
-        .read("gb_albedo", &g.albedo)
-        .read("gb_material", &g.material)
-        .write("denoise_out", &mut out)
-        .push(&AtrousPush {
-            camera,
-            extent: g.extent,
-            step: 1 << i,
-            remodulate: u32::from(last),
-        })
-        .dispatch([w, h, 1]);
-        signal = out;
+        let mut out = image(rg, if last { output } else { "denoise_signal" });
+        rg.compute(&format!("{atrous_name}_{i}"), signal.atrous)
+            .read("denoise_in", &filtered)
+            .read("denoise_footprint", &radius)
+            .read("gb_position", guide.position)
+            .read("gb_normal", guide.normal)
+            .read("gb_albedo", guide.albedo)
+            .read("gb_material", guide.material)
+            .write("denoise_out", &mut out)
+            .push(&AtrousPush {
+                camera: push.camera,
+                extent: guide.extent,
+                step: 1 << i,
+                remodulate: u32::from(last),
+            })
+            .dispatch([w, h, 1]);
+        filtered = out;
     }
-    Ok(signal)
+    Ok(filtered)
 }

@@ -331,8 +331,8 @@ impl Renderer {
                 near_radius,
                 sky_light::history_seed(rg, p),
                 camera.eye,
-                &p.upsample,
-            )),
+                sky_light::light_filter(p),
+            )?),
             _ => None,
         };
         let hvl_low = sum(rg, "hvl_near_add", hvl_low, near_light)?;
