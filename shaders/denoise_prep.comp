@@ -15,8 +15,9 @@
 //   equal weights), SVGF's guide of the luminance weight;
 // - the footprint radius in pixels: specular, denoise_radius from its roughness and the
 //   parallax d / (z + d) the specular pass stores in alpha, averaged over the same neighbours;
-//   diffuse, the signal's stated radius push.footprint (shine::passes::denoise::SKY_RADIUS,
-//   NEAR_RADIUS: the hemisphere's footprint; denoise.rs says why), with the normal tolerance
+//   diffuse (shine::passes::denoise::Footprint, which says why), a stated radius in pixels
+//   (the sky), or push.camera.w times the rays' mean hit distance the light holds in alpha,
+//   averaged so, through denoise_world_radius (HVL's near field); with the normal tolerance
 //   DENOISE_DIFFUSE_NORMAL_TOLERANCE and no roughness test.
 // The firefly clamp is the specular's (src/passes/denoise.rs passes clamp = 0 for the diffuse
 // signals: a few rays leave neighbours at 0, and a lone ray's real light would be cut).
@@ -46,12 +47,14 @@ layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D denoise_footprin
 
 // shine::passes::denoise::PrepPush (32 bytes).
 layout(push_constant) uniform Push {
-    // xyz: camera position; w: the specular pass's roughness limit
+    // xyz: camera position; w: `specular`, the specular pass's roughness limit; `diffuse`, the
+    // footprint's radius over the light's alpha, its rays' mean hit distance (0:
+    // push.footprint is the radius in pixels)
     vec4 camera;
     // image size
     uvec2 extent;
-    // `specular`: the angle one pixel subtends at the eye (perspective), radians; `diffuse`:
-    // the footprint radius in pixels
+    // `specular`, or `diffuse` from hit distances: the angle one pixel subtends at the eye
+    // (perspective), radians; else the footprint radius in pixels
     float footprint;
     // 1: the firefly clamp on
     uint clamp_fireflies;
@@ -80,8 +83,9 @@ Texel texel(ivec2 c) {
     t.traced = position.w > 0.0 && dot(n, n) > 0.0 && t.dist > 0.0;
     if (t.traced) {
         t.normal = normalize(n);
-        t.demodulated = imageLoad(light, c).rgb;
-        t.parallax = 0.0;
+        vec4 l = imageLoad(light, c);
+        t.demodulated = l.rgb;
+        t.parallax = l.a;
     }
     return t;
 #else
@@ -161,7 +165,9 @@ void main() {
     float mean = sum / count;
     float variance = max(sum2 / count - mean * mean, 0.0);
 #ifdef DIFFUSE
-    float radius = push.footprint;
+    float radius = push.camera.w > 0.0
+        ? denoise_world_radius(push.camera.w * parallax / count, centre.dist, push.footprint)
+        : push.footprint;
 #else
     float radius = denoise_radius(brdf_alpha(centre.roughness), parallax / count,
         push.footprint);

@@ -13,7 +13,8 @@
 //! - A lone firefly on the rough floor is gone; the rough region's mean is kept within 5%
 //!   (the clamp's loss stated); the error against the noise-free signal falls more than 2.5×.
 //! - Untraced and background pixels are 0.
-//! - Diffuse: GPU == twin within the same 2%; kd comes back per receiver (the colours' checker
+//! - Diffuse: GPU == twin within the same 2%, in the sky's footprint (pixels) and the near
+//!   field's (hit distances); in the sky's, kd comes back per receiver (the colours' checker
 //!   stays sharp); the error against the noise-free light falls more than 2.5× with the floor's
 //!   and the wall's means within 3%; next to the edge neither side takes the other's light
 //!   (within 10% of its own).
@@ -26,7 +27,7 @@ use common::{
 };
 use glam::{Mat4, Vec3, Vec4};
 use shine::graph::{Executor, ExternalState, Handle, Image, ImageDesc, RenderGraph, vk};
-use shine::passes::denoise::{self, DenoiseParams, pixel_angle};
+use shine::passes::denoise::{self, DenoiseParams, Footprint, pixel_angle};
 use shine::passes::gbuffer::{GBuffer, View};
 use shine::passes::receivers::Receivers;
 use shine::reference::denoise::{Guide, Signal, atrous, prep};
@@ -199,9 +200,15 @@ fn gpu(f: &Frame, params: &DenoiseParams) -> Vec<Vec4> {
     )
 }
 
-/// The twin of `signal` over `input`, rounding to f16 where the device stores an image; the
-/// G-buffer as stored.
-fn twin(f: &Frame, input: &[Vec4], signal: Signal, params: &DenoiseParams) -> Vec<Vec4> {
+/// The twin of `signal` over `input` (the diffuse one in `footprint`), rounding to f16 where
+/// the device stores an image; the G-buffer as stored.
+fn twin(
+    f: &Frame,
+    input: &[Vec4],
+    signal: Signal,
+    footprint: Footprint,
+    params: &DenoiseParams,
+) -> Vec<Vec4> {
     let unorm =
         |v: &[Vec4]| -> Vec<Vec4> { v.iter().map(|t| (*t * 255.0).round() / 255.0).collect() };
     let (albedo, material) = (unorm(&f.albedo), unorm(&f.material));
@@ -215,11 +222,14 @@ fn twin(f: &Frame, input: &[Vec4], signal: Signal, params: &DenoiseParams) -> Ve
         limit: LIMIT,
         signal,
     };
-    let (footprint, clamp) = match signal {
-        Signal::Specular => (pixel_angle(&view(), H), params.clamp),
-        Signal::Diffuse => (denoise::SKY_RADIUS, false),
+    let (footprint, hit_scale, clamp) = match (signal, footprint) {
+        (Signal::Specular, _) => (pixel_angle(&view(), H), 0.0, params.clamp),
+        (Signal::Diffuse, Footprint::Pixels(r)) => (r, 0.0, false),
+        (Signal::Diffuse, Footprint::HitDistance { scale, pixel_angle }) => {
+            (pixel_angle, scale, false)
+        }
     };
-    let (signal, radii) = prep(&g, input, footprint, clamp);
+    let (signal, radii) = prep(&g, input, footprint, hit_scale, clamp);
     let mut signal: Vec<Vec4> = signal.into_iter().map(q16).collect();
     let radii: Vec<f32> = radii.into_iter().map(|r| q16(Vec4::splat(r)).x).collect();
     for i in 0..params.iterations {
@@ -241,7 +251,13 @@ fn denoiser_matches_its_twin_and_keeps_mirrors_sharp() {
     let f = frame();
     let params = DenoiseParams::default();
     let got = gpu(&f, &params);
-    let want = twin(&f, &f.specular, Signal::Specular, &params);
+    let want = twin(
+        &f,
+        &f.specular,
+        Signal::Specular,
+        Footprint::Pixels(0.0),
+        &params,
+    );
     let mean = want.iter().map(|t| t.truncate().length()).sum::<f32>() / want.len() as f32;
     let mut worst = 0.0f32;
     for (i, (a, b)) in got.iter().zip(&want).enumerate() {
@@ -364,7 +380,9 @@ fn diffuse_frame() -> (Frame, Vec<Vec4>, Vec<Vec3>, Vec<Vec3>) {
             let n = f.normal[i].truncate().normalize();
             let t = diffuse_truth(x, n);
             let noise = 0.4 + 1.2 * hash01(y * W + x + 104_729);
-            light.push(q16(Vec3::splat(t * noise).extend(0.0)));
+            // The near field's mean hit distance in alpha (the sky's pass writes 0 there).
+            let hit = 0.05 + 0.5 * hash01(y * W + x + 15_485_863);
+            light.push(q16(Vec3::splat(t * noise).extend(hit)));
             let albedo = (checker(x, y) * 255.0).round() / 255.0;
             let v = (EYE - f.position[i].truncate()).normalize();
             let (kd, _) =
@@ -377,8 +395,14 @@ fn diffuse_frame() -> (Frame, Vec<Vec4>, Vec<Vec3>, Vec<Vec3>) {
     (f, light, kds, truth)
 }
 
-/// The diffuse denoiser's output on the device, the frame's G-buffer as the receivers.
-fn gpu_diffuse(f: &Frame, light: &[Vec4], params: &DenoiseParams) -> Vec<Vec4> {
+/// The diffuse denoiser's output on the device in `footprint`, the frame's G-buffer as the
+/// receivers.
+fn gpu_diffuse(
+    f: &Frame,
+    light: &[Vec4],
+    footprint: Footprint,
+    params: &DenoiseParams,
+) -> Vec<Vec4> {
     run_on_device(
         f,
         light,
@@ -397,7 +421,7 @@ fn gpu_diffuse(f: &Frame, light: &[Vec4], params: &DenoiseParams) -> Vec<Vec4> {
                 &receivers,
                 &light,
                 EYE,
-                denoise::SKY_RADIUS,
+                footprint,
                 params,
             )
             .expect("denoise")
@@ -409,16 +433,26 @@ fn gpu_diffuse(f: &Frame, light: &[Vec4], params: &DenoiseParams) -> Vec<Vec4> {
 fn diffuse_light_matches_its_twin_is_smoothed_and_keeps_edges_and_texture() {
     let (f, light, kd, truth) = diffuse_frame();
     let params = DenoiseParams::default();
-    let got = gpu_diffuse(&f, &light, &params);
-    let want = twin(&f, &light, Signal::Diffuse, &params);
-    let mean = want.iter().map(|t| t.truncate().length()).sum::<f32>() / want.len() as f32;
-    let mut worst = 0.0f32;
-    for (i, (a, b)) in got.iter().zip(&want).enumerate() {
-        let d = (a.truncate() - b.truncate()).length() / (b.truncate().length() + mean);
-        assert!(d < 0.02, "pixel {i}: GPU {a} twin {b}");
-        worst = worst.max(d);
+    let sky = Footprint::Pixels(denoise::SKY_RADIUS);
+    // The near field's footprint (its radius 1 to 16 pixels over this frame's hit distances).
+    let near = Footprint::HitDistance {
+        scale: denoise::NEAR_FOOTPRINT_PER_HIT,
+        pixel_angle: pixel_angle(&view(), H),
+    };
+    let mut got = Vec::new();
+    for footprint in [near, sky] {
+        got = gpu_diffuse(&f, &light, footprint, &params);
+        let want = twin(&f, &light, Signal::Diffuse, footprint, &params);
+        let mean = want.iter().map(|t| t.truncate().length()).sum::<f32>() / want.len() as f32;
+        let mut worst = 0.0f32;
+        for (i, (a, b)) in got.iter().zip(&want).enumerate() {
+            let d = (a.truncate() - b.truncate()).length() / (b.truncate().length() + mean);
+            assert!(d < 0.02, "{footprint:?}, pixel {i}: GPU {a} twin {b}");
+            worst = worst.max(d);
+        }
+        eprintln!("diffuse {footprint:?}: worst relative difference GPU vs twin: {worst:.5}");
     }
-    eprintln!("diffuse: worst relative difference GPU vs twin: {worst:.5}");
+    // The rest on the sky's footprint.
     for x in 0..W {
         assert_eq!(
             got[index(x, 0)].truncate(),

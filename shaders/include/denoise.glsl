@@ -53,6 +53,18 @@ const float DENOISE_MATCH = 0.25;
 // (paper 002 eq. 11) that the bilateral sky filter used.
 const float DENOISE_DIFFUSE_NORMAL_TOLERANCE = 0.03125;
 
+// Least radius of a diffuse footprint driven by hit distances, pixels (rays that meet a wall
+// at once still leave noise).
+const float DENOISE_DIFFUSE_MIN_RADIUS = 1.0;
+
+// A diffuse footprint of `world` units seen at distance `dist` from the eye, in pixels of angle
+// `pixel_angle`, between DENOISE_DIFFUSE_MIN_RADIUS and DENOISE_MAX_RADIUS: HVL's near field's,
+// `world` a multiple of its rays' mean hit distance (NRD's diffuse filters: light found close
+// by changes over that distance).
+float denoise_world_radius(float world, float dist, float pixel_angle) {
+    return clamp(world / (dist * pixel_angle), DENOISE_DIFFUSE_MIN_RADIUS, DENOISE_MAX_RADIUS);
+}
+
 // The reflected lobe's half-angle θ for GGX α: twice the half vector's angle.
 float denoise_lobe_angle(float alpha) {
     float t = alpha * sqrt(DENOISE_LOBE_FRACTION / (1.0 - DENOISE_LOBE_FRACTION));

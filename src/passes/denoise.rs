@@ -1,6 +1,9 @@
-//! The denoiser of the traced signals (issue 47): `specular_prep` and `denoise_atrous`
-//! (`shaders/denoise_prep.comp`, `shaders/denoise_atrous.comp`, formulas in
-//! `shaders/include/denoise.glsl`; CPU twin [`crate::reference::denoise`]).
+//! The denoiser of the traced signals (issue 47): a prep pass and `denoise_atrous`
+//! (`shaders/denoise_prep.comp`, `shaders/denoise_atrous.comp`, each in a `specular` and a
+//! `diffuse` variant; formulas in `shaders/include/denoise.glsl`; CPU twin
+//! [`crate::reference::denoise`]). One pass family for every traced part: the specular
+//! ([`specular`]: `specular_prep`, `denoise_atrous_i`), the sky's visibility and HVL's near
+//! field ([`diffuse`]: `sky_prep`, `sky_atrous_i`, `hvl_near_prep`, `hvl_near_atrous_i`).
 //!
 //! At one sample per pixel (`--ssaa 1`, a host's real-time frame) the specular pass's two
 //! reflection rays leave a rough metal salt-and-pepper and a glossy floor speckled. The filter
@@ -22,8 +25,23 @@
 //!    the variance filtered with the squared weights. The last iteration multiplies by
 //!    `share · ks` again.
 //!
+//! The **diffuse variant** takes the sky's `A · L̃(b) / π` and the near field's `E_near / π`,
+//! demodulated already (their receivers' `kd` comes back in the last iteration, so textures
+//! stay sharp), at receiver resolution, with a diffuse footprint ([`Footprint`]): for a
+//! cosine-weighted signal the "lobe" is the hemisphere, so no angle bounds the reach. The near
+//! field's radius is [`NEAR_FOOTPRINT_PER_HIT`] times its rays' mean hit distance (the pass
+//! writes it in alpha; NRD's diffuse filters do the same), seen from the eye; the sky's is a
+//! stated [`SKY_RADIUS`] receivers, since its open rays have no hit distance. The normal
+//! weight is the receivers' upsample match (`DENOISE_DIFFUSE_NORMAL_TOLERANCE`), no roughness
+//! test, no firefly clamp, and the luminance weight divides by the larger of the two pixels'
+//! deviations (symmetric; over the centre's alone, SVGF's, a few rays' skewed signal lost
+//! energy: the dark majority refuses the rare bright samples).
+//!
 //! Measured (docs/quality.md): `builtin:metals` at one sample, the gold sphere (roughness 0.3)
 //! 0.341 → 0.204 of the truth, the chrome one unchanged; 4–8% of a 256² frame on lavapipe.
+//! The diffuse variant against the bilateral, `builtin:animated` at one sample: the orange
+//! wall 0.145 → 0.143 of the truth (noise-free), 0.070 → 0.060 of the same renderer at 1024
+//! sky and 256 near rays.
 //!
 //! # Decisions
 //!
@@ -38,8 +56,14 @@
 //!   after the composite (`[history]`), and a single frame or a camera cut has none.
 //! * **Orthographic views** take the pixel's width over one metre as its angle (a
 //!   perspective stand-in; no built-in camera is orthographic).
-//! * The sky and HVL's near field keep their joint bilateral filter (`sky_filter.comp`) at
-//!   receiver resolution; this filter serves the full-resolution specular.
+//! * **The sky and HVL's near field go through this filter too** (`denoise.diffuse`, on by
+//!   default; off: their joint bilateral, `sky_filter.comp`, as before issue 47's second part).
+//!   It beat the bilateral on every scene measured, against the path-traced truth and against
+//!   the same renderer with many rays, and leaves no mottle on large matte walls.
+//! * **Receiver resolution** for the diffuse signals, where they are traced and summed before
+//!   the upsample: each receiver holds its own rays, so neighbours' noise is independent there
+//!   (at full resolution the upsample copies a receiver's noise into s × s pixels, which the
+//!   3×3 variance would take for signal), and it costs 1/s² of a full-resolution filter.
 
 use std::ops::RangeInclusive;
 
@@ -56,15 +80,34 @@ pub const ITERATIONS: u32 = 3;
 /// Iterations the settings take.
 pub const ITERATIONS_RANGE: RangeInclusive<u32> = 1..=5;
 /// The sky visibility's footprint radius (the gaussian's σ), in receivers: a stated radius,
-/// the sky pass keeps no hit distances (its open rays have none). `builtin:animated`'s room,
-/// against the same renderer at 1024 sky rays: radius 2, 3, 4 left 0.0625, 0.0576, 0.0575 of
-/// the orange wall (docs/quality.md).
+/// the sky pass keeps no hit distances (its open rays have none). Tried at 2, 3 and 4 with the
+/// near field at the same radius: `builtin:animated`'s orange wall against the same renderer
+/// at 1024 sky and 256 near rays 0.0625, 0.0576, 0.0575; 3, the smallest on that plateau.
 pub const SKY_RADIUS: f32 = 3.0;
-/// HVL's near field's footprint radius, in receivers: stated too (its rays reach only 2R, and
-/// the light they find changes within a few receivers; `builtin:motion-sun`, whose only
-/// traced diffuse signal it is: radius 2, 3, 4 left 0.0216, 0.0259, 0.0282 of the frame
-/// against the same renderer at 256 near rays).
-pub const NEAR_RADIUS: f32 = 2.0;
+/// HVL's near field's footprint radius over its rays' mean hit distance (world units, 2R
+/// for a ray that meets nothing; NRD's diffuse filters' hit-distance-driven radius: light found
+/// close by changes over that distance, so a corner keeps its gradient and an open floor is
+/// smoothed wide). Against the same renderer at 256 near rays: 0.25, 0.5, 1, 2 left
+/// `builtin:animated`'s orange wall at 0.071, 0.060, 0.058, 0.059 and `builtin:motion-sun`'s
+/// frame at 0.018, 0.024, 0.029, 0.032 (docs/quality.md).
+pub const NEAR_FOOTPRINT_PER_HIT: f32 = 0.5;
+
+/// The diffuse footprint's radius (the gaussian's σ).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Footprint {
+    /// A radius in pixels of the filtered image.
+    Pixels(f32),
+    /// `scale` times the rays' mean hit distance the light holds in alpha (averaged over the
+    /// 3×3 neighbours on the same surface), seen from the eye through pixels of angle
+    /// `pixel_angle` ([`pixel_angle`]): `denoise_world_radius`, at least
+    /// `DENOISE_DIFFUSE_MIN_RADIUS` pixels.
+    HitDistance {
+        /// The radius over the mean hit distance.
+        scale: f32,
+        /// The angle one pixel subtends at the eye.
+        pixel_angle: f32,
+    },
+}
 
 /// `[denoise]`: the edge-stopping filter of the traced signals (issue 47): the specular, the
 /// sky's visibility and HVL's near field; its parameters, each declared once.
@@ -109,12 +152,14 @@ impl DenoiseParams {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct PrepPush {
-    /// xyz: camera position; w: the specular pass's roughness limit.
+    /// xyz: camera position; w: the specular pass's roughness limit, or the diffuse
+    /// footprint's radius over the mean hit distance (0: the footprint is in pixels).
     pub camera: [f32; 4],
     /// Image size.
     pub extent: [u32; 2],
-    /// The specular variant: the angle one pixel subtends at the eye ([`pixel_angle`]); the
-    /// diffuse one: the footprint radius in pixels ([`SKY_RADIUS`], [`NEAR_RADIUS`]).
+    /// The specular variant, or the diffuse one from hit distances: the angle one pixel
+    /// subtends at the eye ([`pixel_angle`]); else the footprint radius in pixels
+    /// ([`Footprint`]).
     pub footprint: f32,
     /// 1: the firefly clamp on.
     pub clamp: u32,
@@ -180,8 +225,8 @@ pub fn specular(
 
 /// Adds a prep pass `names[0]` and à-trous iterations `names[1]_i` over `light` (the
 /// demodulated diffuse light, light / π, RGBA16F at receiver resolution: the sky's or HVL's
-/// near field's) guided by `receivers` seen from `camera`, in a footprint of `radius`
-/// receivers ([`SKY_RADIUS`], [`NEAR_RADIUS`]), without the firefly clamp: the filtered light times each receiver's `kd` (RGBA16F, a = 0), as
+/// near field's) guided by `receivers` seen from `camera`, in the footprint `footprint`,
+/// without the firefly clamp: the filtered light times each receiver's `kd` (RGBA16F, a = 0), as
 /// [`crate::passes::sky::bilateral_filter`] does. Returns a new image `names[2]`.
 ///
 /// At receiver resolution, where both signals are traced and summed before the upsample: each
@@ -194,7 +239,7 @@ pub fn diffuse(
     receivers: &Receivers,
     light: &Handle<Image>,
     camera: glam::Vec3,
-    radius: f32,
+    footprint: Footprint,
     params: &DenoiseParams,
 ) -> Result<Handle<Image>, DenoiseError> {
     let guide = Guide {
@@ -204,10 +249,14 @@ pub fn diffuse(
         material: &receivers.material,
         extent: receivers.extent,
     };
+    let (world, footprint) = match footprint {
+        Footprint::Pixels(radius) => (0.0, radius),
+        Footprint::HitDistance { scale, pixel_angle } => (scale.max(0.0), pixel_angle),
+    };
     let push = PrepPush {
-        camera: camera.extend(0.0).to_array(),
+        camera: camera.extend(world).to_array(),
         extent: receivers.extent,
-        footprint: radius,
+        footprint,
         clamp: 0,
     };
     let signal = Signal {

@@ -24,7 +24,8 @@
 //!   little sky is open (`animated`'s room, lit through its window), and a new seed every
 //!   frame made that noise flicker (docs/quality.md, "The sky's noise, filtered"). The filter
 //!   uses the upsample's bilateral match (paper 002 eq. 11), so it does not blur across
-//!   edges, and it leaves the albedo's texture alone.
+//!   edges, and it leaves the albedo's texture alone. The denoiser that replaced it by default
+//!   (issue 47) keeps both properties and smooths large matte walls further (docs/quality.md).
 //! * Not in frames with proxies: they shadow the environment themselves (paper 002). In every
 //!   other frame, `gi = none` included: light from the sky that scatters once is direct light
 //!   (as the path tracer counts it).
@@ -212,7 +213,7 @@ pub fn sky(
         &irradiance,
         camera,
         (params.filter_radius, SKY_SIGMA_PER_RADIUS),
-        denoise::SKY_RADIUS,
+        denoise::Footprint::Pixels(denoise::SKY_RADIUS),
     )?)
 }
 
@@ -231,7 +232,7 @@ impl LightFilter<'_> {
     /// Adds the filter of `light` over `receivers` seen from `camera`: passes
     /// `{label}_filter` (the bilateral) or `{label}_prep` and `{label}_atrous_i`, writing a
     /// new image `output`; `(radius, σ / radius)` are the bilateral's, `footprint` the
-    /// denoiser's radius in receivers. Returns the outgoing radiance (RGBA16F at receiver
+    /// denoiser's. Returns the outgoing radiance (RGBA16F at receiver
     /// resolution).
     pub fn apply(
         self,
@@ -241,7 +242,7 @@ impl LightFilter<'_> {
         light: &Handle<Image>,
         camera: glam::Vec3,
         bilateral: (u32, f32),
-        footprint: f32,
+        footprint: denoise::Footprint,
     ) -> Result<Handle<Image>, DenoiseError> {
         match self {
             Self::Bilateral(upsample) => Ok(bilateral_filter(

@@ -38,6 +38,14 @@ pub const MATCH: f32 = 0.25;
 pub const MIN_WEIGHT: f32 = 1e-3;
 /// `DENOISE_DIFFUSE_NORMAL_TOLERANCE`: the diffuse signal's normal tolerance 1 − cos φ.
 pub const DIFFUSE_NORMAL_TOLERANCE: f32 = 0.03125;
+/// `DENOISE_DIFFUSE_MIN_RADIUS`: least radius of a hit-distance footprint, pixels.
+pub const DIFFUSE_MIN_RADIUS: f32 = 1.0;
+
+/// `denoise_world_radius`: `world` units at `dist` from the eye in pixels of `pixel_angle`,
+/// within [`DIFFUSE_MIN_RADIUS`]..=[`MAX_RADIUS`].
+pub fn world_radius(world: f32, dist: f32, pixel_angle: f32) -> f32 {
+    (world / (dist * pixel_angle)).clamp(DIFFUSE_MIN_RADIUS, MAX_RADIUS)
+}
 
 /// Which traced signal the filter takes: the shaders' variants.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -261,8 +269,16 @@ impl Guide<'_> {
 /// `denoise_prep`: per pixel the demodulated, firefly-clamped (`clamp`) signal with its 3×3
 /// luminance variance in w, and the footprint radius in pixels (−1 where nothing is traced),
 /// from `input`: the specular pass's output (rgb radiance, a parallax) or the diffuse light
-/// (rgb light / π). `footprint`: the angle of a pixel (specular) or the radius (diffuse).
-pub fn prep(g: &Guide<'_>, input: &[Vec4], footprint: f32, clamp: bool) -> (Vec<Vec4>, Vec<f32>) {
+/// (rgb light / π, a the rays' mean hit distance where `hit_scale` > 0). `footprint` and
+/// `hit_scale` are the push constants': the angle of a pixel (specular, or diffuse with
+/// `hit_scale` > 0: the radius `hit_scale` times the mean hit distance) or the radius in pixels.
+pub fn prep(
+    g: &Guide<'_>,
+    input: &[Vec4],
+    footprint: f32,
+    hit_scale: f32,
+    clamp: bool,
+) -> (Vec<Vec4>, Vec<f32>) {
     let count = (g.extent[0] * g.extent[1]) as usize;
     let mut signal = vec![Vec4::ZERO; count];
     let mut radii = vec![-1.0; count];
@@ -308,6 +324,9 @@ pub fn prep(g: &Guide<'_>, input: &[Vec4], footprint: f32, clamp: bool) -> (Vec<
             signal[i] = storable(value.extend(variance));
             radii[i] = match g.signal {
                 Signal::Specular => radius(alpha(centre.roughness), parallax / n, footprint),
+                Signal::Diffuse if hit_scale > 0.0 => {
+                    world_radius(hit_scale * parallax / n, centre.dist, footprint)
+                }
                 Signal::Diffuse => footprint,
             };
         }

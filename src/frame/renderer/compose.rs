@@ -330,7 +330,7 @@ impl Renderer {
                 &near,
                 near_radius,
                 sky_light::history_seed(rg, p),
-                camera.eye,
+                camera,
                 sky_light::light_filter(p),
             )?),
             _ => None,

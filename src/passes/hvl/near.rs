@@ -11,7 +11,8 @@
 //! cosine-weighted rays up to `2R`, each hit sending `(1 − f(t))` of what it reflects from the
 //! punctual lights (next-event estimation with shadow rays). That is Kollig and Keller's bias
 //! compensation (2004, "Illumination in the presence of weak singularities") with a smooth
-//! boundary. The traced light is demodulated, filtered like the sky's
+//! boundary. The traced light is demodulated (with the rays' mean hit distance, which sets the
+//! denoiser's footprint), filtered like the sky's
 //! ([`crate::passes::sky::LightFilter`]: the à-trous denoiser's diffuse variant by default, or
 //! the joint bilateral; then `kd`), and added to the gather's. Diffuse only: the receiver's glossy lobe sees the near field through the HVLs
 //! alone.
@@ -19,7 +20,8 @@
 use std::ops::RangeInclusive;
 
 use crate::graph::{Handle, Image, RenderGraph};
-use crate::passes::denoise::DenoiseError;
+use crate::passes::denoise::{DenoiseError, Footprint, NEAR_FOOTPRINT_PER_HIT, pixel_angle};
+use crate::passes::gbuffer::View;
 use crate::passes::receivers::Receivers;
 use crate::passes::sky::LightFilter;
 use crate::passes::traced_scene::TracedScene;
@@ -90,7 +92,7 @@ pub fn hvl_near(
     near: &NearField,
     range: f32,
     seed: u32,
-    camera: glam::Vec3,
+    camera: &View,
     filter: LightFilter<'_>,
 ) -> Result<Handle<Image>, DenoiseError> {
     let [w, h] = receivers.extent;
@@ -115,8 +117,11 @@ pub fn hvl_near(
         ["hvl_near", "hvl_near_light"],
         receivers,
         &light,
-        camera,
+        camera.eye,
         (near.filter_radius, SIGMA_PER_RADIUS),
-        crate::passes::denoise::NEAR_RADIUS,
+        Footprint::HitDistance {
+            scale: NEAR_FOOTPRINT_PER_HIT,
+            pixel_angle: pixel_angle(camera, receivers.extent[1]),
+        },
     )
 }
