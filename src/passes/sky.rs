@@ -7,10 +7,10 @@
 //! the cosine-weighted sky visibility `A` (ambient occlusion, up to [`SkyParams::range`]; 0:
 //! the whole scene) and the bent normal `b` (the mean open direction), and the receiver sends
 //! `kd/π · A · L̃(b)` (`L̃` the environment's SH irradiance at 3 bands, paper 002 §3).
-//! The demodulated `A · L̃(b) / π` is filtered before it is multiplied by `kd` ([`LightFilter`]):
-//! by default by the traced signals' à-trous denoiser with its diffuse footprint
-//! ([`crate::passes::denoise::diffuse`], issue 47); with `denoise.diffuse = false` by the
-//! `sky_filter` pass (`shaders/sky_filter.comp`), the joint bilateral mean over
+//! The demodulated `A · L̃(b) / π` is filtered before it is multiplied by `kd`
+//! ([`LightFilter`]): by default by the traced signals' à-trous denoiser with its diffuse
+//! footprint ([`crate::passes::denoise::diffuse`], issue 47); with `denoise.diffuse = false`
+//! by the `sky_filter` pass (`shaders/sky_filter.comp`), the joint bilateral mean over
 //! [`SkyParams::filter_radius`] receivers around each one.
 //!
 //! # Decisions
@@ -20,12 +20,13 @@
 //!   the sky's radiance: with few rays the noise is in `A` alone, the colour and direction of
 //!   the sky come from the SH (exact for a uniform sky, `tests/sky.rs`).
 //! * A spatial filter of the demodulated light (issue 47 made it the à-trous denoiser's; the
-//!   bilateral below remains with `denoise.diffuse = false`): 16 rays leave the visibility noisy where
-//!   little sky is open (`animated`'s room, lit through its window), and a new seed every
-//!   frame made that noise flicker (docs/quality.md, "The sky's noise, filtered"). The filter
-//!   uses the upsample's bilateral match (paper 002 eq. 11), so it does not blur across
-//!   edges, and it leaves the albedo's texture alone. The denoiser that replaced it by default
-//!   (issue 47) keeps both properties and smooths large matte walls further (docs/quality.md).
+//!   bilateral below remains with `denoise.diffuse = false`): 16 rays leave the visibility
+//!   noisy where little sky is open (`animated`'s room, lit through its window), and a new
+//!   seed every frame made that noise flicker (docs/quality.md, "The sky's noise, filtered").
+//!   The filter uses the upsample's bilateral match (paper 002 eq. 11), so it does not blur
+//!   across edges, and it leaves the albedo's texture alone. The denoiser that replaced it by
+//!   default (issue 47) keeps both properties and smooths large matte walls further
+//!   (docs/quality.md).
 //! * Not in frames with proxies: they shadow the environment themselves (paper 002). In every
 //!   other frame, `gi = none` included: light from the sky that scatters once is direct light
 //!   (as the path tracer counts it).
@@ -81,8 +82,9 @@ pub struct SkyParams {
     #[serde(skip)]
     #[setting(default = 0)]
     pub seed: u32,
-    /// Radius in receivers of the joint bilateral filter of the sky's light (0: none; unused
-    /// by the cavity pass).
+    /// Radius in receivers of the joint bilateral filter of the sky's light, used with
+    /// `denoise.diffuse = false` or `denoise.enabled = false` (0: none; unused by the cavity
+    /// pass).
     #[setting(default = FILTER_RADIUS, range = FILTER_RADIUS_RANGE, affects = both)]
     pub filter_radius: u32,
 }
@@ -179,8 +181,9 @@ pub const SKY_SIGMA_PER_RADIUS: f32 = 0.5;
 
 /// Adds the `sky` pass and its filter over `receivers` seen from `camera`: the
 /// environment's SH (`environment`, `EnvironmentSh::gpu_data` at [`BANDS`] bands) times each
-/// receiver's sky visibility through `bvh`, filtered by `filter` and multiplied by `kd`. Returns the outgoing radiance (RGBA16F at receiver resolution).
-/// `seed` is added to the parameters' (the frame index when a history averages the frames).
+/// receiver's sky visibility through `bvh`, filtered by `filter` and multiplied by `kd`.
+/// Returns the outgoing radiance (RGBA16F at receiver resolution). `seed` is added to the
+/// parameters' (the frame index when a history averages the frames).
 #[allow(clippy::too_many_arguments)]
 pub fn sky(
     rg: &mut RenderGraph,

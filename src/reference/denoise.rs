@@ -1,7 +1,7 @@
 //! CPU twin of the traced signals' denoiser (issue 47): `shaders/include/denoise.glsl` (same
 //! names without the `denoise_` prefix), `shaders/denoise_prep.comp` ([`prep`]) and
-//! `shaders/denoise_atrous.comp` ([`atrous`]), both variants ([`Signal`]). `tests/denoise.rs` compares the passes with it;
-//! [`crate::passes::denoise`] explains the filter.
+//! `shaders/denoise_atrous.comp` ([`atrous`]), both variants ([`Signal`]). `tests/denoise.rs`
+//! compares the passes with it; [`crate::passes::denoise`] explains the filter.
 
 use glam::{Vec3, Vec4};
 
