@@ -350,7 +350,7 @@ fn fireflies_go_and_the_rough_floor_is_smoothed_with_its_mean_kept() {
 
 /// Albedo of receiver (x, y) in the diffuse test: a checker of 4-pixel squares in two colours.
 fn checker(x: u32, y: u32) -> Vec4 {
-    if (x / 4 + y / 4) % 2 == 0 {
+    if (x / 4 + y / 4).is_multiple_of(2) {
         Vec4::new(0.8, 0.3, 0.2, 1.0)
     } else {
         Vec4::new(0.2, 0.5, 0.8, 1.0)

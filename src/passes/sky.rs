@@ -215,8 +215,10 @@ pub fn sky(
         receivers,
         &irradiance,
         camera,
-        (params.filter_radius, SKY_SIGMA_PER_RADIUS),
-        denoise::Footprint::Pixels(denoise::SKY_RADIUS),
+        Reach {
+            bilateral: (params.filter_radius, SKY_SIGMA_PER_RADIUS),
+            footprint: denoise::Footprint::Pixels(denoise::SKY_RADIUS),
+        },
     )?)
 }
 
@@ -231,12 +233,20 @@ pub enum LightFilter<'a> {
     Denoise(&'a DenoiseParams),
 }
 
+/// How far each [`LightFilter`] reaches for one signal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reach {
+    /// The bilateral's radius in receivers and its gaussian's σ over the radius.
+    pub bilateral: (u32, f32),
+    /// The denoiser's footprint.
+    pub footprint: denoise::Footprint,
+}
+
 impl LightFilter<'_> {
     /// Adds the filter of `light` over `receivers` seen from `camera`: passes
     /// `{label}_filter` (the bilateral) or `{label}_prep` and `{label}_atrous_i`, writing a
-    /// new image `output`; `(radius, σ / radius)` are the bilateral's, `footprint` the
-    /// denoiser's. Returns the outgoing radiance (RGBA16F at receiver
-    /// resolution).
+    /// new image `output`, reaching as far as `reach` says. Returns the outgoing radiance
+    /// (RGBA16F at receiver resolution).
     pub fn apply(
         self,
         rg: &mut RenderGraph,
@@ -244,8 +254,7 @@ impl LightFilter<'_> {
         receivers: &Receivers,
         light: &Handle<Image>,
         camera: glam::Vec3,
-        bilateral: (u32, f32),
-        footprint: denoise::Footprint,
+        reach: Reach,
     ) -> Result<Handle<Image>, DenoiseError> {
         match self {
             Self::Bilateral(upsample) => Ok(bilateral_filter(
@@ -254,7 +263,7 @@ impl LightFilter<'_> {
                 receivers,
                 light,
                 camera,
-                bilateral,
+                reach.bilateral,
                 upsample,
             )),
             Self::Denoise(params) => denoise::diffuse(
@@ -263,7 +272,7 @@ impl LightFilter<'_> {
                 receivers,
                 light,
                 camera,
-                footprint,
+                reach.footprint,
                 params,
             ),
         }

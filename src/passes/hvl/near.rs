@@ -23,7 +23,7 @@ use crate::graph::{Handle, Image, RenderGraph};
 use crate::passes::denoise::{DenoiseError, Footprint, NEAR_FOOTPRINT_PER_HIT, pixel_angle};
 use crate::passes::gbuffer::View;
 use crate::passes::receivers::Receivers;
-use crate::passes::sky::LightFilter;
+use crate::passes::sky::{LightFilter, Reach};
 use crate::passes::traced_scene::TracedScene;
 use crate::shaders;
 
@@ -118,10 +118,12 @@ pub fn hvl_near(
         receivers,
         &light,
         camera.eye,
-        (near.filter_radius, SIGMA_PER_RADIUS),
-        Footprint::HitDistance {
-            scale: NEAR_FOOTPRINT_PER_HIT,
-            pixel_angle: pixel_angle(camera, receivers.extent[1]),
+        Reach {
+            bilateral: (near.filter_radius, SIGMA_PER_RADIUS),
+            footprint: Footprint::HitDistance {
+                scale: NEAR_FOOTPRINT_PER_HIT,
+                pixel_angle: pixel_angle(camera, receivers.extent[1]),
+            },
         },
     )
 }
