@@ -7,7 +7,15 @@
 // variance Σ w² var_q / (Σ w)² (SVGF eq. 6) for the next iteration's luminance weight. The
 // last iteration (push.remodulate) multiplies by the specular pass's share · ks again and
 // writes the radiance with a = 0. Untraced pixels (radius −1) neither give nor take.
+// Variant `diffuse` (the sky's and HVL's near field's light at receiver resolution): the
+// normal tolerance DENOISE_DIFFUSE_NORMAL_TOLERANCE, no roughness test, the luminance weight
+// over the larger of the two pixels' variances (symmetric: a few rays leave a skewed signal,
+// mostly dark with rare bright samples; over the centre's variance alone the dark majority
+// refuses the bright ones and the light loses energy), and the last iteration multiplies by
+// the receiver's kd (brdf_indirect_weights), as sky_filter.comp did.
 // CPU twin: shine::reference::denoise::atrous.
+//! variant specular
+//! variant diffuse DIFFUSE=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "brdf.glsl"
@@ -25,7 +33,7 @@ layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D denoise_out;
 
 // shine::passes::denoise::AtrousPush (32 bytes).
 layout(push_constant) uniform Push {
-    // xyz: camera position; w: the specular pass's roughness limit
+    // xyz: camera position; w: the specular pass's roughness limit (unused by `diffuse`)
     vec4 camera;
     // image size
     uvec2 extent;
@@ -52,7 +60,14 @@ void main() {
     vec2 material_p = imageLoad(gb_material, p).rg;
     float dist_p = length(push.camera.xyz - x_p);
     float l_p = luminance(centre.rgb);
+#ifdef DIFFUSE
+    // No roughness test: the diffuse light does not depend on it.
+    float rough_p = 0.0;
+    float tolerance = DENOISE_DIFFUSE_NORMAL_TOLERANCE;
+#else
+    float rough_p = material_p.x;
     float tolerance = denoise_normal_tolerance(brdf_alpha(material_p.x));
+#endif
     vec3 sum = vec3(0.0);
     float variance = 0.0;
     float weight_sum = 0.0;
@@ -70,11 +85,20 @@ void main() {
                 continue;
             }
             vec4 q = imageLoad(denoise_in, c);
+#ifdef DIFFUSE
+            float rough_q = 0.0;
+#else
+            float rough_q = imageLoad(gb_material, c).r;
+#endif
             float w = denoise_kernel(i) * denoise_kernel(j) * lobe
-                * denoise_geometry_weight(x_p, n_p, dist_p, material_p.x, tolerance,
+                * denoise_geometry_weight(x_p, n_p, dist_p, rough_p, tolerance,
                     imageLoad(gb_position, c).xyz, normalize(imageLoad(gb_normal, c).xyz),
-                    imageLoad(gb_material, c).r)
+                    rough_q)
+#ifdef DIFFUSE
+                * denoise_luminance_weight(l_p, luminance(q.rgb), max(centre.a, q.a));
+#else
                 * denoise_luminance_weight(l_p, luminance(q.rgb), centre.a);
+#endif
             if (w > 0.0) {
                 sum += w * q.rgb;
                 variance += w * w * q.a;
@@ -89,8 +113,12 @@ void main() {
         vec3 ks;
         brdf_indirect_weights(imageLoad(gb_albedo, p).rgb, material_p.y,
             dot(n_p, (push.camera.xyz - x_p) / dist_p), kd, ks);
+#ifdef DIFFUSE
+        imageStore(denoise_out, p, vec4(kd * value, 0.0));
+#else
         float share = specular_trace_weight(material_p.x, push.camera.w);
         imageStore(denoise_out, p, vec4(value * max(share * ks, vec3(DENOISE_MIN_WEIGHT)), 0.0));
+#endif
     } else {
         imageStore(denoise_out, p, denoise_storable(vec4(value, variance)));
     }

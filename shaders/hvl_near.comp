@@ -8,8 +8,9 @@
 // over N cosine-weighted rays (t_k < 2R), L the light the hit reflects towards the receiver
 // from the punctual lights (next-event estimation with shadow rays, path.glsl). Together they
 // are the split of Kollig and Keller's bias compensation (2004) at a smooth boundary. Writes
-// the demodulated light E_near / pi (RGBA16F, a = 0, 0 on background); sky_filter.comp filters
-// it and multiplies by kd.
+// the demodulated light E_near / pi (RGBA16F, 0 on background) and in a the rays' mean hit
+// distance (2R for a ray that meets nothing within 2R: the denoiser's footprint,
+// src/passes/denoise.rs); the denoiser (or sky_filter.comp) filters it and multiplies by kd.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
@@ -67,6 +68,7 @@ void main() {
     rng_state = pcg(pcg(xy.x ^ pcg(push.seed ^ 0x5bd1e995u)) + xy.y);
     vec2 rotation = vec2(rand(), rand());
     vec3 sum = vec3(0.0);
+    float reach = 0.0;
     for (uint s = 0u; s < push.rays; ++s) {
         vec2 xi = vec2(rand(), rand());
         if (s < strata * strata) {
@@ -75,8 +77,10 @@ void main() {
         vec3 d = sample_cosine(n, fract(xi + rotation));
         TraceHit hit;
         if (!trace_closest(origin, d, 0.0, 2.0 * range, hit)) {
+            reach += 2.0 * range;
             continue;
         }
+        reach += hit.t;
         float near = 1.0 - hvl_far_weight(hit.t, range);
         if (near <= 0.0) {
             continue;
@@ -86,5 +90,6 @@ void main() {
             sum += near * l;
         }
     }
-    imageStore(near_light, ixy, vec4(sum / float(max(push.rays, 1u)), 0.0));
+    float rays = float(max(push.rays, 1u));
+    imageStore(near_light, ixy, vec4(sum / rays, reach / rays));
 }

@@ -1,8 +1,10 @@
-//! The traced specular's denoiser (`specular_prep`, `denoise_atrous`; issue 47) on the Vulkan
+//! The traced signals' denoiser (`denoise_prep`, `denoise_atrous`; issue 47) on the Vulkan
 //! device (lavapipe in CI) against its CPU twin (`shine::reference::denoise`), with the
 //! validation layer reporting zero messages, on a synthetic G-buffer: a floor and a wall of
 //! gold, mirror-smooth, rough, fading and untraced columns, a noisy specular signal with
-//! fireflies.
+//! fireflies; and (the `diffuse` variant: the sky's and the near field's light) the same
+//! floor and wall as receivers, matte in two colours, under a noisy light that steps at the
+//! wall's edge.
 //!
 //! - GPU == twin within 2% of the pixel's value plus the image's mean (both round the signal
 //!   to f16 between iterations; 0.3% at worst when written).
@@ -11,6 +13,11 @@
 //! - A lone firefly on the rough floor is gone; the rough region's mean is kept within 5%
 //!   (the clamp's loss stated); the error against the noise-free signal falls more than 2.5×.
 //! - Untraced and background pixels are 0.
+//! - Diffuse: GPU == twin within the same 2%, in the sky's footprint (pixels) and the near
+//!   field's (hit distances); in the sky's, kd comes back per receiver (the colours' checker
+//!   stays sharp); the error against the noise-free light falls more than 2.5× with the floor's
+//!   and the wall's means within 3%; next to the edge neither side takes the other's light
+//!   (within 10% of its own).
 
 mod common;
 
@@ -19,10 +26,11 @@ use common::{
     run_graph, storage_image_with, transfer_storage, uploaded_state,
 };
 use glam::{Mat4, Vec3, Vec4};
-use shine::graph::{Executor, ExternalState, ImageDesc, RenderGraph, vk};
-use shine::passes::denoise::{self, DenoiseParams, pixel_angle};
+use shine::graph::{Executor, ExternalState, Handle, Image, ImageDesc, RenderGraph, vk};
+use shine::passes::denoise::{self, DenoiseParams, Footprint, pixel_angle};
 use shine::passes::gbuffer::{GBuffer, View};
-use shine::reference::denoise::{Guide, atrous, specular_prep};
+use shine::passes::receivers::Receivers;
+use shine::reference::denoise::{Guide, Signal, atrous, prep};
 
 const W: u32 = 40;
 const H: u32 = 32;
@@ -117,8 +125,13 @@ fn view() -> View {
     }
 }
 
-/// The denoiser's output on the device.
-fn gpu(f: &Frame, params: &DenoiseParams) -> Vec<Vec4> {
+/// The denoiser's output on the device: `f`'s G-buffer and `input` uploaded, `filter` adding
+/// the passes over them (position, normal, albedo, material, input).
+fn run_on_device(
+    f: &Frame,
+    input: &[Vec4],
+    filter: impl FnOnce(&mut RenderGraph, [Handle<Image>; 5]) -> Handle<Image>,
+) -> Vec<Vec4> {
     let device = device();
     let e = [W, H];
     let rgba16 = vk::Format::R16G16B16A16_SFLOAT;
@@ -145,27 +158,15 @@ fn gpu(f: &Frame, params: &DenoiseParams) -> Vec<Vec4> {
             e,
             &bytes_unorm8(&f.material),
         ),
-        storage_image_with(&device, "specular", rgba16, e, &bytes_f16(&f.specular)),
+        storage_image_with(&device, "input", rgba16, e, &bytes_f16(input)),
     ];
     let readback = transfer_storage(&device, "readback", u64::from(W * H) * 8, None);
     let mut executor = Executor::new(&device, 1).expect("executor");
     let mut rg: RenderGraph = executor.begin_frame();
-    let [position, normal, albedo, material, specular] = images
+    let handles = images
         .each_ref()
         .map(|i| rg.import_gpu_image(i, uploaded_state(), ExternalState::UNDEFINED));
-    let mut unused = |name: &str, format| rg.create_image(name, ImageDesc::new_2d(format, W, H));
-    let g = GBuffer {
-        position,
-        normal,
-        albedo,
-        material,
-        emissive: unused("unused emissive", rgba16),
-        geometric_normal: unused("unused geometric normal", rgba16),
-        motion: unused("unused motion", shine::passes::gbuffer::MOTION_FORMAT),
-        depth: unused("unused depth", vk::Format::D32_SFLOAT),
-        extent: e,
-    };
-    let out = denoise::specular(&mut rg, &g, &specular, &view(), LIMIT, params).expect("denoise");
+    let out = filter(&mut rg, handles);
     let mut back = rg.import_gpu_buffer(&readback, ExternalState::UNDEFINED, read_by_copy());
     rg.copy_image_to_buffer("read denoised", &out, &mut back);
     run_graph(&device, &mut executor, rg);
@@ -174,8 +175,40 @@ fn gpu(f: &Frame, params: &DenoiseParams) -> Vec<Vec4> {
     texels
 }
 
-/// The twin, rounding to f16 where the device stores an image; the G-buffer as stored.
-fn cpu(f: &Frame, params: &DenoiseParams) -> Vec<Vec4> {
+/// The specular denoiser's output on the device.
+fn gpu(f: &Frame, params: &DenoiseParams) -> Vec<Vec4> {
+    run_on_device(
+        f,
+        &f.specular,
+        |rg, [position, normal, albedo, material, specular]| {
+            let rgba16 = vk::Format::R16G16B16A16_SFLOAT;
+            let mut unused =
+                |name: &str, format| rg.create_image(name, ImageDesc::new_2d(format, W, H));
+            let g = GBuffer {
+                position,
+                normal,
+                albedo,
+                material,
+                emissive: unused("unused emissive", rgba16),
+                geometric_normal: unused("unused geometric normal", rgba16),
+                motion: unused("unused motion", shine::passes::gbuffer::MOTION_FORMAT),
+                depth: unused("unused depth", vk::Format::D32_SFLOAT),
+                extent: [W, H],
+            };
+            denoise::specular(rg, &g, &specular, &view(), LIMIT, params).expect("denoise")
+        },
+    )
+}
+
+/// The twin of `signal` over `input` (the diffuse one in `footprint`), rounding to f16 where
+/// the device stores an image; the G-buffer as stored.
+fn twin(
+    f: &Frame,
+    input: &[Vec4],
+    signal: Signal,
+    footprint: Footprint,
+    params: &DenoiseParams,
+) -> Vec<Vec4> {
     let unorm =
         |v: &[Vec4]| -> Vec<Vec4> { v.iter().map(|t| (*t * 255.0).round() / 255.0).collect() };
     let (albedo, material) = (unorm(&f.albedo), unorm(&f.material));
@@ -187,8 +220,16 @@ fn cpu(f: &Frame, params: &DenoiseParams) -> Vec<Vec4> {
         material: &material,
         camera: EYE,
         limit: LIMIT,
+        signal,
     };
-    let (signal, radii) = specular_prep(&g, &f.specular, pixel_angle(&view(), H), params.clamp);
+    let (footprint, hit_scale, clamp) = match (signal, footprint) {
+        (Signal::Specular, _) => (pixel_angle(&view(), H), 0.0, params.clamp),
+        (Signal::Diffuse, Footprint::Pixels(r)) => (r, 0.0, false),
+        (Signal::Diffuse, Footprint::HitDistance { scale, pixel_angle }) => {
+            (pixel_angle, scale, false)
+        }
+    };
+    let (signal, radii) = prep(&g, input, footprint, hit_scale, clamp);
     let mut signal: Vec<Vec4> = signal.into_iter().map(q16).collect();
     let radii: Vec<f32> = radii.into_iter().map(|r| q16(Vec4::splat(r)).x).collect();
     for i in 0..params.iterations {
@@ -210,7 +251,13 @@ fn denoiser_matches_its_twin_and_keeps_mirrors_sharp() {
     let f = frame();
     let params = DenoiseParams::default();
     let got = gpu(&f, &params);
-    let want = cpu(&f, &params);
+    let want = twin(
+        &f,
+        &f.specular,
+        Signal::Specular,
+        Footprint::Pixels(0.0),
+        &params,
+    );
     let mean = want.iter().map(|t| t.truncate().length()).sum::<f32>() / want.len() as f32;
     let mut worst = 0.0f32;
     for (i, (a, b)) in got.iter().zip(&want).enumerate() {
@@ -298,5 +345,168 @@ fn fireflies_go_and_the_rough_floor_is_smoothed_with_its_mean_kept() {
     assert!(
         lum(spread[index(20, 24)]) > firefly,
         "the clamp removed nothing"
+    );
+}
+
+/// Albedo of receiver (x, y) in the diffuse test: a checker of 4-pixel squares in two colours.
+fn checker(x: u32, y: u32) -> Vec4 {
+    if (x / 4 + y / 4).is_multiple_of(2) {
+        Vec4::new(0.8, 0.3, 0.2, 1.0)
+    } else {
+        Vec4::new(0.2, 0.5, 0.8, 1.0)
+    }
+}
+
+/// The noise-free demodulated light (light / π) at column x on a surface of normal n: the
+/// wall three times the floor, so the edge between them is a step.
+fn diffuse_truth(x: u32, n: Vec3) -> f32 {
+    let base = if n.y > 0.5 { 0.5 } else { 1.5 };
+    base * (1.0 + 0.3 * (x as f32 * 0.2).sin())
+}
+
+/// The diffuse test's frame: `frame()`'s floor and wall, matte (metallic 0) in the checker's
+/// colours, the light the truth times a noise factor of mean 1 (0.4..1.6); returns it, the
+/// light, each receiver's kd and the noise-free outgoing light kd · truth.
+fn diffuse_frame() -> (Frame, Vec<Vec4>, Vec<Vec3>, Vec<Vec3>) {
+    let mut f = frame();
+    let mut light = Vec::new();
+    let mut kds = Vec::new();
+    let mut truth = Vec::new();
+    for y in 0..H {
+        for x in 0..W {
+            let i = index(x, y);
+            f.albedo[i] = checker(x, y);
+            f.material[i].y = 0.0;
+            let n = f.normal[i].truncate().normalize();
+            let t = diffuse_truth(x, n);
+            let noise = 0.4 + 1.2 * hash01(y * W + x + 104_729);
+            // The near field's mean hit distance in alpha (the sky's pass writes 0 there).
+            let hit = 0.05 + 0.5 * hash01(y * W + x + 15_485_863);
+            light.push(q16(Vec3::splat(t * noise).extend(hit)));
+            let albedo = (checker(x, y) * 255.0).round() / 255.0;
+            let v = (EYE - f.position[i].truncate()).normalize();
+            let (kd, _) =
+                shine::passes::brdf_tables::indirect_weights(albedo.truncate(), 0.0, n.dot(v));
+            let kd = if y == 0 { Vec3::ZERO } else { kd };
+            kds.push(kd);
+            truth.push(kd * t);
+        }
+    }
+    (f, light, kds, truth)
+}
+
+/// The diffuse denoiser's output on the device in `footprint`, the frame's G-buffer as the
+/// receivers.
+fn gpu_diffuse(
+    f: &Frame,
+    light: &[Vec4],
+    footprint: Footprint,
+    params: &DenoiseParams,
+) -> Vec<Vec4> {
+    run_on_device(
+        f,
+        light,
+        |rg, [position, normal, albedo, material, light]| {
+            let receivers = Receivers {
+                position,
+                normal,
+                albedo,
+                material,
+                extent: [W, H],
+                scale: 1,
+            };
+            denoise::diffuse(
+                rg,
+                ["test_prep", "test_atrous", "test_light"],
+                &receivers,
+                &light,
+                EYE,
+                footprint,
+                params,
+            )
+            .expect("denoise")
+        },
+    )
+}
+
+#[test]
+fn diffuse_light_matches_its_twin_is_smoothed_and_keeps_edges_and_texture() {
+    let (f, light, kd, truth) = diffuse_frame();
+    let params = DenoiseParams::default();
+    let sky = Footprint::Pixels(denoise::SKY_RADIUS);
+    // The near field's footprint (its radius 1 to 16 pixels over this frame's hit distances).
+    let near = Footprint::HitDistance {
+        scale: denoise::NEAR_FOOTPRINT_PER_HIT,
+        pixel_angle: pixel_angle(&view(), H),
+    };
+    let mut got = Vec::new();
+    for footprint in [near, sky] {
+        got = gpu_diffuse(&f, &light, footprint, &params);
+        let want = twin(&f, &light, Signal::Diffuse, footprint, &params);
+        let mean = want.iter().map(|t| t.truncate().length()).sum::<f32>() / want.len() as f32;
+        let mut worst = 0.0f32;
+        for (i, (a, b)) in got.iter().zip(&want).enumerate() {
+            let d = (a.truncate() - b.truncate()).length() / (b.truncate().length() + mean);
+            assert!(d < 0.02, "{footprint:?}, pixel {i}: GPU {a} twin {b}");
+            worst = worst.max(d);
+        }
+        eprintln!("diffuse {footprint:?}: worst relative difference GPU vs twin: {worst:.5}");
+    }
+    // The rest on the sky's footprint.
+    for x in 0..W {
+        assert_eq!(
+            got[index(x, 0)].truncate(),
+            Vec3::ZERO,
+            "background ({x}, 0)"
+        );
+    }
+
+    // The raw frame is kd times the noisy light; both against kd times the truth.
+    let lum = |v: Vec3| v.dot(Vec3::new(0.2126, 0.7152, 0.0722));
+    let pixels: Vec<usize> = (W as usize..(W * H) as usize).collect();
+    let error = |v: &dyn Fn(usize) -> Vec3| {
+        let e: f32 = pixels
+            .iter()
+            .map(|&i| (v(i) - truth[i]).length_squared() / truth[i].length_squared())
+            .sum();
+        (e / pixels.len() as f32).sqrt()
+    };
+    let raw = error(&|i| kd[i] * light[i].truncate());
+    let filtered = error(&|i| got[i].truncate());
+    eprintln!("diffuse: relative rms error {raw:.4} -> {filtered:.4}");
+    assert!(filtered < raw / 2.5, "rms error {raw} -> {filtered}");
+
+    // Each surface keeps its mean, and next to the edge neither side takes the other's light.
+    let floor = |i: usize| f.normal[i].y > 0.5;
+    let ratio = |keep: &dyn Fn(usize) -> bool| {
+        let (mut a, mut b) = (0.0f32, 0.0f32);
+        for &i in pixels.iter().filter(|&&i| keep(i)) {
+            a += lum(got[i].truncate());
+            b += lum(truth[i]);
+        }
+        a / b
+    };
+    let (floor_mean, wall_mean) = (ratio(&|i| floor(i)), ratio(&|i| !floor(i)));
+    eprintln!("diffuse: mean over the truth, floor {floor_mean:.4}, wall {wall_mean:.4}");
+    assert!((floor_mean - 1.0).abs() < 0.03, "floor mean {floor_mean}");
+    assert!((wall_mean - 1.0).abs() < 0.03, "wall mean {wall_mean}");
+    // The edge's rows: the floor's first two below the wall, the wall's last two above it.
+    let edge = |i: usize, below: bool| {
+        let (x, y) = (i as u32 % W, i as u32 / W);
+        let other = |dy: i32| {
+            let yy = y as i32 + dy;
+            (1..H as i32).contains(&yy) && floor(index(x, yy as u32)) != floor(i)
+        };
+        (floor(i) == below) && (other(-1) || other(-2) || other(1) || other(2))
+    };
+    let (floor_edge, wall_edge) = (ratio(&|i| edge(i, true)), ratio(&|i| edge(i, false)));
+    eprintln!("diffuse: at the edge, floor {floor_edge:.4}, wall {wall_edge:.4}");
+    assert!(
+        (floor_edge - 1.0).abs() < 0.1,
+        "floor at the edge {floor_edge}"
+    );
+    assert!(
+        (wall_edge - 1.0).abs() < 0.1,
+        "wall at the edge {wall_edge}"
     );
 }

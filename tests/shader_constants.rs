@@ -337,6 +337,10 @@ fn denoise_constants_match_the_shader() {
         ("DENOISE_ROUGHNESS_SIGMA", d::ROUGHNESS_SIGMA),
         ("DENOISE_LUMINANCE_SIGMA", d::LUMINANCE_SIGMA),
         ("DENOISE_MIN_WEIGHT", d::MIN_WEIGHT),
+        (
+            "DENOISE_DIFFUSE_NORMAL_TOLERANCE",
+            d::DIFFUSE_NORMAL_TOLERANCE,
+        ),
         ("DENOISE_FIREFLY_RATIO", d::FIREFLY_RATIO),
         ("DENOISE_MATCH", d::MATCH),
         ("DENOISE_LUMINANCE_EPSILON", d::LUMINANCE_EPSILON),

@@ -40,24 +40,27 @@ fn scene() -> Scene {
 }
 
 fn frame(device: &shine::gpu::Device, scene: &Scene, sky: bool) -> HdrImage {
-    frame_with(device, scene, sky, 256, shine::passes::sky::FILTER_RADIUS)
+    frame_with(device, scene, sky, 256, None)
 }
 
-/// The frame with `rays` sky rays per receiver and the sky filter's radius `filter`.
+/// The frame with `rays` sky rays per receiver, filtered by the denoiser (`None`, the default)
+/// or by the joint bilateral of radius `Some(r)` (`denoise.diffuse = false`; 0: unfiltered).
 fn frame_with(
     device: &shine::gpu::Device,
     scene: &Scene,
     sky: bool,
     rays: u32,
-    filter: u32,
+    bilateral: Option<u32>,
 ) -> HdrImage {
+    let radius = bilateral.unwrap_or(shine::passes::sky::FILTER_RADIUS);
     let s = common::scenes::settings(
         SIZE,
         &[
             ("gi", "hvl"),
             ("sky.enabled", &sky.to_string()),
             ("sky.rays", &rays.to_string()),
-            ("sky.filter_radius", &filter.to_string()),
+            ("sky.filter_radius", &radius.to_string()),
+            ("denoise.diffuse", &bilateral.is_none().to_string()),
         ],
     );
     common::scenes::render_once(device, scene, &s)
@@ -122,16 +125,16 @@ fn the_sky_lights_the_floor_around_the_balls_shadow() {
     common::assert_clean(&device);
 }
 
-/// The sky filter: with 4 rays per receiver, the filtered floor is at least twice as close to
-/// the 1024-ray unfiltered floor as the unfiltered one (relative RMSE), and keeps its light
-/// to 2%.
+/// The sky's filters, the joint bilateral (`denoise.diffuse = false`) and the denoiser (the
+/// default): with 4 rays per receiver, each filtered floor is at least twice as close to the
+/// 1024-ray unfiltered floor as the unfiltered one (relative RMSE), and keeps its light to 2%.
 #[test]
 fn the_sky_filter_cuts_the_noise_and_keeps_the_light() {
     let device = common::device();
     let scene = scene();
     let pixels = floor_pixels(&device, &scene);
     let floor = |rays, filter| luminance(&frame_with(&device, &scene, true, rays, filter), &pixels);
-    let clean = floor(1024, 0);
+    let clean = floor(1024, Some(0));
     let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
     let error = |v: &[f64]| {
         (v.iter()
@@ -142,15 +145,21 @@ fn the_sky_filter_cuts_the_noise_and_keeps_the_light() {
             .sqrt()
             / mean(&clean)
     };
-    let (raw, filtered) = (floor(4, 0), floor(4, shine::passes::sky::FILTER_RADIUS));
-    let energy = mean(&filtered) / mean(&clean);
-    println!(
-        "4 rays: relative RMSE {:.4} unfiltered, {:.4} filtered; energy {energy:.4}",
-        error(&raw),
-        error(&filtered)
-    );
-    assert!(error(&filtered) < 0.5 * error(&raw));
-    assert!((energy - 1.0).abs() < 0.02, "energy {energy}");
+    let raw = floor(4, Some(0));
+    for (name, filter) in [
+        ("bilateral", Some(shine::passes::sky::FILTER_RADIUS)),
+        ("denoised", None),
+    ] {
+        let filtered = floor(4, filter);
+        let energy = mean(&filtered) / mean(&clean);
+        println!(
+            "4 rays: relative RMSE {:.4} unfiltered, {:.4} {name}; energy {energy:.4}",
+            error(&raw),
+            error(&filtered)
+        );
+        assert!(error(&filtered) < 0.5 * error(&raw), "{name}");
+        assert!((energy - 1.0).abs() < 0.02, "{name}: energy {energy}");
+    }
     common::assert_clean(&device);
 }
 

@@ -46,6 +46,25 @@ const float DENOISE_HALF_MAX = 65504.0;
 // least this.
 const float DENOISE_MATCH = 0.25;
 
+// The diffuse signals' normal tolerance 1 − cos φ (the sky's visibility, HVL's near field).
+// Their "lobe" is the hemisphere, whose width would mix two walls at their corner, where the
+// visibility and the near light change; so the receivers' own match instead:
+// exp(−(1 − n_p·n_q) / t) ≈ (n_p·n_q)^(1/t), and 1/32 is the upsample's normal power 32
+// (paper 002 eq. 11) that the bilateral sky filter used.
+const float DENOISE_DIFFUSE_NORMAL_TOLERANCE = 0.03125;
+
+// Least radius of a diffuse footprint driven by hit distances, pixels (rays that meet a wall
+// at once still leave noise).
+const float DENOISE_DIFFUSE_MIN_RADIUS = 1.0;
+
+// A diffuse footprint of `world` units seen at distance `dist` from the eye, in pixels of angle
+// `pixel_angle`, between DENOISE_DIFFUSE_MIN_RADIUS and DENOISE_MAX_RADIUS: HVL's near field's,
+// `world` a multiple of its rays' mean hit distance (NRD's diffuse filters: light found close
+// by changes over that distance).
+float denoise_world_radius(float world, float dist, float pixel_angle) {
+    return clamp(world / (dist * pixel_angle), DENOISE_DIFFUSE_MIN_RADIUS, DENOISE_MAX_RADIUS);
+}
+
 // The reflected lobe's half-angle θ for GGX α: twice the half vector's angle.
 float denoise_lobe_angle(float alpha) {
     float t = alpha * sqrt(DENOISE_LOBE_FRACTION / (1.0 - DENOISE_LOBE_FRACTION));
@@ -111,7 +130,8 @@ float denoise_geometry_weight(vec3 x_p, vec3 n_p, float dist_p, float rough_p, f
     return exp(-plane - normal - abs(rough_p - rough_q) / DENOISE_ROUGHNESS_SIGMA);
 }
 
-// SVGF's luminance weight: exp(−|l_p − l_q| / (σ_l sqrt(var_p) + ε)).
+// SVGF's luminance weight: exp(−|l_p − l_q| / (σ_l sqrt(var_p) + ε)) (the diffuse variant
+// passes max(var_p, var_q): denoise_atrous.comp).
 float denoise_luminance_weight(float l_p, float l_q, float variance) {
     return exp(-abs(l_p - l_q) / (DENOISE_LUMINANCE_SIGMA * sqrt(max(variance, 0.0)) + DENOISE_LUMINANCE_EPSILON));
 }

@@ -7,9 +7,11 @@
 //! the cosine-weighted sky visibility `A` (ambient occlusion, up to [`SkyParams::range`]; 0:
 //! the whole scene) and the bent normal `b` (the mean open direction), and the receiver sends
 //! `kd/π · A · L̃(b)` (`L̃` the environment's SH irradiance at 3 bands, paper 002 §3).
-//! The `sky_filter` pass (`shaders/sky_filter.comp`) takes the joint bilateral mean of
-//! `A · L̃(b) / π` over [`SkyParams::filter_radius`] receivers around each one before it
-//! multiplies by `kd`.
+//! The demodulated `A · L̃(b) / π` is filtered before it is multiplied by `kd`
+//! ([`LightFilter`]): by default by the traced signals' à-trous denoiser with its diffuse
+//! footprint ([`crate::passes::denoise::diffuse`], issue 47); with `denoise.diffuse = false`
+//! by the `sky_filter` pass (`shaders/sky_filter.comp`), the joint bilateral mean over
+//! [`SkyParams::filter_radius`] receivers around each one.
 //!
 //! # Decisions
 //!
@@ -17,11 +19,14 @@
 //! * Visibility times the unshadowed irradiance at the bent normal rather than a traced sum of
 //!   the sky's radiance: with few rays the noise is in `A` alone, the colour and direction of
 //!   the sky come from the SH (exact for a uniform sky, `tests/sky.rs`).
-//! * A spatial filter of the demodulated light: 16 rays leave the visibility noisy where
-//!   little sky is open (`animated`'s room, lit through its window), and a new seed every
-//!   frame made that noise flicker (docs/quality.md, "The sky's noise, filtered"). The filter
-//!   uses the upsample's bilateral match (paper 002 eq. 11), so it does not blur across
-//!   edges, and it leaves the albedo's texture alone.
+//! * A spatial filter of the demodulated light (issue 47 made it the à-trous denoiser's; the
+//!   bilateral below remains with `denoise.diffuse = false`): 16 rays leave the visibility
+//!   noisy where little sky is open (`animated`'s room, lit through its window), and a new
+//!   seed every frame made that noise flicker (docs/quality.md, "The sky's noise, filtered").
+//!   The filter uses the upsample's bilateral match (paper 002 eq. 11), so it does not blur
+//!   across edges, and it leaves the albedo's texture alone. The denoiser that replaced it by
+//!   default (issue 47) keeps both properties and smooths large matte walls further
+//!   (docs/quality.md).
 //! * Not in frames with proxies: they shadow the environment themselves (paper 002). In every
 //!   other frame, `gi = none` included: light from the sky that scatters once is direct light
 //!   (as the path tracer counts it).
@@ -34,6 +39,7 @@ use crate::declare::{Section, Settings};
 
 use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, Handle, Image, RenderGraph};
+use crate::passes::denoise::{self, DenoiseError, DenoiseParams};
 use crate::passes::receivers::Receivers;
 use crate::passes::upsample::UpsampleParams;
 use crate::shaders;
@@ -76,8 +82,9 @@ pub struct SkyParams {
     #[serde(skip)]
     #[setting(default = 0)]
     pub seed: u32,
-    /// Radius in receivers of the joint bilateral filter of the sky's light (0: none; unused
-    /// by the cavity pass).
+    /// Radius in receivers of the joint bilateral filter of the sky's light, used with
+    /// `denoise.diffuse = false` or `denoise.enabled = false` (0: none; unused by the cavity
+    /// pass).
     #[setting(default = FILTER_RADIUS, range = FILTER_RADIUS_RANGE, affects = both)]
     pub filter_radius: u32,
 }
@@ -118,6 +125,9 @@ pub enum SkyError {
     /// A parameter out of its range.
     #[error("sky: {0}")]
     OutOfRange(#[from] crate::declare::OutOfRange),
+    /// The denoiser refused its parameters.
+    #[error(transparent)]
+    Denoise(#[from] DenoiseError),
 }
 
 impl SkyParams {
@@ -169,11 +179,11 @@ pub struct SkyFilterPush {
 /// σ of the sky filter's gaussian over its radius.
 pub const SKY_SIGMA_PER_RADIUS: f32 = 0.5;
 
-/// Adds the `sky` and `sky_filter` passes over `receivers` seen from `camera`: the
+/// Adds the `sky` pass and its filter over `receivers` seen from `camera`: the
 /// environment's SH (`environment`, `EnvironmentSh::gpu_data` at [`BANDS`] bands) times each
-/// receiver's sky visibility through `bvh`, filtered with the bilateral match of `upsample`
-/// and multiplied by `kd`. Returns the outgoing radiance (RGBA16F at receiver resolution).
-/// `seed` is added to the parameters' (the frame index when a history averages the frames).
+/// receiver's sky visibility through `bvh`, filtered by `filter` and multiplied by `kd`.
+/// Returns the outgoing radiance (RGBA16F at receiver resolution). `seed` is added to the
+/// parameters' (the frame index when a history averages the frames).
 #[allow(clippy::too_many_arguments)]
 pub fn sky(
     rg: &mut RenderGraph,
@@ -182,7 +192,7 @@ pub fn sky(
     bvh: &TraceImages,
     camera: glam::Vec3,
     params: &SkyParams,
-    upsample: &UpsampleParams,
+    filter: LightFilter<'_>,
     seed: u32,
 ) -> Result<Handle<Image>, SkyError> {
     params.validate()?;
@@ -199,15 +209,74 @@ pub fn sky(
             pass.read("environment", environment);
         },
     );
-    Ok(bilateral_filter(
+    Ok(filter.apply(
         rg,
-        ["sky_filter", "sky_light"],
+        ["sky", "sky_light"],
         receivers,
         &irradiance,
         camera,
-        (params.filter_radius, SKY_SIGMA_PER_RADIUS),
-        upsample,
-    ))
+        Reach {
+            bilateral: (params.filter_radius, SKY_SIGMA_PER_RADIUS),
+            footprint: denoise::Footprint::Pixels(denoise::SKY_RADIUS),
+        },
+    )?)
+}
+
+/// How the sky's and HVL's near field's demodulated light (light / π at receiver resolution)
+/// is filtered before it is multiplied by each receiver's `kd`.
+#[derive(Debug, Clone, Copy)]
+pub enum LightFilter<'a> {
+    /// The joint bilateral mean ([`bilateral_filter`]) with this upsample's match.
+    Bilateral(&'a UpsampleParams),
+    /// The traced signals' à-trous denoiser, its diffuse footprint
+    /// ([`crate::passes::denoise::diffuse`]; `denoise.diffuse`, the default).
+    Denoise(&'a DenoiseParams),
+}
+
+/// How far each [`LightFilter`] reaches for one signal.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Reach {
+    /// The bilateral's radius in receivers and its gaussian's σ over the radius.
+    pub bilateral: (u32, f32),
+    /// The denoiser's footprint.
+    pub footprint: denoise::Footprint,
+}
+
+impl LightFilter<'_> {
+    /// Adds the filter of `light` over `receivers` seen from `camera`: passes
+    /// `{label}_filter` (the bilateral) or `{label}_prep` and `{label}_atrous_i`, writing a
+    /// new image `output`, reaching as far as `reach` says. Returns the outgoing radiance
+    /// (RGBA16F at receiver resolution).
+    pub fn apply(
+        self,
+        rg: &mut RenderGraph,
+        [label, output]: [&str; 2],
+        receivers: &Receivers,
+        light: &Handle<Image>,
+        camera: glam::Vec3,
+        reach: Reach,
+    ) -> Result<Handle<Image>, DenoiseError> {
+        match self {
+            Self::Bilateral(upsample) => Ok(bilateral_filter(
+                rg,
+                [&format!("{label}_filter"), output],
+                receivers,
+                light,
+                camera,
+                reach.bilateral,
+                upsample,
+            )),
+            Self::Denoise(params) => denoise::diffuse(
+                rg,
+                [&format!("{label}_prep"), &format!("{label}_atrous"), output],
+                receivers,
+                light,
+                camera,
+                reach.footprint,
+                params,
+            ),
+        }
+    }
 }
 
 /// Adds a pass `names[0]` of `sky_filter.comp` writing a new image `names[1]`: the joint

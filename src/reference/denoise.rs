@@ -1,7 +1,7 @@
 //! CPU twin of the traced signals' denoiser (issue 47): `shaders/include/denoise.glsl` (same
-//! names without the `denoise_` prefix), `shaders/specular_prep.comp` ([`specular_prep`]) and
-//! `shaders/denoise_atrous.comp` ([`atrous`]). `tests/denoise.rs` compares the passes with it;
-//! [`crate::passes::denoise`] explains the filter.
+//! names without the `denoise_` prefix), `shaders/denoise_prep.comp` ([`prep`]) and
+//! `shaders/denoise_atrous.comp` ([`atrous`]), both variants ([`Signal`]). `tests/denoise.rs`
+//! compares the passes with it; [`crate::passes::denoise`] explains the filter.
 
 use glam::{Vec3, Vec4};
 
@@ -36,6 +36,28 @@ pub const HALF_MAX: f32 = 65504.0;
 pub const MATCH: f32 = 0.25;
 /// `DENOISE_MIN_WEIGHT`: smallest demodulation weight share · ks.
 pub const MIN_WEIGHT: f32 = 1e-3;
+/// `DENOISE_DIFFUSE_NORMAL_TOLERANCE`: the diffuse signal's normal tolerance 1 − cos φ.
+pub const DIFFUSE_NORMAL_TOLERANCE: f32 = 0.03125;
+/// `DENOISE_DIFFUSE_MIN_RADIUS`: least radius of a hit-distance footprint, pixels.
+pub const DIFFUSE_MIN_RADIUS: f32 = 1.0;
+
+/// `denoise_world_radius`: `world` units at `dist` from the eye in pixels of `pixel_angle`,
+/// within [`DIFFUSE_MIN_RADIUS`]..=[`MAX_RADIUS`].
+pub fn world_radius(world: f32, dist: f32, pixel_angle: f32) -> f32 {
+    (world / (dist * pixel_angle)).clamp(DIFFUSE_MIN_RADIUS, MAX_RADIUS)
+}
+
+/// Which traced signal the filter takes: the shaders' variants.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Signal {
+    /// The specular pass's radiance (variant `specular`): demodulated by share · ks, the
+    /// lobe's footprint and normal tolerance, the roughness test.
+    Specular,
+    /// The sky's or near field's demodulated light (variant `diffuse`): remodulated by kd,
+    /// a stated footprint radius, [`DIFFUSE_NORMAL_TOLERANCE`], no roughness test, the
+    /// luminance weight over the larger variance.
+    Diffuse,
+}
 
 /// `denoise_lobe_angle`: the reflected lobe's half-angle for GGX `alpha`.
 pub fn lobe_angle(alpha: f32) -> f32 {
@@ -108,10 +130,16 @@ pub struct Surface {
     pub roughness: f32,
 }
 
-/// `denoise_geometry_weight`: how much `q` stands for `p`.
+/// `denoise_geometry_weight` with the normal tolerance of `p`'s lobe: how much `q` stands for
+/// `p`.
 pub fn geometry_weight(p: &Surface, q: &Surface) -> f32 {
+    geometry_weight_within(p, q, normal_tolerance(alpha(p.roughness)))
+}
+
+/// `denoise_geometry_weight` with the normal tolerance `tolerance` (1 − cos φ).
+pub fn geometry_weight_within(p: &Surface, q: &Surface, tolerance: f32) -> f32 {
     let plane = p.normal.dot(q.position - p.position).abs() / (PLANE_SIGMA * p.dist);
-    let normal = (1.0 - p.normal.dot(q.normal)) / normal_tolerance(alpha(p.roughness));
+    let normal = (1.0 - p.normal.dot(q.normal)) / tolerance;
     (-plane - normal - (p.roughness - q.roughness).abs() / ROUGHNESS_SIGMA).exp()
 }
 
@@ -149,8 +177,10 @@ pub struct Guide<'a> {
     pub material: &'a [Vec4],
     /// Eye position.
     pub camera: Vec3,
-    /// The specular pass's roughness limit.
+    /// The specular pass's roughness limit (unused by [`Signal::Diffuse`]).
     pub limit: f32,
+    /// The signal filtered.
+    pub signal: Signal,
 }
 
 impl Guide<'_> {
@@ -159,9 +189,38 @@ impl Guide<'_> {
         (x >= 0 && y >= 0 && x < w && y < h).then(|| (y * w + x) as usize)
     }
 
-    /// The pixel's surface and its demodulation weight share · ks (floored at
-    /// [`MIN_WEIGHT`]); `None` where the specular pass traces nothing.
-    fn surface(&self, i: usize) -> Option<(Surface, Vec3)> {
+    /// The normal tolerance of centre `p`.
+    fn tolerance(&self, p: &Surface) -> f32 {
+        match self.signal {
+            Signal::Specular => normal_tolerance(alpha(p.roughness)),
+            Signal::Diffuse => DIFFUSE_NORMAL_TOLERANCE,
+        }
+    }
+
+    /// The variance the luminance weight of centre and neighbour takes: the centre's (SVGF), or
+    /// for the diffuse signals the larger of the two.
+    fn variance(&self, p: f32, q: f32) -> f32 {
+        match self.signal {
+            Signal::Specular => p,
+            Signal::Diffuse => p.max(q),
+        }
+    }
+
+    /// The roughness the geometry test compares (0 for the diffuse signal: no test).
+    fn roughness(&self, i: usize) -> f32 {
+        match self.signal {
+            Signal::Specular => self.material[i].x,
+            Signal::Diffuse => 0.0,
+        }
+    }
+
+    /// The pixel's surface, what the input is divided by (share · ks floored at
+    /// [`MIN_WEIGHT`]; 1 for the diffuse light, demodulated already) and what the output is
+    /// multiplied by (share · ks again, or kd); `None` where nothing is traced.
+    fn surface(&self, i: usize) -> Option<(Surface, Vec3, Vec3)> {
+        if self.signal == Signal::Diffuse {
+            return self.diffuse_surface(i);
+        }
         let position = self.position[i];
         let n = self.normal[i].truncate();
         let material = self.material[i];
@@ -182,17 +241,42 @@ impl Guide<'_> {
             dist,
             roughness: material.x,
         };
-        Some((surface, (share * ks).max(Vec3::splat(MIN_WEIGHT))))
+        let weight = (share * ks).max(Vec3::splat(MIN_WEIGHT));
+        Some((surface, weight, weight))
+    }
+
+    /// [`Self::surface`] of a receiver for the diffuse light.
+    fn diffuse_surface(&self, i: usize) -> Option<(Surface, Vec3, Vec3)> {
+        let position = self.position[i];
+        let n = self.normal[i].truncate();
+        let dist = (self.camera - position.truncate()).length();
+        if position.w <= 0.0 || n.dot(n) <= 0.0 || dist <= 0.0 {
+            return None;
+        }
+        let normal = n.normalize();
+        let nv = normal.dot((self.camera - position.truncate()) / dist);
+        let (kd, _) = indirect_weights(self.albedo[i].truncate(), self.material[i].y, nv);
+        let surface = Surface {
+            position: position.truncate(),
+            normal,
+            dist,
+            roughness: 0.0,
+        };
+        Some((surface, Vec3::ONE, kd))
     }
 }
 
-/// `specular_prep`: per pixel the demodulated, firefly-clamped (`clamp`) radiance with its
-/// 3×3 luminance variance in w, and the footprint radius in pixels (−1 where nothing is
-/// traced), from the specular pass's output (rgb radiance, a parallax).
-pub fn specular_prep(
+/// `denoise_prep`: per pixel the demodulated, firefly-clamped (`clamp`) signal with its 3×3
+/// luminance variance in w, and the footprint radius in pixels (−1 where nothing is traced),
+/// from `input`: the specular pass's output (rgb radiance, a parallax) or the diffuse light
+/// (rgb light / π, a the rays' mean hit distance where `hit_scale` > 0). `footprint` and
+/// `hit_scale` are the push constants': the angle of a pixel (specular, or diffuse with
+/// `hit_scale` > 0: the radius `hit_scale` times the mean hit distance) or the radius in pixels.
+pub fn prep(
     g: &Guide<'_>,
-    specular: &[Vec4],
-    pixel_angle: f32,
+    input: &[Vec4],
+    footprint: f32,
+    hit_scale: f32,
     clamp: bool,
 ) -> (Vec<Vec4>, Vec<f32>) {
     let count = (g.extent[0] * g.extent[1]) as usize;
@@ -201,32 +285,33 @@ pub fn specular_prep(
     for y in 0..g.extent[1] as i32 {
         for x in 0..g.extent[0] as i32 {
             let Some(i) = g.index(x, y) else { continue };
-            let Some((centre, weight)) = g.surface(i) else {
+            let Some((centre, weight, _)) = g.surface(i) else {
                 continue;
             };
+            let tolerance = g.tolerance(&centre);
             let mut bound = -1.0f32;
             let (mut sum, mut sum2) = (0.0f32, 0.0f32);
-            let mut parallax = specular[i].w;
+            let mut parallax = input[i].w;
             let mut n = 1.0f32;
             for (dx, dy) in (-1..=1).flat_map(|dy| (-1..=1).map(move |dx| (dx, dy))) {
                 let Some(j) = g.index(x + dx, y + dy).filter(|_| (dx, dy) != (0, 0)) else {
                     continue;
                 };
-                let Some((q, q_weight)) = g.surface(j) else {
+                let Some((q, q_weight, _)) = g.surface(j) else {
                     continue;
                 };
-                if geometry_weight(&centre, &q) < MATCH {
+                if geometry_weight_within(&centre, &q, tolerance) < MATCH {
                     continue;
                 }
-                let l = luminance(specular[j].truncate() / q_weight);
+                let l = luminance(input[j].truncate() / q_weight);
                 bound = bound.max(l);
                 sum += l;
                 sum2 += l * l;
-                parallax += specular[j].w;
+                parallax += input[j].w;
                 n += 1.0;
             }
             bound *= FIREFLY_RATIO;
-            let mut value = specular[i].truncate() / weight;
+            let mut value = input[i].truncate() / weight;
             let mut l_p = luminance(value);
             if clamp && bound >= 0.0 && l_p > bound {
                 value *= bound / l_p;
@@ -237,14 +322,20 @@ pub fn specular_prep(
             let mean = sum / n;
             let variance = (sum2 / n - mean * mean).max(0.0);
             signal[i] = storable(value.extend(variance));
-            radii[i] = radius(alpha(centre.roughness), parallax / n, pixel_angle);
+            radii[i] = match g.signal {
+                Signal::Specular => radius(alpha(centre.roughness), parallax / n, footprint),
+                Signal::Diffuse if hit_scale > 0.0 => {
+                    world_radius(hit_scale * parallax / n, centre.dist, footprint)
+                }
+                Signal::Diffuse => footprint,
+            };
         }
     }
     (signal, radii)
 }
 
 /// `denoise_atrous`: one iteration at tap spacing `step` over `signal` (rgb, variance in w);
-/// with `remodulate` the last one, the radiance times share · ks with w = 0.
+/// with `remodulate` the last one, the radiance times share · ks (or kd) with w = 0.
 pub fn atrous(
     g: &Guide<'_>,
     signal: &[Vec4],
@@ -257,9 +348,10 @@ pub fn atrous(
         for x in 0..g.extent[0] as i32 {
             let Some(i) = g.index(x, y) else { continue };
             let r = radii[i];
-            let Some((p, weight)) = g.surface(i).filter(|_| r >= 0.0) else {
+            let Some((p, _, weight)) = g.surface(i).filter(|_| r >= 0.0) else {
                 continue;
             };
+            let tolerance = g.tolerance(&p);
             let centre = signal[i];
             let l_p = luminance(centre.truncate());
             let (mut sum, mut variance, mut weight_sum) = (Vec3::ZERO, 0.0f32, 0.0f32);
@@ -278,13 +370,13 @@ pub fn atrous(
                         position: g.position[c].truncate(),
                         normal: g.normal[c].truncate().normalize(),
                         dist: 0.0,
-                        roughness: g.material[c].x,
+                        roughness: g.roughness(c),
                     };
                     let w = kernel(k)
                         * kernel(j)
                         * lobe
-                        * geometry_weight(&p, &surface)
-                        * luminance_weight(l_p, luminance(q.truncate()), centre.w);
+                        * geometry_weight_within(&p, &surface, tolerance)
+                        * luminance_weight(l_p, luminance(q.truncate()), g.variance(centre.w, q.w));
                     if w > 0.0 {
                         sum += w * q.truncate();
                         variance += w * w * q.w;

@@ -330,9 +330,9 @@ impl Renderer {
                 &near,
                 near_radius,
                 sky_light::history_seed(rg, p),
-                camera.eye,
-                &p.upsample,
-            )),
+                camera,
+                sky_light::light_filter(p),
+            )?),
             _ => None,
         };
         let hvl_low = sum(rg, "hvl_near_add", hvl_low, near_light)?;

@@ -48,6 +48,15 @@ pub(super) fn cavity_shaded(
     )?))
 }
 
+/// The filter of the sky's and HVL's near field's light `p` asks for: the denoiser's diffuse
+/// variant (`denoise.diffuse`) or the joint bilateral with the upsample's match.
+pub(super) fn light_filter(p: &FrameParams) -> sky::LightFilter<'_> {
+    match &p.denoise_diffuse {
+        Some(params) => sky::LightFilter::Denoise(params),
+        None => sky::LightFilter::Bilateral(&p.upsample),
+    }
+}
+
 /// Where the sky's SH comes from: a host's environment map, projected at [`sky::BANDS`] bands
 /// this frame, or else the scene's environment (the proxies' projection).
 pub(super) struct SkySh<'a> {
@@ -80,7 +89,7 @@ pub(super) fn sky_light(
         bvh,
         camera,
         params,
-        &p.upsample,
+        light_filter(p),
         seed,
     )?)
 }

@@ -11,18 +11,20 @@
 //! cosine-weighted rays up to `2R`, each hit sending `(1 − f(t))` of what it reflects from the
 //! punctual lights (next-event estimation with shadow rays). That is Kollig and Keller's bias
 //! compensation (2004, "Illumination in the presence of weak singularities") with a smooth
-//! boundary. The traced light is demodulated, filtered like the sky's
-//! ([`crate::passes::sky::bilateral_filter`]: joint bilateral, then `kd`), and added to the
-//! gather's. Diffuse only: the receiver's glossy lobe sees the near field through the HVLs
-//! alone.
+//! boundary. The traced light is demodulated (with the rays' mean hit distance, which sets the
+//! denoiser's footprint), filtered like the sky's ([`crate::passes::sky::LightFilter`]: the
+//! à-trous denoiser's diffuse variant by default, or the joint bilateral; then `kd`), and
+//! added to the gather's. Diffuse only: the receiver's glossy lobe sees the near field through
+//! the HVLs alone.
 
 use std::ops::RangeInclusive;
 
 use crate::graph::{Handle, Image, RenderGraph};
+use crate::passes::denoise::{DenoiseError, Footprint, NEAR_FOOTPRINT_PER_HIT, pixel_angle};
+use crate::passes::gbuffer::View;
 use crate::passes::receivers::Receivers;
-use crate::passes::sky::bilateral_filter;
+use crate::passes::sky::{LightFilter, Reach};
 use crate::passes::traced_scene::TracedScene;
-use crate::passes::upsample::UpsampleParams;
 use crate::shaders;
 
 /// Default R as a fraction of the scene's largest side.
@@ -33,7 +35,7 @@ pub const RANGE_RANGE: RangeInclusive<f32> = 0.0..=0.5;
 pub const RAYS: u32 = 4;
 /// Rays per receiver the settings take.
 pub const RAYS_RANGE: RangeInclusive<u32> = 1..=256;
-/// Default radius of the near field's filter, in receivers.
+/// Default radius of the near field's bilateral filter, in receivers.
 pub const FILTER_RADIUS: u32 = 4;
 /// σ of the near field filter's gaussian over its radius (the sky's is 1/2: the near field's
 /// few rays need the wider mean).
@@ -46,7 +48,7 @@ pub struct NearField {
     pub range_fraction: f32,
     /// Rays per receiver.
     pub rays: u32,
-    /// Radius in receivers of the filter.
+    /// Radius in receivers of the bilateral filter (unused by the à-trous denoiser).
     pub filter_radius: u32,
 }
 
@@ -78,10 +80,10 @@ pub struct NearPush {
     pub pad: [u32; 2],
 }
 
-/// Adds `hvl_near` and its filter `hvl_near_filter` over `receivers` seen from `camera`, with
-/// R = `range` world units and the rays of `seed`: returns the near field's outgoing radiance
-/// (RGBA16F at receiver resolution), to be added to the gather's (which must have run with
-/// `near_radius = range`).
+/// Adds `hvl_near` and its filter `filter` (`hvl_near_filter`, or `hvl_near_prep` and
+/// `hvl_near_atrous_i`) over `receivers` seen from `camera`, with R = `range` world units and
+/// the rays of `seed`: returns the near field's outgoing radiance (RGBA16F at receiver
+/// resolution), to be added to the gather's (which must have run with `near_radius = range`).
 #[allow(clippy::too_many_arguments)]
 pub fn hvl_near(
     rg: &mut RenderGraph,
@@ -90,9 +92,9 @@ pub fn hvl_near(
     near: &NearField,
     range: f32,
     seed: u32,
-    camera: glam::Vec3,
-    upsample: &UpsampleParams,
-) -> Handle<Image> {
+    camera: &View,
+    filter: LightFilter<'_>,
+) -> Result<Handle<Image>, DenoiseError> {
     let [w, h] = receivers.extent;
     let mut light = receivers.light_image(rg, "hvl_near_irradiance");
     let push = NearPush {
@@ -110,13 +112,18 @@ pub fn hvl_near(
         .write("near_light", &mut light)
         .push(&push)
         .dispatch([w, h, 1]);
-    bilateral_filter(
+    filter.apply(
         rg,
-        ["hvl_near_filter", "hvl_near_light"],
+        ["hvl_near", "hvl_near_light"],
         receivers,
         &light,
-        camera,
-        (near.filter_radius, SIGMA_PER_RADIUS),
-        upsample,
+        camera.eye,
+        Reach {
+            bilateral: (near.filter_radius, SIGMA_PER_RADIUS),
+            footprint: Footprint::HitDistance {
+                scale: NEAR_FOOTPRINT_PER_HIT,
+                pixel_angle: pixel_angle(camera, receivers.extent[1]),
+            },
+        },
     )
 }
