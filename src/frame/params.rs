@@ -51,9 +51,12 @@ pub struct FrameParams {
     pub specular: Option<SpecularParams>,
     /// The traced specular's filter, when the specular pass runs and `denoise.enabled`.
     pub denoise: Option<DenoiseParams>,
-    /// The sky's and HVL's near field's filter, when `denoise.enabled` and `denoise.diffuse`
-    /// (else their joint bilateral).
+    /// The sky's filter, when `denoise.enabled` and `denoise.diffuse` (else its joint
+    /// bilateral).
     pub denoise_diffuse: Option<DenoiseParams>,
+    /// HVL's near field's filter, when `denoise.enabled` and `denoise.near_field` (else its
+    /// joint bilateral).
+    pub denoise_near: Option<DenoiseParams>,
     /// The sky light, when on and the frame has no proxies (which shadow the environment
     /// themselves), `gi = none` included: the sky's light is direct light, though it travels
     /// in the indirect image. Declared only for a scene with an environment.
@@ -140,6 +143,8 @@ impl FrameParams {
             specular,
             denoise: specular.and(settings.denoise.enabled.then_some(settings.denoise)),
             denoise_diffuse: (settings.denoise.enabled && settings.denoise.diffuse)
+                .then_some(settings.denoise),
+            denoise_near: (settings.denoise.enabled && settings.denoise.near_field)
                 .then_some(settings.denoise),
             sky: (settings.sky.enabled && !gi.contains(GiTechnique::Proxy)).then_some(settings.sky),
             cavity: settings.cavity.enabled.then(|| settings.cavity.params()),

@@ -56,10 +56,14 @@
 //!   after the composite (`[history]`), and a single frame or a camera cut has none.
 //! * **Orthographic views** take the pixel's width over one metre as its angle (a
 //!   perspective stand-in; no built-in camera is orthographic).
-//! * **The sky and HVL's near field go through this filter too** (`denoise.diffuse`, on by
-//!   default; off: their joint bilateral, `sky_filter.comp`, as before issue 47's second part).
-//!   It beat the bilateral on every scene measured, against the path-traced truth and against
-//!   the same renderer with many rays, and leaves no mottle on large matte walls.
+//! * **The sky and HVL's near field go through this filter too** (`denoise.diffuse` for the
+//!   sky, on by default; `denoise.near_field` for the near field, off by default; off: their
+//!   joint bilateral, `sky_filter.comp`, as before issue 47's second part). It beat the
+//!   bilateral on every scene measured, against the path-traced truth and against the same
+//!   renderer with many rays, and leaves no mottle on large matte walls; but on the near field
+//!   it flickered more on a moving figure (`builtin:animated` 0.74× → 0.79× of the truth's
+//!   flicker; the sky alone 0.74×), which issue 47 forbids, so the near field keeps the
+//!   bilateral unless asked.
 //! * **Receiver resolution** for the diffuse signals, where they are traced and summed before
 //!   the upsample: each receiver holds its own rays, so neighbours' noise is independent there
 //!   (at full resolution the upsample copies a receiver's noise into s × s pixels, which the
@@ -127,10 +131,17 @@ pub struct DenoiseParams {
     /// ray's real light would be cut.)
     #[setting(default = true, affects = quality)]
     pub clamp: bool,
-    /// Filter the sky's and HVL's near field's light too, with the diffuse footprint (off:
-    /// their joint bilateral, `sky.filter_radius`).
+    /// Filter the sky's light too, with the diffuse footprint (off: its joint bilateral,
+    /// `sky.filter_radius`).
     #[setting(default = true, affects = both)]
     pub diffuse: bool,
+    /// Filter HVL's traced near field too, with the footprint of its rays' hit distance (off:
+    /// its joint bilateral). Off by default: closer to the truth on still frames
+    /// (`builtin:motion-sun` 0.0716 → 0.0711) but it flickered more on a moving figure
+    /// (`builtin:animated`, indirect light: 0.74× → 0.79× of the truth's flicker; the sky
+    /// alone 0.74×; docs/quality.md).
+    #[setting(default = false, affects = both)]
+    pub near_field: bool,
 }
 
 /// What the denoiser refuses.

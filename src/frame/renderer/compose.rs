@@ -331,7 +331,7 @@ impl Renderer {
                 near_radius,
                 sky_light::history_seed(rg, p),
                 camera,
-                sky_light::light_filter(p),
+                sky_light::light_filter(p, true),
             )?),
             _ => None,
         };

@@ -48,10 +48,15 @@ pub(super) fn cavity_shaded(
     )?))
 }
 
-/// The filter of the sky's and HVL's near field's light `p` asks for: the denoiser's diffuse
-/// variant (`denoise.diffuse`) or the joint bilateral with the upsample's match.
-pub(super) fn light_filter(p: &FrameParams) -> sky::LightFilter<'_> {
-    match &p.denoise_diffuse {
+/// The filter of the sky's light (`near` false) or HVL's near field's (`near`) that `p` asks
+/// for: the denoiser's diffuse variant (`denoise.diffuse`, `denoise.near_field`) or the joint
+/// bilateral with the upsample's match.
+pub(super) fn light_filter(p: &FrameParams, near: bool) -> sky::LightFilter<'_> {
+    match if near {
+        &p.denoise_near
+    } else {
+        &p.denoise_diffuse
+    } {
         Some(params) => sky::LightFilter::Denoise(params),
         None => sky::LightFilter::Bilateral(&p.upsample),
     }
@@ -89,7 +94,7 @@ pub(super) fn sky_light(
         bvh,
         camera,
         params,
-        light_filter(p),
+        light_filter(p, false),
         seed,
     )?)
 }
