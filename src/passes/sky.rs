@@ -229,7 +229,8 @@ pub enum LightFilter<'a> {
     /// The joint bilateral mean ([`bilateral_filter`]) with this upsample's match.
     Bilateral(&'a UpsampleParams),
     /// The traced signals' à-trous denoiser, its diffuse footprint
-    /// ([`crate::passes::denoise::diffuse`]; `denoise.diffuse`, the default).
+    /// ([`crate::passes::denoise::diffuse`]; the sky's default, `denoise.diffuse`; the near
+    /// field's with `denoise.near_field`).
     Denoise(&'a DenoiseParams),
 }
 

@@ -12,10 +12,11 @@
 //! punctual lights (next-event estimation with shadow rays). That is Kollig and Keller's bias
 //! compensation (2004, "Illumination in the presence of weak singularities") with a smooth
 //! boundary. The traced light is demodulated (with the rays' mean hit distance, which sets the
-//! denoiser's footprint), filtered like the sky's ([`crate::passes::sky::LightFilter`]: the
-//! à-trous denoiser's diffuse variant by default, or the joint bilateral; then `kd`), and
-//! added to the gather's. Diffuse only: the receiver's glossy lobe sees the near field through
-//! the HVLs alone.
+//! denoiser's footprint), filtered by one of the sky's filters
+//! ([`crate::passes::sky::LightFilter`]: the joint bilateral by default, or the à-trous
+//! denoiser's diffuse variant with `denoise.near_field`, which flickered more on moving
+//! figures; then `kd`), and added to the gather's. Diffuse only: the receiver's glossy lobe
+//! sees the near field through the HVLs alone.
 
 use std::ops::RangeInclusive;
 
