@@ -344,7 +344,6 @@ fn denoise_constants_match_the_shader() {
         ("DENOISE_FIREFLY_RATIO", d::FIREFLY_RATIO),
         ("DENOISE_MATCH", d::MATCH),
         ("DENOISE_LUMINANCE_EPSILON", d::LUMINANCE_EPSILON),
-        ("DENOISE_HALF_MAX", d::HALF_MAX),
         ("DENOISE_RAY_FLOOR", d::RAY_FLOOR),
         ("DENOISE_RAY_MAX_FACTOR", d::RAY_MAX_FACTOR),
     ] {

@@ -40,8 +40,6 @@ const float DENOISE_MIN_WEIGHT = 1e-3;
 const float DENOISE_FIREFLY_RATIO = 2.0;
 // ε of the luminance weight (a flat region's zero variance keeps equal neighbours only).
 const float DENOISE_LUMINANCE_EPSILON = 1e-6;
-// Largest finite half float: the filter's images are RGBA16F.
-const float DENOISE_HALF_MAX = 65504.0;
 // A neighbour counts for the firefly clamp and the variance when its geometry weight is at
 // least this.
 const float DENOISE_MATCH = 0.25;
@@ -139,7 +137,7 @@ float denoise_luminance_weight(float l_p, float l_q, float variance) {
 // What an RGBA16F texel of the filter holds: each channel at most the half float's largest
 // finite value (a variance, luminance², overflows first; inf would turn 0 · inf into NaN).
 vec4 denoise_storable(vec4 v) {
-    return min(v, vec4(DENOISE_HALF_MAX));
+    return min(v, vec4(HALF_MAX));
 }
 
 // The footprint's gaussian at squared pixel offset `offset2` for `radius` pixels (σ = radius);

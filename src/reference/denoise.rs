@@ -30,7 +30,8 @@ pub const LUMINANCE_SIGMA: f32 = 8.0;
 pub const FIREFLY_RATIO: f32 = 2.0;
 /// `DENOISE_LUMINANCE_EPSILON`: ε of the luminance weight.
 pub const LUMINANCE_EPSILON: f32 = 1e-6;
-/// `DENOISE_HALF_MAX`: the largest finite half float, what the filter's images hold at most.
+/// `HALF_MAX` (shaders/include/color.glsl): the largest finite half float, what the filter's
+/// images (and the history's state) hold at most.
 pub const HALF_MAX: f32 = 65504.0;
 /// `DENOISE_MATCH`: least geometry weight of a neighbour in the clamp and the variance.
 pub const MATCH: f32 = 0.25;
