@@ -222,6 +222,7 @@ fn accumulate_matches_the_cpu_twin() {
             reseed: false,
             trend,
             temporal,
+            ..AccumulateParams::default()
         };
         let cpu = accumulate_cpu(&inputs, &params);
         let gpu = accumulate_gpu(&device, &inputs, &params);

@@ -17,6 +17,9 @@ use crate::passes::debug_view::LightRecords;
 use crate::passes::hvl::{self, HvlParams};
 use crate::passes::receivers::Receivers;
 use crate::passes::rsm::Rsm;
+use crate::passes::sample_history::{
+    SampleHistoryPush, SampleSchedule, SampleSetup, sample_history,
+};
 
 /// The HVL technique's persistent state: its receiver BRDF tables per band count, and which
 /// frame last wrote the amortised gather's history.
@@ -24,6 +27,8 @@ pub struct HvlTechnique {
     brdf: BrdfTables,
     /// Which frame last resolved into the amortised gather's history.
     schedule: Schedule,
+    /// Which frame last wrote the HVLs' own history.
+    samples: SampleSchedule,
 }
 
 /// An HVL frame ready to be declared: its parameters and its tables imported into the graph.
@@ -33,6 +38,8 @@ pub struct PreparedHvl {
     /// Amortised frames: the refreshed slice (0: every receiver) and whether the history
     /// holds the previous frame.
     amortised: Option<Slice>,
+    /// The HVLs' own history, when on.
+    samples: Option<SampleHistoryPush>,
 }
 
 /// What the HVL passes read from the rest of the frame.
@@ -60,6 +67,7 @@ impl HvlTechnique {
         Self {
             brdf: BrdfTables::new(device, "hvl brdf tables"),
             schedule: Schedule::default(),
+            samples: SampleSchedule::default(),
         }
     }
 
@@ -71,6 +79,7 @@ impl HvlTechnique {
     /// Forgets the history (a new scene).
     pub fn reset(&mut self) {
         self.schedule.reset();
+        self.samples.reset();
     }
 
     /// Forgets the history and the tables: a frame that may have uploaded them was dropped
@@ -83,21 +92,25 @@ impl HvlTechnique {
     /// Uploads the BRDF tables `params` needs (once per band count) and imports them into
     /// `rg`; for amortised frames (`params.slices > 1`) at receivers of `receiver_extent`,
     /// picks this frame's slice. Without the previous frame's history (first frame, a resize,
-    /// a frame skipped) the gather shades every receiver.
+    /// a frame skipped) the gather shades every receiver. With a sample weight below 1 the
+    /// HVLs keep their own history over the scene's `lights`.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
         params: HvlParams,
         receiver_extent: [u32; 2],
+        samples: SampleSetup,
     ) -> Result<PreparedHvl, RenderError> {
         let brdf = self.brdf.import(rg, params.conv_bands)?;
         let amortised = self
             .schedule
             .next(rg.frame(), receiver_extent, params.slices, 0);
+        let samples = samples.push(&mut self.samples, rg.frame(), params.count);
         Ok(PreparedHvl {
             params,
             brdf,
             amortised,
+            samples,
         })
     }
 }
@@ -114,7 +127,10 @@ impl PreparedHvl {
         let mut params = self.params;
         params.shadow_seed = inputs.seed;
         params.near_radius = inputs.near_radius;
-        let hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
+        let mut hvls = hvl::hvl_cache(rg, inputs.rsm, &params)?;
+        if let Some(push) = &self.samples {
+            sample_history(rg, "hvl samples", &mut hvls, push);
+        }
         let lights = LightRecords {
             records: hvls,
             count: params.count,

@@ -20,12 +20,17 @@ use crate::passes::debug_view::LightRecords;
 use crate::passes::gbuffer::GBuffer;
 use crate::passes::igi::{self, IgiParams, IgiSlice};
 use crate::passes::rsm::Rsm;
+use crate::passes::sample_history::{
+    SampleHistoryPush, SampleSchedule, SampleSetup, sample_history,
+};
 
 /// The IGI technique's persistent state: the BRDF tables of the GGX resolve per SH order, and
 /// which frame last wrote the amortised light's history.
 pub struct IgiTechnique {
     brdf: BrdfTables,
     schedule: Schedule,
+    /// Which frame last wrote the VPLs' own history.
+    samples: SampleSchedule,
     /// The device's `maxStorageBufferRange` ([`IgiParams::storage_limit`]).
     storage_limit: u64,
 }
@@ -37,6 +42,8 @@ pub struct PreparedIgi {
     brdf: Option<Handle<Buffer>>,
     /// Amortised frames (`igi.slices = 4`): this frame's slice.
     amortised: Option<Slice>,
+    /// The VPLs' own history, when on.
+    samples: Option<SampleHistoryPush>,
 }
 
 /// What the IGI passes read from the rest of the frame.
@@ -58,6 +65,7 @@ impl IgiTechnique {
         Self {
             brdf: BrdfTables::new(device, "igi brdf tables"),
             schedule: Schedule::default(),
+            samples: SampleSchedule::default(),
             storage_limit: u64::from(device.info().max_storage_buffer_range),
         }
     }
@@ -70,22 +78,25 @@ impl IgiTechnique {
     /// Forgets the history (a new scene).
     pub fn reset(&mut self) {
         self.schedule.reset();
+        self.samples.reset();
     }
 
     /// Forgets the tables and the history: a frame that may have uploaded or written them was
     /// dropped unrun.
     pub fn forget_uploads(&mut self) {
         self.brdf.clear();
-        self.schedule.reset();
+        self.reset();
     }
 
     /// Uploads the BRDF tables of the GGX resolve when `params` uses it (once per SH order)
     /// and imports them into `rg`; for amortised frames of `extent`, picks this frame's slice.
+    /// With a sample weight below 1 the VPLs keep their own history over the scene's `lights`.
     pub fn prepare(
         &mut self,
         rg: &mut RenderGraph,
         mut params: IgiParams,
         extent: [u32; 2],
+        samples: SampleSetup,
     ) -> Result<PreparedIgi, RenderError> {
         params.storage_limit = self.storage_limit;
         // The SH history's layout: another order or mode is no history.
@@ -96,10 +107,12 @@ impl IgiTechnique {
         } else {
             None
         };
+        let samples = samples.push(&mut self.samples, rg.frame(), params.vpl_count);
         Ok(PreparedIgi {
             params,
             brdf,
             amortised,
+            samples,
         })
     }
 }
@@ -113,7 +126,10 @@ impl PreparedIgi {
         inputs: &IgiInputs<'_>,
     ) -> Result<(Handle<Image>, LightRecords), RenderError> {
         let (g, params, camera) = (inputs.gbuffer, &self.params, inputs.camera);
-        let lights = igi::vpls(rg, inputs.rsm, params)?;
+        let mut lights = igi::vpls(rg, inputs.rsm, params)?;
+        if let Some(push) = &self.samples {
+            sample_history(rg, "igi samples", &mut lights, push);
+        }
         let lights = igi::sets(rg, lights, params)?;
         let records = LightRecords {
             records: lights.vpls,

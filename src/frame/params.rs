@@ -71,6 +71,9 @@ pub struct FrameParams {
     /// The indirect light's accumulation over frames, when it has a history longer than one
     /// frame.
     pub history: Option<AccumulateParams>,
+    /// Weight of this frame in each HVL's and VPL's own history (`history.samples`; 1: none),
+    /// with or without the screen's history.
+    pub sample_weight: f32,
     /// Temporal antialiasing (camera jitter and the direct light's history), when on.
     pub taa: Option<AccumulateParams>,
     /// Exposure and tonemap of the composite.
@@ -151,6 +154,7 @@ impl FrameParams {
             cubes: settings.cubes.enabled.then_some(settings.cubes),
             upsample,
             history: (settings.history.max_frames > 1).then_some(settings.history),
+            sample_weight: settings.history.samples,
             taa: settings.output.taa.then(AccumulateParams::taa),
             composite: CompositeParams {
                 exposure: settings.output.exposure,

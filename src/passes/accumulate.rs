@@ -30,6 +30,7 @@ use std::ops::RangeInclusive;
 use serde::{Deserialize, Serialize};
 
 use super::gbuffer::GBuffer;
+use super::sample_history::{DEFAULT_SAMPLE_WEIGHT, SAMPLE_WEIGHT_RANGE};
 use crate::declare::{OutOfRange, Section, Settings};
 use crate::graph::{Handle, History, Image, ImageDesc, RenderGraph, vk};
 use crate::shaders;
@@ -129,6 +130,13 @@ pub struct AccumulateParams {
     /// holds still.
     #[setting(default = true, affects = quality)]
     pub temporal: bool,
+    /// Weight of this frame in each HVL's and VPL's own history (issue 43): the samples'
+    /// flux and normal are an EMA over the frames each continued, reset on a stated change
+    /// (`src/passes/sample_history.rs`), so a sample crossing a crease turns over a few frames
+    /// (1: no sample history). Applies with `frames = 1` too: it is the samples', not the
+    /// screen's.
+    #[setting(default = DEFAULT_SAMPLE_WEIGHT, range = SAMPLE_WEIGHT_RANGE, affects = quality)]
+    pub samples: f32,
     /// The indirect light's history: linear radiance, the background passes through. Without
     /// it, TAA: the background accumulates too, a still pixel ([`TAA_STILL_PIXELS`]) keeps
     /// history of any surface of its 3×3 neighbourhood, and the blend is in the space
@@ -150,6 +158,7 @@ impl AccumulateParams {
             reseed: false,
             trend: 0.0,
             temporal: false,
+            samples: 1.0,
             geometry: false,
         }
     }

@@ -23,6 +23,7 @@ pub mod path_trace;
 pub mod proxy;
 pub mod receivers;
 pub mod rsm;
+pub mod sample_history;
 pub mod shadows;
 pub mod sky;
 pub mod specular;

@@ -22,6 +22,7 @@ pub mod igi;
 pub mod light_tables;
 pub mod proxy;
 pub mod resolve;
+pub mod sample_history;
 pub mod scene_texels;
 
 use crate::capture::image_io::HdrImage;

@@ -18,6 +18,7 @@ use crate::passes::debug_view::DebugSources;
 use crate::passes::gbuffer::{self, GBuffer, View};
 use crate::passes::gi_add::gi_add;
 use crate::passes::hvl::{Distribution, near};
+use crate::passes::sample_history::SampleSetup;
 use crate::passes::traced_scene::TracedScene;
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
 use crate::passes::{denoise, specular};
@@ -197,13 +198,17 @@ impl Renderer {
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
         let frame = &scene.gpu.state;
         let receiver_extent = receivers::receiver_extent(p.extent, p.receiver_scale)?;
+        let samples = SampleSetup {
+            weight: p.sample_weight,
+            lights: light_count(frame)?,
+        };
         let hvl = p
             .hvl
-            .map(|h| self.hvl.prepare(rg, h, receiver_extent))
+            .map(|h| self.hvl.prepare(rg, h, receiver_extent, samples))
             .transpose()?;
         let igi = p
             .igi
-            .map(|i| self.igi.prepare(rg, i, p.extent))
+            .map(|i| self.igi.prepare(rg, i, p.extent, samples))
             .transpose()?;
         let aaf = p
             .aaf
