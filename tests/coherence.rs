@@ -4,73 +4,15 @@
 //! identity, and a change in one light's share leaves the other lights' samples in place.
 //! Checked on the CPU twin of `hvl_flux` (tests/hvl.rs ties it to the GPU sample for sample).
 
+mod common;
+
 use std::collections::BTreeMap;
 
-use glam::{Mat3, Vec3, Vec4};
+use common::spot_rsm::{HEIGHT, turned_spot};
+use glam::{Vec3, Vec4};
 use shine::passes::hvl::{Distribution, Hvl, HvlParams};
-use shine::passes::rsm::RsmProjection;
 use shine::reference::hvl::RsmData;
 use shine::reference::hvl_flux::build_flux_cache;
-
-/// RSM side.
-const SIZE: u32 = 64;
-/// The spot's height over the floor, metres.
-const HEIGHT: f32 = 2.5;
-/// The wall's plane x = WALL_X, facing +x.
-const WALL_X: f32 = -1.5;
-/// Where the floor's albedo steps from 0.8 to 0.3 (x, metres): an edge the flux crosses.
-const ALBEDO_EDGE_X: f32 = 0.4;
-
-/// The RSM of a spot at (0, HEIGHT, 0), turned by `angle` about z from straight down, over a
-/// floor (y = 0) with an albedo edge and a wall (x = WALL_X): a crease and an edge in its flux.
-/// Flux: albedo × the texel's solid angle × a smooth spot falloff, as an RSM holds it.
-fn turned_spot(angle: f32) -> RsmData {
-    let turn = Mat3::from_rotation_z(angle);
-    let eye = Vec3::new(0.0, HEIGHT, 0.0);
-    let mut rsm = RsmData {
-        size: SIZE,
-        light: 0,
-        position: Vec::new(),
-        normal: Vec::new(),
-        flux: Vec::new(),
-        light_position: eye,
-        light_direction: turn * Vec3::NEG_Y,
-        projection: RsmProjection::Perspective {
-            fov: std::f32::consts::FRAC_PI_2,
-        },
-    };
-    for j in 0..SIZE {
-        for i in 0..SIZE {
-            let u = (i as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0;
-            let v = (j as f32 + 0.5) / SIZE as f32 * 2.0 - 1.0;
-            let local = Vec3::new(u, -1.0, v);
-            let d = turn * local.normalize();
-            let floor = (d.y < 0.0).then(|| eye.y / -d.y);
-            let wall = (d.x < 0.0).then(|| (WALL_X - eye.x) / d.x);
-            let (t, n, albedo) = match (floor, wall) {
-                (Some(f), Some(w)) if w < f => (w, Vec3::X, 0.6),
-                (Some(f), _) => {
-                    let x = eye.x + f * d.x;
-                    (f, Vec3::Y, if x < ALBEDO_EDGE_X { 0.8 } else { 0.3 })
-                }
-                (None, Some(w)) => (w, Vec3::X, 0.6),
-                (None, None) => {
-                    rsm.position.push(Vec4::ZERO);
-                    rsm.normal.push(Vec4::ZERO);
-                    rsm.flux.push(Vec4::ZERO);
-                    continue;
-                }
-            };
-            let solid_angle = 1.0 / local.length().powi(3);
-            let falloff = (1.0 - (u * u + v * v) / 2.0).max(0.0);
-            let flux = albedo * solid_angle * falloff * n.dot(-d).max(0.0);
-            rsm.position.push((eye + t * d).extend(1.0));
-            rsm.normal.push(n.extend(0.0));
-            rsm.flux.push(Vec4::new(flux, 0.9 * flux, 0.8 * flux, 0.0));
-        }
-    }
-    rsm
-}
 
 /// The samples of a cache by identity (light, sample index): position and flux weight.
 fn by_identity(hvls: &[Hvl]) -> BTreeMap<(u32, u32), (Vec3, f32)> {
@@ -127,13 +69,13 @@ fn a_small_turn_of_the_light_moves_every_sample_a_little_and_keeps_its_identity(
     assert_eq!(HvlParams::default().distribution, Distribution::Flux);
     let count = 1024;
     let step = 0.1f32.to_radians();
-    let first = turned_spot(0.3);
+    let first = turned_spot(0.3, 1.0);
     let footprint = widest_footprint(&first);
     let mut before = by_identity(&cache(std::slice::from_ref(&first), count));
     assert_eq!(before.len(), count as usize);
     let mut worst = 0.0f32;
     for k in 1..=40 {
-        let after = by_identity(&cache(&[turned_spot(0.3 + k as f32 * step)], count));
+        let after = by_identity(&cache(&[turned_spot(0.3 + k as f32 * step, 1.0)], count));
         assert!(
             before.keys().eq(after.keys()),
             "turn {k}: the samples' identities changed"
@@ -162,13 +104,13 @@ fn a_change_in_one_lights_share_leaves_the_other_lights_samples_in_place() {
     let still = RsmData {
         light: 1,
         light_position: Vec3::new(1.0, HEIGHT, 0.5),
-        ..turned_spot(-0.2)
+        ..turned_spot(-0.2, 1.0)
     };
-    let mut before = by_identity(&cache(&[turned_spot(0.0), still.clone()], count));
+    let mut before = by_identity(&cache(&[turned_spot(0.0, 1.0), still.clone()], count));
     let mut counts = Vec::new();
     for k in 1..=12 {
         let after = by_identity(&cache(
-            &[turned_spot(k as f32 * 0.005), still.clone()],
+            &[turned_spot(k as f32 * 0.005, 1.0), still.clone()],
             count,
         ));
         let kept = |m: &BTreeMap<(u32, u32), (Vec3, f32)>| {

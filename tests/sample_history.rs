@@ -8,6 +8,7 @@ mod common;
 
 use std::collections::BTreeMap;
 
+use common::spot_rsm::turned_spot;
 use common::{assert_clean, device, read_by_copy, transfer_storage, uploaded_state};
 use glam::{Vec3, Vec4};
 use shine::gpu::Device;
@@ -16,7 +17,6 @@ use shine::passes::hvl::{Distribution, Hvl, HvlParams, cache_bytes};
 use shine::passes::sample_history::{
     DEFAULT_SAMPLE_WEIGHT, SAMPLE_FLUX_RATIO, SAMPLE_JUMP_RADII, SampleHistoryPush, sample_history,
 };
-use shine::reference::hvl::RsmData;
 use shine::reference::hvl_flux::build_flux_cache;
 use shine::reference::sample_history::filter;
 
@@ -161,53 +161,14 @@ fn the_pass_matches_its_cpu_twin_over_every_reset() {
     assert_clean(&device);
 }
 
-/// The flux cache (1024 samples) of a spot at `angle` (radians, about z from straight down)
-/// over a floor with an albedo edge and a wall, scaled by `power`: tests/coherence.rs's scene.
+/// The flux cache (1024 samples) of tests/common's turned spot at `angle` scaled by `power`.
 fn spot_cache(angle: f32, power: f32) -> Vec<Hvl> {
-    let size = 64u32;
-    let turn = glam::Mat3::from_rotation_z(angle);
-    let eye = Vec3::new(0.0, 2.5, 0.0);
-    let mut rsm = RsmData {
-        size,
-        light: 0,
-        position: Vec::new(),
-        normal: Vec::new(),
-        flux: Vec::new(),
-        light_position: eye,
-        light_direction: turn * Vec3::NEG_Y,
-        projection: shine::passes::rsm::RsmProjection::Perspective {
-            fov: std::f32::consts::FRAC_PI_2,
-        },
-    };
-    for j in 0..size {
-        for i in 0..size {
-            let u = (i as f32 + 0.5) / size as f32 * 2.0 - 1.0;
-            let v = (j as f32 + 0.5) / size as f32 * 2.0 - 1.0;
-            let d = turn * Vec3::new(u, -1.0, v).normalize();
-            let floor = (d.y < 0.0).then(|| eye.y / -d.y);
-            let wall = (d.x < 0.0).then(|| (-1.5 - eye.x) / d.x);
-            let (t, n, albedo) = match (floor, wall) {
-                (Some(f), Some(w)) if w < f => (w, Vec3::X, 0.6),
-                (Some(f), _) => (f, Vec3::Y, if eye.x + f * d.x < 0.4 { 0.8 } else { 0.3 }),
-                (None, Some(w)) => (w, Vec3::X, 0.6),
-                (None, None) => (0.0, Vec3::ZERO, 0.0),
-            };
-            let flux = power * albedo * n.dot(-d).max(0.0) * (1.0 - (u * u + v * v) / 2.0).max(0.0);
-            rsm.position.push(if albedo > 0.0 {
-                (eye + t * d).extend(1.0)
-            } else {
-                Vec4::ZERO
-            });
-            rsm.normal.push(n.extend(0.0));
-            rsm.flux.push(Vec4::new(flux, 0.9 * flux, 0.8 * flux, 0.0));
-        }
-    }
     let params = HvlParams {
         count: 1024,
         distribution: Distribution::Flux,
         ..HvlParams::default()
     };
-    build_flux_cache(&[rsm], &params).expect("flux cache")
+    build_flux_cache(&[turned_spot(angle, power)], &params).expect("flux cache")
 }
 
 /// Records by identity.
@@ -281,7 +242,10 @@ fn a_samples_temporal_filter_resets_on_a_stated_change() {
     let raw = spot_cache(-0.3 + 20.0 * step, power);
     let mut filtered = raw.clone();
     previous = filter(&mut filtered, &previous, &push(true));
-    assert_eq!(filtered, raw, "a light beyond the ratio: every sample starts over");
+    assert_eq!(
+        filtered, raw,
+        "a light beyond the ratio: every sample starts over"
+    );
 
     // A sample moved by 1.5 radii starts over; one moved by half a radius blends.
     let mut moved = spot_cache(-0.3 + 20.0 * step, power);

@@ -4,6 +4,7 @@
 
 pub mod cli;
 pub mod scenes;
+pub mod spot_rsm;
 
 use glam::Vec4;
 use shine::gpu::{
