@@ -7,11 +7,14 @@
 //! wall's edge.
 //!
 //! - GPU == twin within 2% of the pixel's value plus the image's mean (both round the signal
-//!   to f16 between iterations; 0.3% at worst when written).
+//!   to f16 between iterations; 0.3% at worst when written, 1.7% since the lone firefly below
+//!   was added: that pixel alone, whose neighbours come in through the luminance weight's
+//!   tail, where the f16 roundings of three iterations add up).
 //! - A mirror column (footprint under half a pixel) keeps every pixel as it was (sharp stays
 //!   sharp), fireflies aside.
-//! - A lone firefly on the rough floor is gone, also one whose roughness fails every
-//!   neighbour's roughness test (a tile's edge); a mirror pixel's glint among rough ones stays;
+//! - A lone firefly on the rough floor is gone, also one on the wall whose roughness fails
+//!   every neighbour's roughness test (a tile's edge); a mirror pixel's glint among rough ones
+//!   stays;
 //!   the rough region's mean is kept within 5% (the clamp's loss stated); the error against
 //!   the noise-free signal falls more than 2.5×.
 //! - Untraced and background pixels are 0.
@@ -60,12 +63,12 @@ struct Frame {
     specular: Vec<Vec4>,
 }
 
-/// A firefly on the rough floor whose own roughness (0.38, a tile's edge) fails every
+/// A firefly on the rough wall whose own roughness (0.38, a tile's edge) fails every
 /// neighbour's roughness test.
-const LONE_FIREFLY: (u32, u32) = (16, 28);
-/// A polished glint on the rough floor: a mirror pixel (0.04) holding a light's highlight,
-/// ten times its rough neighbours.
-const GLINT: (u32, u32) = (24, 28);
+const LONE_FIREFLY: (u32, u32) = (16, 10);
+/// A polished glint on the rough wall: a mirror pixel (0.04) holding a light's highlight, ten
+/// times its rough neighbours.
+const GLINT: (u32, u32) = (24, 10);
 
 /// Roughness of pixel (x, y): its column's, but [`LONE_FIREFLY`]'s and [`GLINT`]'s.
 fn roughness_at(x: u32, y: u32) -> f32 {
@@ -78,7 +81,7 @@ fn roughness_at(x: u32, y: u32) -> f32 {
 
 /// The pixel (x, y) of a floor (y = 0) below a wall (z = −2), seen from EYE; row 0 is
 /// background. Firefly pixels: (20, 24) on the rough floor, (4, 26) on the mirror floor,
-/// [`LONE_FIREFLY`]; and the [`GLINT`].
+/// [`LONE_FIREFLY`] on the wall; and the [`GLINT`].
 fn frame() -> Frame {
     let mut f = Frame {
         position: Vec::new(),
@@ -316,10 +319,7 @@ fn fireflies_go_and_the_rough_floor_is_smoothed_with_its_mean_kept() {
     // The floor's rough columns, away from the firefly and the wall's edge.
     let floor: Vec<usize> = (22..H)
         .flat_map(|y| (12..28).map(move |x| index(x, y)))
-        .filter(|&i| {
-            let special = [(20, 24), LONE_FIREFLY, GLINT].map(|(x, y)| index(x, y));
-            f.position[i].y.abs() < 1e-4 && !special.contains(&i)
-        })
+        .filter(|&i| f.position[i].y.abs() < 1e-4 && i != index(20, 24))
         .collect();
     assert!(floor.len() > 100, "{} floor pixels", floor.len());
     let lum = |t: Vec4| t.truncate().dot(Vec3::new(0.2126, 0.7152, 0.0722));
@@ -362,9 +362,10 @@ fn fireflies_go_and_the_rough_floor_is_smoothed_with_its_mean_kept() {
     // 40×), while the glint, a mirror pixel among rougher ones, keeps its highlight: a rougher
     // lobe cannot bound a narrower one.
     let lone = lum(got[index(LONE_FIREFLY.0, LONE_FIREFLY.1)]);
+    let wall = lum(GOLD) * smooth(LONE_FIREFLY.0, Vec3::Z);
     assert!(
-        lone < 3.0 * mean_out,
-        "lone firefly {lone} against the mean {mean_out}"
+        lone < 3.0 * wall,
+        "lone firefly {lone} against the noise-free wall's {wall}"
     );
     let glint = index(GLINT.0, GLINT.1);
     assert!(
