@@ -499,7 +499,7 @@ mod tests {
         let shared: Vec<u32> = pixels
             .iter()
             .enumerate()
-            .map(|(i, &(a, s))| rays(a, s, 2, traced, total, (i as f32 * 0.618_034).fract()))
+            .map(|(i, &(a, s))| super::rays(a, s, 2, traced, total, (i as f32 * 0.618_034).fract()))
             .collect();
         assert!(
             shared.iter().step_by(3).all(|&n| n == 2),
@@ -516,7 +516,7 @@ mod tests {
         let wide = alpha(0.1);
         assert!(lobe_tan(wide) > RAY_KEEP_TAN);
         assert_eq!(
-            rays(wide, 1.0, 2, 10.0, 10.0, 0.0),
+            super::rays(wide, 1.0, 2, 10.0, 10.0, 0.0),
             ray_count(ray_weight(wide, 1.0), 2, 10.0, 10.0, 0.0)
         );
     }
