@@ -3,7 +3,8 @@
 // the normalised sum over the 5×5 taps q = p + step (i, j), i, j in -2..2, of
 //   w = h(i) h(j) · lobe(|q − p|², r_p) · geometry(p, q) · luminance(l_p, l_q, var_p)
 // (shaders/include/denoise.glsl: the B3 kernel h, the footprint gaussian of radius r_p from
-// `denoise_radius`, the plane / normal / roughness test, SVGF's luminance weight), and its
+// `denoise_radius`, the plane / normal / roughness test, SVGF's luminance weight over the
+// centre's variance prefiltered by a 3×3 gaussian, denoise_variance_kernel), and its
 // variance Σ w² var_q / (Σ w)² (SVGF eq. 6) for the next iteration's luminance weight. The
 // last iteration (push.remodulate) multiplies by the specular pass's share · ks again and
 // writes the radiance with a = 0. Untraced pixels (radius −1) neither give nor take.
@@ -67,6 +68,23 @@ void main() {
 #else
     float rough_p = material_p.x;
     float tolerance = denoise_normal_tolerance(brdf_alpha(material_p.x));
+    // SVGF's variance prefilter: the luminance weight's variance is the 3×3 gaussian of the
+    // traced neighbours' (the filtered variance of the next iterations stays the centre's).
+    float guide_variance = 0.0;
+    float guide_weight = 0.0;
+    for (int j = -1; j <= 1; ++j) {
+        for (int i = -1; i <= 1; ++i) {
+            ivec2 c = p + ivec2(i, j);
+            if (any(lessThan(c, ivec2(0))) || any(greaterThan(c, ivec2(push.extent) - 1))
+                || imageLoad(denoise_footprint, c).r < 0.0) {
+                continue;
+            }
+            float k = denoise_variance_kernel(i) * denoise_variance_kernel(j);
+            guide_variance += k * imageLoad(denoise_in, c).a;
+            guide_weight += k;
+        }
+    }
+    guide_variance /= guide_weight;
 #endif
     vec3 sum = vec3(0.0);
     float variance = 0.0;
@@ -97,7 +115,7 @@ void main() {
 #ifdef DIFFUSE
                 * denoise_luminance_weight(l_p, luminance(q.rgb), max(centre.a, q.a));
 #else
-                * denoise_luminance_weight(l_p, luminance(q.rgb), centre.a);
+                * denoise_luminance_weight(l_p, luminance(q.rgb), guide_variance);
 #endif
             if (w > 0.0) {
                 sum += w * q.rgb;

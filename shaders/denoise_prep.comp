@@ -8,11 +8,13 @@
 //   demodulated already (light / π, kd comes back in the last iteration);
 // - the firefly clamp (push.clamp): the luminance l_p of the demodulated value is held to
 //   DENOISE_FIREFLY_RATIO times the largest of its 3×3 neighbours on the same surface
-//   (geometry weight ≥ DENOISE_MATCH), so a lone bright pixel no neighbour confirms is cut to
-//   what its neighbourhood holds (the energy
-//   it removes: docs/quality.md, frames with `denoise.clamp` on and off);
+//   (geometry weight ≥ DENOISE_MATCH with the neighbour's roughness taken at
+//   denoise_clamp_roughness: a smoother neighbour counts, whatever the roughness test says),
+//   so a lone bright pixel no neighbour confirms is cut to what its neighbourhood holds, a
+//   tile edge's pixel of its own roughness too (the energy it removes: docs/quality.md,
+//   frames with `denoise.clamp` on and off);
 // - the luminance variance over that 3×3 (the clamped centre and its matching neighbours,
-//   equal weights), SVGF's guide of the luminance weight;
+//   roughness tested, equal weights), SVGF's guide of the luminance weight;
 // - the footprint radius in pixels: specular, denoise_radius from its roughness and the
 //   parallax d / (z + d) the specular pass stores in alpha, averaged over the same neighbours;
 //   diffuse (shine::passes::denoise::Footprint, which says why), a stated radius in pixels
@@ -141,12 +143,20 @@ void main() {
                 continue;
             }
             Texel q = texel(c);
-            if (!q.traced || denoise_geometry_weight(centre.position, centre.normal, centre.dist,
-                    centre.roughness, tolerance, q.position, q.normal, q.roughness) < DENOISE_MATCH) {
+            if (!q.traced) {
                 continue;
             }
             float l = luminance(q.demodulated);
-            bound = max(bound, l);
+            // The clamp's neighbours: the same surface, a lobe no wider than the centre's.
+            if (denoise_geometry_weight(centre.position, centre.normal, centre.dist,
+                    centre.roughness, tolerance, q.position, q.normal,
+                    denoise_clamp_roughness(centre.roughness, q.roughness)) >= DENOISE_MATCH) {
+                bound = max(bound, l);
+            }
+            if (denoise_geometry_weight(centre.position, centre.normal, centre.dist,
+                    centre.roughness, tolerance, q.position, q.normal, q.roughness) < DENOISE_MATCH) {
+                continue;
+            }
             sum += l;
             sum2 += l * l;
             parallax += q.parallax;

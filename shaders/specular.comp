@@ -81,8 +81,7 @@ void main() {
     if (push.config.w != 0u) {
         // Its own stream (the samples' streams below restart per sample).
         rng_state = pcg(pcg(pixel.x ^ pcg(push.frame.w ^ 0x9e3779b9u)) + pixel.y);
-        samples = denoise_ray_count(denoise_ray_weight(a, share), samples, budget.total.y,
-            budget.total.x, rand());
+        samples = denoise_rays(a, share, samples, budget.total.y, budget.total.x, rand());
     }
     vec3 sum = vec3(0.0);
     float eye_distance = length(push.camera.xyz - position.xyz);

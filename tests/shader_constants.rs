@@ -345,6 +345,7 @@ fn denoise_constants_match_the_shader() {
         ("DENOISE_MATCH", d::MATCH),
         ("DENOISE_LUMINANCE_EPSILON", d::LUMINANCE_EPSILON),
         ("DENOISE_RAY_FLOOR", d::RAY_FLOOR),
+        ("DENOISE_RAY_KEEP_TAN", d::RAY_KEEP_TAN),
         ("DENOISE_RAY_MAX_FACTOR", d::RAY_MAX_FACTOR),
     ] {
         assert_eq!(glsl_float("include/denoise.glsl", name), value, "{name}");

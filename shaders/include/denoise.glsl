@@ -34,9 +34,10 @@ const float DENOISE_LUMINANCE_SIGMA = 8.0;
 // Smallest demodulation weight share · ks divided by (keeps grazing, barely traced pixels
 // finite).
 const float DENOISE_MIN_WEIGHT = 1e-3;
-// The firefly clamp: a pixel's luminance at most this many times the largest of its matching
-// 3×3 neighbours' (a local maximum of ordinary noise is left to the filter; a lone sample
-// that found a bright light is cut).
+// The firefly clamp: a pixel's luminance at most this many times the largest of its 3×3
+// neighbours' on the same surface (denoise_clamp_roughness: whatever their roughness, if their
+// lobe is no wider than its own); a local maximum of ordinary noise is left to the filter, a
+// lone sample that found a bright light is cut.
 const float DENOISE_FIREFLY_RATIO = 2.0;
 // ε of the luminance weight (a flat region's zero variance keeps equal neighbours only).
 const float DENOISE_LUMINANCE_EPSILON = 1e-6;
@@ -93,6 +94,13 @@ float denoise_radius(float alpha, float parallax, float pixel_angle) {
 // Least claim of a traced pixel on the frame's specular rays (a mirror's lobe still needs
 // its ray).
 const float DENOISE_RAY_FLOOR = 0.02;
+// A lobe narrower than this tan θ keeps its specular.samples rays when the rays are shared
+// (denoise_rays): the filter cannot widen it (its footprint stays under a pixel), so rays taken
+// from it are grain nothing smooths (builtin:metals' chrome, 0.03, tan θ 0.002: 0.092 of the
+// truth at 2 rays, 0.121 at the ~1.2 the shared budget left it). 0.01 (a half-angle of 0.6°,
+// roughness ≈ 0.07) keeps builtin:metals' and builtin:room's chrome (0.03, 0.05) and shares
+// the silver's (0.1, tan θ 0.02).
+const float DENOISE_RAY_KEEP_TAN = 0.01;
 // Most rays one pixel takes, in multiples of specular.samples.
 const float DENOISE_RAY_MAX_FACTOR = 4.0;
 
@@ -111,6 +119,31 @@ uint denoise_ray_count(float weight, uint samples, float traced, float total, fl
     float spare = float(max(samples, 1u) - 1u);
     float n = total > 0.0 ? 1.0 + spare * traced * weight / total : float(samples);
     return uint(floor(min(n, DENOISE_RAY_MAX_FACTOR * float(samples)) + u));
+}
+
+// Rays of a traced pixel of GGX α and trace share `share` when the frame's rays are shared
+// (specular.adaptive): denoise_ray_count of its claim, but at least `samples` for a lobe
+// narrower than DENOISE_RAY_KEEP_TAN (those rays come on top of the budget: a frame spends at
+// most (samples − 1) more rays per such pixel than `samples` per traced pixel).
+uint denoise_rays(float alpha, float share, uint samples, float traced, float total, float u) {
+    uint n = denoise_ray_count(denoise_ray_weight(alpha, share), samples, traced, total, u);
+    return denoise_lobe_tan(alpha) < DENOISE_RAY_KEEP_TAN ? max(n, max(samples, 1u)) : n;
+}
+
+// The roughness neighbour q is compared at in the firefly clamp's geometry test: a smoother
+// neighbour (a narrower lobe) counts as the centre's own. A wider lobe is a blur of a narrower
+// one over the same surroundings and a blur never exceeds the largest value it averages, so
+// a neighbour as smooth or smoother bounds the centre; a rougher one does not (a mirror beside
+// a rough tile may rightly hold a light's highlight many times its neighbours').
+float denoise_clamp_roughness(float rough_p, float rough_q) {
+    return max(rough_p, rough_q);
+}
+
+// The 3-tap gaussian of SVGF's variance prefilter (offset i in -1..1): 1/4, 1/2, 1/4. The
+// luminance weight of the specular's à-trous divides by the centre's deviation from its 3×3
+// variance blurred so (SVGF eq. 5): two rays leave the 3×3 variance itself noisy.
+float denoise_variance_kernel(int i) {
+    return i == 0 ? 0.5 : 0.25;
 }
 
 // The B3-spline tap of offset i in -2..2: 1/16, 1/4, 3/8, 1/4, 1/16.

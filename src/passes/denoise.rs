@@ -13,7 +13,9 @@
 //! 1. **specular_prep**: the radiance divided by `share · ks` (the trace share of the lobe and
 //!    Schlick's Fresnel at n·v, the albedo's colour), so texture and colour stay sharp; a
 //!    firefly clamp (a pixel's luminance at most twice the largest of its 3×3 neighbours on
-//!    the same surface); the 3×3 luminance variance; the footprint radius
+//!    the same surface whose lobe is no wider than its own, whatever the roughness test: a
+//!    tile's edge pixel of its own roughness is bounded too); the 3×3 luminance variance; the
+//!    footprint radius
 //!    `r = tan θ · max(d / (z + d), ½) / pixel angle` in pixels, θ the reflected lobe's median
 //!    half-angle (twice the GGX half vector's, `tan θ_h = α`), `d / (z + d)` the parallax of
 //!    the hits the specular pass stores (at least ½: what touches the receiver is seen sharp,
@@ -21,9 +23,9 @@
 //! 2. **denoise_atrous** × [`DenoiseParams::iterations`]: 5×5 B3 taps spaced 2^i, weighted by
 //!    the footprint's gaussian (σ = r), the tangent-plane distance, the normals (within the
 //!    lobe's angle: `exp(−(1 − n_p·n_q) / (1 − cos θ))`, so a curved mirror's neighbours,
-//!    which reflect other directions, stay apart), the roughness and SVGF's luminance weight;
-//!    the variance filtered with the squared weights. The last iteration multiplies by
-//!    `share · ks` again.
+//!    which reflect other directions, stay apart), the roughness and SVGF's luminance weight
+//!    (over the centre's variance prefiltered by a 3×3 gaussian, SVGF eq. 5); the variance
+//!    filtered with the squared weights. The last iteration multiplies by `share · ks` again.
 //!
 //! The **diffuse variant** takes the sky's `A · L̃(b) / π` and the near field's `E_near / π`,
 //! demodulated already (their receivers' `kd` comes back in the last iteration, so textures
@@ -38,7 +40,8 @@
 //! energy: the dark majority refuses the rare bright samples).
 //!
 //! Measured (docs/quality.md): `builtin:metals` at one sample, the gold sphere (roughness 0.3)
-//! 0.341 → 0.204 of the truth, the chrome one unchanged; 4–8% of a 256² frame on lavapipe.
+//! 0.341 → 0.201 of the truth (0.194 with the default shared rays, `specular.adaptive`), the
+//! chrome one unchanged; 4–8% of a 256² frame on lavapipe.
 //! The diffuse variant against the bilateral, `builtin:animated` at one sample: the orange
 //! wall 0.145 → 0.143 of the truth (noise-free), 0.070 → 0.060 of the same renderer at 1024
 //! sky and 256 near rays.
@@ -126,7 +129,7 @@ pub struct DenoiseParams {
     #[setting(default = ITERATIONS, range = ITERATIONS_RANGE, affects = both)]
     pub iterations: u32,
     /// Clamp fireflies: a pixel's luminance at most twice the largest of its 3×3 neighbours on
-    /// the same surface.
+    /// the same surface with a lobe no wider than its own.
     /// (The specular's only: the diffuse signals' few rays leave neighbours at 0, and a lone
     /// ray's real light would be cut.)
     #[setting(default = true, affects = quality)]

@@ -25,8 +25,8 @@ pub const MIN_NORMAL_TOLERANCE: f32 = 1e-4;
 pub const ROUGHNESS_SIGMA: f32 = 0.05;
 /// `DENOISE_LUMINANCE_SIGMA`: SVGF's σ_l, in standard deviations of the centre.
 pub const LUMINANCE_SIGMA: f32 = 8.0;
-/// `DENOISE_FIREFLY_RATIO`: a pixel's luminance at most this many times its largest matching
-/// neighbour's.
+/// `DENOISE_FIREFLY_RATIO`: a pixel's luminance at most this many times its largest neighbour's
+/// on the same surface (roughness taken at [`clamp_roughness`]).
 pub const FIREFLY_RATIO: f32 = 2.0;
 /// `DENOISE_LUMINANCE_EPSILON`: ε of the luminance weight.
 pub const LUMINANCE_EPSILON: f32 = 1e-6;
@@ -70,6 +70,33 @@ pub fn lobe_angle(alpha: f32) -> f32 {
 pub const RAY_FLOOR: f32 = 0.02;
 /// `DENOISE_RAY_MAX_FACTOR`: most rays of a pixel, in multiples of `specular.samples`.
 pub const RAY_MAX_FACTOR: f32 = 4.0;
+/// `DENOISE_RAY_KEEP_TAN`: a lobe narrower than this tan θ keeps its `specular.samples` rays
+/// when they are shared ([`rays`]).
+pub const RAY_KEEP_TAN: f32 = 0.01;
+
+/// `denoise_rays`: the rays of a traced pixel of GGX `alpha` and trace share `share`:
+/// [`ray_count`] of its [`ray_weight`], at least `samples` for a lobe narrower than
+/// [`RAY_KEEP_TAN`].
+pub fn rays(alpha: f32, share: f32, samples: u32, traced: f32, total: f32, u: f32) -> u32 {
+    let n = ray_count(ray_weight(alpha, share), samples, traced, total, u);
+    if lobe_tan(alpha) < RAY_KEEP_TAN {
+        n.max(samples.max(1))
+    } else {
+        n
+    }
+}
+
+/// `denoise_clamp_roughness`: the roughness neighbour `q` is compared at in the firefly clamp's
+/// geometry test (a smoother neighbour counts as the centre's own).
+pub fn clamp_roughness(p: f32, q: f32) -> f32 {
+    p.max(q)
+}
+
+/// `denoise_variance_kernel`: the 3-tap gaussian (offset `i` in −1..=1) of SVGF's variance
+/// prefilter.
+pub fn variance_kernel(i: i32) -> f32 {
+    if i == 0 { 0.5 } else { 0.25 }
+}
 
 /// `denoise_ray_weight`: a traced pixel's claim on the specular rays (0 when `share` is 0).
 pub fn ray_weight(alpha: f32, share: f32) -> f32 {
@@ -301,11 +328,17 @@ pub fn prep(
                 let Some((q, q_weight, _)) = g.surface(j) else {
                     continue;
                 };
+                let l = luminance(input[j].truncate() / q_weight);
+                let same_surface = Surface {
+                    roughness: clamp_roughness(centre.roughness, q.roughness),
+                    ..q
+                };
+                if geometry_weight_within(&centre, &same_surface, tolerance) >= MATCH {
+                    bound = bound.max(l);
+                }
                 if geometry_weight_within(&centre, &q, tolerance) < MATCH {
                     continue;
                 }
-                let l = luminance(input[j].truncate() / q_weight);
-                bound = bound.max(l);
                 sum += l;
                 sum2 += l * l;
                 parallax += input[j].w;
@@ -335,6 +368,23 @@ pub fn prep(
     (signal, radii)
 }
 
+/// The specular's luminance-weight variance at (x, y): the [`variance_kernel`] gaussian of the
+/// traced 3×3 neighbours' variances (SVGF's prefilter).
+fn prefiltered_variance(g: &Guide<'_>, signal: &[Vec4], radii: &[f32], x: i32, y: i32) -> f32 {
+    let (mut sum, mut weight) = (0.0f32, 0.0f32);
+    for j in -1..=1 {
+        for k in -1..=1 {
+            let Some(c) = g.index(x + k, y + j).filter(|&c| radii[c] >= 0.0) else {
+                continue;
+            };
+            let w = variance_kernel(k) * variance_kernel(j);
+            sum += w * signal[c].w;
+            weight += w;
+        }
+    }
+    sum / weight
+}
+
 /// `denoise_atrous`: one iteration at tap spacing `step` over `signal` (rgb, variance in w);
 /// with `remodulate` the last one, the radiance times share · ks (or kd) with w = 0.
 pub fn atrous(
@@ -355,6 +405,10 @@ pub fn atrous(
             let tolerance = g.tolerance(&p);
             let centre = signal[i];
             let l_p = luminance(centre.truncate());
+            let guide = match g.signal {
+                Signal::Specular => prefiltered_variance(g, signal, radii, x, y),
+                Signal::Diffuse => centre.w,
+            };
             let (mut sum, mut variance, mut weight_sum) = (Vec3::ZERO, 0.0f32, 0.0f32);
             for j in -2..=2 {
                 for k in -2..=2 {
@@ -377,7 +431,7 @@ pub fn atrous(
                         * kernel(j)
                         * lobe
                         * geometry_weight_within(&p, &surface, tolerance)
-                        * luminance_weight(l_p, luminance(q.truncate()), g.variance(centre.w, q.w));
+                        * luminance_weight(l_p, luminance(q.truncate()), g.variance(guide, q.w));
                     if w > 0.0 {
                         sum += w * q.truncate();
                         variance += w * w * q.w;
@@ -439,5 +493,31 @@ mod tests {
         );
         assert_eq!(ray_weight(alpha(0.3), 0.0), 0.0);
         assert_eq!(ray_count(1.0, 2, 10.0, 0.0, 0.0), 2);
+
+        // With the mirrors' floor (`rays`): the mirrors keep their two rays, the gold still
+        // gains, and the frame spends at most the mirrors' extra ray on top of the budget.
+        let shared: Vec<u32> = pixels
+            .iter()
+            .enumerate()
+            .map(|(i, &(a, s))| super::rays(a, s, 2, traced, total, (i as f32 * 0.618_034).fract()))
+            .collect();
+        assert!(
+            shared.iter().step_by(3).all(|&n| n == 2),
+            "a mirror lost rays"
+        );
+        let gold = shared.iter().skip(1).step_by(3).sum::<u32>() as f32 / 1000.0;
+        assert!((gold - mean(1)).abs() < 1e-6, "gold {gold}");
+        let spent = shared.iter().sum::<u32>() as f32 / traced;
+        assert!(
+            spent < 2.0 * 1.02 + 1.0 / 3.0,
+            "spent {spent} rays per pixel"
+        );
+        // A lobe just wider than the floor's shares as before.
+        let wide = alpha(0.1);
+        assert!(lobe_tan(wide) > RAY_KEEP_TAN);
+        assert_eq!(
+            super::rays(wide, 1.0, 2, 10.0, 10.0, 0.0),
+            ray_count(ray_weight(wide, 1.0), 2, 10.0, 10.0, 0.0)
+        );
     }
 }
