@@ -62,15 +62,22 @@ fn sequence_parts_equal_the_one_process_run_bit_for_bit() {
 
     // Without a history nothing is carried between frames: a range deep in the sequence needs
     // no warm-up, and its frames are still the one-process run's (the frame numbers key the
-    // clock, the jitter and the sampling).
+    // clock, the jitter and the sampling). The samples' own history is one too: with it on,
+    // the range warms up.
+    let no_history = ["--set", "history.frames=1", "--set", "history.samples=1"];
     let cold = dir.join("cold");
-    run(&cold, &["--set", "history.frames=1"]);
+    run(&cold, &no_history);
     let late = dir.join("late");
     let said = run(
         &late,
-        &["--set", "history.frames=1", "--frame-range", "9..=11"],
+        &[&no_history[..], &["--frame-range", "9..=11"]].concat(),
     );
     assert!(said.contains("after 0 warm-up frames"), "{said}");
+    let said = run(
+        &dir.join("late-samples"),
+        &["--set", "history.frames=1", "--frame-range", "9..=11"],
+    );
+    assert!(said.contains("after 9 warm-up frames"), "{said}");
     same_frames(&late, &cold, 9..12);
     assert!(!late.join("f_08.exr").exists(), "a frame outside the range");
 

@@ -202,7 +202,7 @@ fn tiny_temporal_study_reports_flicker_and_writes_the_pictures() {
         "--mode",
         "hvl=gi=hvl",
         "--mode",
-        "igi cold=gi=igi;history.frames=1",
+        "igi cold=gi=igi;history.frames=1;history.samples=1",
         "--format",
         "json",
         "--out",

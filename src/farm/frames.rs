@@ -127,7 +127,8 @@ impl SequenceSlice {
 /// the indirect light's (`history.frames`), TAA's ([`TAA_MAX_FRAMES`]) when on, the automatic
 /// exposure's (1 / `output.adaptation`) when the frames are tonemapped (`ldr`) with it, and an
 /// amortised technique's (`*.slices` frames per refresh, each refresh blending in
-/// [`RESOLVE_ALPHA`] of the fresh light: slices / α).
+/// [`RESOLVE_ALPHA`] of the fresh light: slices / α), and HVL's and IGI's samples' own
+/// (1 / `history.samples`, which `history.frames = 1` leaves on).
 pub fn longest_history(settings: &Settings, ldr: bool) -> u32 {
     let taa = if settings.output.taa {
         TAA_MAX_FRAMES
@@ -154,12 +155,18 @@ pub fn longest_history(settings: &Settings, ldr: bool) -> u32 {
     } else {
         1
     };
+    let samples = if settings.history.samples < 1.0 {
+        (1.0 / settings.history.samples).ceil() as u32
+    } else {
+        1
+    };
     settings
         .history
         .max_frames
         .max(taa)
         .max(exposure)
         .max(amortised)
+        .max(samples)
 }
 
 #[cfg(test)]
@@ -194,8 +201,11 @@ mod tests {
     fn every_history_counts() {
         let mut settings = Settings::default();
         settings.history.max_frames = 1;
+        settings.history.samples = 1.0;
         settings.output.auto_exposure = false;
         assert_eq!(longest_history(&settings, true), 1);
+        settings.history.samples = 0.25;
+        assert_eq!(longest_history(&settings, true), 4);
         settings.hvl.slices = 4;
         assert_eq!(longest_history(&settings, false), 8);
         settings.output.taa = true;
