@@ -98,13 +98,8 @@ void main() {
     }
     cache.h[m].flux = flux;
     cache.h[m].normal_distance = normal;
+    // The history keeps what the next frame's rule reads; the identity is the record's index.
     current.h[id].position_radius = position;
     current.h[id].normal_distance = normal;
     current.h[id].flux = flux;
-    for (int l = 0; l < HVL_EMISSION_MAX_BANDS; ++l) {
-        current.h[id].emission[l] = cache.h[m].emission[l];
-    }
-    current.h[id].light = light;
-    current.h[id].sample_index = index;
-    current.h[id].pad = 0u;
 }

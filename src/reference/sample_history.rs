@@ -32,10 +32,12 @@ fn mix(x: Vec3, y: Vec3, t: f32) -> Vec3 {
 
 /// Filters `cache` in place against `previous` (the history of the last frame, `push.lights ×
 /// push.count` records by identity; ignored without `push.has_history`); returns this frame's
-/// history (empty records where no sample of that identity exists).
+/// history: each identity's position, normal and flux (empty records where no sample of that
+/// identity exists).
 pub fn filter(cache: &mut [Hvl], previous: &[Hvl], push: &SampleHistoryPush) -> Vec<Hvl> {
     let count = push.count as usize;
-    let mut current = vec![bytemuck::Zeroable::zeroed(); count * push.lights.max(1) as usize];
+    let mut current: Vec<Hvl> =
+        vec![bytemuck::Zeroable::zeroed(); count * push.lights.max(1) as usize];
     for now in cache.iter_mut().take(count) {
         if !now.is_valid() || now.light >= push.lights || now.sample_index >= push.count {
             continue;
@@ -59,7 +61,11 @@ pub fn filter(cache: &mut [Hvl], previous: &[Hvl], push: &SampleHistoryPush) -> 
                 now.normal_distance = n.extend(now.normal_distance[3]).to_array();
             }
         }
-        current[id] = Hvl { pad: 0, ..*now };
+        // What the next frame's rule reads; the identity is the record's index.
+        let kept = &mut current[id];
+        kept.position_radius = now.position_radius;
+        kept.normal_distance = now.normal_distance;
+        kept.flux = now.flux;
     }
     current
 }

@@ -198,9 +198,10 @@ impl Renderer {
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;
         let frame = &scene.gpu.state;
         let receiver_extent = receivers::receiver_extent(p.extent, p.receiver_scale)?;
+        let light_count = light_count(frame)?;
         let samples = SampleSetup {
             weight: p.sample_weight,
-            lights: light_count(frame)?,
+            lights: light_count,
         };
         let hvl = p
             .hvl
@@ -235,7 +236,6 @@ impl Renderer {
                 .map(|inputs| (params, inputs)),
             None => None,
         };
-        let light_count = light_count(frame)?;
         // What rays that meet the scene's surfaces read (the specular pass, the cubes' fill
         // and HVL's near field): level-0 texture lookups, and the environment where they
         // escape, lighting the hits too when the scene has one.
