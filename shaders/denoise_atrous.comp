@@ -7,7 +7,8 @@
 // centre's variance prefiltered by a 3×3 gaussian, denoise_variance_kernel), and its
 // variance Σ w² var_q / (Σ w)² (SVGF eq. 6) for the next iteration's luminance weight. The
 // last iteration (push.remodulate) multiplies by the specular pass's share · ks again and
-// writes the radiance with a = 0. Untraced pixels (radius −1) neither give nor take.
+// writes the radiance with a = 0; where the footprint is sharp it writes the traced signal
+// (`denoise_source`) as it came. Untraced pixels (radius −1) neither give nor take.
 // Variant `diffuse` (the sky's and HVL's near field's light at receiver resolution): the
 // normal tolerance DENOISE_DIFFUSE_NORMAL_TOLERANCE, no roughness test, the luminance weight
 // over the larger of the two pixels' variances (symmetric: a few rays leave a skewed signal,
@@ -31,6 +32,10 @@ layout(set = 0, binding = 3, rgba16f) readonly uniform image2D gb_normal;
 layout(set = 0, binding = 4, rgba8) readonly uniform image2D gb_albedo;
 layout(set = 0, binding = 5, rgba8) readonly uniform image2D gb_material;
 layout(set = 0, binding = 6, rgba16f) writeonly uniform image2D denoise_out;
+// The signal as traced (the prep pass's input): the last iteration writes it back where the
+// footprint is sharp (under DENOISE_SHARP_RADIUS), so such a pixel comes out as traced, not
+// through the f16 demodulation's round trips.
+layout(set = 0, binding = 7, rgba16f) readonly uniform image2D denoise_source;
 
 // shine::passes::denoise::AtrousPush (32 bytes).
 layout(push_constant) uniform Push {
@@ -131,11 +136,15 @@ void main() {
         vec3 ks;
         brdf_indirect_weights(imageLoad(gb_albedo, p).rgb, material_p.y,
             dot(n_p, (push.camera.xyz - x_p) / dist_p), kd, ks);
+        bool sharp = radius < DENOISE_SHARP_RADIUS;
 #ifdef DIFFUSE
-        imageStore(denoise_out, p, vec4(kd * value, 0.0));
+        vec3 light = sharp ? imageLoad(denoise_source, p).rgb : value;
+        imageStore(denoise_out, p, vec4(kd * light, 0.0));
 #else
         float share = specular_trace_weight(material_p.x, push.camera.w);
-        imageStore(denoise_out, p, vec4(value * max(share * ks, vec3(DENOISE_MIN_WEIGHT)), 0.0));
+        vec3 radiance = sharp ? imageLoad(denoise_source, p).rgb
+                              : value * max(share * ks, vec3(DENOISE_MIN_WEIGHT));
+        imageStore(denoise_out, p, vec4(radiance, 0.0));
 #endif
     } else {
         imageStore(denoise_out, p, denoise_storable(vec4(value, variance)));

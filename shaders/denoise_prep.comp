@@ -12,7 +12,8 @@
 //   denoise_clamp_roughness: a smoother neighbour counts, whatever the roughness test says),
 //   so a lone bright pixel no neighbour confirms is cut to what its neighbourhood holds, a
 //   tile edge's pixel of its own roughness too (the energy it removes: docs/quality.md,
-//   frames with `denoise.clamp` on and off);
+//   frames with `denoise.clamp` on and off); a sharp footprint (under DENOISE_SHARP_RADIUS) is
+//   never clamped: a mirror's rays agree, its lone bright pixel is a highlight;
 // - the luminance variance over that 3×3 (the clamped centre and its matching neighbours,
 //   roughness tested, equal weights), SVGF's guide of the luminance weight;
 // - the footprint radius in pixels: specular, denoise_radius from its roughness and the
@@ -163,17 +164,6 @@ void main() {
             count += 1.0;
         }
     }
-    vec3 value = centre.demodulated;
-    float l_p = luminance(value);
-    bound *= DENOISE_FIREFLY_RATIO;
-    if (push.clamp_fireflies != 0u && bound >= 0.0 && l_p > bound) {
-        value *= bound / l_p;
-        l_p = bound;
-    }
-    sum += l_p;
-    sum2 += l_p * l_p;
-    float mean = sum / count;
-    float variance = max(sum2 / count - mean * mean, 0.0);
 #ifdef DIFFUSE
     float radius = push.camera.w > 0.0
         ? denoise_world_radius(push.camera.w * parallax / count, centre.dist, push.footprint)
@@ -182,6 +172,17 @@ void main() {
     float radius = denoise_radius(brdf_alpha(centre.roughness), parallax / count,
         push.footprint);
 #endif
+    vec3 value = centre.demodulated;
+    float l_p = luminance(value);
+    bound *= DENOISE_FIREFLY_RATIO;
+    if (push.clamp_fireflies != 0u && radius >= DENOISE_SHARP_RADIUS && bound >= 0.0 && l_p > bound) {
+        value *= bound / l_p;
+        l_p = bound;
+    }
+    sum += l_p;
+    sum2 += l_p * l_p;
+    float mean = sum / count;
+    float variance = max(sum2 / count - mean * mean, 0.0);
     imageStore(denoise_signal, p, denoise_storable(vec4(value, variance)));
     imageStore(denoise_footprint, p, vec4(radius, 0.0, 0.0, 0.0));
 }

@@ -21,6 +21,10 @@ const float DENOISE_MAX_LOBE_ANGLE = 1.0;
 const float DENOISE_MIN_PARALLAX = 0.5;
 // Largest footprint radius, pixels (3 iterations reach 14 pixels).
 const float DENOISE_MAX_RADIUS = 16.0;
+// A footprint under this radius (pixels) is sharp: the lobe's reflection spreads less than a
+// pixel, so its rays agree and there is no noise to filter or to clamp. The pixel is kept as
+// traced: a mirror's lone bright pixel is a reflected highlight, not a firefly.
+const float DENOISE_SHARP_RADIUS = 0.5;
 // σ_p: a neighbour's distance off the centre's tangent plane, relative to the view distance.
 const float DENOISE_PLANE_SIGMA = 0.02;
 // Least normal tolerance 1 − cos φ (a mirror's lobe would otherwise part a plane's own f16
@@ -174,9 +178,9 @@ vec4 denoise_storable(vec4 v) {
 }
 
 // The footprint's gaussian at squared pixel offset `offset2` for `radius` pixels (σ = radius);
-// under half a pixel, the centre alone.
+// under DENOISE_SHARP_RADIUS, the centre alone.
 float denoise_lobe_weight(float offset2, float radius) {
-    if (radius < 0.5) {
+    if (radius < DENOISE_SHARP_RADIUS) {
         return offset2 == 0.0 ? 1.0 : 0.0;
     }
     return exp(-offset2 / (2.0 * radius * radius));

@@ -27,6 +27,10 @@
 //!    (over the centre's variance prefiltered by a 3×3 gaussian, SVGF eq. 5); the variance
 //!    filtered with the squared weights. The last iteration multiplies by `share · ks` again.
 //!
+//! A **sharp** footprint (`r` under `DENOISE_SHARP_RADIUS`, half a pixel: a mirror's rays meet
+//! within the pixel and agree) is neither clamped nor filtered: the last iteration writes the
+//! traced value back as it came, bit for bit.
+//!
 //! The **diffuse variant** takes the sky's `A · L̃(b) / π` and the near field's `E_near / π`,
 //! demodulated already (their receivers' `kd` comes back in the last iteration, so textures
 //! stay sharp), at receiver resolution, with a diffuse footprint ([`Footprint`]): for a
@@ -341,6 +345,7 @@ fn filter(
             .read("gb_normal", guide.normal)
             .read("gb_albedo", guide.albedo)
             .read("gb_material", guide.material)
+            .read("denoise_source", signal.input.1)
             .write("denoise_out", &mut out)
             .push(&AtrousPush {
                 camera: push.camera,

@@ -17,6 +17,9 @@ pub const MAX_LOBE_ANGLE: f32 = 1.0;
 pub const MIN_PARALLAX: f32 = 0.5;
 /// `DENOISE_MAX_RADIUS`: largest footprint radius, pixels.
 pub const MAX_RADIUS: f32 = 16.0;
+/// `DENOISE_SHARP_RADIUS`: a footprint under this radius (pixels) is sharp, its pixel kept as
+/// traced (neither filtered nor clamped: a mirror's rays agree).
+pub const SHARP_RADIUS: f32 = 0.5;
 /// `DENOISE_PLANE_SIGMA`: distance off the tangent plane, relative to the view distance.
 pub const PLANE_SIGMA: f32 = 0.02;
 /// `DENOISE_MIN_NORMAL_TOLERANCE`: least normal tolerance 1 − cos φ.
@@ -183,7 +186,7 @@ pub fn storable(v: Vec4) -> Vec4 {
 
 /// `denoise_lobe_weight`: the footprint's gaussian at squared offset `offset2`.
 pub fn lobe_weight(offset2: f32, radius: f32) -> f32 {
-    if radius < 0.5 {
+    if radius < SHARP_RADIUS {
         return if offset2 == 0.0 { 1.0 } else { 0.0 };
     }
     (-offset2 / (2.0 * radius * radius)).exp()
@@ -294,7 +297,8 @@ impl Guide<'_> {
     }
 }
 
-/// `denoise_prep`: per pixel the demodulated, firefly-clamped (`clamp`) signal with its 3×3
+/// `denoise_prep`: per pixel the demodulated, firefly-clamped (`clamp`, where the footprint is
+/// at least [`SHARP_RADIUS`]) signal with its 3×3
 /// luminance variance in w, and the footprint radius in pixels (−1 where nothing is traced),
 /// from `input`: the specular pass's output (rgb radiance, a parallax) or the diffuse light
 /// (rgb light / π, a the rays' mean hit distance where `hit_scale` > 0). `footprint` and
@@ -344,10 +348,17 @@ pub fn prep(
                 parallax += input[j].w;
                 n += 1.0;
             }
+            let r = match g.signal {
+                Signal::Specular => radius(alpha(centre.roughness), parallax / n, footprint),
+                Signal::Diffuse if hit_scale > 0.0 => {
+                    world_radius(hit_scale * parallax / n, centre.dist, footprint)
+                }
+                Signal::Diffuse => footprint,
+            };
             bound *= FIREFLY_RATIO;
             let mut value = input[i].truncate() / weight;
             let mut l_p = luminance(value);
-            if clamp && bound >= 0.0 && l_p > bound {
+            if clamp && r >= SHARP_RADIUS && bound >= 0.0 && l_p > bound {
                 value *= bound / l_p;
                 l_p = bound;
             }
@@ -356,13 +367,7 @@ pub fn prep(
             let mean = sum / n;
             let variance = (sum2 / n - mean * mean).max(0.0);
             signal[i] = storable(value.extend(variance));
-            radii[i] = match g.signal {
-                Signal::Specular => radius(alpha(centre.roughness), parallax / n, footprint),
-                Signal::Diffuse if hit_scale > 0.0 => {
-                    world_radius(hit_scale * parallax / n, centre.dist, footprint)
-                }
-                Signal::Diffuse => footprint,
-            };
+            radii[i] = r;
         }
     }
     (signal, radii)
@@ -386,13 +391,15 @@ fn prefiltered_variance(g: &Guide<'_>, signal: &[Vec4], radii: &[f32], x: i32, y
 }
 
 /// `denoise_atrous`: one iteration at tap spacing `step` over `signal` (rgb, variance in w);
-/// with `remodulate` the last one, the radiance times share · ks (or kd) with w = 0.
+/// with `remodulate = Some(source)` (the prep's input) the last one: the radiance times share ·
+/// ks (or kd) with w = 0, and where the footprint is sharp ([`SHARP_RADIUS`]) `source` as
+/// traced (times kd for the diffuse signal, whose source is demodulated).
 pub fn atrous(
     g: &Guide<'_>,
     signal: &[Vec4],
     radii: &[f32],
     step: i32,
-    remodulate: bool,
+    remodulate: Option<&[Vec4]>,
 ) -> Vec<Vec4> {
     let mut out = vec![Vec4::ZERO; signal.len()];
     for y in 0..g.extent[1] as i32 {
@@ -440,10 +447,13 @@ pub fn atrous(
                 }
             }
             let value = sum / weight_sum;
-            out[i] = if remodulate {
-                (value * weight).extend(0.0)
-            } else {
-                storable(value.extend(variance / (weight_sum * weight_sum)))
+            out[i] = match remodulate {
+                Some(source) if r < SHARP_RADIUS => match g.signal {
+                    Signal::Specular => source[i].truncate().extend(0.0),
+                    Signal::Diffuse => (source[i].truncate() * weight).extend(0.0),
+                },
+                Some(_) => (value * weight).extend(0.0),
+                None => storable(value.extend(variance / (weight_sum * weight_sum))),
             };
         }
     }
