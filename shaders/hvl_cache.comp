@@ -145,7 +145,7 @@ void main() {
     // Identity: the grid holds the primary light's cells alone, cell `index`.
     hvls.h[index].light = 0u;
     hvls.h[index].sample_index = index;
-    hvls.h[index].pad = 0u;
+    hvls.h[index].light_samples = push.count;
 #else
     vec4 position_radius = source.h[index].position_radius;
     float d = source.h[index].normal_distance.w;
@@ -195,6 +195,6 @@ void main() {
     }
     hvls.h[index].light = source.h[index].light;
     hvls.h[index].sample_index = source.h[index].sample_index;
-    hvls.h[index].pad = 0u;
+    hvls.h[index].light_samples = source.h[index].light_samples;
 #endif
 }

@@ -244,7 +244,7 @@ uint find_column(uint first, float target, float row_total) {
     return lo;
 }
 
-void write_hvl(uint m, vec4 position_radius, vec4 normal_distance, vec4 flux_valid, uint sample_index) {
+void write_hvl(uint m, vec4 position_radius, vec4 normal_distance, vec4 flux_valid, uint sample_index, uint light_samples) {
     // Field by field: naga cannot read the OpCopyLogical of a whole-struct store.
     hvls.h[m].position_radius = position_radius;
     hvls.h[m].normal_distance = normal_distance;
@@ -254,7 +254,7 @@ void write_hvl(uint m, vec4 position_radius, vec4 normal_distance, vec4 flux_val
     }
     hvls.h[m].light = push.light_id;
     hvls.h[m].sample_index = sample_index;
-    hvls.h[m].pad = 0u;
+    hvls.h[m].light_samples = light_samples;
 }
 
 void main() {
@@ -313,6 +313,6 @@ void main() {
     float r = hvl_radius_spacing(area, t.weight, total, budget) * push.radius_scale;
     float fade = clamp(share - float(j), 0.0, 1.0);
     vec3 flux = t.chroma * (total * fade / budget);
-    write_hvl(slot, vec4(t.position, r), vec4(t.normal, d), vec4(flux, 1.0), j);
+    write_hvl(slot, vec4(t.position, r), vec4(t.normal, d), vec4(flux, 1.0), j, n);
 }
 #endif

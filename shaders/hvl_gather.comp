@@ -8,9 +8,16 @@
 // its surface by 1% of its radius; a receiver inside an HVL's sphere is never shadowed from it.
 //   `_vis`: one ray per receiver and HVL, `indirect` the shadowed sum.
 //   `_shadows`: push.shadow_rays = K rays per receiver, one per stratum of the HVLs: stratum k
-//     holds HVLs k, k + K, k + 2K, ... (interleaved, so each is a thinned copy of the whole
-//     cache) and draws one of them in proportion to its weight w_j = (c_j.r + c_j.g + c_j.b) / 3
-//     (c_j the HVL's light; a one-item weighted reservoir over the stratum). With W_k the
+//     holds every light's samples k, k + K, k + 2K, ... of its sequence (by identity, not by
+//     slot: a light's records are consecutive and its first holds its count, so when one
+//     light's count changes the others' strata stay; interleaved, so each is a thinned copy of
+//     the whole cache) and draws one of them in proportion to its weight w_j = (c_j.r + c_j.g + c_j.b) / 3
+//     (c_j the HVL's light) by an exponential race: the least key -ln(u_j) / w_j wins, which
+//     happens with probability w_j / W_k, u_j a hash of the receiver and the HVL's identity
+//     (hvl_shadow_uniform). The draw depends on no order, so an HVL keeps its number when the
+//     records reorder or the counts change (issue 43; a reservoir in slot order with the
+//     receiver's random stream drew anew whenever one light's count moved the others' slots).
+//     With W_k the
 //     stratum's weight outside the spheres, V_k its drawn HVL's visibility and W_in the weight
 //     inside them, the shadowed weight
 //       S = W_in + sum_k W_k V_k
@@ -118,6 +125,16 @@ layout(set = 0, binding = 11, rgba16f) writeonly uniform image2D unshadowed;
 
 // Most shadow rays per receiver of the sampled visibility: shine::passes::hvl::shadows::RAYS_MAX.
 #define HVL_SHADOW_RAYS_MAX 16
+
+// A stratum's race starts with this key (finite: times a zero weight it stays 0, no NaN).
+const float HVL_SHADOW_NO_KEY = 3.0e38;
+
+// The shadow draw's uniform number of the HVL of `identity` (HVL_RECORD_IDENTITY) at the
+// receiver of `receiver_key`, in (0, 1): a hash of the two alone, never of the HVL's slot.
+float hvl_shadow_uniform(uint receiver_key, vec2 identity) {
+    uint h = pcg(receiver_key ^ pcg(uint(identity.x) * 0x9E3779B9u + uint(identity.y)));
+    return (float(h >> 8) + 0.5) * (1.0 / 16777216.0);
+}
 #endif
 
 #ifdef HVL_VISIBILITY
@@ -388,20 +405,35 @@ void main() {
     float weight_total = 0.0;
     float weight_visible = 0.0;
     uint strata = clamp(push.shadow_rays, 1u, uint(HVL_SHADOW_RAYS_MAX));
-    rng_state = pcg(uint(px.x) + push.extent.x * uint(px.y) + pcg(push.seed));
+    uint receiver_key = pcg(uint(px.x) + push.extent.x * uint(px.y) + pcg(push.seed));
     for (uint stratum = 0u; stratum < strata; ++stratum) {
         float weight = 0.0;
         uint pick = 0u;
-        for (uint j = stratum; j < hvl_count; j += strata) {
-            bool inside;
-            vec3 c = pair_light(rc, j, inside);
-            unshadowed_sum += c;
-            float w = (c.r + c.g + c.b) * (1.0 / 3.0);
-            weight_inside += inside ? w : 0.0;
-            float w_out = inside ? 0.0 : w;
-            weight += w_out;
-            // The stratum's reservoir takes HVL j with probability w_j / (its weight so far).
-            pick = rand() * weight < w_out ? j : pick;
+        float best = HVL_SHADOW_NO_KEY;
+        // Light by light (a light's records are consecutive, its first holds its count):
+        // the stratum holds the samples whose index is `stratum` mod K.
+        uint first = 0u;
+        while (first < hvl_count) {
+            uint samples = uint(imageLoad(hvl_records, hvl_record_texel(first, HVL_RECORD_IDENTITY)).z);
+            // An empty slot (the flux distribution's tail) holds no count: the rest is one run.
+            uint end = samples == 0u ? hvl_count : min(first + samples, hvl_count);
+            for (uint j = first + stratum; j < end; j += strata) {
+                bool inside;
+                vec3 c = pair_light(rc, j, inside);
+                unshadowed_sum += c;
+                float w = (c.r + c.g + c.b) * (1.0 / 3.0);
+                weight_inside += inside ? w : 0.0;
+                float w_out = inside ? 0.0 : w;
+                weight += w_out;
+                // The race: HVL j's key -ln(u_j) / w_j against the least so far (compared as
+                // products; w_out = 0 never wins).
+                vec2 identity = imageLoad(hvl_records, hvl_record_texel(j, HVL_RECORD_IDENTITY)).xy;
+                float e = -log(hvl_shadow_uniform(receiver_key, identity));
+                bool take = e < best * w_out;
+                best = take ? e / w_out : best;
+                pick = take ? j : pick;
+            }
+            first = end;
         }
         if (weight > 0.0) {
             vec4 position_radius = imageLoad(hvl_records, hvl_record_texel(pick, HVL_RECORD_POSITION_RADIUS));

@@ -692,11 +692,16 @@ fn amortised_techniques_follow_a_moving_scene() {
 /// after the turn stays near the per-frame one. Measured: HVL 0.039, proxies 0.029, IGI 0.089,
 /// AAF 0.041 (bounds about 1.5× that); with the regather switched off, 0.135, 0.666, 3293 and
 /// non-finite light (the pixels keep the light or records of whatever was there, or nothing).
+/// HVL's figure depends on the shadow draw: its regathered receivers are scattered and keep
+/// their own sampled-shadow ratio, unfiltered. Over three sets of the draw's random numbers
+/// it read 0.039, 0.062 and one under 0.06 with the slot-order reservoir, 0.066, 0.068 and
+/// one under 0.06 with the identity-keyed race (2026-11-29), so its bound is 0.085, still
+/// well under the 0.135 without the regather.
 #[test]
 fn a_turning_camera_regathers_what_it_had_not_seen() {
     let device = common::device();
     for (gi, key, bound) in [
-        ("hvl", "hvl.slices", 0.06),
+        ("hvl", "hvl.slices", 0.085),
         ("proxy", "proxy.slices", 0.045),
         ("igi", "igi.slices", 0.13),
         ("aaf", "aaf.slices", 0.06),

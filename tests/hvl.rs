@@ -17,8 +17,8 @@ use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::hvl::shadows::{self, FilterTexel, ShadowSampling};
 use shine::passes::hvl::{
     CONV_BANDS, CachePush, Distribution, Falloff, GatherHvl, GatherPath, GatherPush, Hvl, HvlError,
-    HvlParams, MAX_HVLS, PrepPush, RadiusHeuristic, Window, gather_variants, hvl_cache, hvl_gather,
-    hvl_gather_prep, records_extent,
+    HvlParams, MAX_HVLS, PrepPush, RECORD_TEXELS, RadiusHeuristic, Window, gather_variants,
+    hvl_cache, hvl_gather, hvl_gather_prep, records_extent,
 };
 use shine::passes::receivers::Receivers;
 use shine::passes::rsm::{Rsm, RsmProjection};
@@ -805,8 +805,10 @@ fn gather_records_match_the_cpu_twin() {
         let cpu = reference::gather_records(&hvls, p.count as usize, emission as usize);
         assert!(gpu.len() >= cpu.len());
         for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
-            let (g, c): (&[f32; 16], &[f32; 16]) = (bytemuck::cast_ref(g), bytemuck::cast_ref(c));
-            for k in 0..16 {
+            const FLOATS: usize = 4 * RECORD_TEXELS as usize;
+            let (g, c): (&[f32; FLOATS], &[f32; FLOATS]) =
+                (bytemuck::cast_ref(g), bytemuck::cast_ref(c));
+            for k in 0..FLOATS {
                 assert!(
                     close(g[k], c[k], 1e-5, 1e-6),
                     "emission {emission}, HVL {i}, float {k}: GPU {} vs CPU {}",
@@ -1022,7 +1024,7 @@ fn single_hvl_against_numerical_integration() {
         },
         light: 0,
         sample_index: 0,
-        pad: 0,
+        light_samples: 1,
     };
     // Metallic 0.5 as unorm8 stores it.
     const HALF: f32 = 128.0 / 255.0;
@@ -1349,6 +1351,76 @@ fn sampled_shadows_approach_one_ray_per_hvl() {
     assert!(
         (clear - 1.0).abs() < 0.02,
         "unshadowed scene: {clear} of the light"
+    );
+    assert_clean(&device);
+}
+
+/// The sampled shadows' draw keeps each light's samples (issue 43): strata by sample index and
+/// a race keyed by identity, so when one light's count changes and every later light's records
+/// move to other slots, those lights' draws stay as they were. Two lights: A's block of 3 or 4
+/// samples (the newest faded in at weight 0, as a share that grows fades it in), then B's, the
+/// synthetic cache, behind a slab that hides part of it: every receiver's light is the same,
+/// bit for bit, with A's block one longer. (Strata by slot fail it: B's samples move one slot
+/// and meet other samples of A in their strata; checked by building that back.)
+/// Another seed does change it, so the equality is the draw's, not the shadows' absence.
+#[test]
+fn the_shadow_draw_keeps_a_lights_samples_when_another_lights_count_changes() {
+    let device = device();
+    let rsm = synthetic_rsm(1.0);
+    let receivers = synthetic_receivers();
+    let base = params(GatherPath::Full, 3, 3);
+    let b_samples = reference::build_cache(&rsm, &base).unwrap();
+    let b_count = b_samples.len() as u32;
+    let brdf = tables(3, [12, 24]);
+    let bvh = GpuBvh::from_world(&device, &world_bvh(&half_slab())).unwrap();
+    let two_lights = |a_count: u32| -> Vec<Hvl> {
+        // A's first three samples are lit, its fourth (when kept) faded in at weight 0.
+        let a = (0..a_count).map(|i| Hvl {
+            light: 0,
+            sample_index: i,
+            light_samples: a_count,
+            flux: if i < 3 {
+                b_samples[i as usize * 7].flux
+            } else {
+                [0.0, 0.0, 0.0, 1.0]
+            },
+            ..b_samples[i as usize * 7]
+        });
+        let b = b_samples.iter().enumerate().map(|(i, h)| Hvl {
+            light: 1,
+            sample_index: i as u32,
+            light_samples: b_count,
+            ..*h
+        });
+        a.chain(b).collect()
+    };
+    let draw = |a_count: u32, seed: u32| {
+        let hvls = two_lights(a_count);
+        let p = HvlParams {
+            count: hvls.len() as u32,
+            visibility: true,
+            shadow_rays: 4,
+            shadow_filter_radius: 0,
+            shadow_seed: seed,
+            ..base
+        };
+        gpu_gather(&device, &receivers, &hvls, &brdf, CAMERA, &p, Some(&bvh))
+    };
+    let energy = |img: &[Vec4]| img.iter().map(|v| v.truncate().element_sum()).sum::<f32>();
+    let unshadowed = gpu_gather(&device, &receivers, &b_samples, &brdf, CAMERA, &base, None);
+    let three = draw(3, 0);
+    assert!(
+        energy(&three) < 0.9 * energy(&unshadowed),
+        "the slab hid too little: {} of {}",
+        energy(&three),
+        energy(&unshadowed)
+    );
+    let differ = |a: &[Vec4], b: &[Vec4]| a.iter().zip(b).filter(|(x, y)| x != y).count();
+    let moved = differ(&three, &draw(4, 0));
+    assert_eq!(moved, 0, "{moved} receivers' light moved with A's count");
+    assert!(
+        differ(&three, &draw(3, 1)) > 0,
+        "another seed drew the same"
     );
     assert_clean(&device);
 }

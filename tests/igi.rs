@@ -107,7 +107,7 @@ fn synthetic_vpls() -> Vec<Hvl> {
                 emission: [0.0; 5],
                 light: k % 2,
                 sample_index: (k * 37) % 64,
-                pad: 0,
+                light_samples: 64,
             }
         })
         .collect()

@@ -278,6 +278,10 @@ fn hvl_records_layout_matches_the_shader() {
         RECORDS_PER_ROW
     );
     assert_eq!(
+        glsl_uint("include/hvl.glsl", "HVL_RECORD_TEXELS"),
+        RECORD_TEXELS
+    );
+    assert_eq!(
         std::mem::size_of::<GatherHvl>(),
         16 * RECORD_TEXELS as usize
     );
@@ -298,6 +302,10 @@ fn hvl_records_layout_matches_the_shader() {
         (
             "HVL_RECORD_EMISSION",
             std::mem::offset_of!(GatherHvl, emission),
+        ),
+        (
+            "HVL_RECORD_IDENTITY",
+            std::mem::offset_of!(GatherHvl, identity),
         ),
     ] {
         assert_eq!(

@@ -26,14 +26,16 @@ struct Hvl {
     // sets)
     uint light;
     uint sample_index;
-    uint pad;
+    // the samples its light keeps (n_k; the cell count on the grid): a light's records are
+    // consecutive from slot - sample_index; 0 for an empty slot of the flux distribution
+    uint light_samples;
 };
 
 // One HVL as the gather reads it: shine::passes::hvl::GatherHvl, written from the cache by
 // hvl_gather_prep.comp with the per-HVL terms of the gather precomputed. The records live in an
 // RGBA32F image, not a storage buffer: llvmpipe loads an image texel about 4x faster than a
-// storage buffer's vec4 (docs/performance.md). Record j is the four texels
-// x = 4 (j mod HVL_RECORDS_PER_ROW) + field, y = j / HVL_RECORDS_PER_ROW
+// storage buffer's vec4 (docs/performance.md). Record j is the HVL_RECORD_TEXELS texels
+// x = HVL_RECORD_TEXELS (j mod HVL_RECORDS_PER_ROW) + field, y = j / HVL_RECORDS_PER_ROW
 // (shine::passes::hvl::RECORDS_PER_ROW), one per field:
 const uint HVL_RECORDS_PER_ROW = 1024u;
 // xyz: centre y_j; w: radius r_j, 0 for an empty cell (skipped)
@@ -44,10 +46,16 @@ const uint HVL_RECORD_NORMAL_AREA = 1u;
 const uint HVL_RECORD_FLUX_E0 = 2u;
 // a_1..a_4 of the emission polynomial
 const uint HVL_RECORD_EMISSION = 3u;
+// x: the HVL's light (Hvl.light), y: its sample index (Hvl.sample_index), z: the samples its
+// light keeps (Hvl.light_samples), as floats (exact below 2^24): its identity, which keys and
+// stratifies the sampled shadows' draw (hvl_gather.comp)
+const uint HVL_RECORD_IDENTITY = 4u;
+// Texels per record (shine::passes::hvl::RECORD_TEXELS).
+const uint HVL_RECORD_TEXELS = 5u;
 
 // The texel of field `field` (HVL_RECORD_*) of record j.
 ivec2 hvl_record_texel(uint j, uint field) {
-    return ivec2(int((j % HVL_RECORDS_PER_ROW) * 4u + field), int(j / HVL_RECORDS_PER_ROW));
+    return ivec2(int((j % HVL_RECORDS_PER_ROW) * HVL_RECORD_TEXELS + field), int(j / HVL_RECORDS_PER_ROW));
 }
 
 // shine::reference::hvl::sender_emission_zh: ZH coefficient l of the Lambert sender's F'

@@ -168,8 +168,8 @@ pub fn zh_poly(zh: &[f32], bands: usize) -> [f32; EMISSION_MAX_BANDS] {
 }
 
 /// The gather's records of the first `count` HVLs (`hvl_gather_prep.comp`): unit normal,
-/// `1 / (π r²)` and the emission polynomial of `emission_bands` bands; an empty cell (radius
-/// ≤ 0) gives a zero record.
+/// `1 / (π r²)` and the emission polynomial of `emission_bands` bands, and its identity; an
+/// empty cell (radius ≤ 0) gives a zero record but for its flux and identity.
 pub fn gather_records(hvls: &[Hvl], count: usize, emission_bands: usize) -> Vec<GatherHvl> {
     hvls.iter()
         .take(count)
@@ -187,6 +187,12 @@ pub fn gather_records(hvls: &[Hvl], count: usize, emission_bands: usize) -> Vec<
                 },
                 flux_e0: [h.flux[0], h.flux[1], h.flux[2], a[0]],
                 emission: [a[1], a[2], a[3], a[4]],
+                identity: [
+                    h.light as f32,
+                    h.sample_index as f32,
+                    h.light_samples as f32,
+                    0.0,
+                ],
             }
         })
         .collect()
@@ -262,6 +268,7 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
         let hvl = match rep {
             None => Hvl {
                 sample_index: m,
+                light_samples: count,
                 ..Hvl::zeroed()
             },
             Some(t) => {
@@ -279,7 +286,7 @@ pub fn build_cache(rsm: &RsmData, params: &HvlParams) -> Result<Vec<Hvl>, HvlErr
                     emission,
                     light: 0,
                     sample_index: m,
-                    pad: 0,
+                    light_samples: count,
                 }
             }
         };

@@ -206,6 +206,8 @@ pub struct Draw {
     pub within: (f32, f32),
     /// Its weight: 1, or the fractional part of the light's share for its newest sample.
     pub fade: f32,
+    /// The samples its light keeps (`n_k`).
+    pub light_samples: u32,
 }
 
 /// Sample `j` of light group `k`, given the faces and their [`running_sums`]; `None` when the
@@ -256,6 +258,7 @@ pub fn draw(faces: &[RsmData], cdf: &[f32], k: usize, j: u32) -> Option<Draw> {
             ((row_goal - before_y) / row_total).clamp(0.0, 1.0),
         ),
         fade: (share - j as f32).clamp(0.0, 1.0),
+        light_samples: n as u32,
     })
 }
 
@@ -355,7 +358,7 @@ pub fn build_flux_cache(faces: &[RsmData], params: &HvlParams) -> Result<Vec<Hvl
                 emission,
                 light: group.light,
                 sample_index: j,
-                pad: 0,
+                light_samples: d.light_samples,
             };
         }
     }

@@ -303,7 +303,7 @@ pub fn gather_cost(params: &HvlParams, receivers: u64) -> PassCost {
 }
 
 /// Texels of a [`GatherHvl`] record in the records image, one per field.
-pub const RECORD_TEXELS: u32 = 4;
+pub const RECORD_TEXELS: u32 = 5;
 
 /// Records per row of the records image (`HVL_RECORDS_PER_ROW` of `shaders/include/hvl.glsl`):
 /// record `j` is texels `RECORD_TEXELS · (j mod RECORDS_PER_ROW) + field` of row
@@ -337,8 +337,8 @@ mod tests {
     fn records_extent_rows_of_whole_records() {
         assert_eq!(records_extent(1), [4, 1]);
         assert_eq!(records_extent(400), [1600, 1]);
-        assert_eq!(records_extent(RECORDS_PER_ROW), [4096, 1]);
-        assert_eq!(records_extent(RECORDS_PER_ROW + 1), [4096, 2]);
+        assert_eq!(records_extent(RECORDS_PER_ROW), [5120, 1]);
+        assert_eq!(records_extent(RECORDS_PER_ROW + 1), [5120, 2]);
         let [w, h] = records_extent(MAX_HVLS);
         assert!(w <= 4096 && h <= 4096, "{w}×{h}");
         assert!(u64::from(w) * u64::from(h) >= u64::from(RECORD_TEXELS * MAX_HVLS));

@@ -119,8 +119,10 @@ pub struct Hvl {
     /// cell. IGI's interleaved set follows from it ([`crate::reference::hvl_flux::sample_set`]),
     /// so a VPL keeps its set when the records reorder.
     pub sample_index: u32,
-    /// Padding to 16 bytes.
-    pub pad: u32,
+    /// The samples its light keeps (`n_k`; the cell count on the grid): a light's records are
+    /// consecutive from slot − `sample_index`, so the sampled shadows can stratify by identity
+    /// (`hvl_gather.comp`). 0 for an empty slot of the flux distribution.
+    pub light_samples: u32,
 }
 
 impl Hvl {
@@ -130,7 +132,7 @@ impl Hvl {
     }
 }
 
-/// One HVL as the gather reads it (64 bytes, one RGBA32F texel per field of the records image:
+/// One HVL as the gather reads it (80 bytes, one RGBA32F texel per field of the records image:
 /// `HVL_RECORD_*` of `shaders/include/hvl.glsl`, [`RECORDS_PER_ROW`]): what depends on the HVL
 /// alone, computed once per frame by `hvl_gather_prep` instead of once per receiver
 /// ([`crate::reference::hvl::gather_records`]).
@@ -146,6 +148,10 @@ pub struct GatherHvl {
     pub flux_e0: [f32; 4],
     /// `a_1 ..= a_4` of the emission polynomial.
     pub emission: [f32; 4],
+    /// x: the HVL's light ([`Hvl::light`]), y: its sample index ([`Hvl::sample_index`]), z:
+    /// the samples its light keeps ([`Hvl::light_samples`]), as floats: its identity, which
+    /// keys and stratifies the sampled shadows' draw (`hvl_gather.comp`).
+    pub identity: [f32; 4],
 }
 
 /// Push constants of `shaders/hvl_gather_prep.comp`, 8 bytes.

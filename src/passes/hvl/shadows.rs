@@ -6,9 +6,13 @@
 //! receiver and HVL ([`ShadowSampling::rays`] = 0, the `_vis` variants) fixes the energy but
 //! multiplies the gather's cost by about 10 on lavapipe (400 rays per receiver). With
 //! `rays = K`, the gather (`shaders/hvl_gather.comp`, `_shadows` variants) splits the HVLs into
-//! K interleaved strata (HVLs k, k + K, k + 2K, …), draws one HVL of each in proportion to its
-//! weight `w_j` (the mean of its light's channels; a one-item weighted reservoir over the
-//! stratum's loop) and traces only those: `S = W_in + Σ_k W_k V_k` (`W_k` a stratum's weight,
+//! K interleaved strata by identity (stratum k: every light's samples k, k + K, k + 2K, … of
+//! its sequence, [`Hvl::light_samples`](super::Hvl::light_samples) telling where each light's
+//! run of records ends), draws one HVL of each in proportion to its weight `w_j` (the mean of
+//! its light's channels) by an exponential race keyed by the HVL's identity (the least
+//! `−ln u_j / w_j` wins; `u_j` a hash of the receiver and the identity), and traces only
+//! those. So an HVL keeps its stratum and its number when another light's count changes and
+//! the records move to other slots (issue 43): `S = W_in + Σ_k W_k V_k` (`W_k` a stratum's weight,
 //! `V_k` its drawn HVL's visibility, `W_in` the weight of HVLs the receiver is inside of) is an
 //! unbiased, noisy shadowed weight beside the exact unshadowed light `U` and its weight `W_u`. The filter
 //! (`shaders/hvl_shadow_filter.comp`) then returns `U · min(1, Σ w S / Σ w W_u)` over the
