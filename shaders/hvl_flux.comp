@@ -3,7 +3,10 @@
 // directional light has one face, a point light six cube faces, consecutive). Texels are drawn
 // in proportion to their flux weight w = r + g + b (0 for an empty texel).
 //
-// Samples with identities (issue 43). Light k (its faces' rows numbered one after the other)
+// Samples with identities (issue 43). Each RSM face is a "light" k here, with its own
+// sequence (a point light's six cube faces are six: one sequence over the six ran from one
+// face's last row into the next face's first, so a sample could step across the room when
+// flux moved between faces; push.light_id is shine::passes::hvl::flux::sequence_id). Light k
 // owns the progressive sequence j = 0, 1, 2, ... of Sobol (0, 2)-sequence points (u_j, v_j)
 // (sobol_02, random.glsl: every prefix of 2^k points is stratified), warped through its own
 // flux: sample j takes the light's row where the light's running row sum passes u_j of its

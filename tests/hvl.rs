@@ -699,11 +699,13 @@ fn flux_cache_matches_the_cpu_reference() {
 
 /// The flux distribution over four faces of three lights (a spot's, a directional light's,
 /// and two faces of a dim point light), as the frame draws every light's bounce: GPU and CPU
-/// keep the same samples in the same slots, light k keeps exactly ⌈s_k⌉ = ⌈M' Φ_k / Φ⌉ of
-/// them (the budget split by flux) carrying Φ_k between them, and the dim light's two faces
-/// share its samples by their flux to within the pattern's stratification.
+/// keep the same samples in the same slots; each face owns a sequence (the point light's two
+/// faces are faces 0 and 1 of light 1, [`sequence_id`]), and sequence k keeps exactly
+/// ⌈s_k⌉ = ⌈M' Φ_k / Φ⌉ samples (the budget split by flux over the four) carrying Φ_k between
+/// them.
 #[test]
 fn flux_cache_splits_the_budget_between_lights() {
+    use shine::passes::hvl::flux::sequence_id;
     use shine::reference::hvl_flux::{budget, draw, running_sums};
     let device = device();
     let spot = synthetic_rsm(1.0);
@@ -731,35 +733,27 @@ fn flux_cache_splits_the_budget_between_lights() {
     let gpu = gpu_cache_faces(&device, &faces, &p);
     assert_eq!((cpu.len(), gpu.len()), (count as usize, count as usize));
     assert_same_flux_cache(&gpu, &cpu, total, "three lights");
-    let m = budget(count, 3) as f32;
-    let light_weights = [weights[0], weights[1], weights[2] + weights[3]];
-    for (k, (light, &w)) in [0, 3, 1].iter().zip(&light_weights).enumerate() {
+    let m = budget(count, 4) as f32;
+    let sequences = [
+        sequence_id(0, 0),
+        sequence_id(3, 0),
+        sequence_id(1, 0),
+        sequence_id(1, 1),
+    ];
+    let cdf = running_sums(&faces, count);
+    for (k, (id, &w)) in sequences.iter().zip(&weights).enumerate() {
         let kept: Vec<&Hvl> = cpu
             .iter()
-            .filter(|h| h.is_valid() && h.light == *light)
+            .filter(|h| h.is_valid() && h.light == *id)
             .collect();
-        assert_eq!(kept.len() as f32, (m * w / total).ceil(), "light {light}");
+        assert_eq!(kept.len() as f32, (m * w / total).ceil(), "sequence {id}");
         let carried: f32 = kept.iter().map(|h| h.flux[0] + h.flux[1] + h.flux[2]).sum();
         assert!(
             close(carried, w, 1e-4, 0.0),
-            "light {light}: {carried} of {w}"
+            "sequence {id}: {carried} of {w}"
         );
-        assert!(draw(&faces, &running_sums(&faces, count), k, kept.len() as u32).is_none());
-    }
-    // The dim light's samples between its two faces.
-    let cdf = running_sums(&faces, count);
-    let mut per_face = [0.0f32; 2];
-    let mut j = 0;
-    while let Some(d) = draw(&faces, &cdf, 2, j) {
-        per_face[d.face - 2] += 1.0;
-        j += 1;
-    }
-    for (f, &n) in per_face.iter().enumerate() {
-        assert_share(
-            n,
-            j as f32 * weights[2 + f] / light_weights[2],
-            &format!("dim face {f} of {per_face:?}"),
-        );
+        assert!(draw(&faces, &cdf, k, kept.len() as u32).is_none());
+        assert!(kept.iter().all(|h| h.light_samples == kept.len() as u32));
     }
     assert_clean(&device);
 }

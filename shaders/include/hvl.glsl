@@ -21,9 +21,9 @@ struct Hvl {
     vec4 flux;
     // ZH coefficients (about n_j) of the sender's F' (paper 003 eq. 20)
     float emission[HVL_EMISSION_MAX_BANDS];
-    // identity: the light's index in the scene (0 on the grid) and the sample's index in that
-    // light's sequence (the flux distribution) or its grid cell; survives reordering (IGI's
-    // sets)
+    // identity: the sample's sequence (the flux distribution: light index in the scene * 6 +
+    // its RSM face among the light's, shine::passes::hvl::flux::sequence_id; 0 on the grid)
+    // and its index in that sequence or its grid cell; survives reordering (IGI's sets)
     uint light;
     uint sample_index;
     // the samples its light keeps (n_k; the cell count on the grid): a light's records are

@@ -98,14 +98,17 @@ impl SampleSchedule {
 }
 
 /// What a frame asks of a technique's sample history: the weight of this frame
-/// ([`AccumulateParams::samples`]; 1: none) and the scene's lights (the identities' first part).
+/// ([`AccumulateParams::samples`]; 1: none) and how many sample sequences the identities' first
+/// part ranges over.
 ///
 /// [`AccumulateParams::samples`]: super::accumulate::AccumulateParams::samples
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampleSetup {
     /// Weight of this frame.
     pub weight: f32,
-    /// Lights in the scene.
+    /// Sample sequences: the scene's lights times
+    /// [`FACES_PER_LIGHT`](crate::passes::hvl::flux::FACES_PER_LIGHT) (each RSM face owns one,
+    /// [`sequence_id`](crate::passes::hvl::flux::sequence_id)).
     pub lights: u32,
 }
 

@@ -16,6 +16,7 @@ use shine_sh::hvl::{RsmFootprint, radius_spacing, rsm_texel_area};
 use shine_sh::sequence::sobol_02;
 
 use super::hvl::{RsmData, sender_emission_zh};
+use crate::passes::hvl::flux::sequence_id;
 use crate::passes::hvl::{EMISSION_MAX_BANDS, Hvl, HvlError, HvlParams};
 use crate::passes::rsm::RsmProjection;
 
@@ -90,32 +91,33 @@ pub fn sample_set(j: u32, sets: u32) -> u32 {
     radical_inverse_digits(j, 5, SET_DIGITS) * sets / SET_SCALE
 }
 
-/// The faces of one light (consecutive in the face list) and their rows.
+/// One RSM face's sample sequence: its identity ([`sequence_id`]) and its rows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightFaces {
-    /// The light's index in the scene (the samples' identity).
+    /// The sequence's identity, the samples' first part ([`Hvl::light`]).
     pub light: u32,
     /// Its first row in the global row order.
     pub row_offset: usize,
-    /// Its rows (the sum of its faces' sides).
+    /// Its rows (the face's side).
     pub rows: usize,
 }
 
-/// The faces grouped by light, in order: each run of consecutive faces of one light.
+/// The faces' sequences, in order, one per face: a point light's six consecutive cube faces
+/// are faces 0–5 of its light.
 pub fn light_faces(faces: &[RsmData]) -> Vec<LightFaces> {
-    let mut groups: Vec<LightFaces> = Vec::new();
-    let mut row = 0;
-    for face in faces {
-        match groups.last_mut() {
-            Some(g) if g.light == face.light => {
-                g.rows += face.size as usize;
-            }
-            _ => groups.push(LightFaces {
-                light: face.light,
-                row_offset: row,
-                rows: face.size as usize,
-            }),
-        }
+    let mut groups: Vec<LightFaces> = Vec::with_capacity(faces.len());
+    let (mut row, mut within) = (0, 0);
+    for (f, face) in faces.iter().enumerate() {
+        within = if f > 0 && faces[f - 1].light == face.light {
+            within + 1
+        } else {
+            0
+        };
+        groups.push(LightFaces {
+            light: sequence_id(face.light, within),
+            row_offset: row,
+            rows: face.size as usize,
+        });
         row += face.size as usize;
     }
     groups

@@ -201,7 +201,7 @@ impl Renderer {
         let light_count = light_count(frame)?;
         let samples = SampleSetup {
             weight: p.sample_weight,
-            lights: light_count,
+            lights: light_count.saturating_mul(crate::passes::hvl::flux::FACES_PER_LIGHT),
         };
         let hvl = p
             .hvl

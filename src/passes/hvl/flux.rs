@@ -1,14 +1,15 @@
 //! The flux distribution's passes ([`Distribution::Flux`](super::Distribution::Flux)):
-//! `hvl_flux_rows` per RSM face, `hvl_flux_marginal` per light, `hvl_flux_budget`, then
+//! `hvl_flux_rows` and `hvl_flux_marginal` per RSM face, `hvl_flux_budget`, then
 //! `hvl_cache` per face (`shaders/hvl_flux.comp`; CPU twin [`crate::reference::hvl_flux`]).
-//! Each light owns a progressive sample sequence whose members keep their identity from frame
-//! to frame (issue 43; the shader's header tells how).
+//! Each RSM face (a point light has six) owns a progressive sample sequence whose members keep
+//! their identity from frame to frame (issue 43; the shader's header tells how).
 
 use glam::Vec3;
 
 use super::{HvlError, HvlParams, encode_projection};
 use crate::graph::{Buffer, BufferDesc, Handle, RenderGraph};
 use crate::passes::rsm::Rsm;
+use crate::passes::shadows::CUBE_FACES;
 use crate::shaders;
 
 /// Push constants of `shaders/hvl_flux.comp` (every stage), 80 bytes.
@@ -46,6 +47,18 @@ pub struct FluxPush {
     pub light_count: u32,
 }
 
+/// Most RSM faces of one light (a point light's cube): the sequences' identities leave this
+/// many per light.
+pub const FACES_PER_LIGHT: u32 = CUBE_FACES.len() as u32;
+
+/// The identity of the sample sequence of face `face` (its place among its light's faces) of
+/// scene light `light`: `light · FACES_PER_LIGHT + face`. Each face owns a sequence: one over
+/// a point light's six faces ran from one face's last row into the next face's first, so a
+/// sample could step across the room when flux moved between faces (issue 43).
+pub fn sequence_id(light: u32, face: u32) -> u32 {
+    light * FACES_PER_LIGHT + face
+}
+
 /// Largest `cdf` buffer, bytes: the storage-buffer range every Vulkan device allows (2²⁷).
 pub const MAX_CDF_BYTES: u64 = 1 << 27;
 
@@ -58,35 +71,34 @@ pub fn cdf_bytes(sides: impl IntoIterator<Item = u32>, lights: usize) -> u64 {
     4 * (texels + 2 * rows + 4 * (lights as u64 + 1))
 }
 
-/// A light's run of faces: its place in the light order, its scene index, its faces, and its
-/// rows in the global row order.
+/// One face's sample sequence (the shader's "light"): its place in the order, its identity
+/// ([`sequence_id`]), its face, and its rows in the global row order.
 struct LightRun {
     order: u32,
     id: u32,
-    faces: std::ops::Range<usize>,
+    face: usize,
     row_offset: u32,
     rows: u32,
 }
 
-/// The faces grouped into runs of one light each (a point light's six cube faces are
-/// consecutive), in order.
+/// The faces' sequences, one per face in order (a point light's six cube faces are
+/// consecutive, faces 0–5 of its light): the twin's [`light_faces`](crate::reference::hvl_flux::light_faces).
 fn light_runs(faces: &[Rsm]) -> Vec<LightRun> {
-    let mut runs: Vec<LightRun> = Vec::new();
-    let mut row = 0;
+    let (mut row, mut within) = (0, 0);
+    let mut runs = Vec::with_capacity(faces.len());
     for (f, face) in faces.iter().enumerate() {
-        match runs.last_mut() {
-            Some(run) if run.id == face.light => {
-                run.faces.end = f + 1;
-                run.rows += face.size;
-            }
-            _ => runs.push(LightRun {
-                order: runs.len() as u32,
-                id: face.light,
-                faces: f..f + 1,
-                row_offset: row,
-                rows: face.size,
-            }),
-        }
+        within = if f > 0 && faces[f - 1].light == face.light {
+            within + 1
+        } else {
+            0
+        };
+        runs.push(LightRun {
+            order: f as u32,
+            id: sequence_id(face.light, within),
+            face: f,
+            row_offset: row,
+            rows: face.size,
+        });
         row += face.size;
     }
     runs
@@ -113,10 +125,7 @@ pub(super) fn flux_cache(
     let texels_total: u32 = faces.iter().map(|f| f.size * f.size).sum();
     let mut pushes = Vec::with_capacity(faces.len());
     let (mut texel_offset, mut row_offset) = (0, 0);
-    for (run, face) in runs
-        .iter()
-        .flat_map(|run| faces[run.faces.clone()].iter().map(move |face| (run, face)))
-    {
+    for (run, face) in runs.iter().map(|run| (run, &faces[run.face])) {
         let (extent, ortho) = encode_projection(face.projection);
         pushes.push(FluxPush {
             light_position_extent: face.light_position.extend(extent).to_array(),
@@ -158,7 +167,7 @@ pub(super) fn flux_cache(
             &shaders::HVL_FLUX_COMP_MARGINAL,
         )
         .write("cdf", &mut cdf)
-        .push(&pushes[run.faces.start])
+        .push(&pushes[run.face])
         .dispatch([1, 1, 1]);
     }
     rg.compute("hvl_flux_budget", &shaders::HVL_FLUX_COMP_BUDGET)

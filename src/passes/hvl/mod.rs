@@ -113,9 +113,10 @@ pub struct Hvl {
     pub flux: [f32; 4],
     /// ZH coefficients (about `n_j`) of the sender's `F'` (eq. 20).
     pub emission: [f32; EMISSION_MAX_BANDS],
-    /// Identity, part 1: the index in the scene of the light this HVL bounces (0 on the grid).
+    /// Identity, part 1: the sample sequence it belongs to (the flux distribution: one per RSM
+    /// face, [`flux::sequence_id`] of its light and face; 0 on the grid).
     pub light: u32,
-    /// Identity, part 2: the sample's index in its light's sequence (by flux) or its grid
+    /// Identity, part 2: the sample's index in its sequence (by flux) or its grid
     /// cell. IGI's interleaved set follows from it ([`crate::reference::hvl_flux::sample_set`]),
     /// so a VPL keeps its set when the records reorder.
     pub sample_index: u32,

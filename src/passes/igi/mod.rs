@@ -10,7 +10,7 @@
 //!    ([`crate::reference::hvl_flux`]).
 //! 2. **Interleaved sets** (§2.3): pixel p of an n×m tile uses set `s = (x mod n) + n (y mod m)`.
 //!    A VPL's set follows from its identity, `⌊φ₅(j)·nm⌋` of its sample (or grid cell) index j
-//!    ([`crate::reference::hvl_flux::sample_set`]): each light's sequence spreads evenly over
+//!    ([`crate::reference::hvl_flux::sample_set`]): each face's sequence spreads evenly over
 //!    the sets, a set's VPLs spread over the whole RSM (the paper's sets of a K×K grid would
 //!    otherwise be columns of it), and a VPL keeps its set when the records reorder as the
 //!    lights' shares change (issue 43; this replaces a fixed permutation of record indices).
