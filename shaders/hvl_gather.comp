@@ -10,8 +10,10 @@
 //   `_shadows`: push.shadow_rays = K rays per receiver, one per stratum of the HVLs: stratum k
 //     holds every light's samples k, k + K, k + 2K, ... of its sequence (by identity, not by
 //     slot: a light's records are consecutive and its first holds its count, so when one
-//     light's count changes the others' strata stay; interleaved, so each is a thinned copy of
-//     the whole cache) and draws one of them in proportion to its weight w_j = (c_j.r + c_j.g + c_j.b) / 3
+//     light's count changes the others' strata stay. On the grid a stratum interleaves the
+//     cells; by flux, the samples k, k + K, ... of a Sobol sequence share the low bits of
+//     their index, so for K a power of two a stratum is a band of the light's flux, one of K)
+//     and draws one of them in proportion to its weight w_j = (c_j.r + c_j.g + c_j.b) / 3
 //     (c_j the HVL's light) by an exponential race: the least key -ln(u_j) / w_j wins, which
 //     happens with probability w_j / W_k, u_j a hash of the receiver and the HVL's identity
 //     (hvl_shadow_uniform). The draw depends on no order, so an HVL keeps its number when the

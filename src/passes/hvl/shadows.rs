@@ -6,8 +6,9 @@
 //! receiver and HVL ([`ShadowSampling::rays`] = 0, the `_vis` variants) fixes the energy but
 //! multiplies the gather's cost by about 10 on lavapipe (400 rays per receiver). With
 //! `rays = K`, the gather (`shaders/hvl_gather.comp`, `_shadows` variants) splits the HVLs into
-//! K interleaved strata by identity (stratum k: every light's samples k, k + K, k + 2K, … of
-//! its sequence, [`Hvl::light_samples`](super::Hvl::light_samples) telling where each light's
+//! K strata by identity (stratum k: every light's samples k, k + K, k + 2K, … of its sequence;
+//! with the flux distribution's Sobol points and K a power of two, a band of each light's
+//! flux, [`Hvl::light_samples`](super::Hvl::light_samples) telling where each light's
 //! run of records ends), draws one HVL of each in proportion to its weight `w_j` (the mean of
 //! its light's channels) by an exponential race keyed by the HVL's identity (the least
 //! `−ln u_j / w_j` wins; `u_j` a hash of the receiver and the identity), and traces only
