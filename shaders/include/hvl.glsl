@@ -37,7 +37,7 @@ struct Hvl {
 // storage buffer's vec4 (docs/performance.md). Record j is the HVL_RECORD_TEXELS texels
 // x = HVL_RECORD_TEXELS (j mod HVL_RECORDS_PER_ROW) + field, y = j / HVL_RECORDS_PER_ROW
 // (shine::passes::hvl::RECORDS_PER_ROW), one per field:
-const uint HVL_RECORDS_PER_ROW = 1024u;
+const uint HVL_RECORDS_PER_ROW = 512u;
 // xyz: centre y_j; w: radius r_j, 0 for an empty cell (skipped)
 const uint HVL_RECORD_POSITION_RADIUS = 0u;
 // xyz: unit normal n_j; w: 1 / (pi r_j^2), eq. 21's denominator (hvl_geometric_factor_of)

@@ -309,8 +309,9 @@ pub const RECORD_TEXELS: u32 = 5;
 /// record `j` is texels `RECORD_TEXELS · (j mod RECORDS_PER_ROW) + field` of row
 /// `j / RECORDS_PER_ROW`. An image, not a storage buffer: llvmpipe loads an image texel about
 /// 4× faster than a storage buffer's vec4, and the gather loads four per receiver–HVL pair
-/// (docs/performance.md).
-pub const RECORDS_PER_ROW: u32 = 1024;
+/// (docs/performance.md). 512 keeps a row of five-texel records within 4096 texels, the
+/// least `maxImageDimension2D` Vulkan allows.
+pub const RECORDS_PER_ROW: u32 = 512;
 
 /// Width and height in texels of the records image of `count` HVLs.
 pub fn records_extent(count: u32) -> [u32; 2] {
@@ -335,10 +336,10 @@ mod tests {
     /// field `field` of record `j`; the largest cache fits the smallest allowed image.
     #[test]
     fn records_extent_rows_of_whole_records() {
-        assert_eq!(records_extent(1), [4, 1]);
-        assert_eq!(records_extent(400), [1600, 1]);
-        assert_eq!(records_extent(RECORDS_PER_ROW), [5120, 1]);
-        assert_eq!(records_extent(RECORDS_PER_ROW + 1), [5120, 2]);
+        assert_eq!(records_extent(1), [5, 1]);
+        assert_eq!(records_extent(400), [2000, 1]);
+        assert_eq!(records_extent(RECORDS_PER_ROW), [2560, 1]);
+        assert_eq!(records_extent(RECORDS_PER_ROW + 1), [2560, 2]);
         let [w, h] = records_extent(MAX_HVLS);
         assert!(w <= 4096 && h <= 4096, "{w}×{h}");
         assert!(u64::from(w) * u64::from(h) >= u64::from(RECORD_TEXELS * MAX_HVLS));
