@@ -71,10 +71,10 @@ pub fn cdf_bytes(sides: impl IntoIterator<Item = u32>, lights: usize) -> u64 {
     4 * (texels + 2 * rows + 4 * (lights as u64 + 1))
 }
 
-/// One face's sample sequence (the shader's "light"): its place in the order, its identity
-/// ([`sequence_id`]), its face, and its rows in the global row order.
+/// One face's sample sequence (the shader's "light"): its identity ([`sequence_id`]), its
+/// face (whose place in the face list is the sequence's in the order), and its rows in the
+/// global row order.
 struct LightRun {
-    order: u32,
     id: u32,
     face: usize,
     row_offset: u32,
@@ -93,7 +93,6 @@ fn light_runs(faces: &[Rsm]) -> Vec<LightRun> {
             0
         };
         runs.push(LightRun {
-            order: f as u32,
             id: sequence_id(face.light, within),
             face: f,
             row_offset: row,
@@ -143,7 +142,7 @@ pub(super) fn flux_cache(
             radius_scale: params.radius_scale,
             light_row_offset: run.row_offset,
             light_rows: run.rows,
-            light_order: run.order,
+            light_order: run.face as u32,
             light_id: run.id,
             light_count: runs.len() as u32,
         });
@@ -163,7 +162,7 @@ pub(super) fn flux_cache(
     }
     for run in &runs {
         rg.compute(
-            &face_name("hvl_flux_marginal", run.order as usize),
+            &face_name("hvl_flux_marginal", run.face),
             &shaders::HVL_FLUX_COMP_MARGINAL,
         )
         .write("cdf", &mut cdf)
