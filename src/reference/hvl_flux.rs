@@ -16,7 +16,7 @@ use shine_sh::hvl::{RsmFootprint, radius_spacing, rsm_texel_area};
 use shine_sh::sequence::sobol_02;
 
 use super::hvl::{RsmData, sender_emission_zh};
-use crate::passes::hvl::flux::sequence_id;
+use crate::passes::hvl::flux::sequence_ids;
 use crate::passes::hvl::{EMISSION_MAX_BANDS, Hvl, HvlError, HvlParams};
 use crate::passes::rsm::RsmProjection;
 
@@ -91,7 +91,7 @@ pub fn sample_set(j: u32, sets: u32) -> u32 {
     radical_inverse_digits(j, 5, SET_DIGITS) * sets / SET_SCALE
 }
 
-/// One RSM face's sample sequence: its identity ([`sequence_id`]) and its rows.
+/// One RSM face's sample sequence: its identity ([`sequence_ids`]) and its rows.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightFaces {
     /// The sequence's identity, the samples' first part ([`Hvl::light`]).
@@ -105,16 +105,12 @@ pub struct LightFaces {
 /// The faces' sequences, in order, one per face: a point light's six consecutive cube faces
 /// are faces 0–5 of its light.
 pub fn light_faces(faces: &[RsmData]) -> Vec<LightFaces> {
+    let ids = sequence_ids(faces.iter().map(|face| face.light));
     let mut groups: Vec<LightFaces> = Vec::with_capacity(faces.len());
-    let (mut row, mut within) = (0, 0);
-    for (f, face) in faces.iter().enumerate() {
-        within = if f > 0 && faces[f - 1].light == face.light {
-            within + 1
-        } else {
-            0
-        };
+    let mut row = 0;
+    for (face, id) in faces.iter().zip(ids) {
         groups.push(LightFaces {
-            light: sequence_id(face.light, within),
+            light: id,
             row_offset: row,
             rows: face.size as usize,
         });

@@ -59,6 +59,22 @@ pub fn sequence_id(light: u32, face: u32) -> u32 {
     light * FACES_PER_LIGHT + face
 }
 
+/// The sequence identities of a face list given each face's scene light in order (a point
+/// light's cube faces consecutive): each face's [`sequence_id`] of its light and its place
+/// among that light's faces.
+pub fn sequence_ids(lights: impl IntoIterator<Item = u32>) -> Vec<u32> {
+    let mut last: Option<u32> = None;
+    let mut within = 0;
+    lights
+        .into_iter()
+        .map(|light| {
+            within = if last == Some(light) { within + 1 } else { 0 };
+            last = Some(light);
+            sequence_id(light, within)
+        })
+        .collect()
+}
+
 /// Largest `cdf` buffer, bytes: the storage-buffer range every Vulkan device allows (2²⁷).
 pub const MAX_CDF_BYTES: u64 = 1 << 27;
 
@@ -84,16 +100,12 @@ struct LightRun {
 /// The faces' sequences, one per face in order (a point light's six cube faces are
 /// consecutive, faces 0–5 of its light): the twin's [`light_faces`](crate::reference::hvl_flux::light_faces).
 fn light_runs(faces: &[Rsm]) -> Vec<LightRun> {
-    let (mut row, mut within) = (0, 0);
+    let ids = sequence_ids(faces.iter().map(|face| face.light));
+    let mut row = 0;
     let mut runs = Vec::with_capacity(faces.len());
-    for (f, face) in faces.iter().enumerate() {
-        within = if f > 0 && faces[f - 1].light == face.light {
-            within + 1
-        } else {
-            0
-        };
+    for (f, (face, id)) in faces.iter().zip(ids).enumerate() {
         runs.push(LightRun {
-            id: sequence_id(face.light, within),
+            id,
             face: f,
             row_offset: row,
             rows: face.size,
