@@ -4,7 +4,9 @@
 //
 // Filter: the mean over a window of k n x k m pixels (k = filter_radius tiles of the n x m
 // pattern; x from p.x - floor(k n / 2), likewise y) of the pixels q with geometry
-// (gb_position.w != 0), a linear depth within depth_tolerance * z_p of p's, and a GEOMETRIC
+// (gb_position.w != 0), a depth offset within depth_tolerance * z_p (plane_test: the distance
+// |n_p . (x_q - x_p)| off p's geometric tangent plane, issue 43; else the linear depths'
+// difference |z_q - z_p|, paper 000 §2.3, which parts a grazing plane's rows), and a GEOMETRIC
 // normal (gb_geometric_normal, not the normal-mapped one) with n_p . n_q >= normal_threshold;
 // p itself always counts. Unclipped and in a continuous region the window holds every
 // interleaved set exactly k^2 times (paper 000 §2.3: a filter exactly as wide as the pattern).
@@ -76,7 +78,9 @@ layout(push_constant) uniform Push {
     uint glossy_tables;
     // roughness of the first glossy table, step between tables (GGX path)
     vec2 roughness_nodes;
-    vec2 pad;
+    // 1: the depth offset is the distance off p's tangent plane; 0: the depths' difference
+    uint plane_test;
+    float pad;
 } push;
 
 vec3 load(uint base, int k) {
@@ -115,8 +119,9 @@ void main() {
             }
             bool centre = dx == 0 && dy == 0;
             if (!centre) {
-                float zq = imageLoad(gb_position, q).w;
-                if (zq == 0.0 || abs(zq - z) > push.depth_tolerance * z) {
+                vec4 pq = imageLoad(gb_position, q);
+                float offset = push.plane_test != 0u ? dot(ng, pq.xyz - position.xyz) : pq.w - z;
+                if (pq.w == 0.0 || abs(offset) > push.depth_tolerance * z) {
                     continue;
                 }
                 vec3 nq = normalize(imageLoad(gb_geometric_normal, q).xyz);

@@ -23,7 +23,7 @@ use shine::passes::brdf_tables::GatherBrdf;
 use shine::passes::composite::Component;
 use shine::passes::gbuffer::GBuffer;
 use shine::passes::hvl::Hvl;
-use shine::passes::igi::{self, FilterMode, Glossy, IgiParams, IgiSlice};
+use shine::passes::igi::{self, FilterMode, GeometryTest, Glossy, IgiParams, IgiSlice};
 use shine::reference::igi::{self as reference, GBufferData};
 use shine::reference::{ReferenceImages, ReferenceParams, render_reference};
 use shine::settings::{GiTechniques, Settings};
@@ -586,22 +586,83 @@ fn filtering_a_constant_field_leaves_it_unchanged() {
     assert_clean(&device);
 }
 
-/// The filter matches its CPU twin on a noisy interleaved field (4×4 sets, 1 and 2 tiles).
+/// The filter matches its CPU twin on a noisy interleaved field (4×4 sets, 1 and 2 tiles),
+/// with either geometry test (the synthetic floor is grazing enough that they differ).
 #[test]
 fn filter_matches_the_cpu_reference() {
     let device = device();
     let (g, vpls, bvh) = (synthetic_gbuffer(), synthetic_vpls(), occluder());
-    for (radius, mode) in [
-        (1, FilterMode::Sh),
-        (2, FilterMode::Sh),
-        (1, FilterMode::Irradiance),
+    for (radius, mode, test) in [
+        (1, FilterMode::Sh, GeometryTest::Plane),
+        (2, FilterMode::Sh, GeometryTest::Plane),
+        (1, FilterMode::Irradiance, GeometryTest::Plane),
+        (1, FilterMode::Sh, GeometryTest::Depth),
     ] {
-        let p = params([4, 4], 3, radius, mode);
+        let p = IgiParams {
+            geometry_test: test,
+            ..params([4, 4], 3, radius, mode)
+        };
         let gpu = run_gpu(&device, &g, &vpls, &bvh, &p, None, None);
         let cpu = cpu_filter(&g, &gpu.coefficients, &p);
         let err = worst(&gpu.indirect, &cpu);
-        assert!(err < 3e-3, "radius {radius} {mode:?}: {err}");
+        assert!(err < 3e-3, "radius {radius} {mode:?} {test:?}: {err}");
     }
+    assert_clean(&device);
+}
+
+/// A floor seen at a grazing angle, 16×16 pixels whose rows lie 10% of their depth apart, and
+/// an interleaved field whose value is its pixel's set: the plane test keeps every neighbour of
+/// the floor, so every pixel whose window lies inside the image averages all 16 sets alike;
+/// the depth test of paper 000 keeps each pixel's own row, whose 4 sets give a stripe per
+/// row (issue 43: such stripes on `builtin:motion-orbit`'s ceiling flickered as the VPLs moved).
+#[test]
+fn a_grazing_floor_averages_every_set() {
+    let device = device();
+    let (vpls, bvh) = (synthetic_vpls(), occluder());
+    let [w, h] = EXTENT;
+    let eye = Vec3::new(0.0, 0.3, 0.0);
+    let mut g = synthetic_gbuffer();
+    for j in 0..h {
+        for i in 0..w {
+            let k = (j * w + i) as usize;
+            let distance = 2.0 * 1.1f32.powi(j as i32);
+            let x = Vec3::new(0.1 * (i as f32 - 8.0), 0.0, -distance);
+            g.position[k] = x.extend((x - eye).length());
+            g.geometric_normal[k] = Vec4::Y;
+            g.normal[k] = Vec4::Y;
+            g.material[k] = q8(Vec4::new(0.8, 0.0, 0.0, 0.0));
+        }
+    }
+    let base = params([4, 4], 3, 1, FilterMode::Irradiance);
+    let c = base.coefficients() as usize;
+    let field: Vec<Vec<Vec3>> = (0..h)
+        .flat_map(|j| (0..w).map(move |i| igi::pixel_set(i, j, [4, 4])))
+        .map(|set| vec![Vec3::splat(1.0 + set as f32); c])
+        .collect();
+    let unity = vec![vec![Vec3::ONE; c]; field.len()];
+    // Inside the image a 4×4 window holds each set once: their mean is 8.5. The filtered
+    // value is read as the output over that of a field of ones (the BRDF's weights apart).
+    let inner = |i: u32, j: u32| (2..=w - 2).contains(&i) && (2..=h - 2).contains(&j);
+    let spread = |test: GeometryTest| {
+        let p = IgiParams {
+            geometry_test: test,
+            ..base
+        };
+        let out = run_gpu(&device, &g, &vpls, &bvh, &p, Some(&field), None).indirect;
+        let one = run_gpu(&device, &g, &vpls, &bvh, &p, Some(&unity), None).indirect;
+        let inside: Vec<f32> = (0..h)
+            .flat_map(|j| (0..w).map(move |i| (i, j)))
+            .filter(|&(i, j)| inner(i, j))
+            .map(|(i, j)| out[(j * w + i) as usize].x / one[(j * w + i) as usize].x)
+            .collect();
+        let (lo, hi) = inside
+            .iter()
+            .fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+        (hi - lo) / hi
+    };
+    let (plane, depth) = (spread(GeometryTest::Plane), spread(GeometryTest::Depth));
+    assert!(plane < 0.01, "plane test: inner pixels spread {plane}");
+    assert!(depth > 0.2, "depth test: inner pixels spread only {depth}");
     assert_clean(&device);
 }
 

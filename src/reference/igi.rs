@@ -10,7 +10,7 @@ use shine_sh::{ShError, basis, kernels, zonal};
 use super::hvl_flux::sample_set;
 use crate::passes::brdf_tables::{GatherBrdf, indirect_weights, table_fresnel_weight};
 use crate::passes::hvl::Hvl;
-use crate::passes::igi::{FilterMode, Glossy, IgiParams, pixel_set};
+use crate::passes::igi::{FilterMode, GeometryTest, Glossy, IgiParams, pixel_set};
 use crate::passes::specular::trace_weight;
 
 /// `IGI_MIN_DISTANCE` of igi.glsl (metres).
@@ -244,8 +244,12 @@ pub fn sh_filter(
                 }
                 let q = (qy * i64::from(w) + qx) as usize;
                 if dx != 0 || dy != 0 {
-                    let zq = g.position[q].w;
-                    if zq == 0.0 || (zq - z).abs() > params.depth_tolerance * z {
+                    let pq = g.position[q];
+                    let offset = match params.geometry_test {
+                        GeometryTest::Plane => ng.dot(pq.truncate() - position.truncate()),
+                        GeometryTest::Depth => pq.w - z,
+                    };
+                    if pq.w == 0.0 || offset.abs() > params.depth_tolerance * z {
                         continue;
                     }
                     let nq = g.geometric_normal[q].truncate().normalize();

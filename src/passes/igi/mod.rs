@@ -131,6 +131,20 @@ crate::choice::named_choice! {
 }
 
 crate::choice::named_choice! {
+    /// How the discontinuity filter measures a neighbour's depth against the pixel's
+    /// ([`IgiParams::depth_tolerance`]).
+    pub enum GeometryTest ("IGI filter geometry test") {
+        /// The neighbour's distance off the pixel's geometric tangent plane (shine's, issue 43):
+        /// a plane seen at a grazing angle keeps its neighbours, whose depths differ by more
+        /// than the tolerance from row to row while they lie on the same plane.
+        Plane = "plane",
+        /// The linear depths' difference (paper 000 §2.3): at grazing view a floor or
+        /// ceiling keeps only its own row, so its pixels average a few of the sets and stripe.
+        Depth = "depth",
+    }
+}
+
+crate::choice::named_choice! {
     /// The glossy lobe of IGI's SH resolve (`src/passes/igi.rs`).
     pub enum Glossy ("IGI glossy lobe") {
         /// GGX through the BRDF SH tables ([`crate::passes::brdf_tables`]), the filtered
@@ -187,10 +201,15 @@ pub struct IgiParams {
     /// wall as the VPL moves (issue 43). 0: the clamp d_min alone (paper 000).
     #[setting(default = 1.0, range = FOOTPRINT, lab = 0.0..=2.0, affects = quality)]
     pub footprint: f32,
-    /// Relative depth tolerance of the filter: a neighbour q is used when
-    /// |z_q − z_p| ≤ depth_tolerance · z_p.
+    /// Relative depth tolerance of the filter: a neighbour q is used when its depth offset
+    /// (by `geometry_test`) is at most depth_tolerance · z_p.
     #[setting(default = 0.05, range = DEPTH_TOLERANCE, lab = 0.01..=0.2, affects = quality)]
     pub depth_tolerance: f32,
+    /// The filter's depth offset: `plane` (|n_p · (x_q − x_p)|, the distance off the pixel's
+    /// geometric tangent plane; shine's, issue 43) or `depth` (|z_q − z_p|, paper 000 §2.3,
+    /// which parts a grazing floor's rows and stripes it).
+    #[setting(default = GeometryTest::Plane, affects = quality)]
+    pub geometry_test: GeometryTest,
     /// Cosine threshold of the filter's geometric-normal test (n_p · n_q ≥ this).
     #[setting(default = 0.9, range = NORMAL_THRESHOLD, lab = 0.5..=0.99, affects = quality)]
     pub normal_threshold: f32,
@@ -267,8 +286,11 @@ pub struct FilterPush {
     pub glossy_tables: u32,
     /// Roughness of the first glossy table and the step between tables (GGX path).
     pub roughness_nodes: [f32; 2],
+    /// 1: the depth offset is the distance off the tangent plane ([`GeometryTest::Plane`]);
+    /// 0: the depths' difference.
+    pub plane_test: u32,
     /// Padding.
-    pub pad: [f32; 2],
+    pub pad: f32,
 }
 
 /// Errors of the IGI passes.
@@ -518,7 +540,8 @@ pub fn sh_filter(
             brdf_tables::GLOSSY_ROUGHNESS_MIN,
             brdf_tables::glossy_roughness_step(),
         ],
-        pad: [0.0; 2],
+        plane_test: u32::from(params.geometry_test == GeometryTest::Plane),
+        pad: 0.0,
     };
     let mut pass = rg.compute("sh_filter", shader);
     pass.read("gb_position", &g.position)
