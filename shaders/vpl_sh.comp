@@ -21,6 +21,7 @@
 #include "amortise.glsl"
 #include "hvl.glsl"
 #include "sample_identity.glsl"
+#include "hvl_near.glsl"
 #define TRACE_NODES_BINDING 6
 #define TRACE_TRIANGLES_BINDING 7
 #define TRACE_TOP_BINDING 8
@@ -77,7 +78,9 @@ layout(push_constant) uniform Push {
     // AMORTISE_REGATHER_SLICE: the pixels `marks` marks (amortised frames,
     // src/passes/amortise.rs); each pixel gathers its own set
     uint slice;
-    uint pad0;
+    // R of the traced near field (world units; 0: none): each VPL's light times
+    // hvl_far_weight of its distance, the near field pass (hvl_near.comp) gives the rest
+    float near_range;
 } push;
 
 // A ray to a VPL stops this fraction short of it (the VPL lies on a surface).
@@ -135,7 +138,8 @@ void main() {
                 continue;
             }
             float footprint = push.footprint * position_radius.w;
-            vec3 e = igi_vpl_irradiance(flux.rgb, vpls.h[j].normal_distance.xyz, w, dist, push.camera_clamp.w, footprint) * scale;
+            vec3 e = igi_vpl_irradiance(flux.rgb, vpls.h[j].normal_distance.xyz, w, dist, push.camera_clamp.w, footprint)
+                * (scale * hvl_far_weight(dist, push.near_range));
             if (all(equal(e, vec3(0.0)))) {
                 continue;
             }

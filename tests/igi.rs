@@ -437,29 +437,50 @@ fn cpu_filter(g: &GBufferData, field: &[Vec<Vec3>], p: &IgiParams) -> Vec<Vec3> 
 fn vpl_sh_projection_matches_shine_sh() {
     let device = device();
     let (g, vpls, bvh) = (synthetic_gbuffer(), synthetic_vpls(), occluder());
-    for (pattern, order, mode) in [
-        ([2, 2], 2, FilterMode::Sh),
-        ([4, 4], 3, FilterMode::Sh),
-        ([3, 2], 4, FilterMode::Sh),
-        ([1, 1], 3, FilterMode::Sh),
-        ([8, 8], 2, FilterMode::Sh),
-        ([2, 3], 3, FilterMode::Irradiance),
+    // The last two leave the light of VPLs nearer than 2R to a traced near field (R = 1 m:
+    // the synthetic VPLs lie 1–3 m from the receivers, so their weights span 0 to 1).
+    for (pattern, order, mode, near_radius) in [
+        ([2, 2], 2, FilterMode::Sh, 0.0),
+        ([4, 4], 3, FilterMode::Sh, 0.0),
+        ([3, 2], 4, FilterMode::Sh, 0.0),
+        ([1, 1], 3, FilterMode::Sh, 0.0),
+        ([8, 8], 2, FilterMode::Sh, 0.0),
+        ([2, 3], 3, FilterMode::Irradiance, 0.0),
+        ([4, 4], 3, FilterMode::Sh, 1.0),
+        ([2, 3], 3, FilterMode::Irradiance, 1.0),
     ] {
-        let p = params(pattern, order, 1, mode);
+        let p = IgiParams {
+            near_radius,
+            ..params(pattern, order, 1, mode)
+        };
         let gpu = run_gpu(&device, &g, &vpls, &bvh, &p, None, None);
         let cpu = reference::vpl_sh(&g, &vpls, CAMERA, &p, occluded(&bvh)).expect("cpu");
         let flat = |c: &[Vec<Vec3>]| c.concat();
         let err = worst(&flat(&gpu.coefficients), &flat(&cpu));
         println!(
-            "{pattern:?} order {order} {mode:?}: worst coefficient error {err:.2e} of the largest"
+            "{pattern:?} order {order} {mode:?} R {near_radius}: worst coefficient error {err:.2e} of the largest"
         );
         // Halves hold 11 significant bits (4.9e-4 relative).
-        assert!(err < 2e-3, "{pattern:?} {order} {mode:?}: {err}");
+        assert!(
+            err < 2e-3,
+            "{pattern:?} {order} {mode:?} R {near_radius}: {err}"
+        );
         // Not a vacuous comparison: many pixels see some VPL (100 when written at 8×8, whose 64
         // sets leave some of the synthetic VPLs' sets empty; 100s more at the others).
         let nonzero = cpu.iter().filter(|c| c[0] != Vec3::ZERO).count();
         assert!(nonzero > 50, "too few lit pixels: {nonzero}");
     }
+    // Not a vacuous weight: R = 1 m leaves a good share of the VPLs' light to the near field.
+    let band0 = |near_radius: f32| -> f32 {
+        let p = IgiParams {
+            near_radius,
+            ..params([4, 4], 3, 1, FilterMode::Sh)
+        };
+        let cpu = reference::vpl_sh(&g, &vpls, CAMERA, &p, occluded(&bvh)).expect("cpu");
+        cpu.iter().map(|c| c[0].x).sum()
+    };
+    let (all, far) = (band0(0.0), band0(1.0));
+    assert!(far < 0.9 * all && far > 0.0, "far share {far} of {all}");
     assert_clean(&device);
 }
 
@@ -830,6 +851,28 @@ fn room_igi_against_the_path_traced_reference() {
         (0.8..=1.15).contains(&ratio),
         "IGI / reference mean {ratio}"
     );
+}
+
+/// The traced near field (`igi.near_range`) gives back light the VPLs' footprint bounds: on
+/// the room, IGI's mean comes nearer the reference's and its error falls, against the same
+/// frame without it (paper 000's VPLs alone).
+#[test]
+fn the_near_field_gives_back_the_light_the_footprint_took() {
+    let reference = room_reference();
+    let with = room_igi(|_| {});
+    let without = room_igi(|s| s.igi.near_range = 0.0);
+    let truth = mean(&reference.indirect);
+    let (a, b) = (
+        compare(&with, &reference.indirect).expect("compare"),
+        compare(&without, &reference.indirect).expect("compare"),
+    );
+    let (ra, rb) = (mean(&with) / truth, mean(&without) / truth);
+    println!(
+        "near field: mean ratio {ra:.3}, RMSE {:.4}; without: {rb:.3}, RMSE {:.4}",
+        a.rmse, b.rmse
+    );
+    assert!((ra - 1.0).abs() < (rb - 1.0).abs(), "{ra} against {rb}");
+    assert!(a.rmse < b.rmse, "{} against {}", a.rmse, b.rmse);
 }
 
 /// Paper 000's point: on the normal-mapped, glossy room, filtering the incident radiance SH

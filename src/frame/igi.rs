@@ -57,6 +57,9 @@ pub struct IgiInputs<'a> {
     pub bvh: &'a TraceImages,
     /// The camera position.
     pub camera: Vec3,
+    /// R of the traced near field in world units (0: none): the VPLs leave the light of
+    /// surfaces within it to `hvl_near` ([`IgiParams::near_radius`]).
+    pub near_radius: f32,
 }
 
 impl IgiTechnique {
@@ -125,7 +128,11 @@ impl PreparedIgi {
         rg: &mut RenderGraph,
         inputs: &IgiInputs<'_>,
     ) -> Result<(Handle<Image>, LightRecords), RenderError> {
-        let (g, params, camera) = (inputs.gbuffer, &self.params, inputs.camera);
+        let params = &IgiParams {
+            near_radius: inputs.near_radius,
+            ..self.params
+        };
+        let (g, camera) = (inputs.gbuffer, inputs.camera);
         let mut lights = igi::vpls(rg, inputs.rsm, params)?;
         if let Some(push) = &self.samples {
             sample_history(rg, "igi samples", &mut lights, push);

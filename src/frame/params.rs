@@ -36,11 +36,13 @@ pub struct FrameParams {
     /// Trilinear texture filtering over the mip chains (off: level 0 only).
     pub mipmaps: bool,
     /// Harmonics Virtual Lights (paper 003), when the frame has them (their `near_radius`, in
-    /// world units, is set by the frame from `hvl_near`).
+    /// world units, is set by the frame from `near_field`).
     pub hvl: Option<HvlParams>,
-    /// HVL's traced near field, when the frame has HVLs and asks for it.
-    pub hvl_near: Option<NearField>,
-    /// Instant GI (paper 000), when the frame has it.
+    /// The traced near field of HVL's or IGI's (`hvl.near_range`, `igi.near_range`), when the
+    /// frame has that technique and asks for it.
+    pub near_field: Option<NearField>,
+    /// Instant GI (paper 000), when the frame has it (its `near_radius` set by the frame from
+    /// `near_field`, as HVL's).
     pub igi: Option<IgiParams>,
     /// Sphere proxies (paper 002), when the frame has them.
     pub proxy: Option<ProxySettings>,
@@ -126,11 +128,13 @@ impl FrameParams {
                 specular_limit,
                 ..*h
             }),
-            hvl_near: (gi.contains(GiTechnique::Hvl) && h.near_range > 0.0).then_some(NearField {
-                range_fraction: h.near_range,
-                rays: h.near_rays,
-                ..NearField::default()
-            }),
+            near_field: if gi.contains(GiTechnique::Hvl) {
+                NearField::asked(h.near_range, h.near_rays)
+            } else if gi.contains(GiTechnique::Igi) {
+                NearField::asked(settings.igi.near_range, settings.igi.near_rays)
+            } else {
+                None
+            },
             igi: gi.contains(GiTechnique::Igi).then_some(IgiParams {
                 specular_limit,
                 ..settings.igi

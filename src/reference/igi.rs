@@ -142,7 +142,8 @@ fn contribution(
     }
     let normal = Vec4::from(vpl.normal_distance).truncate();
     let flux = Vec4::from(vpl.flux).truncate();
-    let e = vpl_irradiance(flux, normal, w, dist, params.clamp_distance, footprint) * scale;
+    let far = shine_sh::hvl::far_weight(dist, params.near_radius);
+    let e = vpl_irradiance(flux, normal, w, dist, params.clamp_distance, footprint) * (scale * far);
     (e != Vec3::ZERO).then_some((w, e))
 }
 

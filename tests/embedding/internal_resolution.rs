@@ -21,8 +21,10 @@ fn frame(bench: &Bench, technique: &str, internal: InternalResolution) -> Vec<[f
 /// HVL's receivers divide again). Measured: +0.05 to +0.11, and +0.17 to +0.30.
 const RMSE_MARGIN: [f64; 3] = [0.12, 0.12, 0.35];
 
-/// How far a step's energy ratio may move from the display size's (measured ≤ 0.041).
-const ENERGY_MARGIN: f64 = 0.05;
+/// How far a step's energy ratio may move from the display size's. Measured ≤ 0.042 but IGI
+/// at 25 %: 0.049 (0.966 → 0.918) since IGI's traced near field (issue 43), which runs on
+/// the receivers, at 25 % 8² of them; 0.041 before.
+const ENERGY_MARGIN: f64 = 0.06;
 
 /// Every technique at 75, 50 and 25 % against the path-traced truth (its noise taken out),
 /// beside the display size's own error. The upsample keeps the light where it was: a

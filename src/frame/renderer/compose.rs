@@ -237,10 +237,10 @@ impl Renderer {
             None => None,
         };
         // What rays that meet the scene's surfaces read (the specular pass, the cubes' fill
-        // and HVL's near field): level-0 texture lookups, and the environment where they
-        // escape, lighting the hits too when the scene has one.
-        let hvl_near = p.hvl_near.filter(|_| hvl.is_some());
-        let environment = (p.specular.is_some() || cubes.is_some() || hvl_near.is_some())
+        // and HVL's or IGI's near field): level-0 texture lookups, and the environment where
+        // they escape, lighting the hits too when the scene has one.
+        let near_field = p.near_field.filter(|_| hvl.is_some() || igi.is_some());
+        let environment = (p.specular.is_some() || cubes.is_some() || near_field.is_some())
             .then(|| rg.import_gpu_image(&scene.environment, SAMPLED_READ, SAMPLED_READ));
         let traced = environment.as_ref().map(|environment| TracedScene {
             handles,
@@ -282,7 +282,12 @@ impl Renderer {
         // without proxies, in scenes with an environment.
         // A host's environment map (its SH in `host_sh`) lights the sky as the scene's does.
         let sky = p.sky.filter(|_| scene.has_environment || host_sh.is_some());
-        let recv = if hvl.is_some() || proxy.is_some() || sky.is_some() || cubes.is_some() {
+        let recv = if hvl.is_some()
+            || proxy.is_some()
+            || sky.is_some()
+            || cubes.is_some()
+            || near_field.is_some()
+        {
             Some(receivers::receivers(rg, g, p.receiver_scale)?)
         } else {
             None
@@ -295,7 +300,7 @@ impl Renderer {
         }
         // Sampled shadows draw new rays each frame a history averages: the indirect light's,
         // or the amortised gather's own.
-        let near_radius = hvl_near.map_or(0.0, |n| n.range_fraction * scene_size(frame.bounds));
+        let near_radius = near_field.map_or(0.0, |n| n.range_fraction * scene_size(frame.bounds));
         let hvl_seed = match p.hvl {
             Some(h) if h.slices > 1 => rg.frame() as u32,
             _ => sky_light::history_seed(rg, p),
@@ -324,11 +329,13 @@ impl Renderer {
         let (hvl_low, hvl_lights) = hvl_low.unzip();
         let hvl_low =
             sky_light::cavity_shaded(rg, p, frame.bounds, &handles.trace, recv.as_ref(), hvl_low)?;
-        // HVL's traced near field, where the gather left it out (after the cavity shading: its
-        // rays are shadowed already). New rays each frame only when the indirect light's history
-        // averages them (the amortised gather's resolve comes before it).
-        let near_light = match (hvl_near, &recv, &traced, &hvl_low) {
-            (Some(near), Some(receivers), Some(traced), Some(_)) => Some(near::hvl_near(
+        // HVL's or IGI's traced near field, where the gather or the VPLs left it out (after
+        // the cavity shading: its rays are shadowed already). New rays each frame only when
+        // the indirect light's history averages them (the amortised gather's resolve comes
+        // before it). IGI's full-resolution light takes it through the receivers' upsample.
+        let bounced = hvl_low.is_some() || (igi.is_some() && rsm.is_some());
+        let near_light = match (near_field, &recv, &traced) {
+            (Some(near), Some(receivers), Some(traced)) if bounced => Some(near::hvl_near(
                 rg,
                 receivers,
                 traced,
@@ -384,6 +391,7 @@ impl Renderer {
                     rsm,
                     bvh: &handles.trace,
                     camera: camera.eye,
+                    near_radius,
                 },
             )?),
             _ => None,

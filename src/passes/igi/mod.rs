@@ -84,7 +84,7 @@ use crate::graph::{Buffer, BufferDesc, Handle, Image, ImageDesc, RenderGraph, vk
 use crate::passes::amortise;
 use crate::passes::brdf_tables;
 use crate::passes::gbuffer::GBuffer;
-use crate::passes::hvl::{self, HvlError, HvlParams};
+use crate::passes::hvl::{self, HvlError, HvlParams, near};
 use crate::passes::rsm::Rsm;
 use crate::shaders;
 
@@ -218,6 +218,22 @@ pub struct IgiParams {
     #[serde(skip)]
     #[setting(default = 0.0)]
     pub specular_limit: f32,
+    /// R of a traced near field, as a fraction of the scene's largest side, as
+    /// `hvl.near_range` (`src/passes/hvl/near.rs`): a VPL's light fades out over 2R..R of
+    /// its distance and `near_rays` traced rays give what surfaces closer than 2R send. The
+    /// footprint bounds a near VPL's light, so a receiver beside a lit wall (a thin object's
+    /// side, a room's corner) got a fraction of it and flickered as the VPLs slid past (issue
+    /// 43). 0: none (paper 000).
+    #[setting(default = near::RANGE, range = near::RANGE_RANGE, lab = 0.0..=0.2, affects = both)]
+    pub near_range: f32,
+    /// Rays per receiver of the near field.
+    #[setting(default = near::RAYS, range = near::RAYS_RANGE, lab = 1..=16, affects = both)]
+    pub near_rays: u32,
+    /// R of the near field in world units (`near_range` times the scene's size; set by the
+    /// frame; 0: none).
+    #[serde(skip)]
+    #[setting(default = 0.0)]
+    pub near_radius: f32,
     /// Pixels per refresh (paper 001): 1 gathers every pixel's VPL set every frame; 4 gathers
     /// the sets of one pixel per 2×2 cell per frame and reprojects the others' SH from the
     /// previous frames ([`IgiSlice`], `igi_reproject`: [`amortise::reproject_records`]).
@@ -262,8 +278,8 @@ pub struct VplShPush {
     pub footprint: f32,
     /// The pixels shaded ([`IgiSlice::slice`]).
     pub slice: u32,
-    /// Padding.
-    pub pad: u32,
+    /// R of the near field in world units ([`IgiParams::near_radius`]; 0: none).
+    pub near_radius: f32,
 }
 
 /// Push constants of `shaders/sh_filter.comp` (64 bytes).
@@ -466,7 +482,7 @@ pub fn vpl_sh(
         vpl_count: params.vpl_count,
         footprint: params.footprint,
         slice: slice.slice,
-        pad: 0,
+        near_radius: params.near_radius,
     };
     let name = if regather { "igi_regather" } else { "vpl_sh" };
     let mut pass = rg.compute(name, shader);
