@@ -5,9 +5,10 @@
 // and stochastic shadows") keeps U's detail and filters only the shadowing:
 //   out = U * min(1, sum_q w_q S_q / sum_q w_q W_u,q)
 // over the (2R+1)^2 receivers q around the receiver, with
-//   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R, push.sigma_per_radius)
-// (the sky filter's weights with twice its sigma: paper 002 eq. 11's match with the upsample's
-// sigma_z and normal exponent), so shadows are not blurred across edges; the ratio is at most 1, as visibility
+//   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_plane_match(...)   (sigma = R,
+// push.sigma_per_radius; the sky filter's weights with twice its sigma: paper 002 eq. 11's match
+// with the upsample's sigma_z and normal exponent, its depth offset measured off the receiver's
+// tangent plane so a grazing floor keeps its rows), so shadows are not blurred across edges; the ratio is at most 1, as visibility
 // is, and exactly 1 where nothing is in the way. Amortised frames (push.slice = 1 + k) filter
 // only the refreshed receivers, one per 2x2 cell at offset (k & 1, k >> 1), over the receivers
 // of the same slice (offsets in steps of 2); the others are left for hvl_resolve (src/passes/amortise.rs). Writes
@@ -71,7 +72,8 @@ void main() {
                 continue;
             }
             float w = exp(-float(dx * dx + dy * dy) * inv_two_sigma2)
-                * bilateral_match(position.w, n, pc.w, imageLoad(recv_normal, c).xyz,
+                * bilateral_plane_match(position.xyz, position.w, n, pc.xyz,
+                    imageLoad(recv_normal, c).xyz,
                     push.depth_sigma, push.normal_power);
             num += w * imageLoad(shadowed, c).a;
             den += w * imageLoad(unshadowed, c).a;

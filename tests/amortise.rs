@@ -728,15 +728,19 @@ fn a_turning_camera_regathers_what_it_had_not_seen() {
 /// again where that shows another surface), a block of records regathered. Measured: HVL 0.224,
 /// 0.154 with one unsampled shadow test per HVL (a held receiver takes its cell's light, at
 /// half resolution for one frame), IGI 0.499, AAF 0.282 (bounds about 1.5× that); without the
-/// change test 2.75, 2.89, 3.44 and 3.23. AAF read 0.126 with the paper's gaussian filter
-/// (`aaf.filter_degree = 0`) and 0.222 with a linear fit: the quadratic fit smooths less at
-/// 32², and the two images differ by more of their noise.
+/// change test 2.75, 2.89, 3.44 and 3.23. Since (session 11): HVL 0.316, 0.169, IGI 0.251, AAF
+/// 0.401; HVL 0.353 once its shadow filter measured the plane offset (docs/quality.md, issue 43,
+/// change 12): the per-frame image filters the floor's shadow draws across its rows, while the
+/// regathered receivers keep their own ratio for the frame, so the two differ by more. AAF
+/// read 0.126 with the paper's gaussian filter (`aaf.filter_degree = 0`) and 0.222 with a
+/// linear fit: the quadratic fit smooths less at 32², and the two images differ by more of
+/// their noise.
 #[test]
 fn a_light_that_jumps_is_followed_at_once() {
     let device = common::device();
     let jump = Motion::LightJumpLast(Vec3::new(0.1, 0.25, 0.28), Vec3::new(1.0, -0.2, 0.0));
     for (gi, key, extra, bound) in [
-        ("hvl", "hvl.slices", None, 0.33),
+        ("hvl", "hvl.slices", None, 0.4),
         ("hvl", "hvl.slices", Some(("hvl.shadow_rays", "0")), 0.23),
         ("igi", "igi.slices", None, 0.75),
         ("aaf", "aaf.slices", None, 0.42),

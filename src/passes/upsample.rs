@@ -299,7 +299,8 @@ pub struct UpsampleInputs<'a> {
 /// The joint bilateral match of a receiver at depth `z_i` with normal `n_i` for a target at
 /// depth `z` with normal `n` (paper 002 §4.2, eq. 11, with ε = σ_z z):
 /// `1 / (1 + |z − z_i| / (σ_z z)) · max(0, n · n_i)^n`. GLSL twin: `bilateral_match` in
-/// `shaders/include/bilateral.glsl` (the upsample and the sky filter).
+/// `shaders/include/bilateral.glsl` (the upsample, the sky's and the near field's bilateral
+/// filter).
 pub fn bilateral_match(
     z: f32,
     n: [f32; 4],
@@ -308,6 +309,27 @@ pub fn bilateral_match(
     params: &UpsampleParams,
 ) -> f32 {
     let wz = 1.0 / (1.0 + (z - z_i).abs() / (params.depth_sigma * z));
+    let cos = n[0] * n_i[0] + n[1] * n_i[1] + n[2] * n_i[2];
+    wz * cos.max(0.0).powf(params.normal_power)
+}
+
+/// [`bilateral_match`] with the depth offset measured off the target's tangent plane:
+/// `1 / (1 + |n · (x_i − x)| / (σ_z z)) · max(0, n · n_i)^n` for a target at `x` (xyz, w its
+/// depth z) with normal `n` and a receiver at `x_i` with normal `n_i` (issue 43). On a plane
+/// seen at a grazing angle the rows' depths differ by more than σ_z z, so the depth test keeps
+/// a receiver's own row and a filter of noisy samples leaves stripes that flicker as the samples
+/// move; the plane's own receivers lie on it at 0. HVL's sampled shadows' ratio filter uses it
+/// ([`crate::passes::hvl::shadows::ratio_filter`]); the upsample keeps paper 002's depth. GLSL
+/// twin: `bilateral_plane_match` in `shaders/include/bilateral.glsl`.
+pub fn bilateral_plane_match(
+    x: [f32; 4],
+    n: [f32; 4],
+    x_i: [f32; 4],
+    n_i: [f32; 4],
+    params: &UpsampleParams,
+) -> f32 {
+    let offset = (0..3).map(|k| n[k] * (x_i[k] - x[k])).sum::<f32>();
+    let wz = 1.0 / (1.0 + offset.abs() / (params.depth_sigma * x[3]));
     let cos = n[0] * n_i[0] + n[1] * n_i[1] + n[2] * n_i[2];
     wz * cos.max(0.0).powf(params.normal_power)
 }

@@ -23,7 +23,9 @@
 //! "Combining analytic direct illumination and stochastic shadows"), which keeps `U`'s detail
 //! and denoises only the shadowing. The weights are a gaussian of the offset (σ = the radius,
 //! twice the sky filter's: the visibility's noise needs the wider mean) times paper 002's
-//! bilateral match, so shadows do not bleed across edges.
+//! bilateral match with its depth offset measured off the receiver's tangent plane
+//! ([`bilateral_plane_match`]: a grazing floor keeps its rows' receivers, issue 43), so
+//! shadows do not bleed across edges.
 //!
 //! Amortised frames (`hvl.slices = 4`) filter the refreshed slice over its own receivers
 //! (steps of 2), and the receivers regathered after a disocclusion, scattered, take their own
@@ -37,7 +39,7 @@ use std::ops::RangeInclusive;
 use crate::graph::{Handle, Image, RenderGraph};
 use crate::passes::amortise;
 use crate::passes::receivers::Receivers;
-use crate::passes::upsample::{UpsampleParams, bilateral_match};
+use crate::passes::upsample::{UpsampleParams, bilateral_plane_match};
 use crate::shaders;
 
 /// Most shadow rays per receiver (`HVL_SHADOW_RAYS_MAX` in `shaders/hvl_gather.comp`).
@@ -227,10 +229,10 @@ pub fn ratio_filter(
                         continue;
                     }
                     let w = (-((dx * dx + dy * dy) as f32) * inv_two_sigma2).exp()
-                        * bilateral_match(
-                            centre.position[3],
+                        * bilateral_plane_match(
+                            centre.position,
                             n,
-                            q.position[3],
+                            q.position,
                             q.normal,
                             &sampling.matching,
                         );
