@@ -4,7 +4,10 @@
 // of the sky pass's demodulated light A L~(b) / pi over the (2R+1)^2 receivers around it:
 //   w = exp(-|offset|^2 / (2 sigma^2)) * bilateral_match(...)   (sigma = R / 2 for the sky, R
 //       for HVL's near field, push.sigma_per_radius; the match is
-//       paper 002's eq. 11 with the upsample's sigma_z and normal exponent)
+//       paper 002's eq. 11 with the upsample's sigma_z and normal exponent; for the near field,
+//       push.world_sigma > 0, the match's depth offset is measured off the receiver's
+//       tangent plane, bilateral_plane_match, and a gaussian of sigma world_sigma over the
+//       receivers' world distance bounds the reach: issue 43, change 13)
 // and sends kd times the mean towards the camera (kd from brdf_indirect_weights), so the
 // albedo's texture is not blurred. R = 0 modulates only. Writes RGBA16F, a = 0, 0 on
 // background. tests/sky.rs checks the filtered light against the path tracer.
@@ -35,8 +38,10 @@ layout(push_constant) uniform Push {
     float normal_power;
     // sigma of the gaussian over the radius R (the sky: 1/2)
     float sigma_per_radius;
-    uint pad1;
-    uint pad2;
+    // sigma of a gaussian over the receivers' world distance, the match's depth offset then
+    // measured off the receiver's tangent plane; 0: neither (the sky)
+    float world_sigma;
+    uint pad;
 } push;
 
 void main() {
@@ -68,9 +73,17 @@ void main() {
             if (!(pc.w > 0.0)) {
                 continue;
             }
-            float w = exp(-float(dx * dx + dy * dy) * inv_two_sigma2)
-                * bilateral_match(position.w, n, pc.w, imageLoad(recv_normal, c).xyz,
-                    push.depth_sigma, push.normal_power);
+            vec3 nc = imageLoad(recv_normal, c).xyz;
+            float w = exp(-float(dx * dx + dy * dy) * inv_two_sigma2);
+            if (push.world_sigma > 0.0) {
+                vec3 d = pc.xyz - position.xyz;
+                w *= exp(-dot(d, d) / (2.0 * push.world_sigma * push.world_sigma))
+                    * bilateral_plane_match(position.xyz, position.w, n, pc.xyz, nc,
+                        push.depth_sigma, push.normal_power);
+            } else {
+                w *= bilateral_match(position.w, n, pc.w, nc, push.depth_sigma,
+                    push.normal_power);
+            }
             sum += w * imageLoad(sky_irradiance, c).rgb;
             weight_sum += w;
         }

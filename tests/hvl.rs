@@ -1419,6 +1419,97 @@ fn the_shadow_draw_keeps_a_lights_samples_when_another_lights_count_changes() {
     assert_clean(&device);
 }
 
+/// The near field's and the sky's bilateral filter (`sky_filter.comp`) against its CPU twin
+/// `bilateral_cpu`, on the synthetic receivers moved off their planes and to other depths,
+/// with random light: the sky's depth match (no world reach) and the near field's plane match
+/// within a world reach, radii 1 and 4: every channel within 0.5% (half floats), and the world
+/// reach changes the result (it bounds what the plane match alone would average).
+#[test]
+fn near_field_filter_matches_the_cpu_twin() {
+    use shine::passes::sky::{self, BilateralTexel};
+    let device = device();
+    let mut receivers = synthetic_receivers();
+    for (i, p) in receivers.position.iter_mut().enumerate() {
+        if p.w > 0.0 {
+            p.w = 2.0 + (i % 7) as f32 * 0.3;
+            p.y += (i % 5) as f32 * 0.01;
+        }
+    }
+    let mut rng = common::Rng(11);
+    let n = receivers.position.len();
+    let light: Vec<Vec4> = (0..n)
+        .map(|_| q16(Vec4::new(rng.next(), rng.next(), rng.next(), 0.0)))
+        .collect();
+    let images = ReceiverImages::new(&device, &receivers);
+    let light_image = storage_image_with(
+        &device,
+        "near_irradiance",
+        vk::Format::R16G16B16A16_SFLOAT,
+        RECV,
+        &bytes_f16(&light),
+    );
+    let texels: Vec<BilateralTexel> = (0..n)
+        .map(|i| BilateralTexel {
+            position: receivers.position[i].to_array(),
+            normal: receivers.normal[i].to_array(),
+            albedo: receivers.albedo[i].truncate().to_array(),
+            metallic: receivers.material[i].y,
+            light: light[i].truncate().to_array(),
+        })
+        .collect();
+    let upsample = shine::passes::upsample::UpsampleParams::default();
+    let mut results = Vec::new();
+    for (radius, world_sigma) in [(1, 0.0), (4, 0.0), (1, 0.3), (4, 0.3)] {
+        let readback = transfer_storage(&device, "readback", n as u64 * 8, None);
+        let mut executor = Executor::new(&device, 1).unwrap();
+        let mut rg = executor.begin_frame();
+        let recv = images.import(&mut rg, RECV);
+        let l = rg.import_gpu_image(&light_image, uploaded_state(), UNUSED_AFTER);
+        let filtered = sky::bilateral_filter(
+            &mut rg,
+            ["near_filter", "near_light"],
+            &recv,
+            &l,
+            CAMERA,
+            (radius, 1.0),
+            world_sigma,
+            &upsample,
+        );
+        read_indirect(&mut rg, &filtered, &readback);
+        common::run_graph(&device, &mut executor, rg);
+        let gpu = common::decode_rgba16f(&device.read_buffer(&readback).unwrap());
+        let cpu = sky::bilateral_cpu(
+            &texels,
+            RECV[0] as usize,
+            CAMERA,
+            (radius, 1.0),
+            world_sigma,
+            &upsample,
+        );
+        for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {
+            for k in 0..3 {
+                assert!(
+                    close(g[k], c[k], 5e-3, 1e-4),
+                    "radius {radius}, world σ {world_sigma}, pixel {i}: GPU {g} vs CPU {c:?}"
+                );
+            }
+        }
+        results.push(cpu);
+    }
+    let apart = |a: &[[f32; 3]], b: &[[f32; 3]]| {
+        a.iter()
+            .zip(b)
+            .filter(|(x, y)| (x[0] - y[0]).abs() > 1e-3)
+            .count()
+    };
+    assert!(
+        apart(&results[1], &results[3]) > n / 4,
+        "the world reach changed {} of {n}",
+        apart(&results[1], &results[3])
+    );
+    assert_clean(&device);
+}
+
 /// The shadow filter on a floor seen at a grazing angle (issue 43): its rows lie 10% of their
 /// depth apart, and each row's sampled shadow weight is the same noisy draw, 0.2 or 0.8 of the
 /// unshadowed in alternate rows. Measured off the receiver's tangent plane, every floor

@@ -17,7 +17,8 @@ float bilateral_match(float z, vec3 n, float z_i, vec3 n_i, float depth_sigma, f
 // in place of |z − z_i| (issue 43): on a plane seen at a grazing angle the rows' depths differ by
 // more than σ_z z, so the depth test keeps a receiver's own row and a filter of noisy samples
 // leaves stripes that flicker as the samples move; the plane's own receivers lie on it at 0.
-// HVL's sampled shadows' ratio filter uses it (docs/quality.md, issue 43, change 12).
+// HVL's sampled shadows' ratio filter (docs/quality.md, issue 43, change 12) and the near
+// field's filter (sky_filter.comp with a world reach, change 13) use it.
 // CPU twin: shine::passes::upsample::bilateral_plane_match.
 float bilateral_plane_match(vec3 x, float z, vec3 n, vec3 x_i, vec3 n_i, float depth_sigma,
     float normal_power) {

@@ -39,9 +39,10 @@ use crate::declare::{Section, Settings};
 
 use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, Handle, Image, RenderGraph};
+use crate::passes::brdf_tables::indirect_weights;
 use crate::passes::denoise::{self, DenoiseError, DenoiseParams};
 use crate::passes::receivers::Receivers;
-use crate::passes::upsample::UpsampleParams;
+use crate::passes::upsample::{UpsampleParams, bilateral_match, bilateral_plane_match};
 use crate::shaders;
 
 /// Default rays per receiver.
@@ -172,8 +173,11 @@ pub struct SkyFilterPush {
     pub normal_power: f32,
     /// σ of the gaussian over the radius ([`SKY_SIGMA_PER_RADIUS`] for the sky).
     pub sigma_per_radius: f32,
+    /// σ of a gaussian over the receivers' world distance, with the match's depth offset
+    /// measured off the receiver's tangent plane; 0: neither (the sky's).
+    pub world_sigma: f32,
     /// Padding.
-    pub pad: [u32; 2],
+    pub pad: u32,
 }
 
 /// σ of the sky filter's gaussian over its radius.
@@ -217,6 +221,7 @@ pub fn sky(
         camera,
         Reach {
             bilateral: (params.filter_radius, SKY_SIGMA_PER_RADIUS),
+            world_sigma: 0.0,
             footprint: denoise::Footprint::Pixels(denoise::SKY_RADIUS),
         },
     )?)
@@ -239,6 +244,10 @@ pub enum LightFilter<'a> {
 pub struct Reach {
     /// The bilateral's radius in receivers and its gaussian's σ over the radius.
     pub bilateral: (u32, f32),
+    /// The bilateral's σ over the receivers' world distance, its match then measured off the
+    /// receiver's tangent plane (HVL's near field, [`crate::passes::hvl::near`]); 0: neither,
+    /// the depth match alone (the sky's).
+    pub world_sigma: f32,
     /// The denoiser's footprint.
     pub footprint: denoise::Footprint,
 }
@@ -265,6 +274,7 @@ impl LightFilter<'_> {
                 light,
                 camera,
                 reach.bilateral,
+                reach.world_sigma,
                 upsample,
             )),
             Self::Denoise(params) => denoise::diffuse(
@@ -283,7 +293,9 @@ impl LightFilter<'_> {
 /// Adds a pass `names[0]` of `sky_filter.comp` writing a new image `names[1]`: the joint
 /// bilateral mean of the demodulated light
 /// `light` (RGBA16F at receiver resolution, light over π) over `(radius, σ / radius)`: a
-/// gaussian over the receivers within the radius, times the bilateral match of `upsample`;
+/// gaussian over the receivers within the radius, times the bilateral match of `upsample`
+/// (with `world_sigma` > 0, the plane match times a gaussian of that σ over the receivers'
+/// world distance, [`Reach::world_sigma`]);
 /// then times the receiver's `kd` seen from `camera`.
 /// Returns the outgoing radiance (RGBA16F at receiver resolution). The sky pass's filter, and
 /// HVL's near field's ([`crate::passes::hvl::near`]).
@@ -294,6 +306,7 @@ pub fn bilateral_filter(
     light: &Handle<Image>,
     camera: glam::Vec3,
     (radius, sigma_per_radius): (u32, f32),
+    world_sigma: f32,
     upsample: &UpsampleParams,
 ) -> Handle<Image> {
     let [w, h] = receivers.extent;
@@ -305,7 +318,8 @@ pub fn bilateral_filter(
         depth_sigma: upsample.depth_sigma,
         normal_power: upsample.normal_power,
         sigma_per_radius,
-        pad: [0; 2],
+        world_sigma,
+        pad: 0,
     };
     rg.compute(name, &shaders::SKY_FILTER_COMP)
         .read("recv_position", &receivers.position)
@@ -316,6 +330,96 @@ pub fn bilateral_filter(
         .write("sky", &mut out)
         .push(&push)
         .dispatch([w, h, 1]);
+    out
+}
+
+/// One receiver's inputs to [`bilateral_cpu`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BilateralTexel {
+    /// xyz world position, w view depth (0: background).
+    pub position: [f32; 4],
+    /// Shading normal (xyz).
+    pub normal: [f32; 4],
+    /// Albedo (RGB).
+    pub albedo: [f32; 3],
+    /// Metallic.
+    pub metallic: f32,
+    /// The demodulated light to filter (RGB, light over π).
+    pub light: [f32; 3],
+}
+
+/// CPU twin of `sky_filter.comp` ([`bilateral_filter`]) over a `width`-wide row-major image
+/// seen from `camera`: each receiver's outgoing radiance `kd` times the joint bilateral mean
+/// of `light`, 0 on background. `world_sigma` as [`SkyFilterPush::world_sigma`].
+pub fn bilateral_cpu(
+    texels: &[BilateralTexel],
+    width: usize,
+    camera: glam::Vec3,
+    (radius, sigma_per_radius): (u32, f32),
+    world_sigma: f32,
+    upsample: &UpsampleParams,
+) -> Vec<[f32; 3]> {
+    use glam::Vec3;
+    let height = texels.len() / width.max(1);
+    let r = radius as i64;
+    let sigma = sigma_per_radius * radius as f32;
+    let inv_two_sigma2 = if r > 0 { 0.5 / (sigma * sigma) } else { 0.0 };
+    let xyz = |v: [f32; 4]| Vec3::new(v[0], v[1], v[2]);
+    let mut out = vec![[0.0; 3]; texels.len()];
+    for y in 0..height as i64 {
+        for x in 0..width as i64 {
+            let centre = &texels[y as usize * width + x as usize];
+            let n = xyz(centre.normal);
+            if !(centre.position[3] > 0.0) || n.length_squared() <= 0.0 {
+                continue;
+            }
+            let n = n.normalize();
+            let n4 = n.extend(0.0).to_array();
+            let (mut sum, mut weight_sum) = (Vec3::ZERO, 0.0f32);
+            for dy in -r..=r {
+                for dx in -r..=r {
+                    let (cx, cy) = (x + dx, y + dy);
+                    if cx < 0 || cy < 0 || cx >= width as i64 || cy >= height as i64 {
+                        continue;
+                    }
+                    let q = &texels[cy as usize * width + cx as usize];
+                    if !(q.position[3] > 0.0) {
+                        continue;
+                    }
+                    let mut w = (-((dx * dx + dy * dy) as f32) * inv_two_sigma2).exp();
+                    if world_sigma > 0.0 {
+                        let d = xyz(q.position) - xyz(centre.position);
+                        w *= (-d.length_squared() / (2.0 * world_sigma * world_sigma)).exp()
+                            * bilateral_plane_match(
+                                centre.position,
+                                n4,
+                                q.position,
+                                q.normal,
+                                upsample,
+                            );
+                    } else {
+                        w *= bilateral_match(
+                            centre.position[3],
+                            n4,
+                            q.position[3],
+                            q.normal,
+                            upsample,
+                        );
+                    }
+                    sum += w * Vec3::from(q.light);
+                    weight_sum += w;
+                }
+            }
+            let light = if weight_sum > 0.0 {
+                sum / weight_sum
+            } else {
+                Vec3::from(centre.light)
+            };
+            let view = (camera - xyz(centre.position)).normalize();
+            let (kd, _) = indirect_weights(Vec3::from(centre.albedo), centre.metallic, n.dot(view));
+            out[y as usize * width + x as usize] = (kd * light).to_array();
+        }
+    }
     out
 }
 

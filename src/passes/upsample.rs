@@ -318,8 +318,9 @@ pub fn bilateral_match(
 /// depth z) with normal `n` and a receiver at `x_i` with normal `n_i` (issue 43). On a plane
 /// seen at a grazing angle the rows' depths differ by more than σ_z z, so the depth test keeps
 /// a receiver's own row and a filter of noisy samples leaves stripes that flicker as the samples
-/// move; the plane's own receivers lie on it at 0. HVL's sampled shadows' ratio filter uses it
-/// ([`crate::passes::hvl::shadows::ratio_filter`]); the upsample keeps paper 002's depth. GLSL
+/// move; the plane's own receivers lie on it at 0. HVL's sampled shadows' ratio filter
+/// ([`crate::passes::hvl::shadows::ratio_filter`]) and the near field's filter (with a world
+/// reach, [`crate::passes::sky::bilateral_cpu`]) use it; the upsample keeps paper 002's depth. GLSL
 /// twin: `bilateral_plane_match` in `shaders/include/bilateral.glsl`.
 pub fn bilateral_plane_match(
     x: [f32; 4],
