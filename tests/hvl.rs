@@ -1471,8 +1471,11 @@ fn near_field_filter_matches_the_cpu_twin() {
             &recv,
             &l,
             CAMERA,
-            (radius, 1.0),
-            world_sigma,
+            sky::BilateralReach {
+                radius,
+                sigma_per_radius: 1.0,
+                world_sigma,
+            },
             &upsample,
         );
         read_indirect(&mut rg, &filtered, &readback);
@@ -1482,8 +1485,11 @@ fn near_field_filter_matches_the_cpu_twin() {
             &texels,
             RECV[0] as usize,
             CAMERA,
-            (radius, 1.0),
-            world_sigma,
+            sky::BilateralReach {
+                radius,
+                sigma_per_radius: 1.0,
+                world_sigma,
+            },
             &upsample,
         );
         for (i, (g, c)) in gpu.iter().zip(&cpu).enumerate() {

@@ -86,6 +86,12 @@ impl Receivers {
     }
 }
 
+/// Whether a receiver's position texel (xyz world, w view depth) is on a surface: view depth
+/// above 0 (background holds 0; NaN is not), as the receivers' passes test it.
+pub fn on_surface(position: [f32; 4]) -> bool {
+    position[3] > 0.0
+}
+
 /// Push constants of `shaders/receivers.comp`.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]

@@ -41,7 +41,7 @@ use crate::gpu_scene::bvh::TraceImages;
 use crate::graph::{Buffer, Handle, Image, RenderGraph};
 use crate::passes::brdf_tables::indirect_weights;
 use crate::passes::denoise::{self, DenoiseError, DenoiseParams};
-use crate::passes::receivers::Receivers;
+use crate::passes::receivers::{Receivers, on_surface};
 use crate::passes::upsample::{UpsampleParams, bilateral_match, bilateral_plane_match};
 use crate::shaders;
 
@@ -220,8 +220,11 @@ pub fn sky(
         &irradiance,
         camera,
         Reach {
-            bilateral: (params.filter_radius, SKY_SIGMA_PER_RADIUS),
-            world_sigma: 0.0,
+            bilateral: BilateralReach {
+                radius: params.filter_radius,
+                sigma_per_radius: SKY_SIGMA_PER_RADIUS,
+                world_sigma: 0.0,
+            },
             footprint: denoise::Footprint::Pixels(denoise::SKY_RADIUS),
         },
     )?)
@@ -242,14 +245,23 @@ pub enum LightFilter<'a> {
 /// How far each [`LightFilter`] reaches for one signal.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Reach {
-    /// The bilateral's radius in receivers and its gaussian's σ over the radius.
-    pub bilateral: (u32, f32),
-    /// The bilateral's σ over the receivers' world distance, its match then measured off the
+    /// The bilateral's reach.
+    pub bilateral: BilateralReach,
+    /// The denoiser's footprint.
+    pub footprint: denoise::Footprint,
+}
+
+/// How far the joint bilateral ([`bilateral_filter`]) reaches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BilateralReach {
+    /// Radius in receivers.
+    pub radius: u32,
+    /// σ of the gaussian over the radius, over the radius.
+    pub sigma_per_radius: f32,
+    /// σ of a gaussian over the receivers' world distance, the match then measured off the
     /// receiver's tangent plane (HVL's near field, [`crate::passes::hvl::near`]); 0: neither,
     /// the depth match alone (the sky's).
     pub world_sigma: f32,
-    /// The denoiser's footprint.
-    pub footprint: denoise::Footprint,
 }
 
 impl LightFilter<'_> {
@@ -274,7 +286,6 @@ impl LightFilter<'_> {
                 light,
                 camera,
                 reach.bilateral,
-                reach.world_sigma,
                 upsample,
             )),
             Self::Denoise(params) => denoise::diffuse(
@@ -292,10 +303,10 @@ impl LightFilter<'_> {
 
 /// Adds a pass `names[0]` of `sky_filter.comp` writing a new image `names[1]`: the joint
 /// bilateral mean of the demodulated light
-/// `light` (RGBA16F at receiver resolution, light over π) over `(radius, σ / radius)`: a
+/// `light` (RGBA16F at receiver resolution, light over π) as far as `reach`: a
 /// gaussian over the receivers within the radius, times the bilateral match of `upsample`
-/// (with `world_sigma` > 0, the plane match times a gaussian of that σ over the receivers'
-/// world distance, [`Reach::world_sigma`]);
+/// (with a world σ, the plane match times a gaussian of that σ over the receivers' world
+/// distance, [`BilateralReach::world_sigma`]);
 /// then times the receiver's `kd` seen from `camera`.
 /// Returns the outgoing radiance (RGBA16F at receiver resolution). The sky pass's filter, and
 /// HVL's near field's ([`crate::passes::hvl::near`]).
@@ -305,8 +316,7 @@ pub fn bilateral_filter(
     receivers: &Receivers,
     light: &Handle<Image>,
     camera: glam::Vec3,
-    (radius, sigma_per_radius): (u32, f32),
-    world_sigma: f32,
+    reach: BilateralReach,
     upsample: &UpsampleParams,
 ) -> Handle<Image> {
     let [w, h] = receivers.extent;
@@ -314,11 +324,11 @@ pub fn bilateral_filter(
     let push = SkyFilterPush {
         camera: camera.extend(0.0).to_array(),
         extent: receivers.extent,
-        radius,
+        radius: reach.radius,
         depth_sigma: upsample.depth_sigma,
         normal_power: upsample.normal_power,
-        sigma_per_radius,
-        world_sigma,
+        sigma_per_radius: reach.sigma_per_radius,
+        world_sigma: reach.world_sigma,
         pad: 0,
     };
     rg.compute(name, &shaders::SKY_FILTER_COMP)
@@ -350,15 +360,19 @@ pub struct BilateralTexel {
 
 /// CPU twin of `sky_filter.comp` ([`bilateral_filter`]) over a `width`-wide row-major image
 /// seen from `camera`: each receiver's outgoing radiance `kd` times the joint bilateral mean
-/// of `light`, 0 on background. `world_sigma` as [`SkyFilterPush::world_sigma`].
+/// of `light` as far as `reach`, 0 on background.
 pub fn bilateral_cpu(
     texels: &[BilateralTexel],
     width: usize,
     camera: glam::Vec3,
-    (radius, sigma_per_radius): (u32, f32),
-    world_sigma: f32,
+    reach: BilateralReach,
     upsample: &UpsampleParams,
 ) -> Vec<[f32; 3]> {
+    let BilateralReach {
+        radius,
+        sigma_per_radius,
+        world_sigma,
+    } = reach;
     use glam::Vec3;
     let height = texels.len() / width.max(1);
     let r = radius as i64;
@@ -370,7 +384,7 @@ pub fn bilateral_cpu(
         for x in 0..width as i64 {
             let centre = &texels[y as usize * width + x as usize];
             let n = xyz(centre.normal);
-            if !(centre.position[3] > 0.0) || n.length_squared() <= 0.0 {
+            if !on_surface(centre.position) || n.length_squared() <= 0.0 {
                 continue;
             }
             let n = n.normalize();
@@ -383,7 +397,7 @@ pub fn bilateral_cpu(
                         continue;
                     }
                     let q = &texels[cy as usize * width + cx as usize];
-                    if !(q.position[3] > 0.0) {
+                    if !on_surface(q.position) {
                         continue;
                     }
                     let mut w = (-((dx * dx + dy * dy) as f32) * inv_two_sigma2).exp();

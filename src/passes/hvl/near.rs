@@ -26,7 +26,7 @@ use crate::graph::{Handle, Image, RenderGraph};
 use crate::passes::denoise::{DenoiseError, Footprint, NEAR_FOOTPRINT_PER_HIT, pixel_angle};
 use crate::passes::gbuffer::View;
 use crate::passes::receivers::Receivers;
-use crate::passes::sky::{LightFilter, Reach};
+use crate::passes::sky::{BilateralReach, LightFilter, Reach};
 use crate::passes::traced_scene::TracedScene;
 use crate::shaders;
 
@@ -151,8 +151,11 @@ pub fn hvl_near(
         &light,
         camera.eye,
         Reach {
-            bilateral: (near.filter_radius, SIGMA_PER_RADIUS),
-            world_sigma: range * WORLD_SIGMA_PER_RANGE,
+            bilateral: BilateralReach {
+                radius: near.filter_radius,
+                sigma_per_radius: SIGMA_PER_RADIUS,
+                world_sigma: range * WORLD_SIGMA_PER_RANGE,
+            },
             footprint: Footprint::HitDistance {
                 scale: NEAR_FOOTPRINT_PER_HIT,
                 pixel_angle: pixel_angle(camera, receivers.extent[1]),

@@ -38,7 +38,7 @@ use std::ops::RangeInclusive;
 
 use crate::graph::{Handle, Image, RenderGraph};
 use crate::passes::amortise;
-use crate::passes::receivers::Receivers;
+use crate::passes::receivers::{Receivers, on_surface};
 use crate::passes::upsample::{UpsampleParams, bilateral_plane_match};
 use crate::shaders;
 
@@ -246,11 +246,6 @@ pub fn ratio_filter(
         }
     }
     out
-}
-
-/// Whether a receiver's position is on a surface (view depth above 0; NaN is not).
-fn on_surface(position: [f32; 4]) -> bool {
-    position[3] > 0.0
 }
 
 /// `n` scaled to unit length (xyz; w kept); zero stays zero.
