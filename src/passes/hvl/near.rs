@@ -39,12 +39,14 @@ use crate::shaders;
 pub const RANGE: f32 = 0.1;
 /// R (fractions of the scene's largest side) the settings take; 0: no near field.
 pub const RANGE_RANGE: RangeInclusive<f32> = 0.0..=0.5;
-/// Default rays per receiver. 8 since issue 43's change 13 (4 before): with the filter's world
-/// reach ([`WORLD_SIGMA_PER_RANGE`]) the rays' noise is averaged over fewer receivers, and 8
-/// rays took the motion scenes' single frames' error further down (HVL at t = 0.5 s: `sun`
-/// 0.221 → 0.215, `crossing` 0.208 → 0.177) and their cold flicker back (`sun` 3.91× → 3.69×
-/// the truth's) for +21 ms of `hvl_near` at 256² on lavapipe (docs/performance.md).
-pub const RAYS: u32 = 8;
+/// Default rays per receiver. 8 were tried with the filter's world reach (issue 43, change 13):
+/// on the motion scenes they lowered the error further (HVL at t = 0.5 s: `sun` 0.221 →
+/// 0.215, `crossing` 0.208 → 0.177) for +21 ms of `hvl_near` at 256², but on
+/// `builtin:animated`, a scene they were not chosen on, one ray in 8 found its lamp's small
+/// bright patch and the filter spread it into a blob (64², t = 0.5 s: 0.518 → 0.607, energy
+/// 1.045 → 1.071; 16 and 32 rays 0.519 and 0.515). Such a patch is a firefly for any few
+/// rays; 4 stay the default (docs/quality.md).
+pub const RAYS: u32 = 4;
 /// Rays per receiver the settings take.
 pub const RAYS_RANGE: RangeInclusive<u32> = 1..=256;
 /// Default radius of the near field's bilateral filter, in receivers.

@@ -106,6 +106,14 @@ pub const PATTERN: RangeInclusive<u32> = 1..=8;
 
 /// VPL counts: the RSM is cut into cells by the HVL cache pass, one VPL each.
 pub const VPL_COUNT: RangeInclusive<u32> = hvl::CACHE_COUNT;
+/// Default VPL count M: 512 since issue 43's change 14 (256 before). With 256, IGI's frames
+/// without a screen history flickered 4.4× (`motion-orbit`) and 5.2× (`motion-sun`) the
+/// path-traced truth's, above the issue's 4×, and neither the filter (every pixel gathering
+/// every VPL: `sun` 4.9×) nor a wider near field (its error on `builtin:animated`) took it
+/// under; 512 read 3.4× and 3.6×, with every motion scene's and the still frames' error lower
+/// (the cornell box 0.134 → 0.127), for `vpl_sh` 150 → 267 ms at 256² on lavapipe, about
+/// +16% of IGI's frame (docs/quality.md, docs/performance.md).
+pub const DEFAULT_VPL_COUNT: u32 = 512;
 /// SH orders of the per-pixel incident radiance (paper 000 §3.1 uses 3).
 pub const SH_ORDERS: RangeInclusive<u32> = 2..=4;
 /// Discontinuity-filter window sizes k, in interleaving tiles (0: no filter).
@@ -169,7 +177,7 @@ pub struct IgiParams {
     pub m: u32,
     /// Number M of VPLs taken from the RSM (cut into exactly this many cells), shared out over
     /// the n·m sets; at most `rsm.size²`.
-    #[setting(default = 256, range = VPL_COUNT, lab = 64..=1024, affects = both)]
+    #[setting(default = DEFAULT_VPL_COUNT, range = VPL_COUNT, lab = 64..=1024, affects = both)]
     pub vpl_count: u32,
     /// Where the VPLs are placed on the RSM: `grid` (cells uniform in the RSM's image) or
     /// `flux` (texels drawn in proportion to their reflected flux), as `hvl.distribution`.
