@@ -1419,6 +1419,19 @@ fn the_shadow_draw_keeps_a_lights_samples_when_another_lights_count_changes() {
     assert_clean(&device);
 }
 
+/// The synthetic receivers at varied depths and moved off their planes, so both the depth
+/// match's and the plane match's offset terms count in the filters' twin tests.
+fn receivers_off_their_planes() -> ReceiverData {
+    let mut receivers = synthetic_receivers();
+    for (i, p) in receivers.position.iter_mut().enumerate() {
+        if p.w > 0.0 {
+            p.w = 2.0 + (i % 7) as f32 * 0.3;
+            p.y += (i % 5) as f32 * 0.01;
+        }
+    }
+    receivers
+}
+
 /// The near field's and the sky's bilateral filter (`sky_filter.comp`) against its CPU twin
 /// `bilateral_cpu`, on the synthetic receivers moved off their planes and to other depths,
 /// with random light: the sky's depth match (no world reach) and the near field's plane match
@@ -1428,13 +1441,7 @@ fn the_shadow_draw_keeps_a_lights_samples_when_another_lights_count_changes() {
 fn near_field_filter_matches_the_cpu_twin() {
     use shine::passes::sky::{self, BilateralTexel};
     let device = device();
-    let mut receivers = synthetic_receivers();
-    for (i, p) in receivers.position.iter_mut().enumerate() {
-        if p.w > 0.0 {
-            p.w = 2.0 + (i % 7) as f32 * 0.3;
-            p.y += (i % 5) as f32 * 0.01;
-        }
-    }
+    let receivers = receivers_off_their_planes();
     let mut rng = common::Rng(11);
     let n = receivers.position.len();
     let light: Vec<Vec4> = (0..n)
@@ -1567,20 +1574,14 @@ fn a_grazing_floor_filters_its_shadows_across_the_rows() {
 }
 
 /// `hvl_shadow_filter` alone against its CPU twin `ratio_filter`, on the synthetic receivers
-/// (their depths and positions varied, so the plane match's offset term counts) with random unshadowed
-/// light and weights and random shadowed weights (some above the unshadowed, as one frame's
-/// estimate can be), radii 0, 1 and 3, every receiver and amortised slices 1 and 4: every
-/// channel within 0.5% (half floats), and the filter changes most receivers.
+/// off their planes ([`receivers_off_their_planes`]) with random unshadowed light and weights
+/// and random shadowed weights (some above the unshadowed, as one frame's estimate can be),
+/// radii 0, 1 and 3, every receiver and amortised slices 1 and 4: every channel within 0.5%
+/// (half floats), and the filter changes most receivers.
 #[test]
 fn shadow_filter_matches_the_cpu_twin() {
     let device = device();
-    let mut receivers = synthetic_receivers();
-    for (i, p) in receivers.position.iter_mut().enumerate() {
-        if p.w > 0.0 {
-            p.w = 2.0 + (i % 7) as f32 * 0.3;
-            p.y += (i % 5) as f32 * 0.01;
-        }
-    }
+    let receivers = receivers_off_their_planes();
     let mut rng = common::Rng(7);
     let n = receivers.position.len();
     let unshadowed: Vec<Vec4> = (0..n)
