@@ -8,8 +8,8 @@
 //   w_q = exp(-|offset|^2 / (2 sigma^2)) * bilateral_plane_match(...)   (sigma = R,
 // push.sigma_per_radius; the sky filter's weights with twice its sigma: paper 002 eq. 11's match
 // with the upsample's sigma_z and normal exponent, its depth offset measured off the receiver's
-// tangent plane so a grazing floor keeps its rows), so shadows are not blurred across edges; the ratio is at most 1, as visibility
-// is, and exactly 1 where nothing is in the way. Amortised frames (push.slice = 1 + k) filter
+// tangent plane so a grazing floor keeps its rows), so shadows are not blurred across edges;
+// the ratio is at most 1, as visibility is, and exactly 1 where nothing is in the way. Amortised frames (push.slice = 1 + k) filter
 // only the refreshed receivers, one per 2x2 cell at offset (k & 1, k >> 1), over the receivers
 // of the same slice (offsets in steps of 2); the others are left for hvl_resolve (src/passes/amortise.rs). Writes
 // RGBA16F, a = 0, 0 on background. CPU twin: shine::passes::hvl::shadows::ratio_filter.
