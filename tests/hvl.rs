@@ -1419,6 +1419,17 @@ fn the_shadow_draw_keeps_a_lights_samples_when_another_lights_count_changes() {
     assert_clean(&device);
 }
 
+/// An RGBA16F storage image of the receivers' size holding `texels`, for the filters' inputs.
+fn receiver_image_f16(device: &Device, name: &str, texels: &[Vec4]) -> shine::gpu::Image {
+    storage_image_with(
+        device,
+        name,
+        vk::Format::R16G16B16A16_SFLOAT,
+        RECV,
+        &bytes_f16(texels),
+    )
+}
+
 /// The synthetic receivers at varied depths and moved off their planes, so both the depth
 /// match's and the plane match's offset terms count in the filters' twin tests.
 fn receivers_off_their_planes() -> ReceiverData {
@@ -1448,13 +1459,7 @@ fn near_field_filter_matches_the_cpu_twin() {
         .map(|_| q16(Vec4::new(rng.next(), rng.next(), rng.next(), 0.0)))
         .collect();
     let images = ReceiverImages::new(&device, &receivers);
-    let light_image = storage_image_with(
-        &device,
-        "near_irradiance",
-        vk::Format::R16G16B16A16_SFLOAT,
-        RECV,
-        &bytes_f16(&light),
-    );
+    let light_image = receiver_image_f16(&device, "near_irradiance", &light);
     let texels: Vec<BilateralTexel> = (0..n)
         .map(|i| BilateralTexel {
             position: receivers.position[i].to_array(),
@@ -1595,18 +1600,9 @@ fn shadow_filter_matches_the_cpu_twin() {
         .map(|u| q16(Vec4::new(0.0, 0.0, 0.0, u.w * 1.2 * rng.next())))
         .collect();
     let images = ReceiverImages::new(&device, &receivers);
-    let upload = |name: &str, texels: &[Vec4]| {
-        storage_image_with(
-            &device,
-            name,
-            vk::Format::R16G16B16A16_SFLOAT,
-            RECV,
-            &bytes_f16(texels),
-        )
-    };
     let (s_image, u_image) = (
-        upload("shadowed", &shadowed),
-        upload("unshadowed", &unshadowed),
+        receiver_image_f16(&device, "shadowed", &shadowed),
+        receiver_image_f16(&device, "unshadowed", &unshadowed),
     );
     let texels: Vec<FilterTexel> = (0..n)
         .map(|i| FilterTexel {
