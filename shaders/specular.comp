@@ -7,13 +7,26 @@
 // scene with an environment, one cosine-sampled ray from the hit that sees it (f·π·L_env when
 // unoccluded), or the environment where the ray escapes: the one-bounce light the path-traced
 // reference sees in a mirror. Emission of the hit surfaces adds nothing (the GI techniques'
-// convention).
+// convention). With push.options.x (specular.regularise) a hit's BRDF is evaluated no sharper
+// than the receiver's roughness (path regularisation, Kaplanyan and Dachsbacher 2013, as AAF's
+// hit_roughness_min): a point light's highlight on a mirror, seen through a rough lobe, is
+// blurred by that lobe anyway, and unregularised it is found by one ray in hundreds.
 // The mean is weighted by specular_trace_weight(roughness, limit): pixels rougher than the
 // limit keep their SH glossy term and are skipped here. With the denoiser after it
 // (config.z = 1, src/passes/denoise.rs) alpha holds the samples' mean parallax d / (z + d)
 // (d the hit distance, 1 where a ray escapes; z the pixel's distance from the eye), the
 // footprint of the reflection the filter spans; else 0. No CPU twin: tests/specular.rs checks
 // the pass against the path tracer.
+// A pixel's rays are split over dispatches of at most push.options.z rays each
+// (shine::passes::specular::RAYS_PER_DISPATCH): lavapipe ends every loop of an invocation after
+// 65 535 iterations in all (docs/pitfalls.md), and each ray's traversals are loops. Variant
+// `whole` traces every ray in one dispatch; `first`, `middle` and `last` carry the sums from
+// one dispatch to the next in `partial_sum` (rgb: radiance, a: parallax) and `partial_met`
+// (the rays that met the lobe), in f32, so the split changes no bit of the sums' order.
+//! variant whole
+//! variant first PARTIAL_OUT=1
+//! variant middle PARTIAL_IN=1 PARTIAL_OUT=1
+//! variant last PARTIAL_IN=1
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #define SURFACE_SAMPLE(tex, uvw) textureLod(sampler2DArray(tex, texture_sampler), uvw, 0.0)
@@ -31,7 +44,7 @@
 
 layout(local_size_x = 8, local_size_y = 8) in;
 
-// shine::passes::specular::SpecularPush (48 bytes).
+// shine::passes::specular::SpecularPush (64 bytes).
 layout(push_constant) uniform Push {
     // x: width, y: height, z: light count, w: seed (varies per frame).
     uvec4 frame;
@@ -41,6 +54,9 @@ layout(push_constant) uniform Push {
     // parallax in alpha (the denoiser follows), w: 1 to share the frame's x · traced-pixels
     // rays by the lobes' widths (`budget`, denoise_ray_count).
     uvec4 config;
+    // x: 1 to regularise the paths (a hit's roughness at least the receiver's), y: the first
+    // ray of this dispatch, z: the most rays of one dispatch, w: padding.
+    uvec4 options;
 } push;
 
 #define PATH_LIGHT_COUNT push.frame.z
@@ -52,11 +68,32 @@ layout(set = 0, binding = 10, rgba16f) readonly uniform image2D gb_normal;
 layout(set = 0, binding = 11, rgba16f) readonly uniform image2D gb_geometric_normal;
 layout(set = 0, binding = 15, rgba8) readonly uniform image2D gb_albedo;
 layout(set = 0, binding = 16, rgba8) readonly uniform image2D gb_material;
+#ifdef PARTIAL_IN
+layout(set = 0, binding = 22, rgba32f) readonly uniform image2D partial_sum_in;
+layout(set = 0, binding = 23, r32f) readonly uniform image2D partial_met_in;
+#endif
+#ifdef PARTIAL_OUT
+layout(set = 0, binding = 24, rgba32f) writeonly uniform image2D partial_sum;
+layout(set = 0, binding = 25, r32f) writeonly uniform image2D partial_met;
+#else
 layout(set = 0, binding = 12, rgba16f) writeonly uniform image2D specular;
+#endif
 // specular_budget_total.comp: the frame's total claim on the rays and its traced pixels.
 layout(set = 0, binding = 21, std430) readonly buffer Budget {
     vec2 total;
 } budget;
+
+// Writes what this dispatch leaves: the sums for the next one, or the pixel's radiance (the
+// sum over its `samples` rays times the trace share) and mean parallax.
+void finish(ivec2 ixy, vec3 sum, float parallax, float parallax_count, float share, uint samples) {
+#ifdef PARTIAL_OUT
+    imageStore(partial_sum, ixy, vec4(sum, parallax));
+    imageStore(partial_met, ixy, vec4(parallax_count));
+#else
+    float alpha = push.config.z != 0u ? (parallax_count > 0.0 ? parallax / parallax_count : 1.0) : 0.0;
+    imageStore(specular, ixy, samples > 0u ? vec4(share * sum / float(samples), alpha) : vec4(0.0));
+#endif
+}
 
 void main() {
     uvec2 pixel = gl_GlobalInvocationID.xy;
@@ -70,7 +107,7 @@ void main() {
     vec3 n = normalize(imageLoad(gb_normal, ixy).xyz);
     vec3 v = normalize(push.camera.xyz - position.xyz);
     if (position.w == 0.0 || share <= 0.0 || dot(n, v) <= 0.0) {
-        imageStore(specular, ixy, vec4(0.0));
+        finish(ixy, vec3(0.0), 0.0, 0.0, 0.0, 0u);
         return;
     }
     vec3 ng = normalize(imageLoad(gb_geometric_normal, ixy).xyz);
@@ -87,7 +124,15 @@ void main() {
     float eye_distance = length(push.camera.xyz - position.xyz);
     float parallax = 0.0;
     float parallax_count = 0.0;
-    for (uint s = 0u; s < samples; ++s) {
+#ifdef PARTIAL_IN
+    vec4 carried = imageLoad(partial_sum_in, ixy);
+    sum = carried.rgb;
+    parallax = carried.a;
+    parallax_count = imageLoad(partial_met_in, ixy).r;
+#endif
+    uint first = push.options.y;
+    uint end = min(samples, first + max(push.options.z, 1u));
+    for (uint s = first; s < end; ++s) {
         rng_state = pcg(pcg(pcg(pixel.x ^ pcg(push.frame.w)) + pixel.y) + s);
         vec3 h = sample_ggx_half(n, a, vec2(rand(), rand()));
         vec3 l = reflect(-v, h);
@@ -107,6 +152,10 @@ void main() {
         if (trace_closest(origin, l, 0.0, PT_FAR, hit)) {
             parallax += hit.t / (eye_distance + hit.t);
             Vertex x = shade(hit, l);
+            if (push.options.x != 0u) {
+                // Path regularisation: the hit's lobe no sharper than the receiver's.
+                x.s.roughness = max(x.s.roughness, roughness_metallic.x);
+            }
             incoming = punctual_lights(x, -l);
             if (push.config.y != 0u) {
                 vec3 d = sample_cosine(x.s.normal, vec2(rand(), rand()));
@@ -124,6 +173,5 @@ void main() {
             sum += radiance;
         }
     }
-    float alpha = push.config.z != 0u ? (parallax_count > 0.0 ? parallax / parallax_count : 1.0) : 0.0;
-    imageStore(specular, ixy, vec4(share * sum / float(samples), alpha));
+    finish(ixy, sum, parallax, parallax_count, share, samples);
 }

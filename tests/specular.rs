@@ -300,3 +300,59 @@ fn the_shared_budget_moves_rays_to_the_wide_lobes() {
     );
     common::assert_clean(&device);
 }
+
+/// lavapipe ends an invocation's loops after 65 535 iterations in all (docs/pitfalls.md), and
+/// every ray's traversals are loops: with all of a pixel's rays in one dispatch,
+/// builtin:metals at 256 rays a pixel (up to 1 024 with the shared budget) kept a few hundred
+/// of them where the spheres see each other, and those pixels came out up to a third too dark.
+/// Split over dispatches of `RAYS_PER_DISPATCH`, the spheres at 256 rays keep the energy of 16
+/// (64 at most a pixel, within the limit).
+#[test]
+fn many_rays_a_pixel_are_all_traced() {
+    let device = common::device();
+    let scene = Scene::builtin("metals").expect("scene");
+    let render = |component: &str, samples: u32| {
+        let mut s = Settings {
+            width: SIZE,
+            height: SIZE,
+            ..Settings::default()
+        };
+        s.set("output.component", component).expect("component");
+        s.set("specular.samples", &samples.to_string())
+            .expect("samples");
+        s.set("denoise.enabled", "false").expect("denoise");
+        let mut renderer = Renderer::new(&device).expect("renderer");
+        renderer.set_scene(&scene, 0.0).expect("scene");
+        renderer.render(&s).expect("render").hdr
+    };
+    // The spheres: pixels whose normal lies along no axis of the room.
+    let normals = render("normal", 1);
+    let spheres: Vec<usize> = normals
+        .texels
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| {
+            let n = Vec3::new(n[0], n[1], n[2]);
+            n.length() > 0.5 && n.abs().max_element() < 0.98
+        })
+        .map(|(p, _)| p)
+        .collect();
+    assert!(spheres.len() > 50, "{} sphere pixels", spheres.len());
+    let energy = |image: &HdrImage| -> f64 {
+        spheres
+            .iter()
+            .map(|&p| (0..3).map(|c| f64::from(image.texels[p][c])).sum::<f64>())
+            .sum()
+    };
+    let few = energy(&render("indirect", 16));
+    let many = energy(&render("indirect", 256));
+    println!(
+        "spheres' indirect energy at 256 rays over 16: {:.4}",
+        many / few
+    );
+    assert!(
+        (many / few - 1.0).abs() < 0.03,
+        "256 rays {many} against 16 {few}"
+    );
+    common::assert_clean(&device);
+}

@@ -47,6 +47,13 @@ pub const LIMIT_RANGE: RangeInclusive<f32> = 0.0..=1.0;
 pub const SAMPLES: u32 = 2;
 /// Reflection rays per pixel the settings take.
 pub const SAMPLES_RANGE: RangeInclusive<u32> = 1..=256;
+/// Most rays of a pixel one dispatch traces: more are split over dispatches that carry the
+/// sums in f32 (`specular.comp`'s variants). lavapipe ends every loop of an invocation after
+/// 65 535 iterations in all (docs/pitfalls.md), and each ray's traversals are loops: on
+/// builtin:metals at 256 rays a pixel, the spheres' pixels that see each other kept 156–206 of
+/// their rays and came out up to a third too dark. 16, as the path tracer's
+/// `MAX_SAMPLES_PER_DISPATCH`.
+pub const RAYS_PER_DISPATCH: u32 = 16;
 
 /// `[specular]`: reflection rays for the sharp part of every glossy lobe (issue 21), in every
 /// frame with a GI technique; the techniques keep the lobes rougher than `limit`. The
@@ -72,6 +79,14 @@ pub struct SpecularParams {
     /// gold sphere 0.201 → 0.194 of the truth, the chrome one unchanged (docs/quality.md).
     #[setting(default = true, affects = both)]
     pub adaptive: bool,
+    /// Path regularisation (Kaplanyan and Dachsbacher 2013, as `aaf.hit_roughness_min`): a
+    /// reflection ray's hit is shaded with a lobe no sharper than the receiver's, so a light's
+    /// highlight on a mirror, seen in a rough floor, is the blur the floor's lobe makes of it
+    /// anyway rather than a firefly one ray in hundreds finds. On builtin:metals at one
+    /// sample the gold sphere (roughness 0.3, beside the mirrors) 0.195 → 0.154 of the
+    /// path-traced truth, which is not regularised (docs/quality.md).
+    #[setting(default = true, affects = quality)]
+    pub regularise: bool,
     /// Seed of the random numbers (set by the frame).
     #[serde(skip)]
     #[setting(default = 0)]
@@ -116,7 +131,7 @@ pub fn trace_weight(roughness: f32, limit: f32) -> f32 {
     1.0 - t * t * (3.0 - 2.0 * t)
 }
 
-/// Push constants of `shaders/specular.comp` (48 bytes).
+/// Push constants of `shaders/specular.comp` (64 bytes).
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SpecularPush {
@@ -128,6 +143,19 @@ pub struct SpecularPush {
     /// parallax in alpha (the denoiser follows), 1 to share the rays by the lobes' widths
     /// ([`SpecularParams::adaptive`]).
     pub config: [u32; 4],
+    /// 1 to regularise the paths ([`SpecularParams::regularise`]), then padding.
+    pub options: [u32; 4],
+}
+
+/// The most rays one pixel takes in a frame of `params`: `samples`, or with the shared budget
+/// `DENOISE_RAY_MAX_FACTOR` times it (a mirror's kept rays are at most `samples`).
+pub fn max_rays(params: &SpecularParams) -> u32 {
+    let samples = params.samples.max(1);
+    if params.adaptive {
+        (crate::reference::denoise::RAY_MAX_FACTOR * samples as f32) as u32
+    } else {
+        samples
+    }
 }
 
 /// Push constants of `shaders/specular_budget.comp` (32 bytes).
@@ -208,26 +236,59 @@ pub fn specular(
         rg.fill_buffer("budget_unused", &mut unused, 0);
         unused
     };
-    let mut pass = rg.compute("specular", &shaders::SPECULAR_COMP);
-    scene.bind(&mut pass);
-    pass.read("gb_position", &g.position)
-        .read("gb_normal", &g.normal)
-        .read("gb_geometric_normal", &g.geometric_normal)
-        .read("gb_albedo", &g.albedo)
-        .read("gb_material", &g.material)
-        .read("budget", &budget);
-    pass.write("specular", &mut out)
-        .push(&SpecularPush {
-            frame: [w, h, scene.light_count, frame_seed],
-            camera: camera.extend(params.limit).to_array(),
-            config: [
-                params.samples,
-                u32::from(scene.environment_lighting),
-                u32::from(parallax),
-                u32::from(params.adaptive),
-            ],
-        })
-        .dispatch([w, h, 1]);
+    let push = |first: u32| SpecularPush {
+        frame: [w, h, scene.light_count, frame_seed],
+        camera: camera.extend(params.limit).to_array(),
+        config: [
+            params.samples,
+            u32::from(scene.environment_lighting),
+            u32::from(parallax),
+            u32::from(params.adaptive),
+        ],
+        options: [u32::from(params.regularise), first, RAYS_PER_DISPATCH, 0],
+    };
+    let dispatches = max_rays(params).div_ceil(RAYS_PER_DISPATCH).max(1);
+    let mut carried: Option<(Handle<Image>, Handle<Image>)> = None;
+    for i in 0..dispatches {
+        let last = i + 1 == dispatches;
+        let shader = match (i == 0, last) {
+            (true, true) => &shaders::SPECULAR_COMP_WHOLE,
+            (true, false) => &shaders::SPECULAR_COMP_FIRST,
+            (false, false) => &shaders::SPECULAR_COMP_MIDDLE,
+            (false, true) => &shaders::SPECULAR_COMP_LAST,
+        };
+        let mut next = (!last).then(|| {
+            let image = |rg: &mut RenderGraph, name: &str, format| {
+                rg.create_image(name, ImageDesc::new_2d(format, w, h))
+            };
+            (
+                image(rg, "partial_sum", vk::Format::R32G32B32A32_SFLOAT),
+                image(rg, "partial_met", vk::Format::R32_SFLOAT),
+            )
+        });
+        let name = if dispatches == 1 {
+            "specular".to_string()
+        } else {
+            format!("specular_{i}")
+        };
+        let mut pass = rg.compute(&name, shader);
+        scene.bind(&mut pass);
+        pass.read("gb_position", &g.position)
+            .read("gb_normal", &g.normal)
+            .read("gb_geometric_normal", &g.geometric_normal)
+            .read("gb_albedo", &g.albedo)
+            .read("gb_material", &g.material)
+            .read("budget", &budget);
+        if let Some((sum, met)) = &carried {
+            pass.read("partial_sum_in", sum).read("partial_met_in", met);
+        }
+        match &mut next {
+            Some((sum, met)) => pass.write("partial_sum", sum).write("partial_met", met),
+            None => pass.write("specular", &mut out),
+        };
+        pass.push(&push(i * RAYS_PER_DISPATCH)).dispatch([w, h, 1]);
+        carried = next;
+    }
     Ok(out)
 }
 
