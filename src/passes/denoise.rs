@@ -44,8 +44,9 @@
 //! energy: the dark majority refuses the rare bright samples).
 //!
 //! Measured (docs/quality.md): `builtin:metals` at one sample, the gold sphere (roughness 0.3)
-//! 0.341 → 0.201 of the truth (0.194 with the default shared rays, `specular.adaptive`), the
-//! chrome one unchanged; 4–8% of a 256² frame on lavapipe.
+//! 0.341 → 0.201 of the truth (0.194 with the default shared rays, `specular.adaptive`; 0.154
+//! with the regularised paths, `specular.regularise`), the chrome one unchanged; 4–8% of a
+//! 256² frame on lavapipe.
 //! The diffuse variant against the bilateral, `builtin:animated` at one sample: the orange
 //! wall 0.145 → 0.143 of the truth (noise-free), 0.070 → 0.060 of the same renderer at 1024
 //! sky and 256 near rays.
