@@ -312,18 +312,13 @@ fn many_rays_a_pixel_are_all_traced() {
     let device = common::device();
     let scene = Scene::builtin("metals").expect("scene");
     let render = |component: &str, samples: u32| {
-        let mut s = Settings {
-            width: SIZE,
-            height: SIZE,
-            ..Settings::default()
-        };
-        s.set("output.component", component).expect("component");
-        s.set("specular.samples", &samples.to_string())
-            .expect("samples");
-        s.set("denoise.enabled", "false").expect("denoise");
-        let mut renderer = Renderer::new(&device).expect("renderer");
-        renderer.set_scene(&scene, 0.0).expect("scene");
-        renderer.render(&s).expect("render").hdr
+        frame_with(
+            &device,
+            &scene,
+            component,
+            Some(samples),
+            &[("denoise.enabled", "false")],
+        )
     };
     // The spheres: pixels whose normal lies along no axis of the room.
     let normals = render("normal", 1);
