@@ -1,4 +1,4 @@
-//! The proxy passes of paper 002 (`src/passes/proxy.rs`) on the Vulkan device against their
+//! The proxy passes of paper 002 (`src/passes/proxy/`) on the Vulkan device against their
 //! CPU twin built from shine-sh, on a synthetic receiver buffer: a 24×24 patch of ground
 //! (y = 0, normal +y) with a background column, a few proxies above it (one poking through the
 //! ground, one far away), the spheres scene's sky. Validation must report nothing.

@@ -1,5 +1,5 @@
 //! The proxy technique (paper 002) as the frame uses it: the scene's proxy spheres and
-//! environment on the GPU, and the passes it adds to a frame (`src/passes/proxy.rs`).
+//! environment on the GPU, and the passes it adds to a frame (`src/passes/proxy/`).
 //!
 //! The proxies follow their nodes every frame (placed by the frame's node world matrices,
 //! uploaded through a staging ring), with the albedo of their node's first material. With the

@@ -1,4 +1,4 @@
-//! CPU twin of the proxy passes (paper 002, `src/passes/proxy.rs`): [`accumulate_cpu`] and
+//! CPU twin of the proxy passes (paper 002, `src/passes/proxy/`): [`accumulate_cpu`] and
 //! [`shade_cpu`] compose the shine-sh functions exactly as `proxy_accumulate.comp` and
 //! `proxy_shade.comp` compose their GLSL twins; `tests/proxy.rs` ties the two.
 
