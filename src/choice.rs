@@ -1,7 +1,7 @@
 //! Named choices: enums whose variant names are the single source for settings files, the
 //! command line and the error that lists the known names. Each module that owns a choice
 //! (`passes::hvl::RadiusHeuristic`, `capture::tonemap::Tonemap`, …) declares it with
-//! [`named_choice!`]; the settings only use them.
+//! `named_choice!`; the settings only use them.
 
 /// A name that matches no variant of a named choice.
 #[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]

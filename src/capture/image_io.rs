@@ -255,7 +255,7 @@ pub fn write_bytes_atomically(path: &Path, bytes: &[u8]) -> Result<(), ImageIoEr
     write_atomically(path, |w| w.write_all(bytes).map_err(|e| io_error(path, e)))
 }
 
-/// Removes the temporary files that writes of `path` ([`write_atomically`]) left behind when
+/// Removes the temporary files that writes of `path` (`write_atomically`) left behind when
 /// their process was killed: a re-queued task calls it for the files it is about to write, so
 /// no half-written file stays beside them. Only for paths no other running process writes.
 pub fn remove_stale_temporaries(path: &Path) -> Result<(), ImageIoError> {

@@ -1,6 +1,6 @@
 //! The environment light projected to SH (paper 002 §3: `L` and `L̃ = L ⋆ g_cos`).
 //!
-//! The environment is evaluated only through [`shine_scene::Environment::radiance`], whatever
+//! The environment is evaluated only through [`shine_scene::environment::Environment::radiance`], whatever
 //! it holds (procedural sky or equirectangular map), and projected per colour channel by the
 //! Gauss–Legendre × uniform-φ quadrature of shine-sh ([`SphereQuadrature::project`]) with
 //! [`PROJECTION_NODES_Z`] × [`PROJECTION_NODES_PHI`] nodes: exact for band-limited functions up

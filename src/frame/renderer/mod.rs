@@ -302,7 +302,7 @@ impl Renderer {
     /// `update …` passes, without waiting for the GPU. A bad update is refused (nothing
     /// changes).
     ///
-    /// A light cut ([`light_cut::LIGHT_CUT_RATIO`]: a light switched on or off, or its power
+    /// A light cut (`LIGHT_CUT_RATIO`: a light switched on or off, or its power
     /// changed more than that) restarts the indirect light's histories.
     pub fn update(&mut self, update: &FrameUpdate) -> Result<(), RenderError> {
         let scene = self.scene.as_mut().ok_or(RenderError::NoScene)?;

@@ -16,10 +16,10 @@
 //! - `motion-sweep`, `motion-orbit`, `motion-sun`, `motion-crossing`, `motion-dolly`: one
 //!   static room with one thing moving in each (a spot's sweep, a point light's orbit, a sun's
 //!   turn, a box crossing a fixed spot's beam, the camera), for the temporal studies (issue 43;
-//!   [`motions`]).
+//!   `motions`).
 //! - `metals`: four metal spheres (chrome, silver, gold, copper; roughness 0.03 to 0.5) in a
 //!   closed matte room under a warm spot and a cool point light, for measuring a specular
-//!   denoiser at one sample per pixel; nothing was tuned on it ([`metals`]).
+//!   denoiser at one sample per pixel; nothing was tuned on it (`metals`).
 //!
 //! `assets/<name>.glb` holds the exported files; a test checks they equal what [`build`]
 //! produces now.
