@@ -195,3 +195,96 @@ fn compare_reads_pngs_as_displayed_and_writes_the_maps() {
     let map = shine::capture::image_io::read_png(&flip).expect("map");
     assert!(map.texels.iter().all(|t| t[..3].iter().all(|&c| c < 8)));
 }
+
+/// `--surfaces` with `--positions` and `--second-reference`: the noise-free metrics per
+/// surface, where a 16×16 floor (y = 0) and an 8×8 box top (y = 1) facing the same way are two surfaces,
+/// each with its own pixels and error (the box top's image is off by half its value, the
+/// floor's exact); `--positions` alone, or positions as PNG, are refused with a message.
+#[test]
+fn compare_reports_each_plane_against_the_two_references() {
+    use shine::capture::image_io::{HdrImage, write_exr};
+    let dir = scratch("cli_compare_planes");
+    let (w, h) = (16u32, 16u32);
+    let top = |x: u32, y: u32| x >= 8 && y < 8;
+    let image = |f: &dyn Fn(u32, u32) -> [f32; 4]| HdrImage {
+        width: w,
+        height: h,
+        texels: (0..h)
+            .flat_map(|y| (0..w).map(move |x| (x, y)))
+            .map(|(x, y)| f(x, y))
+            .collect(),
+    };
+    let write = |name: &str, img: &HdrImage| {
+        let path = dir.join(name);
+        write_exr(&path, img).expect("write");
+        path.to_str().expect("utf-8 path").to_string()
+    };
+    let reference = write("ref.exr", &image(&|_, _| [0.4, 0.4, 0.4, 1.0]));
+    let tested = write(
+        "test.exr",
+        &image(&|x, y| if top(x, y) { [0.2; 4] } else { [0.4; 4] }),
+    );
+    let normals = write("normals.exr", &image(&|_, _| [0.0, 1.0, 0.0, 1.0]));
+    let positions = write(
+        "positions.exr",
+        &image(&|x, y| [x as f32, if top(x, y) { 1.0 } else { 0.0 }, y as f32, 1.0]),
+    );
+    let out = shine(&[
+        "compare",
+        &tested,
+        &reference,
+        "--second-reference",
+        &reference,
+        "--surfaces",
+        &normals,
+        "--positions",
+        &positions,
+        "--format",
+        "json",
+    ]);
+    assert!(out.status.success(), "{}", text(&out));
+    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let surfaces: Vec<(u64, f64)> = report["noise_free"]
+        .as_array()
+        .expect("noise_free")
+        .iter()
+        .filter(|r| r["over"].as_str().is_some_and(|o| o.starts_with("surface")))
+        .map(|r| {
+            let m = &r["metrics"];
+            (
+                m["pixels"].as_u64().expect("pixels"),
+                m["energy_ratio"].as_f64().expect("energy"),
+            )
+        })
+        .collect();
+    assert_eq!(surfaces.len(), 2, "{report}");
+    assert_eq!((surfaces[0].0, surfaces[1].0), (192, 64), "{report}");
+    assert!(
+        (surfaces[0].1 - 1.0).abs() < 1e-6 && (surfaces[1].1 - 0.5).abs() < 1e-6,
+        "{report}"
+    );
+    // --positions without --surfaces: the argument parser refuses it (status 2), naming it.
+    let out = shine(&["compare", &tested, &reference, "--positions", &positions]);
+    assert_eq!(out.status.code(), Some(2), "{}", text(&out));
+    assert!(text(&out).contains("--surfaces"), "{}", text(&out));
+    // Positions as PNG lose their negative components: refused with a message.
+    let png = dir.join("positions.png");
+    let ldr = shine::capture::image_io::LdrImage {
+        width: w,
+        height: h,
+        texels: vec![[0, 0, 0, 255]; (w * h) as usize],
+    };
+    shine::capture::image_io::write_png(&png, &ldr).expect("png");
+    fails_cleanly(
+        &shine(&[
+            "compare",
+            &tested,
+            &reference,
+            "--surfaces",
+            &normals,
+            "--positions",
+            png.to_str().expect("utf-8 path"),
+        ]),
+        "needs the positions as EXR",
+    );
+}

@@ -6,7 +6,7 @@
 mod common;
 
 use shine::capture::image_compare::{Comparison, compare};
-use shine::capture::regions::surface_metrics;
+use shine::capture::regions::{SurfacePixels, surface_metrics, surface_pixels};
 use shine::frame::renderer::Renderer;
 use shine::passes::composite::Component;
 use shine::reference::{ReferenceParams, render_reference};
@@ -124,7 +124,7 @@ fn indirect_light_against_the_path_traced_reference() {
         Component::Indirect,
         GiTechniques::from_str("hvl").expect("hvl"),
     );
-    let surfaces = surface_metrics(&image, &reference.indirect, &normals).expect("surfaces");
+    let surfaces = surface_metrics(&image, &reference.indirect, &normals, None).expect("surfaces");
     let axis_aligned: Vec<_> = surfaces
         .iter()
         .filter(|s| s.normal.iter().any(|c| c.abs() > 0.99))
@@ -139,6 +139,47 @@ fn indirect_light_against_the_path_traced_reference() {
         let lowest = if s.normal[1] > 0.99 { 0.8 } else { 0.85 };
         assert!((lowest..=1.15).contains(&s.energy_ratio), "{s:?}");
     }
+}
+
+/// `output.component = "position"` shows each pixel's world position, and with it
+/// `surface_pixels` parts parallel planes: the Cornell box's floor and the short box's top
+/// (the tall one's is above the eye) both face up. By their normals alone they are one
+/// surface, which holds pixels at the box top's height; with the positions the floor keeps
+/// only its own, every one at y = 0 (where the scene builds it) within 1 cm, 1% of the box's
+/// diagonal, and the box top falls under the 1% share of pixels a surface needs.
+#[test]
+fn positions_part_the_floor_from_the_box_tops() {
+    let normals = raster_with(Component::Normal, GiTechniques::none());
+    let positions = raster_with(Component::Position, GiTechniques::none());
+    let up = |surfaces: Vec<SurfacePixels>| -> Vec<SurfacePixels> {
+        surfaces
+            .into_iter()
+            .filter(|s| s.normal[1] > 0.99)
+            .collect()
+    };
+    let heights = |s: &SurfacePixels| -> (f32, f32) {
+        let ys = s.pixels.iter().map(|&i| positions.texels[i][1]);
+        (
+            ys.clone().fold(f32::MAX, f32::min),
+            ys.fold(f32::MIN, f32::max),
+        )
+    };
+    let alone = up(surface_pixels(&normals, None).expect("surfaces"));
+    let parted = up(surface_pixels(&normals, Some(&positions)).expect("surfaces"));
+    assert_eq!((alone.len(), parted.len()), (1, 1), "{alone:?} {parted:?}");
+    let (low, high) = heights(&alone[0]);
+    let (floor_low, floor_high) = heights(&parted[0]);
+    println!(
+        "up-facing: {} px at y {low:.3}..{high:.3} by normals, {} px at y {floor_low:.4}..{floor_high:.4} with positions",
+        alone[0].pixels.len(),
+        parted[0].pixels.len()
+    );
+    assert!(high > 0.1, "the box top joins the floor by normals alone");
+    assert!(parted[0].pixels.len() < alone[0].pixels.len());
+    assert!(
+        floor_low.abs() < 1e-3 && floor_high < 0.01,
+        "{floor_low}..{floor_high}"
+    );
 }
 
 /// Paper 002's frame (`--gi proxy`: the sky shadowed by the sphere proxies plus their indirect

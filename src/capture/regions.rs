@@ -90,7 +90,7 @@ pub const SURFACE_ANGLE_DEGREES: f64 = 10.0;
 /// Surfaces with fewer pixels than this share of the lit ones are left out.
 pub const SURFACE_MIN_SHARE: f64 = 0.01;
 
-/// The metrics over one surface orientation of [`surface_metrics`].
+/// The metrics over one surface of [`surface_metrics`].
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
 pub struct Surface {
     /// The unit normal of the surface's first pixel (row-major order).
@@ -105,48 +105,118 @@ pub struct Surface {
     pub relative_rmse: f64,
 }
 
-/// The metrics per surface orientation: `normals` is an image of unit world normals (e.g.
+/// Planes facing the same way farther apart than this share of the scene's size (the
+/// diagonal of the positions' bounding box) are separate surfaces when
+/// [`surface_pixels`] has positions: the floor and the top of a box on it.
+pub const SURFACE_PLANE_SHARE: f64 = 0.01;
+
+/// The pixels of one surface of [`surface_pixels`].
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfacePixels {
+    /// The unit normal of the surface's first pixel (row-major order).
+    pub normal: [f64; 3],
+    /// The surface's pixels (row-major indices).
+    pub pixels: Vec<usize>,
+}
+
+/// The surfaces of an image: `normals` is an image of unit world normals (e.g.
 /// `output.component = "normal"`, rendered without supersampling so edges stay sharp; zero on
 /// the background). Pixels join the first surface whose normal is within
 /// [`SURFACE_ANGLE_DEGREES`] of theirs, in row-major order; surfaces with fewer than
-/// [`SURFACE_MIN_SHARE`] of the pixels are left out. Parallel planes facing the same way (a
-/// floor and the top of a box on it) are one surface.
-pub fn surface_metrics(
-    image: &HdrImage,
-    reference: &HdrImage,
+/// [`SURFACE_MIN_SHARE`] of the pixels are left out. Without `positions`, parallel planes
+/// facing the same way (a floor and the top of a box on it) are one surface; with an image of
+/// world positions (`output.component = "position"`, same size) a pixel also has to lie
+/// within [`SURFACE_PLANE_SHARE`] of the scene's size of the surface's plane (through its
+/// first pixel), so they part, and a curved object's tops, whose planes step, fall away as
+/// small surfaces.
+pub fn surface_pixels(
     normals: &HdrImage,
-) -> Result<Vec<Surface>, CompareError> {
-    check(image, reference)?;
-    check(normals, reference)?;
+    positions: Option<&HdrImage>,
+) -> Result<Vec<SurfacePixels>, CompareError> {
+    if let Some(positions) = positions {
+        check(positions, normals)?;
+    }
     let min_cos = SURFACE_ANGLE_DEGREES.to_radians().cos();
-    let mut surfaces: Vec<([f64; 3], Vec<usize>)> = Vec::new();
-    for (i, t) in normals.texels.iter().enumerate() {
+    let unit = |t: &[f32; 4]| {
         let n = [f64::from(t[0]), f64::from(t[1]), f64::from(t[2])];
         let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
         // Background (0) and NaN normals belong to no surface.
-        if len.is_nan() || len <= 1e-3 {
+        (len.is_finite() && len > 1e-3).then(|| n.map(|c| c / len))
+    };
+    let point = |i: usize| positions.map(|p| p.texels[i].map(f64::from));
+    let tolerance = positions.map_or(0.0, |p| SURFACE_PLANE_SHARE * scene_size(normals, p));
+    let dot =
+        |a: &[f64; 3], b: &[f64], o: &[f64]| (0..3).map(|c| a[c] * (b[c] - o[c])).sum::<f64>();
+    let mut surfaces: Vec<(SurfacePixels, Option<[f64; 4]>)> = Vec::new();
+    for (i, t) in normals.texels.iter().enumerate() {
+        let Some(n) = unit(t) else {
             continue;
-        }
-        let n = n.map(|c| c / len);
-        let dot = |m: &[f64; 3]| n[0] * m[0] + n[1] * m[1] + n[2] * m[2];
-        match surfaces.iter_mut().find(|(m, _)| dot(m) >= min_cos) {
-            Some((_, pixels)) => pixels.push(i),
-            None => surfaces.push((n, vec![i])),
+        };
+        let x = point(i);
+        let joins = |(s, origin): &(SurfacePixels, Option<[f64; 4]>)| {
+            dot(&s.normal, &n, &[0.0; 3]) >= min_cos
+                && match (origin, &x) {
+                    (Some(o), Some(x)) => dot(&s.normal, x, o).abs() <= tolerance,
+                    _ => true,
+                }
+        };
+        match surfaces.iter_mut().find(|s| joins(s)) {
+            Some((s, _)) => s.pixels.push(i),
+            None => surfaces.push((
+                SurfacePixels {
+                    normal: n,
+                    pixels: vec![i],
+                },
+                x,
+            )),
         }
     }
-    let lit: usize = surfaces.iter().map(|(_, p)| p.len()).sum();
+    let lit: usize = surfaces.iter().map(|(s, _)| s.pixels.len()).sum();
     if lit == 0 {
         return Err(CompareError::EmptyMask);
     }
     Ok(surfaces
         .into_iter()
-        .filter(|(_, pixels)| pixels.len() as f64 >= SURFACE_MIN_SHARE * lit as f64)
-        .map(|(normal, pixels)| {
+        .map(|(s, _)| s)
+        .filter(|s| s.pixels.len() as f64 >= SURFACE_MIN_SHARE * lit as f64)
+        .collect())
+}
+
+/// The diagonal of the bounding box of `positions` over the pixels `normals` marks as
+/// surface (finite positions only).
+fn scene_size(normals: &HdrImage, positions: &HdrImage) -> f64 {
+    let mut low = [f64::INFINITY; 3];
+    let mut high = [f64::NEG_INFINITY; 3];
+    for (n, p) in normals.texels.iter().zip(&positions.texels) {
+        if n[..3].iter().all(|&c| c == 0.0) || p[..3].iter().any(|c| !c.is_finite()) {
+            continue;
+        }
+        for c in 0..3 {
+            low[c] = low[c].min(f64::from(p[c]));
+            high[c] = high[c].max(f64::from(p[c]));
+        }
+    }
+    let d2: f64 = (0..3).map(|c| (high[c] - low[c]).powi(2)).sum();
+    if d2.is_finite() { d2.sqrt() } else { 0.0 }
+}
+
+/// The metrics per surface of [`surface_pixels`] (`positions`: parallel planes apart).
+pub fn surface_metrics(
+    image: &HdrImage,
+    reference: &HdrImage,
+    normals: &HdrImage,
+    positions: Option<&HdrImage>,
+) -> Result<Vec<Surface>, CompareError> {
+    check(image, reference)?;
+    check(normals, reference)?;
+    Ok(surface_pixels(normals, positions)?
+        .into_iter()
+        .map(|s| {
             let (reference_mean, energy_ratio, relative_rmse) =
-                pixel_metrics(image, reference, pixels.iter().copied());
+                pixel_metrics(image, reference, s.pixels.iter().copied());
             Surface {
-                normal,
-                pixels: pixels.len(),
+                normal: s.normal,
+                pixels: s.pixels.len(),
                 reference_mean,
                 energy_ratio,
                 relative_rmse,
@@ -263,14 +333,52 @@ mod tests {
                 t[..3].copy_from_slice(&n);
             }
         }
-        let surfaces = surface_metrics(&test, &reference, &normals).unwrap();
+        let surfaces = surface_metrics(&test, &reference, &normals, None).unwrap();
         assert_eq!(surfaces.len(), 2, "{surfaces:?}");
         assert_eq!((surfaces[0].pixels, surfaces[1].pixels), (100, 98));
         assert!((surfaces[0].energy_ratio - 2.0).abs() < 1e-12);
         assert!((surfaces[1].energy_ratio - 1.0).abs() < 1e-12);
         assert!(surfaces[1].normal[1] > 0.999);
-        assert!(surface_metrics(&test, &reference, &image(4, 6, |_, _| 1.0)).is_err());
-        assert!(surface_metrics(&test, &reference, &image(w, h, |_, _| 0.0)).is_err());
+        assert!(surface_metrics(&test, &reference, &image(4, 6, |_, _| 1.0), None).is_err());
+        assert!(surface_metrics(&test, &reference, &image(w, h, |_, _| 0.0), None).is_err());
+    }
+
+    /// A floor (y = 0) and a box top (y = 0.5) on it face the same way: one surface by their
+    /// normals alone, two with positions; a pixel 0.5% of the scene off the floor's plane stays
+    /// on it; positions of another size are an error.
+    #[test]
+    fn positions_part_parallel_planes() {
+        let (w, h) = (20, 10);
+        let normals = image(w, h, |_, _| 0.0);
+        let normals = HdrImage {
+            texels: normals
+                .texels
+                .iter()
+                .map(|_| [0.0, 1.0, 0.0, 1.0])
+                .collect(),
+            ..normals
+        };
+        let mut positions = image(w, h, |_, _| 0.0);
+        for y in 0..h {
+            for x in 0..w {
+                let top = x >= 15 && y < 4;
+                let height = if top {
+                    0.5
+                } else if (x, y) == (3, 3) {
+                    0.1
+                } else {
+                    0.0
+                };
+                positions.texels[(y * w + x) as usize] = [x as f32, height, y as f32, 1.0];
+            }
+        }
+        let alone = surface_pixels(&normals, None).unwrap();
+        assert_eq!(alone.len(), 1, "{alone:?}");
+        let parted = surface_pixels(&normals, Some(&positions)).unwrap();
+        let sizes: Vec<usize> = parted.iter().map(|s| s.pixels.len()).collect();
+        assert_eq!(sizes, vec![180, 20], "{parted:?}");
+        assert!(parted[0].pixels.contains(&(3 * w as usize + 3)));
+        assert!(surface_pixels(&normals, Some(&image(4, 6, |_, _| 0.0))).is_err());
     }
 
     /// An image twice as bright on its left half: the left tiles report energy 2 and relative

@@ -8,7 +8,8 @@ use shine::capture::image_compare::{compare, flip_map};
 use shine::capture::image_io::{HdrImage, read_exr, read_png_linear, write_png};
 use shine::capture::noise_free as nf;
 use shine::capture::regions::{
-    Region, Surface, error_heatmap, mask_pixels, masked_metrics, region_grid, surface_metrics,
+    Region, Surface, SurfacePixels, error_heatmap, mask_pixels, masked_metrics, region_grid,
+    surface_metrics, surface_pixels,
 };
 use std::path::{Path, PathBuf};
 
@@ -38,10 +39,17 @@ pub struct CompareArgs {
     #[arg(long)]
     mask: Option<PathBuf>,
     /// Also report energy ratio and relative RMSE per surface orientation, from this image of
-    /// world normals (`--set output.component=normal --ssaa 1`): normals within 10° are one
-    /// surface; surfaces under 1% of the pixels are left out.
+    /// world normals (`--set output.component=geometric-normal --ssaa 1`; `normal`, the
+    /// shading normals, parts a normal-mapped plane into many): normals within 10° are one
+    /// surface; surfaces under 1% of the pixels are left out. With --second-reference, also
+    /// the noise-free metrics per surface.
     #[arg(long)]
     surfaces: Option<PathBuf>,
+    /// With --surfaces: this image of world positions (`--set output.component=position
+    /// --ssaa 1`) parts parallel planes, a floor from the top of a box on it: a surface's
+    /// pixels lie within 1% of the scene's size of its plane.
+    #[arg(long, requires = "surfaces")]
+    positions: Option<PathBuf>,
     /// A second reference of another seed: the truth becomes the two references' mean, and the
     /// relative RMSE with the truth's own noise subtracted and the 99.9th percentile of the
     /// per-pixel error are reported, over every pixel and over --mask
@@ -86,19 +94,43 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         Some(path) => Some(read_image(path)?.0),
         None => None,
     };
+    let surface_sets = match &args.surfaces {
+        Some(path) => {
+            let positions = match &args.positions {
+                Some(p) => Some(read_exr_only(p, "--positions", "positions")?),
+                None => None,
+            };
+            let normals = read_exr_only(path, "--surfaces", "normals")?;
+            Some((normals, positions))
+        }
+        None => None,
+    };
+    // Before the noise-free metrics: it checks the guides' sizes against the images'.
+    let surfaces = match &surface_sets {
+        Some((normals, positions)) => {
+            surface_metrics(&image, &reference, normals, positions.as_ref())?
+        }
+        None => Vec::new(),
+    };
     let noise_free = match &args.second_reference {
         Some(path) => {
             let second = read_image(path)?.0;
             let mut reports = vec![(
-                "every pixel",
+                "every pixel".to_string(),
                 nf::noise_free(&image, &reference, &second, None)?,
             )];
             if let Some(mask) = &mask {
                 let pixels = mask_pixels(mask, &reference)?;
                 reports.push((
-                    "mask",
+                    "mask".to_string(),
                     nf::noise_free(&image, &reference, &second, Some(&pixels))?,
                 ));
+            }
+            if let Some((normals, positions)) = &surface_sets {
+                for s in surface_pixels(normals, positions.as_ref())? {
+                    let m = nf::noise_free(&image, &reference, &second, Some(&s.pixels))?;
+                    reports.push((surface_label(&s), m));
+                }
             }
             reports
         }
@@ -112,20 +144,6 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     let masked = match &mask {
         Some(mask) => Some(masked_metrics(&image, &reference, mask)?),
         None => None,
-    };
-    let surfaces = match &args.surfaces {
-        Some(path) => match read_image(path)? {
-            // A PNG clamps the normals' negative components away.
-            (_, true) => {
-                return Err(format!(
-                    "{}: --surfaces needs the normals as EXR (a PNG loses their negative components)",
-                    path.display()
-                )
-                .into());
-            }
-            (normals, false) => surface_metrics(&image, &reference, &normals)?,
-        },
-        None => Vec::new(),
     };
     if let Some(path) = &args.heatmap {
         write_png(path, &flip_map(&image, &reference)?)
@@ -176,8 +194,26 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// Reads a guide image that must be EXR: a PNG clamps negative components away.
+fn read_exr_only(path: &Path, flag: &str, what: &str) -> Result<HdrImage, CliError> {
+    match read_image(path)? {
+        (_, true) => Err(format!(
+            "{}: {flag} needs the {what} as EXR (a PNG loses their negative components)",
+            path.display()
+        )
+        .into()),
+        (image, false) => Ok(image),
+    }
+}
+
+/// How the noise-free report names a surface: by its normal.
+fn surface_label(s: &SurfacePixels) -> String {
+    let [x, y, z] = s.normal;
+    format!("surface ({x:+.2} {y:+.2} {z:+.2})")
+}
+
 /// One line per pixel set: the metrics against the two seeds' mean.
-fn print_noise_free(reports: &[(&str, nf::NoiseFree)]) {
+fn print_noise_free(reports: &[(String, nf::NoiseFree)]) {
     if reports.is_empty() {
         return;
     }

@@ -79,6 +79,12 @@ crate::choice::named_choice! {
         Indirect = "indirect",
         /// The G-buffer's world shading normal, unlit (for `shine compare --surfaces`).
         Normal = "normal",
+        /// The G-buffer's geometric (face) normal, unlit: what `shine compare --surfaces` should
+        /// read on normal-mapped surfaces, whose shading normals part one plane into many.
+        GeometricNormal = "geometric-normal",
+        /// The G-buffer's world position (xyz, at half precision), unlit (for `shine compare
+        /// --positions`: parallel planes apart).
+        Position = "position",
     }
 }
 

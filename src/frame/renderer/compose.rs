@@ -22,7 +22,7 @@ use crate::passes::sample_history::SampleSetup;
 use crate::passes::traced_scene::TracedScene;
 use crate::passes::{accumulate, direct, history, receivers, rsm, upsample};
 use crate::passes::{denoise, specular};
-use shine_graph::{Handle, Image, RenderGraph};
+use shine_graph::{Handle, Image, ImageDesc, RenderGraph, vk};
 
 impl Renderer {
     /// Declares every pass of a frame: the G-buffer, shadows and direct light, the techniques'
@@ -143,10 +143,22 @@ impl Renderer {
             .accumulate
             .apply(rg, p.history, p.extent, indirect, &g, |_| geometry_then)?;
         // `[output] component`: the composite sums its two inputs; one of them alone shows a part.
+        // The position goes through an RGBA16F copy, the composite's input format.
+        let position;
         let (first, second) = match (p.component, indirect.as_ref()) {
             (Component::Full, indirect) => (&direct, indirect),
             (Component::Direct, _) => (&direct, None),
             (Component::Normal, _) => (&g.normal, None),
+            (Component::GeometricNormal, _) => (&g.geometric_normal, None),
+            (Component::Position, _) => {
+                let mut half = rg.create_image(
+                    "position_half",
+                    ImageDesc::new_2d(vk::Format::R16G16B16A16_SFLOAT, g.extent[0], g.extent[1]),
+                );
+                rg.blit_image("position_half", &g.position, &mut half, vk::Filter::NEAREST);
+                position = half;
+                (&position, None)
+            }
             (Component::Indirect, Some(indirect)) => (indirect, None),
             (Component::Indirect, None) => {
                 return Err(RenderError::Invalid(
