@@ -120,8 +120,9 @@ pub struct SurfacePixels {
 }
 
 /// The surfaces of an image: `normals` is an image of unit world normals (e.g.
-/// `output.component = "normal"`, rendered without supersampling so edges stay sharp; zero on
-/// the background). Pixels join the first surface whose normal is within
+/// `output.component = "geometric-normal"`, rendered without supersampling so edges stay
+/// sharp; zero on the background; the shading normals of `"normal"` part a normal-mapped
+/// plane into many). Pixels join the first surface whose normal is within
 /// [`SURFACE_ANGLE_DEGREES`] of theirs, in row-major order; surfaces with fewer than
 /// [`SURFACE_MIN_SHARE`] of the pixels are left out. Without `positions`, parallel planes
 /// facing the same way (a floor and the top of a box on it) are one surface; with an image of
