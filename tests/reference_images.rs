@@ -146,7 +146,8 @@ fn indirect_light_against_the_path_traced_reference() {
 /// (the tall one's is above the eye) both face up. By their normals alone they are one
 /// surface, which holds pixels at the box top's height; with the positions the floor keeps
 /// only its own, every one at y = 0 (where the scene builds it) within 1 cm, 1% of the box's
-/// diagonal, and the box top falls under the 1% share of pixels a surface needs.
+/// diagonal, and the box top falls under the 1% share of pixels a surface needs. Its
+/// `geometric-normal` image equals the shading normals' (no normal maps).
 #[test]
 fn positions_part_the_floor_from_the_box_tops() {
     let normals = raster_with(Component::Normal, GiTechniques::none());
@@ -180,6 +181,15 @@ fn positions_part_the_floor_from_the_box_tops() {
         floor_low.abs() < 1e-3 && floor_high < 0.01,
         "{floor_low}..{floor_high}"
     );
+    // The Cornell box has no normal maps: its geometric normals are its shading normals.
+    let geometric = raster_with(Component::GeometricNormal, GiTechniques::none());
+    let apart = normals
+        .texels
+        .iter()
+        .zip(&geometric.texels)
+        .map(|(a, b)| (0..3).map(|c| (a[c] - b[c]).abs()).fold(0.0, f32::max))
+        .fold(0.0, f32::max);
+    assert!(apart < 2e-3, "geometric and shading normals {apart} apart");
 }
 
 /// Paper 002's frame (`--gi proxy`: the sky shadowed by the sphere proxies plus their indirect
