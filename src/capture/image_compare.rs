@@ -74,7 +74,7 @@ pub struct Comparison {
 }
 
 /// Checks that two images can be compared: the same size, every texel present.
-pub(crate) fn check(a: &HdrImage, b: &HdrImage) -> Result<(), CompareError> {
+pub fn check(a: &HdrImage, b: &HdrImage) -> Result<(), CompareError> {
     if (a.width, a.height) != (b.width, b.height) {
         return Err(CompareError::SizeMismatch(
             a.width, a.height, b.width, b.height,

@@ -138,19 +138,13 @@ pub fn surface_pixels(
         check(positions, normals)?;
     }
     let min_cos = SURFACE_ANGLE_DEGREES.to_radians().cos();
-    let unit = |t: &[f32; 4]| {
-        let n = [f64::from(t[0]), f64::from(t[1]), f64::from(t[2])];
-        let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
-        // Background (0) and NaN normals belong to no surface.
-        (len.is_finite() && len > 1e-3).then(|| n.map(|c| c / len))
-    };
     let point = |i: usize| positions.map(|p| p.texels[i].map(f64::from));
     let tolerance = positions.map_or(0.0, |p| SURFACE_PLANE_SHARE * scene_size(normals, p));
     let dot =
         |a: &[f64; 3], b: &[f64], o: &[f64]| (0..3).map(|c| a[c] * (b[c] - o[c])).sum::<f64>();
     let mut surfaces: Vec<(SurfacePixels, Option<[f64; 4]>)> = Vec::new();
     for (i, t) in normals.texels.iter().enumerate() {
-        let Some(n) = unit(t) else {
+        let Some(n) = unit_normal(t) else {
             continue;
         };
         let x = point(i);
@@ -183,13 +177,21 @@ pub fn surface_pixels(
         .collect())
 }
 
-/// The diagonal of the bounding box of `positions` over the pixels `normals` marks as
-/// surface (finite positions only).
+/// The unit normal a texel of a normal image holds; `None` on the background (0) and for NaN
+/// normals, which belong to no surface.
+fn unit_normal(t: &[f32; 4]) -> Option<[f64; 3]> {
+    let n = [f64::from(t[0]), f64::from(t[1]), f64::from(t[2])];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    (len.is_finite() && len > 1e-3).then(|| n.map(|c| c / len))
+}
+
+/// The diagonal of the bounding box of `positions` over the pixels with a normal
+/// ([`unit_normal`]; finite positions only).
 fn scene_size(normals: &HdrImage, positions: &HdrImage) -> f64 {
     let mut low = [f64::INFINITY; 3];
     let mut high = [f64::NEG_INFINITY; 3];
     for (n, p) in normals.texels.iter().zip(&positions.texels) {
-        if n[..3].iter().all(|&c| c == 0.0) || p[..3].iter().any(|c| !c.is_finite()) {
+        if unit_normal(n).is_none() || p[..3].iter().any(|c| !c.is_finite()) {
             continue;
         }
         for c in 0..3 {
@@ -208,22 +210,35 @@ pub fn surface_metrics(
     normals: &HdrImage,
     positions: Option<&HdrImage>,
 ) -> Result<Vec<Surface>, CompareError> {
-    check(image, reference)?;
     check(normals, reference)?;
-    Ok(surface_pixels(normals, positions)?
-        .into_iter()
-        .map(|s| {
-            let (reference_mean, energy_ratio, relative_rmse) =
-                pixel_metrics(image, reference, s.pixels.iter().copied());
-            Surface {
-                normal: s.normal,
-                pixels: s.pixels.len(),
-                reference_mean,
-                energy_ratio,
-                relative_rmse,
-            }
-        })
-        .collect())
+    let surfaces = surface_pixels(normals, positions)?;
+    surfaces
+        .iter()
+        .map(|s| surface_of(image, reference, s))
+        .collect()
+}
+
+/// The metrics of `image` against `reference` over one surface of [`surface_pixels`] (of a
+/// normal image of their size).
+pub fn surface_of(
+    image: &HdrImage,
+    reference: &HdrImage,
+    surface: &SurfacePixels,
+) -> Result<Surface, CompareError> {
+    check(image, reference)?;
+    let n = reference.texels.len();
+    if let Some(&i) = surface.pixels.iter().find(|&&i| i >= n) {
+        return Err(CompareError::PixelOutOfRange(i, n));
+    }
+    let (reference_mean, energy_ratio, relative_rmse) =
+        pixel_metrics(image, reference, surface.pixels.iter().copied());
+    Ok(Surface {
+        normal: surface.normal,
+        pixels: surface.pixels.len(),
+        reference_mean,
+        energy_ratio,
+        relative_rmse,
+    })
 }
 
 /// Reference mean, energy ratio and relative RMSE over `pixels` (indices, row-major), on

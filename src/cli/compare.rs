@@ -9,7 +9,7 @@ use shine::capture::image_io::{HdrImage, read_exr, read_png_linear, write_png};
 use shine::capture::noise_free as nf;
 use shine::capture::regions::{
     Region, Surface, SurfacePixels, error_heatmap, mask_pixels, masked_metrics, region_grid,
-    surface_metrics, surface_pixels,
+    surface_of, surface_pixels,
 };
 use std::path::{Path, PathBuf};
 
@@ -94,6 +94,7 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
         Some(path) => Some(read_image(path)?.0),
         None => None,
     };
+    // The surfaces' pixels, found once for their metrics and their noise-free reports.
     let surface_sets = match &args.surfaces {
         Some(path) => {
             let positions = match &args.positions {
@@ -101,17 +102,15 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                 None => None,
             };
             let normals = read_exr_only(path, "--surfaces", "normals")?;
-            Some((normals, positions))
-        }
-        None => None,
-    };
-    // Before the noise-free metrics: it checks the guides' sizes against the images'.
-    let surfaces = match &surface_sets {
-        Some((normals, positions)) => {
-            surface_metrics(&image, &reference, normals, positions.as_ref())?
+            shine::capture::image_compare::check(&normals, &reference)?;
+            surface_pixels(&normals, positions.as_ref())?
         }
         None => Vec::new(),
     };
+    let surfaces = surface_sets
+        .iter()
+        .map(|s| surface_of(&image, &reference, s))
+        .collect::<Result<Vec<Surface>, _>>()?;
     let noise_free = match &args.second_reference {
         Some(path) => {
             let second = read_image(path)?.0;
@@ -126,11 +125,9 @@ pub fn run(args: &CompareArgs) -> Result<(), CliError> {
                     nf::noise_free(&image, &reference, &second, Some(&pixels))?,
                 ));
             }
-            if let Some((normals, positions)) = &surface_sets {
-                for s in surface_pixels(normals, positions.as_ref())? {
-                    let m = nf::noise_free(&image, &reference, &second, Some(&s.pixels))?;
-                    reports.push((surface_label(&s), m));
-                }
+            for s in &surface_sets {
+                let m = nf::noise_free(&image, &reference, &second, Some(&s.pixels))?;
+                reports.push((surface_label(s), m));
             }
             reports
         }
